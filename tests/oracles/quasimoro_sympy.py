@@ -410,10 +410,10 @@ def quasimoro_reduced(params: dict | None = None, inertia_about: str = "axle") -
     """Numeric (numpy) callables of the Quasimoro model.
 
     Reduced (nu = (th1dot, th2dot, th3dot)):
-      ``M_r(q)`` 3x3, ``C_r(q, nu)`` 3x3, ``g_r(q)`` 3x1, ``B_r(q)`` 3x2,
-      ``h_r(q, nu) = C_r nu`` 3x1, ``Mdot_r(q, nu)`` 3x3.
+      ``M_r(q)`` 3x3, ``C_r(q, nu)`` 3x3, ``g_r(q)`` (3,), ``B_r(q)`` 3x2,
+      ``h_r(q, nu) = C_r nu`` (3,), ``Mdot_r(q, nu)`` 3x3.
     Full (v = qdot, 6-vector):
-      ``M(q)`` 6x6, ``C(q, v)`` 6x6 (Christoffel), ``g(q)`` 6x1, ``B(q)`` 6x2,
+      ``M(q)`` 6x6, ``C(q, v)`` 6x6 (Christoffel), ``g(q)`` (6,), ``B(q)`` 6x2,
       ``S(q)`` 6x3, ``Sdot(q, nu)`` 6x3, ``A(q)`` 4x6 (contact-point velocity
       constraints, rank 3), ``V(q)`` potential energy, ``T(q, v)`` kinetic.
     Also ``rhs(t, state, tau=None)``: state = (q, nu) -> (qdot, nudot).
@@ -435,6 +435,10 @@ def quasimoro_reduced(params: dict | None = None, inertia_about: str = "axle") -
         setattr(ns, name, _bind(L[name], 1, pvals))
     for name in ("C_r", "h_r", "Mdot_r", "C", "Sdot", "T"):
         setattr(ns, name, _bind(L[name], 2, pvals))
+    # vectors as flat 1-D arrays
+    ns.g_r = (lambda f: (lambda q: f(q).ravel()))(ns.g_r)
+    ns.g = (lambda f: (lambda q: f(q).ravel()))(ns.g)
+    ns.h_r = (lambda f: (lambda q, w: f(q, w).ravel()))(ns.h_r)
     ns.V = lambda q: float(L["V"](tuple(np.asarray(q, float)), pvals))
     ns.T = (lambda f: (lambda q, v: float(f(q, v))))(ns.T)
 

@@ -1,0 +1,230 @@
+"""Command-line interface: ``robotdyn list | info | dump | simulate | compare`` (every command has ``--json``).
+
+Robot modules may add their own subcommands by defining ``register_cli(subparsers, parents)``; each such
+subcommand sets ``func(args) -> int``.
+
+Bad input gives one line ``robotdyn: error: ...`` on stderr and exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+
+from .errors import RobotDynError
+from .inputs import as_vector, parse_assignments
+
+
+def _load(args):
+    from .robot import Robot
+    from .robots import module
+
+    mod = module(args.robot)
+    return mod, Robot(mod.SPEC, parse_assignments(args.param))
+
+
+def _emit(args, data: dict, text: str) -> None:
+    if args.json:
+        print(json.dumps(data, indent=2, default=_jsonable))
+    else:
+        print(text)
+
+
+def _jsonable(x):
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    raise TypeError(f"not JSON serialisable: {type(x).__name__}")
+
+
+def _matrix_text(name: str, rows: list[str], cols: list[str], A: np.ndarray) -> str:
+    w = max(12, *(len(c) + 1 for c in cols))
+    lines = [f"{name}:", " " * 14 + "".join(f"{c:>{w}}" for c in cols)]
+    for r, row in zip(rows, np.atleast_2d(A)):
+        lines.append(f"{r:>14}" + "".join(f"{x:>{w}.6g}" for x in row))
+    return "\n".join(lines)
+
+
+def _vector_text(name: str, rows: list[str], x: np.ndarray) -> str:
+    return f"{name}:\n" + "\n".join(f"{r:>14}  {v:.10g}" for r, v in zip(rows, x))
+
+
+# --------------------------------------------------------------------------------------------- commands
+def cmd_list(args) -> int:
+    from .robots import module, names
+
+    data = {n: module(n).SPEC.title for n in names()}
+    _emit(args, {"robots": data}, "\n".join(f"{n:<20} {t}" for n, t in data.items()))
+    return 0
+
+
+def cmd_info(args) -> int:
+    mod, robot = _load(args)
+    info = robot.info()
+    info["scenarios"] = {k: s.description for k, s in getattr(mod, "SCENARIOS", {}).items()}
+    lines = [
+        f"{info['robot']}: {info['title']}",
+        f"paper: shared/papers/{info['paper']}",
+        f"coordinates q ({len(info['coordinates'])}): {', '.join(info['coordinates'])}   [m, rad]",
+        f"independent velocities ({info['mobility']}): {', '.join(info['independent_velocities'])}",
+        "parameters:",
+        *(f"  {k:<14} = {v['value']!s:<10} {v['unit']:<8} {v['description']}" for k, v in info["parameters"].items()),
+        "actuators:",
+        *(f"  {a['name']}: on {a['joint']}" + (f", reacting on {a['reaction']}" if a["reaction"] else "")
+          for a in info["actuators"]),
+        "constraints:",
+        *(f"  {c}" for c in info["constraints"]),
+        f"terrain: {info['terrain']}",
+        "scenarios:",
+        *(f"  {k}: {d}" for k, d in info["scenarios"].items()),
+    ]
+    _emit(args, info, "\n".join(lines))
+    return 0
+
+
+def cmd_dump(args) -> int:
+    _, robot = _load(args)
+    q = robot.check_q(args.q)
+    if args.full:
+        v = as_vector(args.v, robot.nq, "v", robot.velocity_labels)
+        M, C, g = robot.full(q, v)
+        out = {"coordinates": robot.coordinates, "velocities": robot.velocity_labels, "M": M, "C": C, "g": g}
+        text = [_matrix_text("M (full)", robot.coordinates, robot.coordinates, M),
+                _matrix_text("C (full)", robot.coordinates, robot.coordinates, C),
+                _vector_text("g (full)", robot.coordinates, g)]
+        if args.a is not None:
+            a = as_vector(args.a, robot.nq, "a", robot.velocity_labels)
+            out["tau"] = M @ a + C @ v + g
+            text.append(_vector_text("tau (full, M a + C v + g)", robot.coordinates, out["tau"]))
+        elif args.tau is not None:
+            tau = as_vector(args.tau, robot.nq, "tau", robot.coordinates)
+            out["a"] = np.linalg.solve(M, tau - C @ v - g)
+            text.append(_vector_text("a (full)", robot.velocity_labels, out["a"]))
+        _emit(args, out, "\n".join(text))
+        return 0
+    robot.check_constraints(q)
+    nu = robot.check_nu(args.v, "v")
+    red = robot.reduced(q, nu, coriolis=True)
+    names = robot.velocity_names
+    motors = [m.name for m in robot.motors]
+    out = {"coordinates": names, "q": q, "q_names": robot.coordinates, "M": red.M, "C": red.C, "g": red.g,
+           "B": red.B, "motors": motors, "S": red.S, "condition": red.projection.condition}
+    text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g})",
+            _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
+            _vector_text("g", names, red.g), _matrix_text("B", names, motors, red.B)]
+    if args.a is not None:
+        nudot = robot.check_nu(args.a, "a")
+        Q, tau, resid = robot.inverse_dynamics(q, nu, nudot)
+        out.update(tau=Q, motor_torques=dict(zip(motors, tau)), motor_residual=resid)
+        text += [_vector_text("tau (generalised forces M a + C v + g)", names, Q),
+                 _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
+    elif args.tau is not None:
+        tau = robot.check_tau(args.tau)
+        nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
+        out["a"] = nudot
+        text.append(_vector_text("a (independent accelerations)", names, nudot))
+    _emit(args, out, "\n".join(text))
+    return 0
+
+
+def cmd_simulate(args) -> int:
+    mod, robot = _load(args)
+    scenarios = getattr(mod, "SCENARIOS", {})
+    if args.scenario not in scenarios:
+        raise RobotDynError(
+            f"unknown scenario {args.scenario!r} for {args.robot}; expected one of {', '.join(scenarios) or '(none)'}"
+        )
+    sc = scenarios[args.scenario]
+    traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet)
+    if args.csv:
+        traj.to_csv(args.csv)
+    if args.plot:
+        from .plotting import plot_trajectory
+
+        plot_trajectory(traj, sc.plot or traj.velocity_names, args.plot, f"{args.robot}: {sc.name}", sc.zoom,
+                        sc.references)
+    drift = float(np.max(traj.residual)) if traj.residual.size else 0.0
+    final = dict(zip(traj.coordinates + traj.velocity_names, np.concatenate([traj.q[-1], traj.nu[-1]])))
+    out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,
+           "energy_start": float(traj.energy[0]), "energy_end": float(traj.energy[-1]),
+           "max_holonomic_residual": drift, "wall_time_s": traj.stats["wall"], "csv": args.csv, "plot": args.plot}
+    text = [f"{args.robot} / {sc.name}: {sc.description}",
+            f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations)",
+            "final state:", *(f"  {k:<14} {v: .8g}" for k, v in final.items()),
+            f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
+    if args.csv:
+        text.append(f"wrote {args.csv}")
+    if args.plot:
+        text.append(f"wrote {args.plot}")
+    _emit(args, out, "\n".join(text))
+    return 0
+
+
+def cmd_compare(args) -> int:
+    mod, robot = _load(args)
+    if not hasattr(mod, "compare"):
+        raise RobotDynError(f"robot {args.robot!r} has no paper comparison")
+    cmp = mod.compare(robot)
+    _emit(args, {"title": cmp.title, "rows": cmp.as_dicts()}, cmp.table())
+    return 0
+
+
+# ------------------------------------------------------------------------------------------------ parser
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="robotdyn", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--json", action="store_true", help="machine-readable output")
+    robot_args = argparse.ArgumentParser(add_help=False)
+    robot_args.add_argument("robot", metavar="ROBOT", help="robot name (robotdyn list)")
+    robot_args.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                            help="override a parameter (repeatable; robotdyn info ROBOT lists them)")
+
+    p = sub.add_parser("list", parents=[common], help="list the robots")
+    p.set_defaults(func=cmd_list)
+    p = sub.add_parser("info", parents=[common, robot_args], help="coordinates, parameters, actuators")
+    p.set_defaults(func=cmd_info)
+    p = sub.add_parser("dump", parents=[common, robot_args],
+                       help="minimal-coordinate M, C, g and torques (or accelerations) at a state")
+    p.add_argument("--q", nargs="+", required=True, help="natural coordinates, in the order info lists them")
+    p.add_argument("--v", nargs="+", required=True, help="independent velocities (with --full: all velocities)")
+    group = p.add_mutually_exclusive_group()
+    group.add_argument("--a", nargs="+", help="accelerations -> torques (inverse dynamics)")
+    group.add_argument("--tau", nargs="+", help="motor torques -> accelerations (forward dynamics)")
+    p.add_argument("--full", action="store_true", help="the unconstrained tree's M, C, g instead")
+    p.set_defaults(func=cmd_dump)
+    p = sub.add_parser("simulate", parents=[common, robot_args], help="run a scenario")
+    p.add_argument("--scenario", required=True, help="scenario name (robotdyn info ROBOT lists them)")
+    p.add_argument("--t-end", type=float, default=None, help="duration [s] (default: the scenario's)")
+    p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file")
+    p.add_argument("--plot", help="save the paper's figures reproduced to this image file")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(func=cmd_simulate)
+    p = sub.add_parser("compare", parents=[common, robot_args], help="the paper comparison table")
+    p.set_defaults(func=cmd_compare)
+
+    from .robots import module, names
+
+    for name in names():
+        hook = getattr(module(name), "register_cli", None)
+        if hook is not None:
+            hook(sub, [common, robot_args])
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``robotdyn`` console script."""
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        return int(args.func(args) or 0)
+    except RobotDynError as exc:
+        print(f"robotdyn: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("robotdyn: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,113 @@
+"""Constraint interface and the shared kinematics evaluation.
+
+A constraint contributes rows to the Pfaffian system :math:`A(q) v = 0` and their time derivative
+:math:`\\dot A(q, v)`, so that accelerations satisfy :math:`A a + \\dot A v = 0` (the drift term is
+:math:`\\dot A v`). Holonomic rows also give a position residual :math:`\\phi(q)` whose gradient they are (on the
+constraint manifold). All rows act on Pinocchio's velocity vector; with robotdyn's natural coordinates
+:math:`\\dot q = v`.
+
+The kinematics (frame placements, LOCAL_WORLD_ALIGNED frame Jacobians and their time variation) is computed once
+per state by :class:`KinematicState` and shared by every constraint, motor and the projection.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+def skew(x: np.ndarray) -> np.ndarray:
+    """The cross-product matrix :math:`[x]_\\times` with :math:`[x]_\\times y = x \\times y`."""
+    return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+
+
+class KinematicState:
+    """Kinematics of a model at one state (q, v), computed once.
+
+    Runs ``computeJointJacobiansTimeVariation`` (placements, Jacobians and their time derivative) and
+    ``updateFramePlacements``. Frame quantities are cached per frame.
+
+    Attributes:
+        q, v: The state (natural coordinates, velocities), copied.
+    """
+
+    def __init__(self, model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> None:
+        self.model, self.data = model, data
+        self.q = np.array(q, dtype=float)
+        self.v = np.array(v, dtype=float)
+        pin.computeJointJacobiansTimeVariation(model, data, self.q, self.v)
+        pin.updateFramePlacements(model, data)
+        self._frames: dict[int, tuple[pin.SE3, np.ndarray, np.ndarray]] = {}
+
+    def frame(self, fid: int) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
+        """Placement, Jacobian (6 x nv) and its time derivative for a frame, in LOCAL_WORLD_ALIGNED.
+
+        The Jacobian's first three rows give the classical velocity of the frame origin in world axes [m/s],
+        the last three the angular velocity [rad/s]; :math:`\\dot J v` is the classical acceleration at
+        :math:`\\dot v = 0`.
+        """
+        if fid not in self._frames:
+            placement = self.data.oMf[fid].copy()
+            jac = pin.getFrameJacobian(self.model, self.data, fid, LWA).copy()
+            djac = pin.getFrameJacobianTimeVariation(self.model, self.data, fid, LWA).copy()
+            self._frames[fid] = (placement, jac, djac)
+        return self._frames[fid]
+
+    def joint_axis(self, jid: int) -> np.ndarray:
+        """World direction of a one-degree-of-freedom joint's axis (its own Jacobian column)."""
+        jac = pin.getJointJacobian(self.model, self.data, jid, LWA)
+        col = self.model.joints[jid].idx_v
+        ang = jac[3:, col]
+        return ang if np.linalg.norm(ang) > 0.5 else jac[:3, col]
+
+
+@dataclass
+class ConstraintRows:
+    """Rows contributed by constraints at one state.
+
+    Attributes:
+        A: Constraint Jacobian, shape (k, nv).
+        Adot: Its time derivative along the motion, shape (k, nv); the drift term is ``Adot @ v``.
+        residual: Position residual of holonomic rows (0 on nonholonomic rows), shape (k,).
+        holonomic: Which rows are holonomic, shape (k,).
+        labels: A name for each row (constraint name and component).
+    """
+
+    A: np.ndarray
+    Adot: np.ndarray
+    residual: np.ndarray
+    holonomic: np.ndarray
+    labels: list[str]
+
+    @staticmethod
+    def stack(parts: list[ConstraintRows], nv: int) -> ConstraintRows:
+        """Stack the rows of several constraints (an empty list gives zero rows)."""
+        if not parts:
+            return ConstraintRows(np.zeros((0, nv)), np.zeros((0, nv)), np.zeros(0), np.zeros(0, bool), [])
+        return ConstraintRows(
+            np.vstack([p.A for p in parts]),
+            np.vstack([p.Adot for p in parts]),
+            np.concatenate([p.residual for p in parts]),
+            np.concatenate([p.holonomic for p in parts]),
+            [label for p in parts for label in p.labels],
+        )
+
+
+class Constraint:
+    """Base class of constraints (rolling contacts, loop closures, ...).
+
+    Subclasses implement :meth:`rows`. ``name`` identifies the constraint in messages.
+    """
+
+    name: str = "constraint"
+
+    def rows(self, kin: KinematicState) -> ConstraintRows:
+        """The constraint's rows at the state held by ``kin``."""
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(name={self.name!r})"

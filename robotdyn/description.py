@@ -1,0 +1,227 @@
+"""Robot descriptions: Xacro -> URDF -> Pinocchio model with natural coordinates.
+
+A description is expanded with xacro's Python API (no ROS), validated with yourdfpy, and built into a Pinocchio
+model whose configuration vector ``q`` holds *natural coordinates*: every joint has one coordinate and
+:math:`\\dot q = v`. To get there:
+
+- ``continuous`` joints become unbounded ``revolute`` joints, so a wheel angle is the angle itself (unwrapped),
+  not Pinocchio's (cos, sin) pair;
+- the root joint is a chain of one-degree-of-freedom joints on massless links rather than Pinocchio's planar or
+  free-flyer joint: ``planar`` gives (x, y, psi), ``floating`` gives (x, y, z, yaw, pitch, roll) with the
+  Z-Y-X Euler convention, both in the world frame (m, rad). (Pinocchio 4.1's ``JointModelComposite`` was tried
+  and rejected: its frame-Jacobian time variation is wrong, which the rolling contact's drift needs.)
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import DescriptionError
+
+URDF_DIR = Path(__file__).resolve().parent.parent / "urdf"
+"""Directory of the Xacro descriptions shipped with robotdyn."""
+
+ROOT_KINDS = ("fixed", "planar", "floating")
+_UNBOUNDED = 1.0e9
+_ROOT_CHAINS = {
+    "fixed": [],
+    "planar": [("x", "prismatic", "1 0 0"), ("y", "prismatic", "0 1 0"), ("psi", "revolute", "0 0 1")],
+    "floating": [
+        ("x", "prismatic", "1 0 0"),
+        ("y", "prismatic", "0 1 0"),
+        ("z", "prismatic", "0 0 1"),
+        ("yaw", "revolute", "0 0 1"),
+        ("pitch", "revolute", "0 1 0"),
+        ("roll", "revolute", "1 0 0"),
+    ],
+}
+
+
+def expand_xacro(path: str | Path, args: dict[str, object] | None = None) -> str:
+    """Expand a Xacro file into a URDF string.
+
+    Args:
+        path: The ``.xacro`` (or plain ``.urdf``) file. Includes are resolved relative to it.
+        args: Values of the file's ``xacro:arg`` s, converted with ``str``.
+
+    Returns:
+        The URDF XML text.
+
+    Raises:
+        DescriptionError: The file is missing or xacro cannot expand it.
+    """
+    import xacro
+
+    path = Path(path)
+    if not path.is_file():
+        raise DescriptionError(f"description file not found: {path}")
+    mappings = {str(k): str(v) for k, v in (args or {}).items()}
+    try:
+        doc = xacro.process_file(str(path), mappings=mappings)
+    except Exception as exc:  # xacro raises a variety of exception types
+        msg = " ".join(str(exc).split()) or type(exc).__name__
+        raise DescriptionError(f"cannot expand xacro {path.name}: {msg}") from None
+    return doc.toxml()
+
+
+def validate_urdf(urdf: str) -> None:
+    """Check a URDF string with yourdfpy (parses, one tree, known joint types, physical inertias).
+
+    Raises:
+        DescriptionError: naming the first problem found.
+    """
+    import yourdfpy
+
+    try:
+        robot = yourdfpy.URDF.load(io.StringIO(urdf), build_scene_graph=False, load_meshes=False)
+    except Exception as exc:
+        raise DescriptionError(f"invalid URDF: {' '.join(str(exc).split())}") from None
+    if not robot.validate():
+        raise DescriptionError("invalid URDF: yourdfpy validation failed (check links, joints and inertials)")
+    for link in robot.robot.links:
+        inertial = link.inertial
+        if inertial is None or inertial.mass is None:
+            continue
+        if inertial.mass < 0 or not math.isfinite(inertial.mass):
+            raise DescriptionError(f"link {link.name!r} has mass {inertial.mass}; expected a finite value >= 0")
+        inertia = np.asarray(inertial.inertia, dtype=float)
+        eig = np.linalg.eigvalsh(inertia)
+        if inertial.mass > 0 and (eig.min() < -1e-12 or not np.all(np.isfinite(eig))):
+            raise DescriptionError(
+                f"link {link.name!r} has a non-positive inertia tensor (eigenvalues {np.round(eig, 6).tolist()}); "
+                "expected a positive semi-definite central inertia"
+            )
+        a, b, c = np.sort(eig)
+        if inertial.mass > 0 and c > a + b + 1e-9 * max(c, 1.0):
+            raise DescriptionError(
+                f"link {link.name!r} violates the triangle inequality of principal inertias "
+                f"({a:.6g}, {b:.6g}, {c:.6g}); no rigid body has that inertia"
+            )
+
+
+def _naturalise(urdf: str, root: str) -> tuple[str, list[str]]:
+    """Rewrite continuous joints as unbounded revolute ones and prepend the root chain.
+
+    Returns:
+        The new URDF text and the names of the root-chain joints.
+    """
+    if root not in ROOT_KINDS:
+        raise DescriptionError(f"unknown root joint kind {root!r}; expected one of {', '.join(ROOT_KINDS)}")
+    try:
+        tree = ET.fromstring(urdf)
+    except ET.ParseError as exc:
+        raise DescriptionError(f"URDF is not well-formed XML: {exc}") from None
+    links = {el.get("name") for el in tree.findall("link")}
+    children = {j.find("child").get("link") for j in tree.findall("joint") if j.find("child") is not None}
+    roots = sorted(links - children)
+    if len(roots) != 1:
+        raise DescriptionError(f"URDF must have exactly one root link, found {roots}")
+    for joint in tree.findall("joint"):
+        jtype = joint.get("type")
+        if jtype in ("floating", "planar"):
+            raise DescriptionError(
+                f"joint {joint.get('name')!r} has type {jtype!r}; only revolute, continuous, prismatic and fixed "
+                "joints are supported inside the tree (the root joint is chosen separately)"
+            )
+        if jtype == "continuous":
+            joint.set("type", "revolute")
+            lim = joint.find("limit")
+            if lim is None:
+                lim = ET.SubElement(joint, "limit")
+                lim.set("effort", "0")
+                lim.set("velocity", "0")
+            lim.set("lower", str(-_UNBOUNDED))
+            lim.set("upper", str(_UNBOUNDED))
+    chain = _ROOT_CHAINS[root]
+    parent = "robotdyn_world"
+    if chain:
+        ET.SubElement(tree, "link", name=parent)
+    names = []
+    for i, (name, jtype, axis) in enumerate(chain):
+        child = roots[0] if i == len(chain) - 1 else f"robotdyn_root_{name}"
+        if child != roots[0]:
+            ET.SubElement(tree, "link", name=child)
+        joint = ET.SubElement(tree, "joint", name=name, type=jtype)
+        ET.SubElement(joint, "parent", link=parent)
+        ET.SubElement(joint, "child", link=child)
+        ET.SubElement(joint, "axis", xyz=axis)
+        ET.SubElement(joint, "limit", lower=str(-_UNBOUNDED), upper=str(_UNBOUNDED), effort="0", velocity="0")
+        names.append(name)
+        parent = child
+    return ET.tostring(tree, encoding="unicode"), names
+
+
+@dataclass
+class Description:
+    """A Pinocchio model in natural coordinates, with its visual geometry.
+
+    Attributes:
+        model: The Pinocchio model (``nq == nv``, :math:`\\dot q = v`).
+        visual: The visual geometry model (for the viewer).
+        urdf: The URDF text the model was built from (root chain included).
+        root: ``"fixed"``, ``"planar"`` or ``"floating"``.
+        joint_names: Joint name of each coordinate, in ``q`` order.
+        lower, upper: Joint limits of each coordinate (``±inf`` when unbounded).
+    """
+
+    model: pin.Model
+    visual: pin.GeometryModel
+    urdf: str
+    root: str
+    joint_names: list[str] = field(default_factory=list)
+    lower: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    upper: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __repr__(self) -> str:
+        return f"Description(model={self.model.name!r}, root={self.root!r}, nq={self.model.nq})"
+
+    def q_index(self, joint: str) -> int:
+        """Index in ``q`` (and ``v``) of a one-degree-of-freedom joint."""
+        if not self.model.existJointName(joint):
+            raise DescriptionError(f"no joint named {joint!r}; joints are {', '.join(self.joint_names)}")
+        return int(self.model.joints[self.model.getJointId(joint)].idx_q)
+
+    def frame_id(self, frame: str) -> int:
+        """Pinocchio frame index of a link or joint frame, with a clear error for a typo."""
+        if not self.model.existFrame(frame):
+            links = sorted({f.name for f in self.model.frames if f.type == pin.FrameType.BODY})
+            raise DescriptionError(f"no frame named {frame!r}; links are {', '.join(links)}")
+        return int(self.model.getFrameId(frame))
+
+
+def build_description(urdf: str, root: str = "planar", package_dirs: list[str] | None = None) -> Description:
+    """Build a :class:`Description` from URDF text.
+
+    Args:
+        urdf: URDF XML (already expanded from Xacro).
+        root: Root joint kind: ``"fixed"``, ``"planar"`` (x, y, psi) or ``"floating"``
+            (x, y, z, yaw, pitch, roll).
+        package_dirs: Where ``package://`` meshes are looked up.
+    """
+    validate_urdf(urdf)
+    text, _ = _naturalise(urdf, root)
+    try:
+        model = pin.buildModelFromXML(text)
+    except Exception as exc:
+        raise DescriptionError(f"Pinocchio cannot build the model: {' '.join(str(exc).split())}") from None
+    if model.nq != model.nv:
+        raise DescriptionError("internal: natural coordinates require nq == nv")
+    try:
+        visual = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.VISUAL, package_dirs=package_dirs or [])
+    except Exception:
+        visual = pin.GeometryModel()
+    names: list[str] = [""] * model.nq
+    for jid in range(1, model.njoints):
+        joint = model.joints[jid]
+        names[joint.idx_q] = model.names[jid]
+    lower = np.where(model.lowerPositionLimit <= -_UNBOUNDED, -np.inf, model.lowerPositionLimit)
+    upper = np.where(model.upperPositionLimit >= _UNBOUNDED, np.inf, model.upperPositionLimit)
+    return Description(model, visual, text, root, names, np.array(lower), np.array(upper))
+

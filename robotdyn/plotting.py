@@ -1,0 +1,63 @@
+"""Plots of trajectories and comparisons (matplotlib, Agg backend: files, no window)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+def _unit(name: str) -> str:
+    base = name[:-4] if name.endswith("_dot") else name
+    unit = "m" if base in ("x", "y", "z") else "rad"
+    return unit + ("/s" if name.endswith("_dot") else "")
+
+
+def plot_trajectory(
+    traj,
+    columns: Sequence[str],
+    path=None,
+    title: str = "",
+    zoom: float | None = None,
+    references: dict[str, list[tuple[float, str]]] | None = None,
+):
+    """Plot columns of a :class:`~robotdyn.simulation.Trajectory` against time.
+
+    Args:
+        traj: The trajectory.
+        columns: Coordinate or velocity names, one row of axes each.
+        path: Where to save the figure (PNG/PDF/SVG by extension); ``None`` to only return it.
+        title: Figure title.
+        zoom: If given, a second column of axes shows only ``0 <= t <= zoom`` (the paper's transient windows).
+        references: Horizontal reference lines per column, e.g. a paper's printed amplitude.
+
+    Returns:
+        The matplotlib figure.
+    """
+    ncol = 2 if zoom else 1
+    fig, axes = plt.subplots(len(columns), ncol, figsize=(5.5 * ncol, 2.3 * len(columns)), squeeze=False)
+    for i, name in enumerate(columns):
+        y = traj.column(name)
+        for j in range(ncol):
+            ax = axes[i, j]
+            mask = slice(None) if j == 0 else traj.t <= zoom
+            ax.plot(traj.t[mask], y[mask], lw=1.2, label="robotdyn")
+            for value, label in (references or {}).get(name, []):
+                ax.axhline(value, color="C3", ls="--", lw=1.0, label=label)
+            ax.set_ylabel(f"{name} [{_unit(name)}]")
+            ax.grid(alpha=0.3)
+            if i == len(columns) - 1:
+                ax.set_xlabel("t [s]")
+            if i == 0:
+                ax.set_title("whole run" if j == 0 else f"first {zoom:g} s")
+            if (references or {}).get(name) and j == ncol - 1:
+                ax.legend(fontsize=7, loc="upper right")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    if path is not None:
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+    return fig

@@ -1,0 +1,134 @@
+"""Projection of the constraint system onto independent velocities.
+
+Given stacked rows :math:`A(q) v = 0` (m x n, possibly rank-deficient) and a choice of independent velocities
+:math:`\\nu = v_{\\text{ind}}`, build :math:`S(q)` with :math:`v = S\\nu` and :math:`AS = 0`:
+:math:`S = P\\,[I;\\; -A_d^{-1} A_i]` after removing redundant rows with a rank-revealing QR (never inverting a
+singular block). The mobility is :math:`n - \\operatorname{rank} A`.
+
+Time derivative: from :math:`\\dot A S + A \\dot S = 0` with a zero independent block,
+:math:`\\dot S_d = -A_d^{-1} \\dot A S`, so :math:`w = \\dot S \\nu` solves :math:`A w = -\\dot A v`
+(the acceleration offset :math:`a = S\\dot\\nu + w`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from .errors import SingularConstraintError
+
+RANK_TOL = 1e-9
+"""Relative tolerance on QR diagonal entries below which rows are counted as redundant."""
+MAX_CONDITION = 1e10
+"""Condition number of the dependent block above which the choice of independent velocities is refused."""
+
+
+def independent_rows(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
+    """Indices of a maximal set of linearly independent rows of ``A`` (rank-revealing QR with pivoting)."""
+    if A.shape[0] == 0:
+        return np.zeros(0, dtype=int)
+    _, R, piv = scipy.linalg.qr(A.T, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(R))
+    if diag.size == 0 or diag[0] == 0.0:
+        return np.zeros(0, dtype=int)
+    rank = int(np.sum(diag > tol * max(diag[0], 1.0)))
+    return np.sort(piv[:rank])
+
+
+def auto_independent(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
+    """A well-conditioned choice of independent velocity indices (the columns QR pivoting chooses last)."""
+    n = A.shape[1]
+    rows = independent_rows(A, tol)
+    if rows.size == 0:
+        return np.arange(n)
+    _, _, piv = scipy.linalg.qr(A[rows], mode="economic", pivoting=True)
+    return np.sort(piv[rows.size :])
+
+
+@dataclass
+class Projection:
+    """:math:`S(q)` and the data to differentiate it.
+
+    Attributes:
+        S: (n, k) with :math:`v = S\\nu`.
+        independent: Indices of :math:`\\nu` in :math:`v` (k,).
+        dependent: The other indices.
+        rows: Indices of the independent constraint rows used.
+        condition: Condition number of the dependent block :math:`A_d` (1 when there are no constraints).
+    """
+
+    S: np.ndarray
+    independent: np.ndarray
+    dependent: np.ndarray
+    rows: np.ndarray
+    condition: float
+    _lu: tuple | None = None
+
+    @property
+    def mobility(self) -> int:
+        """Number of independent velocities :math:`k = n - \\operatorname{rank} A`."""
+        return int(self.S.shape[1])
+
+    def solve_dependent(self, rhs: np.ndarray) -> np.ndarray:
+        """:math:`A_d^{-1}` rhs (rhs indexed by the used rows)."""
+        if self._lu is None:
+            return np.zeros((0,) + rhs.shape[1:])
+        return scipy.linalg.lu_solve(self._lu, rhs)
+
+    def Sdot(self, Adot: np.ndarray) -> np.ndarray:
+        """:math:`\\dot S` (n, k) given :math:`\\dot A` (all rows) along the motion."""
+        out = np.zeros_like(self.S)
+        if self.rows.size:
+            out[self.dependent] = -self.solve_dependent(Adot[self.rows] @ self.S)
+        return out
+
+    def offset(self, drift: np.ndarray) -> np.ndarray:
+        """:math:`w` with :math:`A w = -\\text{drift}` and zero independent part (drift = :math:`\\dot A v`)."""
+        w = np.zeros(self.S.shape[0])
+        if self.rows.size:
+            w[self.dependent] = -self.solve_dependent(drift[self.rows])
+        return w
+
+
+def project(A: np.ndarray, independent: np.ndarray | None = None, names: list[str] | None = None) -> Projection:
+    """Build :math:`S` for the constraint rows ``A`` and the given independent velocity indices.
+
+    Args:
+        A: Stacked constraint Jacobian (m, n).
+        independent: Indices of the independent velocities; ``None`` chooses a well-conditioned set.
+        names: Velocity names, used in error messages.
+
+    Raises:
+        SingularConstraintError: The number of independent velocities does not match the mobility, or the
+            dependent block is singular / ill-conditioned at this configuration.
+    """
+    n = A.shape[1]
+    names = names or [f"v{i}" for i in range(n)]
+    rows = independent_rows(A)
+    if independent is None:
+        independent = auto_independent(A)
+    independent = np.asarray(independent, dtype=int)
+    dependent = np.setdiff1d(np.arange(n), independent)
+    if dependent.size != rows.size:
+        raise SingularConstraintError(
+            f"{independent.size} independent velocities chosen ({', '.join(names[i] for i in independent)}) but the "
+            f"constraints leave {n - rows.size} (n = {n}, rank A = {rows.size}); expected exactly the mobility"
+        )
+    S = np.zeros((n, n - rows.size))
+    S[independent, np.arange(independent.size)] = 1.0
+    if rows.size == 0:
+        return Projection(S, independent, dependent, rows, 1.0, None)
+    Ad = A[np.ix_(rows, dependent)]
+    cond = float(np.linalg.cond(Ad))
+    if not np.isfinite(cond) or cond > MAX_CONDITION:
+        raise SingularConstraintError(
+            f"the dependent velocities ({', '.join(names[i] for i in dependent)}) cannot be solved from the "
+            f"independent ones here: constraint block singular (condition number {cond:.3g}); choose other "
+            "independent velocities or move away from this singular configuration",
+            condition=cond,
+        )
+    lu = scipy.linalg.lu_factor(Ad)
+    S[dependent] = -scipy.linalg.lu_solve(lu, A[np.ix_(rows, independent)])
+    return Projection(S, independent, dependent, rows, cond, lu)

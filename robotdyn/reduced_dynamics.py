@@ -1,0 +1,90 @@
+"""Equations of motion in minimal (independent) velocities.
+
+With :math:`v = S\\nu` and :math:`a = S\\dot\\nu + w` (:math:`w = \\dot S \\nu`, see :mod:`robotdyn.projection`),
+D'Alembert's principle (constraint forces do no work on admissible motions) gives
+
+.. math:: M_r \\dot\\nu + C_r \\nu + g_r = B_r \\tau,\\qquad
+          M_r = S^T M S,\\; C_r = S^T(M\\dot S + C S),\\; g_r = S^T g,\\; B_r = S^T B,
+
+where :math:`C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, S\\nu, w)` (one RNEA call gives the whole reduced bias) and
+:math:`\\dot M_r - 2C_r` is skew-symmetric because Pinocchio's C is Christoffel-consistent.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from .actuation import input_matrix
+from .constraint import ConstraintRows, KinematicState
+from .projection import Projection, project
+
+
+@dataclass
+class ReducedDynamics:
+    """The minimal-coordinate model at one state (q, nu).
+
+    Attributes:
+        M: :math:`M_r` (k, k) [kg m^2 or kg].
+        h: :math:`C_r\\nu + g_r` (k,), the whole bias [N m or N].
+        g: :math:`g_r` (k,).
+        B: :math:`B_r` (k, n_motors).
+        S: (n, k) with v = S nu.
+        w: :math:`\\dot S\\nu` (n,), the acceleration offset.
+        v: Full velocity :math:`S\\nu` (n,).
+        C: :math:`C_r` (k, k), only when requested (else ``None``).
+        Sdot: :math:`\\dot S` (n, k), only with C.
+        projection: The :class:`~robotdyn.projection.Projection` used.
+        rows: The stacked constraint rows at this state.
+    """
+
+    M: np.ndarray
+    h: np.ndarray
+    g: np.ndarray
+    B: np.ndarray
+    S: np.ndarray
+    w: np.ndarray
+    v: np.ndarray
+    projection: Projection
+    rows: ConstraintRows
+    C: np.ndarray | None = None
+    Sdot: np.ndarray | None = None
+
+    def __repr__(self) -> str:
+        return f"ReducedDynamics(k={self.M.shape[0]}, n={self.S.shape[0]}, motors={self.B.shape[1]})"
+
+
+def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
+    """Evaluate the reduced model of ``robot`` at (q, nu).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,), already validated.
+        nu: Independent velocities (k,).
+        coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`).
+        independent: Override of the independent velocity indices.
+    """
+    model, data = robot.model, robot.data
+    ind = robot.independent_indices if independent is None else independent
+    kin0 = KinematicState(model, data, q, np.zeros(model.nv))
+    rows0 = robot.constraint_rows(kin0)
+    proj = project(rows0.A, ind, robot.velocity_labels)
+    v = proj.S @ nu
+    kin = KinematicState(model, data, q, v)
+    rows = robot.constraint_rows(kin)
+    B = input_matrix(robot.motors, kin)
+    w = proj.offset(rows.Adot @ v)
+    S = proj.S
+    M = pin.crba(model, data, q)
+    Mr = S.T @ M @ S
+    g = pin.computeGeneralizedGravity(model, data, q)
+    h = S.T @ pin.rnea(model, data, q, v, w)
+    out = ReducedDynamics(Mr, h, S.T @ g, S.T @ B, S, w, v, proj, rows)
+    if coriolis:
+        Sdot = proj.Sdot(rows.Adot)
+        C = pin.computeCoriolisMatrix(model, data, q, v)
+        out.C = S.T @ (M @ Sdot + C @ S)
+        out.Sdot = Sdot
+    return out

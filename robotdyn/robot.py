@@ -1,0 +1,325 @@
+"""A robot: description + parameters + constraints + motors, with the dynamics API.
+
+:class:`RobotSpec` is the declarative description of a robot (what a robot module or a user's constraint file
+supplies); :class:`Robot` builds it for given parameter values and evaluates full and reduced dynamics,
+forward/inverse dynamics and energies. Configurations are natural coordinates named by
+:attr:`Robot.coordinates` (m, rad); velocities of the minimal model are the independent velocities named by
+:attr:`Robot.velocity_names` (m/s, rad/s).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .actuation import Motor
+from .constraint import ConstraintRows, KinematicState
+from .description import URDF_DIR, Description, build_description, expand_xacro
+from .dynamics import energy
+from .errors import ConstraintError, InputError
+from .inputs import as_vector
+from .loop_closure import LoopClosure
+from .projection import auto_independent
+from .reduced_dynamics import ReducedDynamics, reduce
+from .rolling_contact import OmniWheel, RollingWheel
+from .terrain import FlatTerrain, Terrain
+
+
+@dataclass
+class Parameter:
+    """A physical parameter: name, default, unit, meaning; ``xacro=False`` if it is not a xacro argument."""
+
+    name: str
+    default: float | str
+    unit: str = ""
+    description: str = ""
+    choices: tuple[str, ...] | None = None
+    xacro: bool = True
+
+    def convert(self, value) -> float | str:
+        """Validate and convert a user value."""
+        if self.choices is not None:
+            if str(value) not in self.choices:
+                raise InputError(f"parameter {self.name} = {value!r}; expected one of {', '.join(self.choices)}")
+            return str(value)
+        try:
+            out = float(value)
+        except (TypeError, ValueError):
+            raise InputError(f"parameter {self.name} = {value!r} is not a number [{self.unit}]") from None
+        if not np.isfinite(out):
+            raise InputError(f"parameter {self.name} = {value!r} is not finite; expected a number [{self.unit}]")
+        return out
+
+
+@dataclass
+class Wheel:
+    """A wheel: its frame (centre), radius (number or parameter name), axle axis in the frame, kind."""
+
+    frame: str
+    radius: float | str
+    axis: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    kind: str = "standard"
+    roller_angle: float | str = 0.0
+    radius_joint: str | None = None
+    name: str | None = None
+
+
+@dataclass
+class Closure:
+    """A loop closure between two frames, closing the given components (in frame1's axes)."""
+
+    frame1: str
+    frame2: str
+    components: Sequence[str] = ("x", "y", "z")
+    name: str | None = None
+
+
+@dataclass
+class MotorSpec:
+    """A motor on a joint, reacting on ``reaction`` (a link) or on the joint's parent."""
+
+    name: str
+    joint: str
+    reaction: str | None = None
+
+
+@dataclass
+class RobotSpec:
+    """Everything needed to build a robot.
+
+    Attributes:
+        name: Registry name (``robotdyn list``).
+        title: One-line human description.
+        xacro: The Xacro/URDF file (relative paths are under ``urdf/``).
+        root: ``"fixed"``, ``"planar"`` or ``"floating"``.
+        parameters: The physical parameters with defaults and units.
+        wheels, closures, motors: The constraint and actuator declarations.
+        labels: Display name of a coordinate for a joint name (e.g. ``wheel_A_joint -> theta1``).
+        independent: Coordinate labels whose velocities are the independent ones (``None``: automatic).
+        terrain: A terrain, or a function of the parameter values returning one (default: flat z = 0).
+        paper: The paper's file name in ``shared/papers``.
+        neutral: Coordinate values of a valid configuration (default all zero), used e.g. by ``info``.
+    """
+
+    name: str
+    title: str
+    xacro: str | Path
+    root: str = "planar"
+    parameters: list[Parameter] = field(default_factory=list)
+    wheels: list[Wheel] = field(default_factory=list)
+    closures: list[Closure] = field(default_factory=list)
+    motors: list[MotorSpec] = field(default_factory=list)
+    labels: dict[str, str] = field(default_factory=dict)
+    independent: list[str] | None = None
+    terrain: Terrain | Callable[[dict], Terrain] | None = None
+    paper: str = ""
+    neutral: dict[str, float] = field(default_factory=dict)
+
+    def parameter(self, name: str) -> Parameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise InputError(
+            f"unknown parameter {name!r} for {self.name}; expected one of {', '.join(p.name for p in self.parameters)}"
+        )
+
+
+class Robot:
+    """A built robot.
+
+    Args:
+        spec: Its :class:`RobotSpec`.
+        params: Parameter overrides (name -> value); unknown names are an error.
+        terrain: Terrain override.
+
+    Attributes:
+        coordinates: Names of the natural coordinates q (m, rad).
+        velocity_names: Names of the independent velocities nu.
+        params: Resolved parameter values.
+        model, data: The Pinocchio model and data (natural coordinates, nq == nv).
+        constraints, motors: The constraint and motor objects.
+    """
+
+    def __init__(self, spec: RobotSpec, params: dict | None = None, terrain: Terrain | None = None) -> None:
+        self.spec = spec
+        values = {p.name: p.convert(p.default) for p in spec.parameters}
+        for name, value in (params or {}).items():
+            values[name] = spec.parameter(name).convert(value)
+        self.params = values
+        path = Path(spec.xacro)
+        if not path.is_absolute():
+            path = URDF_DIR / path
+        xacro_args = {p.name: values[p.name] for p in spec.parameters if p.xacro}
+        self.description: Description = build_description(expand_xacro(path, xacro_args), spec.root)
+        self.model = self.description.model
+        self.data = self.model.createData()
+        self.model.gravity.linear = np.array([0.0, 0.0, -float(values.get("g", 9.81))])
+        self.coordinates = [spec.labels.get(j, j) for j in self.description.joint_names]
+        self.velocity_labels = [f"{c}_dot" for c in self.coordinates]
+        if terrain is None:
+            terrain = spec.terrain(values) if callable(spec.terrain) else spec.terrain
+        self.terrain = terrain if terrain is not None else FlatTerrain()
+        self.constraints = [self._wheel(w) for w in spec.wheels] + [
+            LoopClosure(self.description, c.frame1, c.frame2, c.components, c.name) for c in spec.closures
+        ]
+        self.motors = [Motor(self.description, m.name, m.joint, m.reaction) for m in spec.motors]
+        if spec.independent is not None:
+            self.independent_indices = np.array([self.coordinate_index(c) for c in spec.independent], dtype=int)
+        else:
+            kin = KinematicState(self.model, self.data, self.neutral(), np.zeros(self.model.nv))
+            self.independent_indices = auto_independent(self.constraint_rows(kin).A)
+        self.velocity_names = [self.velocity_labels[i] for i in self.independent_indices]
+
+    def __repr__(self) -> str:
+        return (
+            f"Robot({self.spec.name!r}, coordinates={self.coordinates}, independent={self.velocity_names}, "
+            f"constraints={len(self.constraints)}, motors={[m.name for m in self.motors]})"
+        )
+
+    # ----------------------------------------------------------------------------------------------- set-up
+    def _value(self, x) -> float:
+        return float(self.params[x]) if isinstance(x, str) else float(x)
+
+    def _wheel(self, w: Wheel):
+        kw = dict(axis=w.axis, terrain=None, radius_joint=w.radius_joint, name=w.name)
+        kw["terrain"] = self.terrain
+        if w.kind == "omni":
+            return OmniWheel(self.description, w.frame, self._value(w.radius), self._value(w.roller_angle), **kw)
+        if w.kind != "standard":
+            raise InputError(f"wheel {w.frame!r}: kind {w.kind!r}; expected 'standard' or 'omni'")
+        return RollingWheel(self.description, w.frame, self._value(w.radius), **kw)
+
+    # ------------------------------------------------------------------------------------------ coordinates
+    @property
+    def nq(self) -> int:
+        """Number of natural coordinates (= number of full velocities)."""
+        return self.model.nq
+
+    @property
+    def mobility(self) -> int:
+        """Number of independent velocities."""
+        return len(self.independent_indices)
+
+    def coordinate_index(self, label: str) -> int:
+        """Index of a coordinate by its display name or joint name."""
+        if label in self.coordinates:
+            return self.coordinates.index(label)
+        if label in self.description.joint_names:
+            return self.description.joint_names.index(label)
+        raise InputError(f"unknown coordinate {label!r}; expected one of {', '.join(self.coordinates)}")
+
+    def neutral(self) -> np.ndarray:
+        """A valid configuration: the spec's ``neutral`` values, zero elsewhere."""
+        q = np.zeros(self.nq)
+        for label, value in self.spec.neutral.items():
+            q[self.coordinate_index(label)] = self._value(value)
+        return q
+
+    def check_q(self, q) -> np.ndarray:
+        """Validate a configuration (length, finiteness, joint limits)."""
+        q = as_vector(q, self.nq, "q", self.coordinates)
+        lo, hi = self.description.lower, self.description.upper
+        bad = np.flatnonzero((q < lo - 1e-12) | (q > hi + 1e-12))
+        if bad.size:
+            i = bad[0]
+            raise InputError(
+                f"q[{self.coordinates[i]}] = {q[i]:.6g} is outside its joint range [{lo[i]:.6g}, {hi[i]:.6g}]"
+            )
+        return q
+
+    def check_nu(self, nu, what: str = "v") -> np.ndarray:
+        """Validate a vector of independent velocities (or accelerations)."""
+        return as_vector(nu, self.mobility, what, self.velocity_names)
+
+    def check_tau(self, tau) -> np.ndarray:
+        """Validate motor torques."""
+        return as_vector(tau, len(self.motors), "tau", [m.name for m in self.motors])
+
+    # ------------------------------------------------------------------------------------------ constraints
+    def constraint_rows(self, kin: KinematicState) -> ConstraintRows:
+        """All constraint rows at the state of ``kin``."""
+        return ConstraintRows.stack([c.rows(kin) for c in self.constraints], self.model.nv)
+
+    def constraint_residual(self, q) -> np.ndarray:
+        """Position residuals of the holonomic constraint rows at q (m, rad)."""
+        kin = KinematicState(self.model, self.data, q, np.zeros(self.model.nv))
+        rows = self.constraint_rows(kin)
+        return rows.residual[rows.holonomic]
+
+    def check_constraints(self, q, tol: float = 1e-6) -> None:
+        """Raise :class:`ConstraintError` if q violates a holonomic constraint by more than ``tol``."""
+        kin = KinematicState(self.model, self.data, q, np.zeros(self.model.nv))
+        rows = self.constraint_rows(kin)
+        if rows.residual.size and np.max(np.abs(rows.residual)) > tol:
+            i = int(np.argmax(np.abs(rows.residual)))
+            raise ConstraintError(
+                f"q violates constraint {rows.labels[i]} by {rows.residual[i]:.3g}; expected |residual| <= {tol:g} "
+                "(solve the closures/contacts first)"
+            )
+
+    # ------------------------------------------------------------------------------------------- dynamics
+    def reduced(self, q, nu, coriolis: bool = False) -> ReducedDynamics:
+        """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduced_dynamics`."""
+        return reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
+
+    def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Full-coordinate M(q), C(q, v), g(q) of the unconstrained tree (Pinocchio)."""
+        q, v = np.asarray(q, float), np.asarray(v, float)
+        M = pin.crba(self.model, self.data, q).copy()
+        C = pin.computeCoriolisMatrix(self.model, self.data, q, v).copy()
+        g = pin.computeGeneralizedGravity(self.model, self.data, q).copy()
+        return M, C, g
+
+    def forward_dynamics(self, q, nu, tau) -> np.ndarray:
+        """Independent accelerations :math:`\\dot\\nu = M_r^{-1}(B_r\\tau - C_r\\nu - g_r)`."""
+        red = self.reduced(q, nu)
+        return np.linalg.solve(red.M, red.B @ np.asarray(tau, float) - red.h)
+
+    def inverse_dynamics(self, q, nu, nudot) -> tuple[np.ndarray, np.ndarray, float]:
+        """Generalised forces and motor torques for given independent accelerations.
+
+        Returns:
+            ``(Q, tau, residual)``: :math:`Q = M_r\\dot\\nu + C_r\\nu + g_r` (k,), the motor torques tau solving
+            :math:`B_r\\tau = Q` in least squares, and the norm of what the motors cannot produce (0 when the
+            motion is feasible).
+        """
+        red = self.reduced(q, nu)
+        Q = red.M @ np.asarray(nudot, float) + red.h
+        if red.B.shape[1] == 0:
+            return Q, np.zeros(0), float(np.linalg.norm(Q))
+        tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)
+        return Q, tau, float(np.linalg.norm(red.B @ tau - Q))
+
+    def velocity(self, q, nu) -> np.ndarray:
+        """Full velocity v = S(q) nu."""
+        return self.reduced(q, nu).v
+
+    def energy(self, q, v) -> float:
+        """Total mechanical energy (kinetic + potential) [J]."""
+        kinetic, potential = energy(self.model, self.data, np.asarray(q, float), np.asarray(v, float))
+        return kinetic + potential
+
+    def info(self) -> dict:
+        """Coordinates, independent velocities, parameters (value, unit) and actuators, as plain data."""
+        return {
+            "robot": self.spec.name,
+            "title": self.spec.title,
+            "paper": self.spec.paper,
+            "coordinates": self.coordinates,
+            "independent_velocities": self.velocity_names,
+            "mobility": self.mobility,
+            "parameters": {
+                p.name: {"value": self.params[p.name], "unit": p.unit, "description": p.description}
+                for p in self.spec.parameters
+            },
+            "actuators": [
+                {"name": m.name, "joint": self.spec.labels.get(m.joint, m.joint), "reaction": m.reaction}
+                for m in self.motors
+            ],
+            "constraints": [repr(c) for c in self.constraints],
+            "terrain": repr(self.terrain),
+        }

@@ -1,0 +1,185 @@
+"""Rolling without slipping of a wheel on a terrain z = f(x, y).
+
+A wheel is a thin disc of radius R whose centre is the origin of a frame of the model and whose axle is a unit
+vector ``axis`` in that frame. With terrain normal n at the contact point p and axle a (world):
+
+- :math:`u = (n - (n\\cdot a)a) / \\|n - (n\\cdot a)a\\|` points from p to the centre c, :math:`p = c - R u`,
+  with n taken at p itself (a fixed point on curved terrain);
+- the material point of the wheel at p has zero velocity:
+  :math:`A_w v = v_c + \\omega \\times (p - c) - u \\dot R = 0` (world rows),
+  expressed in the contact frame (t1 = rolling direction :math:`a \\times n` normalised, t2 = :math:`n \\times t_1`,
+  n): the t1 and t2 rows are nonholonomic, the n row is the derivative of the holonomic contact condition
+  :math:`\\phi = (p_z - f(p_x, p_y)) / \\|(-f_x, -f_y, 1)\\|`;
+- the time derivative follows the contact point as it moves around the rim (not a body-fixed point):
+  :math:`\\dot A_w v = a_c^0 + \\dot\\omega^0 \\times r + \\omega \\times \\dot r - \\dot u \\dot R`,
+  :math:`r = p - c`, :math:`\\dot r = -(R\\dot u + \\dot R u)`, with :math:`\\dot u` from a 3x3 implicit solve on
+  curved terrain (see ``shared/notes/rolling-contact-and-projection.md``).
+
+An omni (Swedish) wheel keeps the normal row and one tangential row along its rollers' axis, at ``roller_angle``
+from t1 towards t2 (0 for a 90-degree omni wheel whose rollers leave the lateral motion free).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .constraint import Constraint, ConstraintRows, KinematicState, skew
+from .errors import ConstraintError, DescriptionError
+from .terrain import FlatTerrain, Terrain
+
+
+class RollingWheel(Constraint):
+    """A standard wheel rolling without slipping (three rows: longitudinal, lateral, normal).
+
+    Args:
+        description: The robot's :class:`~robotdyn.description.Description`.
+        frame: Frame (link) whose origin is the wheel centre.
+        radius: Wheel radius R [m] (> 0); with ``radius_joint`` the radius is ``radius + q[radius_joint]``.
+        axis: Axle direction in the wheel frame (normalised here).
+        terrain: The ground (default: the plane z = 0).
+        radius_joint: Optional prismatic joint whose coordinate adds to the radius (adaptable wheels).
+        name: Name used in row labels and messages (default: the frame name).
+    """
+
+    _directions = np.eye(3)
+    _row_names = ("longitudinal", "lateral", "normal")
+
+    def __init__(
+        self,
+        description,
+        frame: str,
+        radius: float,
+        axis=(0.0, 1.0, 0.0),
+        terrain: Terrain | None = None,
+        radius_joint: str | None = None,
+        name: str | None = None,
+    ) -> None:
+        self.frame = frame
+        self.fid = description.frame_id(frame)
+        self.nv = description.model.nv
+        radius = float(radius)
+        if not np.isfinite(radius) or (radius <= 0 and radius_joint is None):
+            raise DescriptionError(f"wheel {frame!r}: radius {radius} is not > 0; expected a positive radius in m")
+        self.radius = radius
+        axis = np.asarray(axis, dtype=float)
+        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-12:
+            raise DescriptionError(f"wheel {frame!r}: axle axis {axis.tolist()} has zero length; expected a 3-vector")
+        self.axis = axis / np.linalg.norm(axis)
+        self.terrain = terrain if terrain is not None else FlatTerrain()
+        self.radius_index = None if radius_joint is None else description.q_index(radius_joint)
+        self.name = name or frame
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(frame={self.frame!r}, radius={self.radius}, terrain={self.terrain!r})"
+
+    def contact(self, kin: KinematicState) -> dict:
+        """Contact geometry and its rates at the state of ``kin`` (world frame).
+
+        Returns:
+            dict with ``p`` (contact point), ``n`` (normal), ``u`` (unit vector contact -> centre), ``R``,
+            ``E`` (3x3, columns t1, t2, n), ``Edot``, ``r`` (p - c), ``rdot``, ``udot``, ``a`` (axle),
+            ``phi`` (holonomic residual [m]), and the frame Jacobian ``J`` and ``dJ``.
+        """
+        placement, jac, djac = kin.frame(self.fid)
+        v = kin.v
+        c = placement.translation
+        a = placement.rotation @ self.axis
+        cdot = jac[:3] @ v
+        omega = jac[3:] @ v
+        adot = np.cross(omega, a)
+        R, Rdot = self.radius, 0.0
+        if self.radius_index is not None:
+            R += kin.q[self.radius_index]
+            Rdot = v[self.radius_index]
+            if R <= 0:
+                raise ConstraintError(f"wheel {self.name!r}: radius {R:.6g} m is not positive at this configuration")
+        terrain = self.terrain
+        n = terrain.normal(c[0], c[1])
+        for _ in range(100):
+            w = n - (n @ a) * a
+            nw = np.linalg.norm(w)
+            if nw < 1e-9:
+                raise ConstraintError(
+                    f"wheel {self.name!r}: the axle is parallel to the ground normal (wheel lying flat); "
+                    "expected a wheel standing on the terrain"
+                )
+            u = w / nw
+            p = c - R * u
+            if terrain.is_flat:
+                break
+            n_new = terrain.normal(p[0], p[1])
+            if np.linalg.norm(n_new - n) < 1e-15:
+                n = n_new
+                break
+            n = n_new
+        else:
+            raise ConstraintError(
+                f"wheel {self.name!r}: the contact point did not converge; the terrain is curved more sharply "
+                "than the wheel (expected terrain curvature radius > wheel radius)"
+            )
+        w = n - (n @ a) * a
+        nw = np.linalg.norm(w)
+        u = w / nw
+        p = c - R * u
+        mz = np.sqrt(1.0 + np.sum(terrain.gradient(p[0], p[1]) ** 2))
+        phi = (p[2] - terrain.height(p[0], p[1])) / mz
+        P = (np.eye(3) - np.outer(u, u)) / nw
+        Qa = np.eye(3) - np.outer(a, a)
+        rhs_const = -(n @ adot) * a - (n @ a) * adot
+        if terrain.is_flat:
+            N = np.zeros((3, 3))
+            udot = P @ rhs_const
+        else:
+            N = terrain.normal_derivative(p[0], p[1])
+            K = np.eye(3) + R * P @ Qa @ N
+            udot = np.linalg.solve(K, P @ (Qa @ N @ (cdot - Rdot * u) + rhs_const))
+        pdot = cdot - R * udot - Rdot * u
+        ndot = N @ pdot
+        r = -R * u
+        rdot = -R * udot - Rdot * u
+        c1 = np.cross(a, n)
+        nc1 = np.linalg.norm(c1)
+        t1 = c1 / nc1
+        t2 = np.cross(n, t1)
+        c1dot = np.cross(adot, n) + np.cross(a, ndot)
+        t1dot = (c1dot - t1 * (t1 @ c1dot)) / nc1
+        t2dot = np.cross(ndot, t1) + np.cross(n, t1dot)
+        E = np.column_stack([t1, t2, n])
+        Edot = np.column_stack([t1dot, t2dot, ndot])
+        return dict(p=p, n=n, u=u, R=R, E=E, Edot=Edot, r=r, rdot=rdot, udot=udot, a=a, phi=phi, J=jac, dJ=djac)
+
+    def rows(self, kin: KinematicState) -> ConstraintRows:
+        g = self.contact(kin)
+        jac, djac = g["J"], g["dJ"]
+        Aw = jac[:3] - skew(g["r"]) @ jac[3:]
+        Awdot = djac[:3] - skew(g["rdot"]) @ jac[3:] - skew(g["r"]) @ djac[3:]
+        if self.radius_index is not None:
+            Aw[:, self.radius_index] -= g["u"]
+            Awdot[:, self.radius_index] -= g["udot"]
+        D = self._directions  # rows: coefficients of (t1, t2, n)
+        W = D @ g["E"].T
+        Wdot = D @ g["Edot"].T
+        A = W @ Aw
+        Adot = Wdot @ Aw + W @ Awdot
+        holonomic = D[:, 2] != 0
+        residual = np.where(holonomic, g["phi"], 0.0)
+        labels = [f"{self.name}.{s}" for s in self._row_names]
+        return ConstraintRows(A, Adot, residual, holonomic, labels)
+
+
+class OmniWheel(RollingWheel):
+    """An omni/Swedish wheel: rolls without slipping along its rollers' axis only, and touches the ground.
+
+    Args:
+        roller_angle: Angle [rad] of the constrained direction from the rolling direction t1 towards t2
+            (0: a 90-degree omni wheel, lateral motion free; pi/4: a 45-degree mecanum wheel).
+        Other arguments as :class:`RollingWheel`.
+    """
+
+    _row_names = ("driving", "normal")
+
+    def __init__(self, description, frame: str, radius: float, roller_angle: float = 0.0, **kwargs) -> None:
+        super().__init__(description, frame, radius, **kwargs)
+        self.roller_angle = float(roller_angle)
+        ca, sa = np.cos(self.roller_angle), np.sin(self.roller_angle)
+        self._directions = np.array([[ca, sa, 0.0], [0.0, 0.0, 1.0]])

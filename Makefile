@@ -1,0 +1,35 @@
+# robotdyn: everything a newcomer needs, from a fresh machine with Python 3.11 and pip.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+
+.PHONY: demo test bench venv clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[test]"
+	touch $(STAMP)
+
+venv: $(STAMP)
+
+## make demo: install, then compute the Quasimoro's reduced dynamics, compare it with the paper and simulate
+demo: $(STAMP)
+	$(PY) -m robotdyn info quasimoro
+	$(PY) -m robotdyn dump quasimoro --q 0 0 0 0.3 0 0 --v 1.0 0.5 0.2 --a 0.1 0.2 0.3
+	$(PY) -m robotdyn compare quasimoro
+	mkdir -p out
+	$(PY) -m robotdyn simulate quasimoro --scenario rectilinear --t-end 10 --csv out/quasimoro_rectilinear.csv --plot out/quasimoro_rectilinear.png
+
+## make test: install, then run the whole test suite, notebooks included
+test: $(STAMP)
+	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q --nbmake notebooks
+
+## make bench: speed of the reduced model against raw Pinocchio, side by side in one run
+bench: $(STAMP)
+	$(PY) bench/bench.py
+
+clean:
+	rm -rf $(VENV) out .pytest_cache

@@ -196,7 +196,51 @@ class Description:
         return int(self.model.getFrameId(frame))
 
 
-def build_description(urdf: str, root: str = "planar", package_dirs: list[str] | None = None) -> Description:
+def drop_inertials(urdf: str, links) -> str:
+    """Remove the ``<inertial>`` of the named links (they become massless); unknown link names are an error."""
+    links = list(links or [])
+    if not links:
+        return urdf
+    try:
+        tree = ET.fromstring(urdf)
+    except ET.ParseError as exc:
+        raise DescriptionError(f"URDF is not well-formed XML: {exc}") from None
+    by_name = {el.get("name"): el for el in tree.findall("link")}
+    for name in links:
+        if name not in by_name:
+            raise DescriptionError(f"massless link {name!r} does not exist; links are {', '.join(sorted(by_name))}")
+        for inertial in by_name[name].findall("inertial"):
+            by_name[name].remove(inertial)
+    return ET.tostring(tree, encoding="unicode")
+
+
+def lock_joints(model: pin.Model, visual: pin.GeometryModel, locked: dict[str, float]):
+    """Replace the named one-DOF joints by fixed ones at the given values (m or rad), merging the inertias.
+
+    Uses ``pin.buildReducedModel``; the remaining joints keep their natural coordinates.
+    """
+    ids, q_ref = [], np.zeros(model.nq)
+    for name, value in locked.items():
+        if name not in list(model.names)[1:]:
+            raise DescriptionError(f"locked joint {name!r} does not exist; joints are {', '.join(list(model.names)[1:])}")
+        jid = int(model.getJointId(name))
+        i = int(model.joints[jid].idx_q)
+        lo, hi = model.lowerPositionLimit[i], model.upperPositionLimit[i]
+        value = float(value)
+        if not np.isfinite(value) or value < lo - 1e-12 or value > hi + 1e-12:
+            raise DescriptionError(f"locked joint {name!r} = {value:g} is outside its range [{lo:.6g}, {hi:.6g}]")
+        ids.append(jid)
+        q_ref[i] = value
+    return pin.buildReducedModel(model, visual, sorted(ids), q_ref)
+
+
+def build_description(
+    urdf: str,
+    root: str = "planar",
+    package_dirs: list[str] | None = None,
+    locked: dict[str, float] | None = None,
+    massless: list[str] | None = None,
+) -> Description:
     """Build a :class:`Description` from URDF text.
 
     Args:
@@ -204,7 +248,11 @@ def build_description(urdf: str, root: str = "planar", package_dirs: list[str] |
         root: Root joint kind: ``"fixed"``, ``"planar"`` (x, y, psi) or ``"floating"``
             (x, y, z, yaw, pitch, roll).
         package_dirs: Where ``package://`` meshes are looked up.
+        locked: Joints to lock (name -> value in m or rad): they become fixed, their bodies merge with the parent.
+        massless: Links whose inertial is dropped (e.g. a third-party URDF's placeholder with a non-physical
+            inertia tensor).
     """
+    urdf = drop_inertials(urdf, massless)
     validate_urdf(urdf)
     text, _ = _naturalise(urdf, root)
     try:
@@ -217,6 +265,8 @@ def build_description(urdf: str, root: str = "planar", package_dirs: list[str] |
         visual = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.VISUAL, package_dirs=package_dirs or [])
     except Exception:
         visual = pin.GeometryModel()
+    if locked:
+        model, visual = lock_joints(model, visual, locked)
     names: list[str] = [""] * model.nq
     for jid in range(1, model.njoints):
         joint = model.joints[jid]

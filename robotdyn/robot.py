@@ -103,6 +103,16 @@ class RobotSpec:
         terrain: A terrain, or a function of the parameter values returning one (default: flat z = 0).
         paper: The paper's file name in ``shared/papers``.
         neutral: Coordinate values of a valid configuration (default all zero), used e.g. by ``info``.
+        xacro_args: Fixed xacro arguments (name -> string) that are not parameters (e.g. from ``--xacro-arg``).
+        package_dirs: Directories where ``package://`` URIs (meshes) are resolved.
+        locked: Joints replaced by fixed ones at the given values (name -> m or rad), e.g. an arm held still.
+        massless: Links whose URDF inertial is ignored.
+        constraints: Factories ``make(robot) -> Constraint`` for constraints beyond wheels and closures (e.g. a
+            joint coupling, or wheels whose kind depends on the parameters); called with the robot under
+            construction (description, params and terrain are set).
+        operational: Minimal velocities that are not a subset of v (e.g. a platform twist in body axes): an object
+            with ``build(description)`` returning a model with ``names`` and ``reduce(robot, q, nu, coriolis)``,
+            such as :class:`robotdyn.operational_space.OperationalVelocities`; ``None``: ``independent`` is used.
     """
 
     name: str
@@ -118,6 +128,12 @@ class RobotSpec:
     terrain: Terrain | Callable[[dict], Terrain] | None = None
     paper: str = ""
     neutral: dict[str, float] = field(default_factory=dict)
+    xacro_args: dict[str, str] = field(default_factory=dict)
+    package_dirs: list[str] = field(default_factory=list)
+    locked: dict[str, float] = field(default_factory=dict)
+    massless: list[str] = field(default_factory=list)
+    constraints: list[Callable] = field(default_factory=list)
+    operational: object | None = None
 
     def parameter(self, name: str) -> Parameter:
         for p in self.parameters:
@@ -153,8 +169,10 @@ class Robot:
         path = Path(spec.xacro)
         if not path.is_absolute():
             path = URDF_DIR / path
-        xacro_args = {p.name: values[p.name] for p in spec.parameters if p.xacro}
-        self.description: Description = build_description(expand_xacro(path, xacro_args), spec.root)
+        xacro_args = {**spec.xacro_args, **{p.name: values[p.name] for p in spec.parameters if p.xacro}}
+        self.description: Description = build_description(
+            expand_xacro(path, xacro_args), spec.root, [str(d) for d in spec.package_dirs], spec.locked, spec.massless
+        )
         self.model = self.description.model
         self.data = self.model.createData()
         self.model.gravity.linear = np.array([0.0, 0.0, -float(values.get("g", 9.81))])
@@ -165,7 +183,7 @@ class Robot:
         self.terrain = terrain if terrain is not None else FlatTerrain()
         self.constraints = [self._wheel(w) for w in spec.wheels] + [
             LoopClosure(self.description, c.frame1, c.frame2, c.components, c.name) for c in spec.closures
-        ]
+        ] + [make(self) for make in spec.constraints]
         self.motors = [Motor(self.description, m.name, m.joint, m.reaction) for m in spec.motors]
         if spec.independent is not None:
             self.independent_indices = np.array([self.coordinate_index(c) for c in spec.independent], dtype=int)
@@ -173,6 +191,9 @@ class Robot:
             kin = KinematicState(self.model, self.data, self.neutral(), np.zeros(self.model.nv))
             self.independent_indices = auto_independent(self.constraint_rows(kin).A)
         self.velocity_names = [self.velocity_labels[i] for i in self.independent_indices]
+        self.operational = spec.operational.build(self.description) if spec.operational is not None else None
+        if self.operational is not None:
+            self.velocity_names = list(self.operational.names)
 
     def __repr__(self) -> str:
         return (
@@ -202,7 +223,7 @@ class Robot:
     @property
     def mobility(self) -> int:
         """Number of independent velocities."""
-        return len(self.independent_indices)
+        return len(self.velocity_names)
 
     def coordinate_index(self, label: str) -> int:
         """Index of a coordinate by its display name or joint name."""
@@ -264,6 +285,8 @@ class Robot:
     # ------------------------------------------------------------------------------------------- dynamics
     def reduced(self, q, nu, coriolis: bool = False) -> ReducedDynamics:
         """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduced_dynamics`."""
+        if self.operational is not None:
+            return self.operational.reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
         return reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
 
     def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

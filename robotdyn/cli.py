@@ -173,6 +173,48 @@ def cmd_compare(args) -> int:
     return 0
 
 
+def cmd_view(args) -> int:
+    """The meshcat viewer: the robot (and a scenario's animation); a standalone HTML file or a live server."""
+    from .viewer import Viewer
+
+    mod, robot = _load(args)
+    traj = None
+    if args.scenario is not None:
+        scenarios = getattr(mod, "SCENARIOS", {})
+        if args.scenario not in scenarios:
+            raise RobotDynError(f"unknown scenario {args.scenario!r} for {args.robot}; "
+                                f"expected one of {', '.join(scenarios) or '(none)'}")
+        if args.t_end is not None and not (np.isfinite(args.t_end) and args.t_end > 0):
+            raise RobotDynError(f"--t-end {args.t_end:g}; expected a positive duration in s")
+        traj = scenarios[args.scenario].run(robot, t_end=args.t_end, progress=not args.quiet)
+    viewer = Viewer(robot, live=args.html is None, frames=args.frames)
+    viewer.display(robot.neutral() if traj is None else traj.q[0])
+    if traj is not None:
+        viewer.animate(traj)
+    out = {"robot": args.robot, "scenario": args.scenario, "html": args.html, "url": viewer.url,
+           "duration_s": None if traj is None else float(traj.t[-1] - traj.t[0])}
+    if args.html:
+        viewer.save(args.html)
+        viewer.close()
+        _emit(args, out, f"wrote {args.html}" + ("" if traj is None else f" ({out['duration_s']:g} s animation)"))
+        return 0
+    _emit(args, out, f"meshcat viewer of {args.robot} at {viewer.url}  (Ctrl-C to stop)")
+    if args.open:
+        import webbrowser
+
+        webbrowser.open(viewer.url)
+    try:
+        import time
+
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        viewer.close()
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------ parser
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="robotdyn", description=__doc__.splitlines()[0])
@@ -206,11 +248,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_simulate)
     p = sub.add_parser("compare", parents=[common, robot_args], help="the paper comparison table")
     p.set_defaults(func=cmd_compare)
+    p = sub.add_parser("view", parents=[common, robot_args],
+                       help="meshcat viewer (live on localhost, or a standalone HTML file with --html)")
+    p.add_argument("--scenario", help="animate this scenario (robotdyn info ROBOT lists them)")
+    p.add_argument("--t-end", type=float, default=None, help="duration [s] of the scenario (default: the scenario's)")
+    p.add_argument("--html", help="write a standalone HTML file (opens offline) instead of starting a server")
+    p.add_argument("--frames", action="store_true", help="show the link frames initially")
+    p.add_argument("--open", action="store_true", help="open the live viewer in the default web browser")
+    p.add_argument("--quiet", action="store_true", help="no simulation progress on stderr")
+    p.set_defaults(func=cmd_view)
 
     from .robots import module, names
 
     for name in names():
-        hook = getattr(module(name), "register_cli", None)
+        try:
+            mod = module(name)
+        except Exception as exc:  # a broken robot module must not take the whole CLI down
+            print(f"robotdyn: warning: robot module {name!r} failed to import: {exc}", file=sys.stderr)
+            continue
+        hook = getattr(mod, "register_cli", None)
         if hook is not None:
             hook(sub, [common, robot_args])
     return parser

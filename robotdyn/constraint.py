@@ -25,14 +25,22 @@ def skew(x: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
 
 
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:math:`a \\times b` for 3-vectors (several times faster than ``np.cross`` on single vectors)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 class KinematicState:
     """Kinematics of a model at one state (q, v), computed once.
 
     Runs ``computeJointJacobiansTimeVariation`` (placements, Jacobians and their time derivative) and
-    ``updateFramePlacements``. Frame quantities are cached per frame.
+    ``updateFramePlacements``. Frame quantities are cached per frame; ``geometry`` is a cache for
+    configuration-only quantities of constraints (e.g. a wheel's contact point), which
+    :meth:`with_velocity` carries over to the same configuration at another velocity.
 
     Attributes:
         q, v: The state (natural coordinates, velocities), copied.
+        geometry: Configuration-level cache, keyed by the constraint.
     """
 
     def __init__(self, model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> None:
@@ -42,6 +50,14 @@ class KinematicState:
         pin.computeJointJacobiansTimeVariation(model, data, self.q, self.v)
         pin.updateFramePlacements(model, data)
         self._frames: dict[int, tuple[pin.SE3, np.ndarray, np.ndarray]] = {}
+        self.geometry: dict = {}
+
+    def with_velocity(self, v: np.ndarray) -> KinematicState:
+        """The same configuration at velocity ``v`` (recomputes the Jacobians' time variation, keeps
+        :attr:`geometry`)."""
+        out = KinematicState(self.model, self.data, self.q, v)
+        out.geometry = self.geometry
+        return out
 
     def frame(self, fid: int) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
         """Placement, Jacobian (6 x nv) and its time derivative for a frame, in LOCAL_WORLD_ALIGNED.

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .constraint import Constraint, ConstraintRows, KinematicState, skew
+from .constraint import Constraint, ConstraintRows, KinematicState, cross, skew
 from .errors import ConstraintError, DescriptionError
 from .terrain import FlatTerrain, Terrain
 
@@ -72,32 +72,24 @@ class RollingWheel(Constraint):
     def __repr__(self) -> str:
         return f"{type(self).__name__}(frame={self.frame!r}, radius={self.radius}, terrain={self.terrain!r})"
 
-    def contact(self, kin: KinematicState) -> dict:
-        """Contact geometry and its rates at the state of ``kin`` (world frame).
-
-        Returns:
-            dict with ``p`` (contact point), ``n`` (normal), ``u`` (unit vector contact -> centre), ``R``,
-            ``E`` (3x3, columns t1, t2, n), ``Edot``, ``r`` (p - c), ``rdot``, ``udot``, ``a`` (axle),
-            ``phi`` (holonomic residual [m]), and the frame Jacobian ``J`` and ``dJ``.
-        """
-        placement, jac, djac = kin.frame(self.fid)
-        v = kin.v
+    def _geometry(self, kin: KinematicState) -> tuple:
+        """Configuration-level contact geometry (cached in ``kin.geometry``): c, a, R, n, u, p, |w|, phi, N."""
+        key = (id(self), "geometry")
+        if key in kin.geometry:
+            return kin.geometry[key]
+        placement, _, _ = kin.frame(self.fid)
         c = placement.translation
         a = placement.rotation @ self.axis
-        cdot = jac[:3] @ v
-        omega = jac[3:] @ v
-        adot = np.cross(omega, a)
-        R, Rdot = self.radius, 0.0
+        R = self.radius
         if self.radius_index is not None:
             R += kin.q[self.radius_index]
-            Rdot = v[self.radius_index]
             if R <= 0:
                 raise ConstraintError(f"wheel {self.name!r}: radius {R:.6g} m is not positive at this configuration")
         terrain = self.terrain
         n = terrain.normal(c[0], c[1])
         for _ in range(100):
             w = n - (n @ a) * a
-            nw = np.linalg.norm(w)
+            nw = np.sqrt(w @ w)
             if nw < 1e-9:
                 raise ConstraintError(
                     f"wheel {self.name!r}: the axle is parallel to the ground normal (wheel lying flat); "
@@ -108,44 +100,62 @@ class RollingWheel(Constraint):
             if terrain.is_flat:
                 break
             n_new = terrain.normal(p[0], p[1])
-            if np.linalg.norm(n_new - n) < 1e-15:
-                n = n_new
-                break
+            change = n_new - n
             n = n_new
+            if change @ change < 1e-30:
+                w = n - (n @ a) * a
+                nw = np.sqrt(w @ w)
+                u = w / nw
+                p = c - R * u
+                break
         else:
             raise ConstraintError(
                 f"wheel {self.name!r}: the contact point did not converge; the terrain is curved more sharply "
                 "than the wheel (expected terrain curvature radius > wheel radius)"
             )
-        w = n - (n @ a) * a
-        nw = np.linalg.norm(w)
-        u = w / nw
-        p = c - R * u
-        mz = np.sqrt(1.0 + np.sum(terrain.gradient(p[0], p[1]) ** 2))
-        phi = (p[2] - terrain.height(p[0], p[1])) / mz
+        grad = terrain.gradient(p[0], p[1])
+        phi = (p[2] - terrain.height(p[0], p[1])) / np.sqrt(1.0 + grad @ grad)
+        N = None if terrain.is_flat else terrain.normal_derivative(p[0], p[1])
+        c1 = cross(a, n)
+        nc1 = np.sqrt(c1 @ c1)
+        t1 = c1 / nc1
+        E = np.array([t1, cross(n, t1), n]).T
+        out = (c, a, R, n, u, p, nw, phi, N, E, nc1)
+        kin.geometry[key] = out
+        return out
+
+    def contact(self, kin: KinematicState) -> dict:
+        """Contact geometry and its rates at the state of ``kin`` (world frame).
+
+        Returns:
+            dict with ``p`` (contact point), ``n`` (normal), ``u`` (unit vector contact -> centre), ``R``,
+            ``E`` (3x3, columns t1, t2, n), ``Edot``, ``r`` (p - c), ``rdot``, ``udot``, ``a`` (axle),
+            ``phi`` (holonomic residual [m]), and the frame Jacobian ``J`` and ``dJ``.
+        """
+        c, a, R, n, u, p, nw, phi, N, E, nc1 = self._geometry(kin)
+        _, jac, djac = kin.frame(self.fid)
+        v = kin.v
+        cdot = jac[:3] @ v
+        omega = jac[3:] @ v
+        adot = cross(omega, a)
+        Rdot = 0.0 if self.radius_index is None else v[self.radius_index]
         P = (np.eye(3) - np.outer(u, u)) / nw
-        Qa = np.eye(3) - np.outer(a, a)
         rhs_const = -(n @ adot) * a - (n @ a) * adot
-        if terrain.is_flat:
-            N = np.zeros((3, 3))
+        if N is None:
             udot = P @ rhs_const
+            ndot = np.zeros(3)
         else:
-            N = terrain.normal_derivative(p[0], p[1])
+            Qa = np.eye(3) - np.outer(a, a)
             K = np.eye(3) + R * P @ Qa @ N
             udot = np.linalg.solve(K, P @ (Qa @ N @ (cdot - Rdot * u) + rhs_const))
-        pdot = cdot - R * udot - Rdot * u
-        ndot = N @ pdot
+            ndot = N @ (cdot - R * udot - Rdot * u)
         r = -R * u
         rdot = -R * udot - Rdot * u
-        c1 = np.cross(a, n)
-        nc1 = np.linalg.norm(c1)
-        t1 = c1 / nc1
-        t2 = np.cross(n, t1)
-        c1dot = np.cross(adot, n) + np.cross(a, ndot)
+        t1 = E[:, 0]
+        c1dot = cross(adot, n) + cross(a, ndot)
         t1dot = (c1dot - t1 * (t1 @ c1dot)) / nc1
-        t2dot = np.cross(ndot, t1) + np.cross(n, t1dot)
-        E = np.column_stack([t1, t2, n])
-        Edot = np.column_stack([t1dot, t2dot, ndot])
+        t2dot = cross(ndot, t1) + cross(n, t1dot)
+        Edot = np.array([t1dot, t2dot, ndot]).T
         return dict(p=p, n=n, u=u, R=R, E=E, Edot=Edot, r=r, rdot=rdot, udot=udot, a=a, phi=phi, J=jac, dJ=djac)
 
     def rows(self, kin: KinematicState) -> ConstraintRows:

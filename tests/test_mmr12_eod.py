@@ -1,0 +1,135 @@
+"""MMR12-EOD (Zuniga-Aviles et al. 2014): model, reduced dynamics (eq 22), kinematics (eqs 1-14, 27-31).
+
+References are independent of the model path: finite differences, energy balance, Pinocchio's KKT constrained
+forward dynamics, the closed forms of eqs 12-14, a separate numeric product of Table 2's HTG chain and the
+paper's printed numbers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import robotdyn
+from robotdyn.errors import InputError, RobotDynError
+from robotdyn.robots import mmr12_eod as mm
+from robotdyn.simulation import power, simulate
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return robotdyn.load("mmr12_eod")
+
+
+def random_q(robot, rng, lift=False):
+    """A configuration in the joint ranges; lambda_C = 0 (drive wheels on the ground) unless ``lift``."""
+    q = robot.neutral()
+    lo, hi = robot.description.lower, robot.description.upper
+    for i, name in enumerate(robot.coordinates):
+        a = lo[i] if np.isfinite(lo[i]) else -3.0
+        c = hi[i] if np.isfinite(hi[i]) else 3.0
+        q[i] = rng.uniform(a + 1e-3 * (c - a), c - 1e-3 * (c - a))
+    if not lift:
+        q[robot.coordinate_index("lambda_C")] = 0.0
+    return q
+
+
+# ----------------------------------------------------------------------------------- model and constraints
+def test_model_loads_with_expected_coordinates(robot):
+    assert robot.nq == 16
+    assert robot.mobility == 12
+    assert set(robot.coordinates) == {"x", "y", "psi", "lambda_C", *mm.ACTUATED}
+    assert robot.velocity_names == [f"{c}_dot" for c in mm.ACTUATED]
+    total = pin.computeTotalMass(robot.model)
+    masses = ["m_platform", "m_turret", "m_boom", "m_link3", "m_link4", "m_load"]
+    expected = sum(robot.params[k] for k in masses) + 2 * robot.params["m_wheel"] + 4 * robot.params["m_arm"] + 0.2
+    assert total == pytest.approx(expected, rel=1e-12)
+
+
+def test_AS_zero_and_S_matches_eqs_12_to_14(robot):
+    rng = np.random.default_rng(0)
+    iR, iL = robot.velocity_names.index("theta_R_dot"), robot.velocity_names.index("theta_L_dot")
+    ix, iy, ipsi = (robot.coordinate_index(c) for c in ("x", "y", "psi"))
+    for _ in range(20):
+        q = random_q(robot, rng)
+        nu = rng.normal(size=robot.mobility)
+        red = robot.reduced(q, nu)
+        assert np.max(np.abs(red.rows.A @ red.S)) < 1e-13
+        ref = mm.paper_platform_rates(robot.params, q[ipsi], nu[iR], nu[iL])
+        assert red.v[[ix, iy, ipsi]] == pytest.approx(ref, abs=1e-12)
+        assert red.v[robot.coordinate_index("lambda_C")] == pytest.approx(0.0, abs=1e-13)
+        # eq 12: no lateral velocity; eq 13 with the right wheel at -b
+        assert -red.v[ix] * np.sin(q[ipsi]) + red.v[iy] * np.cos(q[ipsi]) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_Mr_symmetric_positive_definite(robot):
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        red = robot.reduced(random_q(robot, rng), np.zeros(robot.mobility))
+        assert np.max(np.abs(red.M - red.M.T)) < 1e-12 * np.max(np.abs(red.M))
+        assert np.linalg.eigvalsh(red.M).min() > 0
+
+
+def test_reduced_dynamics_matches_kkt_forward_dynamics(robot):
+    """Eq 22 (projection path) vs Pinocchio's constrained forward dynamics (KKT with J = A, gamma = Adot v)."""
+    rng = np.random.default_rng(2)
+    model, data = robot.model, robot.data
+    for _ in range(10):
+        q = random_q(robot, rng)
+        nu = rng.normal(size=robot.mobility)
+        tau = rng.normal(size=len(robot.motors)) * 5
+        red = robot.reduced(q, nu)
+        nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
+        a_red = red.S @ nudot + red.w
+        rows = red.rows.A[red.projection.rows]
+        gamma = (red.rows.Adot @ red.v)[red.projection.rows]
+        tau_full = np.zeros(robot.nq)
+        for j, m in enumerate(robot.motors):
+            tau_full[m.index] += tau[j]
+        a_kkt = pin.forwardDynamics(model, data, q, red.v, tau_full, rows, gamma)
+        assert a_red == pytest.approx(a_kkt, abs=1e-8 * (1 + np.max(np.abs(a_kkt))))
+
+
+def test_Mr_dot_minus_2Cr_is_skew_by_finite_differences(robot):
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = random_q(robot, rng)
+        q[robot.coordinate_index("theta1")] = np.clip(q[robot.coordinate_index("theta1")], 0.2, 2.9)
+        nu = rng.normal(size=robot.mobility)
+        red = robot.reduced(q, nu, coriolis=True)
+        eps = 1e-6
+        Mp = robot.reduced(q + eps * red.v, nu).M
+        Mm = robot.reduced(q - eps * red.v, nu).M
+        Mdot = (Mp - Mm) / (2 * eps)
+        N = Mdot - 2 * red.C
+        assert np.max(np.abs(N + N.T)) < 1e-6 * max(1.0, np.max(np.abs(Mdot)))
+        # and C_r nu + g_r is the bias of eq 22
+        assert red.C @ nu + red.g == pytest.approx(red.h, abs=1e-9 * (1 + np.max(np.abs(red.h))))
+
+
+def test_energy_balance_torque_free_and_with_torque(robot):
+    q0 = robot.neutral()
+    nu0 = np.zeros(robot.mobility)
+    nu0[robot.velocity_names.index("theta_R_dot")] = 2.0
+    nu0[robot.velocity_names.index("theta_L_dot")] = -1.0
+    nu0[robot.velocity_names.index("theta1_dot")] = 0.3
+    traj = simulate(robot, 0.5, q0, nu0, None, n_out=11, rtol=1e-10, atol=1e-12, progress=False)
+    assert np.max(np.abs(traj.energy - traj.energy[0])) < 1e-6 * abs(traj.energy[0])
+    assert np.ptp(traj.column("theta1")) > 0.05  # it did move
+    # with torque: E(T) - E(0) = integral of motor power
+    torque = lambda t, q, nu: np.full(len(robot.motors), 0.5) * np.cos(3 * t)  # noqa: E731
+    traj = simulate(robot, 0.5, q0, nu0, torque, n_out=201, rtol=1e-10, atol=1e-12, progress=False)
+    P = power(robot, traj, torque)
+    work = np.trapezoid(P, traj.t) if hasattr(np, "trapezoid") else np.trapz(P, traj.t)
+    assert traj.energy[-1] - traj.energy[0] == pytest.approx(work, abs=1e-4 * max(1.0, abs(work)))
+
+
+# -------------------------------------------------------------------------------------------- joint ranges
+@pytest.mark.parametrize("label, value", [("lambda2", -0.1), ("theta_C1", 1.7), ("theta_C4", -2.0),
+                                          ("lambda6", 0.5), ("lambda_C", -0.01), ("theta1", -0.2)])
+def test_out_of_range_joint_is_a_clear_error(robot, label, value):
+    q = robot.neutral()
+    q[robot.coordinate_index(label)] = value
+    with pytest.raises(InputError, match=rf"q\[{label}\] = .* outside its joint range"):
+        robot.check_q(q)

@@ -1,0 +1,418 @@
+"""Three-wheeled robot with adaptable-radius wheels on rough terrain (Mardani & Ebrahimi 2016).
+
+Paper: A. Mardani, S. Ebrahimi, "A Novel Multimode Mobile Robot with Adaptable Wheel Geometry for Maneuverability
+Improvement" (``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``).
+Description: ``urdf/adaptable_wheel.urdf.xacro``.
+
+Model (derived by Pinocchio from the description): floating body (x, y, z, yaw, pitch, roll; Z-Y-X Euler) with
+three wheels fr, fl, r at the eq-8 positions, each with a spin joint ``theta_<i>`` (wheel motor), an adjustment
+angle ``q_<i>`` (adjustment motor, 0-180 deg) and a prismatic radius ``Rch_<i>`` (the close-loop pattern radius).
+The wheel radius is :math:`R_T = R_{ru} + R_{ch}` and the mechanism law of eq 1,
+:math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)`, is a holonomic :class:`~robotdyn.joint_coupling.JointCoupling`, so
+the radius follows the configuration through the constraint layer. Each wheel rolls on the terrain
+(:class:`~robotdyn.rolling_contact.RollingWheel` with ``radius_joint``); ``lateral=slip`` drops the lateral
+no-slip row (the paper's kinematic missions turn the robot about a vertical axis away from its wheel axles,
+which rolling without lateral slip forbids: see ``docs/errata/adaptable_wheel.md``).
+
+Paper transcription, kept apart from the model: the inverse kinematics of eqs 4-24 (:func:`solve_ik`,
+:func:`run_mission`), the static torque estimate of eq 35 (:func:`paper_torque_eq35`) and the fuller route of
+eqs 25-34 (:func:`static_torques`), with the contact forces from :func:`robotdyn.statics.solve_contact_forces`.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+import pinocchio as pin
+from scipy.optimize import root
+
+from ..comparison import Comparison
+from ..errors import ConstraintError, InputError, RobotDynError
+from ..joint_coupling import JointCoupling
+from ..robot import MotorSpec, Parameter, Robot, RobotSpec
+from ..rolling_contact import OmniWheel, RollingWheel
+from ..scenario import Scenario
+from ..statics import solve_contact_forces
+from ..terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
+
+WHEELS = ("fr", "fl", "r")
+"""Wheel tags: front right, front left, rear (eq 8)."""
+COS30 = float(np.cos(np.pi / 6))
+IK_TOL = 1e-10
+"""Convergence criterion ||C|| of the inverse kinematics (the paper used 1e-5, Table 1)."""
+
+
+# ------------------------------------------------------------------------------------------ the mechanism
+def radius_law(q: float, w: float) -> float:
+    """Eq 1: close-loop pattern radius :math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)` [m] for adjustment angle q [rad]."""
+    return w * np.cos(0.5 * q) * COS30
+
+
+def radius_law_d(q: float, w: float) -> float:
+    """Eq 33: :math:`dR_{ch}/dq = -\\tfrac12 w\\sin(q/2)\\cos(\\pi/6)` [m/rad]."""
+    return -0.5 * w * np.sin(0.5 * q) * COS30
+
+
+def radius_law_dd(q: float, w: float) -> float:
+    """:math:`d^2R_{ch}/dq^2 = -\\tfrac14 w\\cos(q/2)\\cos(\\pi/6)` [m/rad^2]."""
+    return -0.25 * w * np.cos(0.5 * q) * COS30
+
+
+def _terrain(p: dict) -> Terrain:
+    if p["terrain"] == "rough":
+        return SineTerrain(1.0 / 15.0, 0.5, 0.5)  # Table 1: Z = sin(0.5(x + y))/15
+    if p["terrain"] == "ramp":
+        return RampTerrain(p["ramp_slope"], p["ramp_heading"])
+    return FlatTerrain()
+
+
+def _wheel_factory(tag: str) -> Callable[[Robot], RollingWheel]:
+    def make(robot: Robot) -> RollingWheel:
+        kind = RollingWheel if robot.params["lateral"] == "rolling" else partial(OmniWheel, roller_angle=0.0)
+        return kind(robot.description, f"wheel_{tag}", robot.params["R_ru"], axis=(0.0, 1.0, 0.0),
+                    terrain=robot.terrain, radius_joint=f"radius_{tag}_joint", name=tag)
+
+    return make
+
+
+def _coupling_factory(tag: str) -> Callable[[Robot], JointCoupling]:
+    def make(robot: Robot) -> JointCoupling:
+        w = robot.params["w"]
+        return JointCoupling(robot.description, f"radius_{tag}_joint", f"adjust_{tag}_joint",
+                             partial(radius_law, w=w), partial(radius_law_d, w=w), partial(radius_law_dd, w=w),
+                             name=f"eq1_{tag}")
+
+    return make
+
+
+_Q0 = 2 * np.pi / 3
+SPEC = RobotSpec(
+    name="adaptable_wheel",
+    title="Tricycle with adaptable-radius wheels on rough terrain (Mardani & Ebrahimi 2016)",
+    xacro="adaptable_wheel.urdf.xacro",
+    root="floating",
+    paper="mardani_ebrahimi_2016_adaptable_wheel_robot.txt",
+    parameters=[
+        Parameter("m", 10.0, "kg", "total mass (Table 1)"),
+        Parameter("m_wheel", 0.0, "kg", "mass of each wheel hub (paper: all mass lumped in the body)"),
+        Parameter("I_adjust", 0.0, "kg m^2", "rotor inertia of each adjustment motor (not in the paper)"),
+        Parameter("w", 0.3, "m", "cross-linkage leg length (Table 1, eq 1)"),
+        Parameter("Lx", 0.6, "m", "Table 1 L_x (see L_reading)"),
+        Parameter("Ly", 0.6, "m", "Table 1 L_y (see L_reading)"),
+        Parameter("L_reading", "half", "", "half: Lx, Ly are the eq-8 offsets (body 2Lx x 2Ly); full: body Lx x Ly",
+                  choices=("half", "full")),
+        Parameter("R_ru", 0.02, "m", "rubber height, added to the pattern radius (Table 1)"),
+        Parameter("body_height", 0.05, "m", "body plate thickness (inertia only; not in the paper)"),
+        Parameter("mu", 1.0, "-", "static friction coefficient (Table 1)", xacro=False),
+        Parameter("g", 9.81, "m/s^2", "gravitational acceleration (not printed in the paper)", xacro=False),
+        Parameter("terrain", "rough", "", "rough: Z = sin(0.5(x+y))/15 (Table 1); ramp; flat",
+                  choices=("rough", "ramp", "flat"), xacro=False),
+        Parameter("ramp_slope", 0.2, "-", "slope of the ramp terrain (mission 2)", xacro=False),
+        Parameter("ramp_heading", -np.pi / 2, "rad", "direction in which the ramp rises (mission 2)", xacro=False),
+        Parameter("lateral", "rolling", "", "rolling: wheels roll without slipping; slip: lateral row dropped",
+                  choices=("rolling", "slip"), xacro=False),
+    ],
+    constraints=[_wheel_factory(t) for t in WHEELS] + [_coupling_factory(t) for t in WHEELS],
+    motors=[MotorSpec(f"spin_{t}", f"wheel_{t}_joint") for t in WHEELS]
+    + [MotorSpec(f"adjust_{t}", f"adjust_{t}_joint") for t in WHEELS],
+    labels={
+        **{f"wheel_{t}_joint": f"theta_{t}" for t in WHEELS},
+        **{f"adjust_{t}_joint": f"q_{t}" for t in WHEELS},
+        **{f"radius_{t}_joint": f"Rch_{t}" for t in WHEELS},
+    },
+    terrain=_terrain,
+    neutral={
+        "z": 0.02 + radius_law(_Q0, 0.3),
+        **{f"q_{t}": _Q0 for t in WHEELS},
+        **{f"Rch_{t}": radius_law(_Q0, 0.3) for t in WHEELS},
+    },
+)
+
+
+def offsets(p: dict) -> dict[str, np.ndarray]:
+    """Eq 8: wheel centres in the body frame X_CG Y_CG Z_CG [m] (Lx, Ly read per ``L_reading``)."""
+    s = 1.0 if p["L_reading"] == "half" else 0.5
+    lx, ly = s * p["Lx"], s * p["Ly"]
+    return {"fr": np.array([lx, -ly, 0.0]), "fl": np.array([lx, ly, 0.0]), "r": np.array([-lx, 0.0, 0.0])}
+
+
+def q_range_radius(p: dict) -> tuple[float, float]:
+    """Smallest and largest total radius R_T [m] over the adjustment range q in [0, pi] (eq 1)."""
+    return p["R_ru"], p["R_ru"] + p["w"] * COS30
+
+
+# ------------------------------------------------------------------------------------ eqs 4-24 (transcribed)
+def _rx(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def _ry(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0, s], [0, 1.0, 0], [-s, 0, c]])
+
+
+def _rz(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+_R2 = {"fr": _rx(np.pi / 2), "r": _rx(np.pi / 2), "fl": _rx(-np.pi / 2)}  # eq 9
+_SIGN = {"fr": -1.0, "r": -1.0, "fl": 1.0}  # eq 11: translation (0, -+R_T, 0) in frame b
+
+
+def paper_normal(terrain: Terrain, x: float, y: float) -> np.ndarray:
+    """Eq 3 (read as :math:`N = (-f_x, -f_y, 1)`, not normalised)."""
+    fx, fy = terrain.gradient(x, y)
+    return np.array([-fx, -fy, 1.0])
+
+
+@dataclass
+class Commands:
+    """The six commands of section 3 at one instant: path point (x_d, y_d) [m], height h_CG [m] along the normal,
+    and the body angles q_xd, q_yd, q_zd [rad] of eq 4 (rotations about fixed Y, then X, then Z)."""
+
+    xd: float
+    yd: float
+    h: float
+    qx: float = 0.0
+    qy: float = 0.0
+    qz: float = 0.0
+
+
+def body_pose(cmd: Commands, terrain: Terrain) -> tuple[np.ndarray, np.ndarray]:
+    """Eqs 4-6: rotation :math:`R_{CG}^0 = R_y(q_{yd}) R_x(q_{xd}) R_z(q_{zd})` and CG position
+    :math:`d_{CG}^0 = [x_d, y_d, f(x_d, y_d)] + h_{CG}\\,n(x_d, y_d)` (world frame, m)."""
+    R = _ry(cmd.qy) @ _rx(cmd.qx) @ _rz(cmd.qz)
+    n = terrain.normal(cmd.xd, cmd.yd)
+    d = np.array([cmd.xd, cmd.yd, terrain.height(cmd.xd, cmd.yd)]) + cmd.h * n
+    return R, d
+
+
+def contact_frame(R_cg: np.ndarray, d_cg: np.ndarray, offset: np.ndarray, tag: str, beta: float,
+                  RT: float) -> tuple[np.ndarray, np.ndarray]:
+    """Eqs 7-11: rotation :math:`R_{3i}^0` and origin :math:`d_{3i}^0` of the contact frame of wheel ``tag``."""
+    R3 = R_cg @ _R2[tag] @ _rz(beta)
+    d3 = d_cg + R_cg @ offset + R3 @ np.array([0.0, _SIGN[tag] * RT, 0.0])
+    return R3, d3
+
+
+def wheel_constraints(R_cg, d_cg, offset, tag, beta, RT, terrain) -> np.ndarray:
+    """Eqs 12 and 14 of one wheel: :math:`C_i = d_{3i}(3) - f(d_{3i}(1), d_{3i}(2))` and
+    :math:`CC_i = [1\\,0\\,0] (R_{3i}^0)^T N` at the contact point."""
+    R3, d3 = contact_frame(R_cg, d_cg, offset, tag, beta, RT)
+    return np.array([d3[2] - terrain.height(d3[0], d3[1]), R3[:, 0] @ paper_normal(terrain, d3[0], d3[1])])
+
+
+def ik_residual(x: np.ndarray, R_cg, d_cg, p: dict, terrain: Terrain) -> np.ndarray:
+    """Eq 15: :math:`C = [C_{fr}, C_{fl}, C_r, CC_{fr}, CC_{fl}, CC_r]` for the unknowns of eq 16,
+    :math:`x = [\\beta_{fr}, \\beta_{fl}, \\beta_r, q_{fr}, q_{fl}, q_r]` (rad)."""
+    off = offsets(p)
+    out = np.empty(6)
+    for k, tag in enumerate(WHEELS):
+        RT = p["R_ru"] + radius_law(x[3 + k], p["w"])
+        out[[k, 3 + k]] = wheel_constraints(R_cg, d_cg, off[tag], tag, x[k], RT, terrain)
+    return out
+
+
+class MechanismRangeError(InputError):
+    """A command needs an adjustment angle outside the mechanism's range 0-180 deg."""
+
+
+def _needed_radius(R_cg, d_cg, p, terrain, tag, beta0: float) -> float:
+    """The radius R_T [m] wheel ``tag`` would need (eqs 12, 14 solved for (beta, R_T): always well posed)."""
+    off = offsets(p)[tag]
+    RT0 = float(d_cg[2] - terrain.height(*(d_cg + R_cg @ off)[:2]))
+    sol = root(lambda z: wheel_constraints(R_cg, d_cg, off, tag, z[0], z[1], terrain), [beta0, RT0],
+               method="hybr", options={"xtol": 1e-14})
+    return float(sol.x[1])
+
+
+def solve_ik(cmd: Commands, p: dict, terrain: Terrain, guess: np.ndarray | None = None,
+             tol: float = IK_TOL) -> tuple[np.ndarray, float, int]:
+    """Solve eq 15 for eq 16's unknowns by scipy's root finder (eq 24's Newton-Raphson, hybrid variant).
+
+    Args:
+        cmd: The six commands.
+        p: Parameters (w, Lx, Ly, L_reading, R_ru).
+        terrain: The surface of eq 2.
+        guess: Initial (beta_fr, beta_fl, beta_r, q_fr, q_fl, q_r) [rad]; default zeros and 120 deg.
+        tol: Required ||C|| (eq 24's error).
+
+    Returns:
+        ``(x, error, nfev)``: the solution (q in [0, pi]), ||C|| and the number of residual evaluations.
+
+    Raises:
+        MechanismRangeError: a wheel needs q outside 0-180 deg (names the wheel, the radius and the limit).
+        ConstraintError: no solution found.
+    """
+    R_cg, d_cg = body_pose(cmd, terrain)
+    x0 = np.array([0.0, 0.0, 0.0, _Q0, _Q0, _Q0]) if guess is None else np.array(guess, float)
+    f = partial(ik_residual, R_cg=R_cg, d_cg=d_cg, p=p, terrain=terrain)
+    sol = root(f, x0, method="hybr", options={"xtol": 1e-15})
+    x = sol.x.copy()
+    x[3:] = np.abs(x[3:])  # eq 1 is even in q: -q and q give the same radius
+    err = float(np.linalg.norm(f(x)))
+    lo, hi = q_range_radius(p)
+    for k, tag in enumerate(WHEELS):
+        if err > tol or not (0.0 <= x[3 + k] <= np.pi):
+            RT = _needed_radius(R_cg, d_cg, p, terrain, tag, x[k] if np.isfinite(x[k]) else 0.0)
+            if RT > hi + 1e-12:
+                raise MechanismRangeError(
+                    f"wheel {tag}: the commands need radius R_T = {RT:.4f} m, more than the {hi:.4f} m the mechanism "
+                    "gives at its limit q = 0 deg (adjustment range 0-180 deg)")
+            if RT < lo - 1e-12:
+                raise MechanismRangeError(
+                    f"wheel {tag}: the commands need radius R_T = {RT:.4f} m, less than the {lo:.4f} m the mechanism "
+                    "gives at its limit q = 180 deg (adjustment range 0-180 deg)")
+    if err > tol:
+        raise ConstraintError(f"inverse kinematics did not converge: ||C|| = {err:.3g} > {tol:g} ({sol.message})")
+    return x, err, int(sol.nfev)
+
+
+def euler_zyx(R: np.ndarray) -> tuple[float, float, float]:
+    """(yaw, pitch, roll) [rad] with :math:`R = R_z(yaw) R_y(pitch) R_x(roll)` (the floating root's convention)."""
+    return float(np.arctan2(R[1, 0], R[0, 0])), float(np.arcsin(-np.clip(R[2, 0], -1, 1))), float(
+        np.arctan2(R[2, 1], R[2, 2]))
+
+
+def model_configuration(robot: Robot, cmd: Commands, x: np.ndarray, spins: np.ndarray | None = None) -> np.ndarray:
+    """The model's natural coordinates for commands ``cmd`` and an IK solution ``x`` (eq 16).
+
+    The body pose comes from eqs 4-6 (converted to the root's Z-Y-X Euler angles), q_i from x and the radius
+    coordinates from the coupling law (eq 1). Wheel spin angles are ``spins`` (default 0; they do not change the
+    contact geometry of a round wheel).
+    """
+    R, d = body_pose(cmd, robot.terrain)
+    q = robot.neutral()
+    for label, value in zip(("x", "y", "z"), d):
+        q[robot.coordinate_index(label)] = value
+    for label, value in zip(("yaw", "pitch", "roll"), euler_zyx(R)):
+        q[robot.coordinate_index(label)] = value
+    for k, tag in enumerate(WHEELS):
+        q[robot.coordinate_index(f"q_{tag}")] = x[3 + k]
+        q[robot.coordinate_index(f"Rch_{tag}")] = radius_law(x[3 + k], robot.params["w"])
+        q[robot.coordinate_index(f"theta_{tag}")] = 0.0 if spins is None else spins[k]
+    return q
+
+
+# ------------------------------------------------------------------------------------------- missions (sec 7)
+@dataclass
+class Mission:
+    """A kinematic mission of section 7: a path (x_d, y_d)(t) with its velocity, h_CG and body angles.
+
+    Attributes:
+        name, description: Identification.
+        terrain: ``"rough"`` or ``"ramp"`` (the parameter values of :data:`SPEC` give the surface).
+        path: t -> (x_d, y_d, dx_d/dt, dy_d/dt) [m, m/s].
+        h: h_CG [m].
+        qx, qy: t -> q_xd, q_yd [rad] (body roll/pitch commands of eq 4).
+        t_end, dt: Simulation times (Table 1: 0-5 s, 0.01 s).
+    """
+
+    name: str
+    description: str
+    terrain: str
+    path: Callable[[float], tuple[float, float, float, float]]
+    h: float = 0.15
+    qx: Callable[[float], float] = lambda t: 0.0
+    qy: Callable[[float], float] = lambda t: 0.0
+    t_end: float = 5.0
+    dt: float = 0.01
+
+
+MISSIONS = {
+    "mission1": Mission(
+        "mission1", "sec 7 / Table 1: circle x_d = sin t, y_d = cos t on Z = sin(0.5(x+y))/15, h_CG = 0.15 m, "
+        "body level, 0-5 s step 0.01 s", "rough", lambda t: (np.sin(t), np.cos(t), np.cos(t), -np.sin(t))),
+    "mission2": Mission(
+        "mission2", "sec 7: body kept level on a ramp of slope 0.2 (rising towards -y), straight path along +x at "
+        "0.2 m/s (path and heading not printed: our choice), h_CG = 0.15 m, 0-5 s step 0.01 s", "ramp",
+        lambda t: (0.2 * t, 0.0, 0.2, 0.0)),
+}
+
+
+@dataclass
+class IKRun:
+    """Inverse kinematics along a mission (one row per time step).
+
+    Attributes:
+        t: Times [s]. beta, q: (N, 3) eq 16's unknowns per wheel (fr, fl, r) [rad]. RT: (N, 3) radii [m].
+        error: (N,) ||C|| (eq 24). yaw: (N,) q_zd [rad]. cg: (N, 3) CG position [m].
+        contacts: (N, 3, 3) contact points [m]. nfev: (N,) residual evaluations of the root finder.
+    """
+
+    mission: Mission
+    t: np.ndarray
+    beta: np.ndarray
+    q: np.ndarray
+    RT: np.ndarray
+    error: np.ndarray
+    yaw: np.ndarray
+    cg: np.ndarray
+    contacts: np.ndarray
+    nfev: np.ndarray
+    commands: list = field(default_factory=list)
+
+
+def mission_params(robot_params: dict, mission: Mission) -> dict:
+    """The parameters with the mission's terrain selected."""
+    return {**robot_params, "terrain": mission.terrain}
+
+
+def yaw_update(qz: float, path_angle_change: float, R_cg: np.ndarray, dqx: float, dqy: float) -> float:
+    """Eqs 18-23 over one step: :math:`\\Delta q_{zd} = (\\Delta q_{path} - R_{CG}^0(3,1{:}2)[\\Delta q_{xd},
+    \\Delta q_{yd}]) / R_{CG}^0(3,3)` (eq 22 times dt; q_path is the path tangent's direction, eq 18)."""
+    return qz + (path_angle_change - R_cg[2, :2] @ np.array([dqx, dqy])) / R_cg[2, 2]
+
+
+def run_mission(mission: Mission | str, params: dict | None = None, tol: float = IK_TOL) -> IKRun:
+    """Inverse kinematics at every step of a mission (the flowchart of Fig. 8).
+
+    Each step solves eq 15 by :func:`solve_ik` from the previous step's solution and updates q_zd by eqs 18-23.
+
+    Raises:
+        MechanismRangeError, ConstraintError: as :func:`solve_ik`, with the time of the failing step.
+    """
+    if isinstance(mission, str):
+        if mission not in MISSIONS:
+            raise InputError(f"unknown mission {mission!r}; expected one of {', '.join(MISSIONS)}")
+        mission = MISSIONS[mission]
+    base = {p.name: p.convert(p.default) for p in SPEC.parameters}
+    p = {**base, **(params or {}), "terrain": mission.terrain}
+    terrain = _terrain(p)
+    t = np.arange(0.0, mission.t_end + 0.5 * mission.dt, mission.dt)
+    n = len(t)
+    out = IKRun(mission, t, np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), np.zeros(n),
+                np.zeros((n, 3)), np.zeros((n, 3, 3)), np.zeros(n, int))
+    x_prev = None
+    x0, y0, vx, vy = mission.path(t[0])
+    path_angle = np.arctan2(vy, vx)
+    qz = path_angle
+    off = offsets(p)
+    for i, ti in enumerate(t):
+        xd, yd, vx, vy = mission.path(ti)
+        new_angle = np.arctan2(vy, vx)
+        if i > 0:
+            change = (new_angle - path_angle + np.pi) % (2 * np.pi) - np.pi
+            qx_prev, qy_prev = mission.qx(t[i - 1]), mission.qy(t[i - 1])
+            R_prev, _ = body_pose(Commands(xd, yd, mission.h, qx_prev, qy_prev, qz), terrain)
+            qz = yaw_update(qz, change, R_prev, mission.qx(ti) - qx_prev, mission.qy(ti) - qy_prev)
+        path_angle = new_angle
+        cmd = Commands(xd, yd, mission.h, mission.qx(ti), mission.qy(ti), qz)
+        try:
+            x, err, nfev = solve_ik(cmd, p, terrain, x_prev, tol)
+        except RobotDynError as exc:
+            raise type(exc)(f"{mission.name}, t = {ti:.2f} s: {exc}") from None
+        x_prev = x
+        R, d = body_pose(cmd, terrain)
+        out.beta[i], out.q[i], out.error[i], out.nfev[i], out.yaw[i], out.cg[i] = x[:3], x[3:], err, nfev, qz, d
+        out.RT[i] = p["R_ru"] + radius_law(x[3:], p["w"])
+        for k, tag in enumerate(WHEELS):
+            out.contacts[i, k] = contact_frame(R, d, off[tag], tag, x[k], out.RT[i, k])[1]
+        out.commands.append(cmd)
+    return out

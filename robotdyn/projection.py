@@ -56,7 +56,8 @@ class Projection:
         independent: Indices of :math:`\\nu` in :math:`v` (k,).
         dependent: The other indices.
         rows: Indices of the independent constraint rows used.
-        condition: Condition number of the dependent block :math:`A_d` (1 when there are no constraints).
+        condition: 1-norm condition number of the dependent block :math:`A_d` (1 without constraints).
+        Ad_inv: :math:`A_d^{-1}` (rows used x dependent), ``None`` without constraints.
     """
 
     S: np.ndarray
@@ -64,41 +65,65 @@ class Projection:
     dependent: np.ndarray
     rows: np.ndarray
     condition: float
-    _lu: tuple | None = None
+    Ad_inv: np.ndarray | None = None
 
     @property
     def mobility(self) -> int:
         """Number of independent velocities :math:`k = n - \\operatorname{rank} A`."""
         return int(self.S.shape[1])
 
-    def solve_dependent(self, rhs: np.ndarray) -> np.ndarray:
-        """:math:`A_d^{-1}` rhs (rhs indexed by the used rows)."""
-        if self._lu is None:
-            return np.zeros((0,) + rhs.shape[1:])
-        return scipy.linalg.lu_solve(self._lu, rhs)
-
     def Sdot(self, Adot: np.ndarray) -> np.ndarray:
         """:math:`\\dot S` (n, k) given :math:`\\dot A` (all rows) along the motion."""
         out = np.zeros_like(self.S)
         if self.rows.size:
-            out[self.dependent] = -self.solve_dependent(Adot[self.rows] @ self.S)
+            out[self.dependent] = -self.Ad_inv @ (Adot[self.rows] @ self.S)
         return out
 
     def offset(self, drift: np.ndarray) -> np.ndarray:
         """:math:`w` with :math:`A w = -\\text{drift}` and zero independent part (drift = :math:`\\dot A v`)."""
         w = np.zeros(self.S.shape[0])
         if self.rows.size:
-            w[self.dependent] = -self.solve_dependent(drift[self.rows])
+            w[self.dependent] = -self.Ad_inv @ drift[self.rows]
         return w
 
 
-def project(A: np.ndarray, independent: np.ndarray | None = None, names: list[str] | None = None) -> Projection:
+def _build(A, independent, dependent, rows, names) -> Projection:
+    n = A.shape[1]
+    S = np.zeros((n, n - rows.size))
+    S[independent, np.arange(independent.size)] = 1.0
+    if rows.size == 0:
+        return Projection(S, independent, dependent, rows, 1.0, None)
+    Ad = A[np.ix_(rows, dependent)]
+    try:
+        Ad_inv = np.linalg.inv(Ad)
+        cond = float(np.abs(Ad).sum(axis=0).max() * np.abs(Ad_inv).sum(axis=0).max())
+    except np.linalg.LinAlgError:
+        cond = float("inf")
+    if not np.isfinite(cond) or cond > MAX_CONDITION:
+        raise SingularConstraintError(
+            f"the dependent velocities ({', '.join(names[i] for i in dependent)}) cannot be solved from the "
+            f"independent ones here: constraint block singular (condition number {cond:.3g}); choose other "
+            "independent velocities or move away from this singular configuration",
+            condition=cond,
+        )
+    S[dependent] = -Ad_inv @ A[np.ix_(rows, independent)]
+    return Projection(S, independent, dependent, rows, cond, Ad_inv)
+
+
+def project(
+    A: np.ndarray,
+    independent: np.ndarray | None = None,
+    names: list[str] | None = None,
+    hint: Projection | None = None,
+) -> Projection:
     """Build :math:`S` for the constraint rows ``A`` and the given independent velocity indices.
 
     Args:
         A: Stacked constraint Jacobian (m, n).
         independent: Indices of the independent velocities; ``None`` chooses a well-conditioned set.
         names: Velocity names, used in error messages.
+        hint: A projection at a nearby state: its choice of independent rows is reused when it still spans the
+            row space (checked: :math:`\\|A S\\|` must vanish), which skips the rank-revealing QR.
 
     Raises:
         SingularConstraintError: The number of independent velocities does not match the mobility, or the
@@ -106,6 +131,14 @@ def project(A: np.ndarray, independent: np.ndarray | None = None, names: list[st
     """
     n = A.shape[1]
     names = names or [f"v{i}" for i in range(n)]
+    if hint is not None and (independent is None or np.array_equal(hint.independent, independent)):
+        try:
+            proj = _build(A, hint.independent, hint.dependent, hint.rows, names)
+        except SingularConstraintError:
+            proj = None
+        scale = max(1.0, float(np.abs(A).max())) if A.size else 1.0
+        if proj is not None and (A.size == 0 or np.abs(A @ proj.S).max() <= 1e-10 * scale):
+            return proj
     rows = independent_rows(A)
     if independent is None:
         independent = auto_independent(A)
@@ -116,19 +149,4 @@ def project(A: np.ndarray, independent: np.ndarray | None = None, names: list[st
             f"{independent.size} independent velocities chosen ({', '.join(names[i] for i in independent)}) but the "
             f"constraints leave {n - rows.size} (n = {n}, rank A = {rows.size}); expected exactly the mobility"
         )
-    S = np.zeros((n, n - rows.size))
-    S[independent, np.arange(independent.size)] = 1.0
-    if rows.size == 0:
-        return Projection(S, independent, dependent, rows, 1.0, None)
-    Ad = A[np.ix_(rows, dependent)]
-    cond = float(np.linalg.cond(Ad))
-    if not np.isfinite(cond) or cond > MAX_CONDITION:
-        raise SingularConstraintError(
-            f"the dependent velocities ({', '.join(names[i] for i in dependent)}) cannot be solved from the "
-            f"independent ones here: constraint block singular (condition number {cond:.3g}); choose other "
-            "independent velocities or move away from this singular configuration",
-            condition=cond,
-        )
-    lu = scipy.linalg.lu_factor(Ad)
-    S[dependent] = -scipy.linalg.lu_solve(lu, A[np.ix_(rows, independent)])
-    return Projection(S, independent, dependent, rows, cond, lu)
+    return _build(A, independent, dependent, rows, names)

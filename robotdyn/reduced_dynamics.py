@@ -70,7 +70,8 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     ind = robot.independent_indices if independent is None else independent
     kin0 = KinematicState(model, data, q, np.zeros(model.nv))
     rows0 = robot.constraint_rows(kin0)
-    proj = project(rows0.A, ind, robot.velocity_labels)
+    proj = project(rows0.A, ind, robot.velocity_labels, hint=robot._projection_hint)
+    robot._projection_hint = proj
     v = proj.S @ nu
     kin = kin0.with_velocity(v)
     rows = robot.constraint_rows(kin)

@@ -191,6 +191,7 @@ class Robot:
             kin = KinematicState(self.model, self.data, self.neutral(), np.zeros(self.model.nv))
             self.independent_indices = auto_independent(self.constraint_rows(kin).A)
         self.velocity_names = [self.velocity_labels[i] for i in self.independent_indices]
+        self._projection_hint = None  # the last projection, whose row choice the next one tries first
         self.operational = spec.operational.build(self.description) if spec.operational is not None else None
         if self.operational is not None:
             self.velocity_names = list(self.operational.names)

@@ -1,0 +1,224 @@
+"""Omnidirectional mobile robot on three active caster wheels (Chung, Yi, Kim, Han).
+
+Paper: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free dynamic modeling including wheel dynamics
+for an omni-directional mobile robot with three caster wheels" (``shared/papers/chung_yi_omni_caster_dynamics.txt``).
+Description: ``urdf/omni_caster.urdf.xacro`` (Fig. 2, Tables 1-2).
+
+Coordinates: (x, y, psi) of the platform centre C and heading (world, m and rad), the steering angles phi_i
+(platform relative to offset link i, eq 9-11: omega = eta_i' + phi_i') and the wheel angles theta_i.
+Minimal velocities: the platform twist in BODY axes, u' = (v_cx, v_cy, omega) of eq (2) -- eq (6)-(8) write v_c in
+the platform's unit vectors i, j -- through :mod:`robotdyn.operational_space`, so that the reduced inertia is the
+paper's operational-space inertia I_uu* (eq 48) and the reduced bias its u'^T P_uuu* u' (eq 49).
+Each wheel rolls without slipping (both tangential rows) and touches the floor; the 9 rows have rank 6 (the normal
+rows vanish on the plane) and the mobility is 3 (Grubler count of section 2).
+
+This module holds the parameters, a transcription of the paper's closed forms (eqs 12-17, 43, 48-52, 60, 61),
+kept apart from the model (which Pinocchio derives from the description), the trajectories of section 5 and the
+paper comparison.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..comparison import Comparison
+from ..errors import InputError, SingularConstraintError
+from ..operational_space import OperationalVelocities
+from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
+
+CHAINS = (1, 2, 3)
+NU_NAMES = ["v_cx", "v_cy", "omega"]
+
+SPEC = RobotSpec(
+    name="omni_caster",
+    title="Omnidirectional platform on three active caster wheels (Chung, Yi, Kim, Han)",
+    xacro="omni_caster.urdf.xacro",
+    root="planar",
+    paper="chung_yi_omni_caster_dynamics.txt",
+    parameters=[
+        Parameter("l", 0.173, "m", "distance A1A2 between the front steering axes (Table 1)"),
+        Parameter("a", 0.05, "m", "A1, A2 lie a behind C along -j (Table 1, eq 6-7)"),
+        Parameter("b", 0.1, "m", "distance C A3 and platform radius (Table 1, eq 8, 50)"),
+        Parameter("h", 0.045, "m", "height of the steering joint above the wheel centre (Table 1, eq 6)"),
+        Parameter("d", 0.025, "m", "caster offset, steering axis to wheel centre (Table 1)"),
+        Parameter("r", 0.025, "m", "wheel radius (Table 1)"),
+        Parameter("m_pl", 5.0, "kg", "platform mass (from the printed diag(5, 5, 0.025) = eq 50; Table 2 garbled)"),
+        Parameter("m_wheel", 0.5, "kg", "mass of each wheel (Table 2)"),
+        Parameter("I_wheel_axle", 1.5625e-4, "kg m^2", "wheel inertia about its axle (Table 2)"),
+        Parameter("I_wheel_diam", 0.7813e-4, "kg m^2", "wheel inertia about a diameter, incl. the vertical (Table 2)"),
+        Parameter("m_link", 0.025, "kg", "mass of each offset steering link (Table 2 as printed)"),
+        Parameter("p", 0.0125, "m", "wheel centre to link mass centre, towards A_i (eq 37; not printed: d/2)"),
+        Parameter("I_link_x", 8.438e-6, "kg m^2", "link central inertia about its x (A_i -> O_i) (Table 2)"),
+        Parameter("I_link_y", 11.042e-6, "kg m^2", "link central inertia about its y (axle direction) (Table 2)"),
+        Parameter("I_link_z", 2.604e-6, "kg m^2", "link central inertia about the vertical (Table 2)"),
+    ],
+    wheels=[Wheel(f"wheel_link_{i}", "r", name=f"wheel_{i}") for i in CHAINS],
+    motors=[MotorSpec(f"drive_{i}", f"wheel_{i}") for i in CHAINS] + [MotorSpec(f"steer_{i}", f"steer_{i}") for i in CHAINS],
+    labels={**{f"steer_{i}": f"phi{i}" for i in CHAINS}, **{f"wheel_{i}": f"theta{i}" for i in CHAINS}},
+    operational=OperationalVelocities("platform", ("vx", "vy", "wz"), "local", NU_NAMES),
+)
+
+NOC_INDEPENDENT = ["theta1", "theta2", "phi3"]
+"""The paper's independent joint set of the natural orthogonal complement, eq (A9)."""
+
+NO_WHEELS = {"m_wheel": 0.0, "I_wheel_axle": 0.0, "I_wheel_diam": 0.0, "m_link": 0.0, "I_link_x": 0.0,
+             "I_link_y": 0.0, "I_link_z": 0.0}
+"""Parameter overrides that switch the wheel dynamics off (wheels and offset links massless)."""
+
+
+def noc_spec() -> RobotSpec:
+    """The same robot with the paper's NOC minimal coordinates (theta1', theta2', phi3'), eq (A9)."""
+    return dataclasses.replace(SPEC, operational=None, independent=list(NOC_INDEPENDENT))
+
+
+def steering_configuration(robot: Robot, phi, psi: float = 0.0, x: float = 0.0, y: float = 0.0) -> np.ndarray:
+    """Natural coordinates with the given steering angles (phi1, phi2, phi3) [rad], wheel angles zero."""
+    phi = np.asarray(phi, float)
+    if phi.shape != (3,) or not np.all(np.isfinite(phi)):
+        raise InputError(f"steering angles {phi.tolist()}; expected 3 finite angles (phi1, phi2, phi3) in rad")
+    q = robot.neutral()
+    for label, value in (("x", x), ("y", y), ("psi", psi)):
+        q[robot.coordinate_index(label)] = value
+    for i in CHAINS:
+        q[robot.coordinate_index(f"phi{i}")] = phi[i - 1]
+    return q
+
+
+# ------------------------------------------------------------------------------------ paper transcription
+def _anchor(p: dict, i: int) -> tuple[float, float]:
+    """(x, y) components of the vector A_iC (eq 6-8) in platform axes."""
+    return {1: (p["l"] / 2, p["a"]), 2: (-p["l"] / 2, p["a"]), 3: (0.0, -p["b"])}[i]
+
+
+def paper_forward(p: dict, i: int, phi: float) -> np.ndarray:
+    """[iG_phi^u] of eq (12)-(14) as printed: u' = G (eta_i', theta_i', phi_i')."""
+    d, r, a, l, b = p["d"], p["r"], p["a"], p["l"], p["b"]
+    s, c = np.sin(phi), np.cos(phi)
+    if i == 1:
+        return np.array([[-d * s - a, r * c, -a], [-d * c + l / 2, -r * s, l / 2], [1.0, 0.0, 1.0]])
+    if i == 2:
+        return np.array([[-d * s - a, r * c, -a], [-d * c - l / 2, -r * s, -l / 2], [1.0, 0.0, 1.0]])
+    return np.array([[-d * s + b, r * c, b], [-d * c, -r * s, 0.0], [1.0, 0.0, 1.0]])
+
+
+def paper_inverse(p: dict, i: int, phi: float, corrected: bool = True) -> np.ndarray:
+    """[iG_u^phi] of eq (15)-(17): (eta_i', theta_i', phi_i') = G u'.
+
+    Args:
+        corrected: Apply the erratum of eq (16), entry (1, 3): the paper prints ``l/2 r cos phi2 - a r sin phi2``;
+            the inverse of eq (13) (and the model) give ``-l/2 r cos phi2 - a r sin phi2`` (the chain-2 mirror of
+            eq 15, l -> -l). ``False`` returns the matrix as printed.
+    """
+    d, r, a, l, b = p["d"], p["r"], p["a"], p["l"], p["b"]
+    s, c = np.sin(phi), np.cos(phi)
+    if i == 1:
+        G = [[-r * s, -r * c, l / 2 * r * c - a * r * s],
+             [d * c, -d * s, l / 2 * d * s + a * d * c],
+             [r * s, r * c, d * r + a * r * s - l / 2 * r * c]]
+    elif i == 2:
+        e13 = (-l / 2 * r * c - a * r * s) if corrected else (l / 2 * r * c - a * r * s)
+        G = [[-r * s, -r * c, e13],
+             [d * c, -d * s, -l / 2 * d * s + a * d * c],
+             [r * s, r * c, d * r + a * r * s + l / 2 * r * c]]
+    else:
+        G = [[-r * s, -r * c, b * r * s],
+             [d * c, -d * s, -b * d * c],
+             [r * s, r * c, d * r - b * r * s]]
+    return np.array(G) / (d * r)
+
+
+def paper_chain_inertia(p: dict) -> np.ndarray:
+    """[iI_phi_phi*] of eq (43): diag(m2 p^2 + I_z1 + I_z2, 3/2 m1 r^2 + m2 r^2, 0), (eta, theta, phi) order.
+
+    As printed, 3/2 m1 r^2 assumes the wheel's axle inertia is m1 r^2 / 2 (true of Table 2's values).
+    """
+    m1, m2, r = p["m_wheel"], p["m_link"], p["r"]
+    return np.diag([m2 * p["p"] ** 2 + p["I_wheel_diam"] + p["I_link_z"], 1.5 * m1 * r**2 + m2 * r**2, 0.0])
+
+
+def paper_platform_inertia(p: dict) -> np.ndarray:
+    """[pl I_uu*] of eq (50): diag(m_pl, m_pl, m_pl b^2 / 2)."""
+    return np.diag([p["m_pl"], p["m_pl"], 0.5 * p["m_pl"] * p["b"] ** 2])
+
+
+def paper_inertia(p: dict, phi) -> np.ndarray:
+    """I_uu* of eq (48) with (51): sum_i G_i^T I_phiphi G_i + pl I_uu*, G_i of eq (15)-(17) (corrected (16))."""
+    I = paper_chain_inertia(p)
+    out = paper_platform_inertia(p).copy()
+    for i in CHAINS:
+        G = paper_inverse(p, i, phi[i - 1])
+        out += G.T @ I @ G
+    return out
+
+
+def _dforward_dphi(p: dict, i: int, phi: float) -> np.ndarray:
+    """d[iG_phi^u]/d phi_i (the only non-zero plane of the Hessian [iH_phiphi^u], eq 18 and A.1)."""
+    d, r = p["d"], p["r"]
+    s, c = np.sin(phi), np.cos(phi)
+    return np.array([[-d * c, -r * s, 0.0], [d * s, -r * c, 0.0], [0.0, 0.0, 0.0]])
+
+
+def paper_bias(p: dict, phi, nu, platform_terms: bool = True) -> np.ndarray:
+    """u'^T P_uuu* u' of eq (49) with P_phiphiphi* = 0 (eq 43 is constant), [iH_uu^phi] of eq (19).
+
+    The paper does not print the platform's [pl P_uuu*]; with ``platform_terms`` it is taken as the Newton-Euler
+    terms of a rigid body in body axes, m_pl (-omega v_cy, omega v_cx, 0) (our reading, see the errata).
+    """
+    phi = np.asarray(phi, float)
+    nu = np.asarray(nu, float)
+    I = paper_chain_inertia(p)
+    out = np.zeros(3)
+    for i in CHAINS:
+        Gu = paper_inverse(p, i, phi[i - 1])
+        H = np.zeros((3, 3, 3))  # H[m, j, k] = d G_phi^u[m, j] / d phi_k, joint order (eta, theta, phi)
+        H[:, :, 2] = _dforward_dphi(p, i, phi[i - 1])
+        Hphi = -np.einsum("nm,mjk,ja,kb->nab", Gu, H, Gu, Gu)  # eq (19)
+        phidd = np.einsum("nab,a,b->n", Hphi, nu, nu)  # joint accelerations at u'' = 0
+        out += Gu.T @ I @ phidd
+    if platform_terms:
+        vx, vy, w = nu
+        out += p["m_pl"] * np.array([-w * vy, w * vx, 0.0])
+    return out
+
+
+def offset_link_correction(p: dict, phi, nu) -> np.ndarray:
+    """What eq (43)'s "P_phiphiphi* = 0" leaves out when the link's mass centre is off the wheel axis (p != 0).
+
+    Derived here (see the errata): with e the unit vector A_i -> O_i, the link's mass centre moves at
+    v = r theta' e - p eta' (k x e), so its inertia forces on (eta, theta) are m2 (p^2 eta'' - p r theta' eta',
+    r^2 theta'' + r p eta'^2); the velocity products are missing from eq (43)-(49). Returns sum_i G_i^T of them.
+    """
+    out = np.zeros(3)
+    m2, pp, r = p["m_link"], p["p"], p["r"]
+    for i in CHAINS:
+        Gu = paper_inverse(p, i, phi[i - 1])
+        eta_d, theta_d, _ = Gu @ np.asarray(nu, float)
+        out += Gu.T @ np.array([-m2 * pp * r * theta_d * eta_d, m2 * r * pp * eta_d**2, 0.0])
+    return out
+
+
+def paper_impulse(I_uu: np.ndarray, n, u_dot, e: float) -> float:
+    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.impulse)."""
+    n = np.asarray(n, float)
+    return float(-(1 + e) * np.dot(u_dot, n) / (n @ np.linalg.inv(I_uu) @ n))
+
+
+# ------------------------------------------------------------------------------------------ the model side
+def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
+    """[iG_u^phi] from the model: (eta_i', theta_i', phi_i') per unit platform twist, columns (v_cx, v_cy, omega).
+
+    eta_i' is the offset link's absolute yaw rate (its frame Jacobian), theta_i', phi_i' the joint rates; all from
+    S of the operational projection (the model's constraint Jacobians).
+    """
+    from ..constraint import KinematicState
+
+    red = robot.reduced(q, np.zeros(3))
+    kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
+    out = {}
+    for i in CHAINS:
+        _, jac, _ = kin.frame(robot.description.frame_id(f"link_{i}"))
+        eta = jac[5] @ red.S
+        out[i] = np.vstack([eta, red.S[robot.coordinate_index(f"theta{i}")], red.S[robot.coordinate_index(f"phi{i}")]])
+    return out

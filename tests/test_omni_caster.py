@@ -1,0 +1,157 @@
+"""Omni caster robot (Chung, Yi, Kim, Han): model from the URDF vs independent references.
+
+References: the paper's closed forms transcribed in robotdyn.robots.omni_caster (eqs 12-17, 43, 48-51, 60), a
+derivation of the offset link's missing velocity terms, A S = 0, finite differences and energy balance.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robotdyn.errors import InputError, RobotDynError, SingularConstraintError
+from robotdyn.robot import Robot
+from robotdyn.robots import omni_caster as oc
+
+TOL = 1e-10
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return Robot(oc.SPEC)
+
+
+@pytest.fixture(scope="module")
+def bare():
+    return Robot(oc.SPEC, dict(oc.NO_WHEELS))
+
+
+def _states(n, seed):
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        phi = rng.uniform(-np.pi, np.pi, 3)
+        pose = rng.uniform(-5, 5, 3)
+        yield phi, pose, rng.normal(size=3)
+
+
+def _q(robot, phi, pose):
+    return oc.steering_configuration(robot, phi, psi=pose[2], x=pose[0], y=pose[1])
+
+
+# ------------------------------------------------------------------------------------------ priority 1
+def test_loads_with_mobility_three(robot):
+    assert robot.mobility == 3
+    assert robot.velocity_names == ["v_cx", "v_cy", "omega"]
+    assert sorted(robot.coordinates) == sorted(["x", "y", "psi", "phi1", "phi2", "phi3", "theta1", "theta2", "theta3"])
+    q = robot.neutral()
+    robot.check_constraints(q, tol=1e-12)
+    red = robot.reduced(q, np.zeros(3))
+    assert red.projection.rows.size == 6  # 9 rows of rank 6: the three normal rows vanish on the plane
+    assert np.linalg.matrix_rank(red.rows.A, tol=1e-9) == 6
+
+
+def test_AS_zero_and_outputs_identity(robot):
+    import pinocchio as pin
+
+    fid = robot.description.frame_id("platform")
+    for phi, pose, nu in _states(50, 1):
+        q = _q(robot, phi, pose)
+        red = robot.reduced(q, nu)
+        assert np.abs(red.rows.A @ red.S).max() < 1e-13
+        pin.computeJointJacobians(robot.model, robot.data, q)
+        pin.updateFramePlacements(robot.model, robot.data)
+        J = pin.getFrameJacobian(robot.model, robot.data, fid, pin.ReferenceFrame.LOCAL)[[0, 1, 5]]
+        np.testing.assert_allclose(J @ red.S, np.eye(3), atol=1e-13)
+        # body axes: the world velocity of C is R(psi) (v_cx, v_cy)
+        v = red.v
+        ix, iy = robot.coordinate_index("x"), robot.coordinate_index("y")
+        c, s = np.cos(pose[2]), np.sin(pose[2])
+        np.testing.assert_allclose([v[ix], v[iy]], [c * nu[0] - s * nu[1], s * nu[0] + c * nu[1]], atol=1e-13)
+
+
+def test_inertia_matches_eq48_at_200_configurations(robot):
+    worst = 0.0
+    for phi, pose, _ in _states(200, 2):
+        M = robot.reduced(_q(robot, phi, pose), np.zeros(3)).M
+        worst = max(worst, np.abs(M - oc.paper_inertia(robot.params, phi)).max())
+    assert worst < TOL
+
+
+def test_no_wheel_inertia_is_platform_diag(bare):
+    p = bare.params
+    expected = np.diag([p["m_pl"], p["m_pl"], p["m_pl"] * p["b"] ** 2 / 2])
+    np.testing.assert_allclose(expected, np.diag([5.0, 5.0, 0.025]))  # the paper's printed no-wheel matrix
+    for phi, pose, _ in _states(200, 3):
+        M = bare.reduced(_q(bare, phi, pose), np.zeros(3)).M
+        assert np.abs(M - expected).max() < TOL
+
+
+def test_printed_with_wheel_matrix_not_reachable_with_table_parameters(robot):
+    # trace of the translational block is independent of the steering angles (a sum of cos^2 + sin^2 per chain)
+    traces = [np.trace(robot.reduced(_q(robot, phi, pose), np.zeros(3)).M[:2, :2]) for phi, pose, _ in _states(20, 4)]
+    assert np.ptp(traces) < 1e-10
+    printed = 5.4329 + 7.5379
+    assert abs(traces[0] - printed) > 0.2  # 12.731 vs 12.971: no steering configuration reproduces it
+
+
+def test_wrong_nu_length_is_an_error(robot):
+    with pytest.raises(InputError):
+        robot.reduced(robot.neutral(), np.zeros(2))
+    with pytest.raises(RobotDynError):
+        robot.check_nu([1, 2])
+
+
+# ------------------------------------------------------------------------------------------ priority 2
+def test_kinematic_matrices_eq12_to_17(robot):
+    p = robot.params
+    worst_inv, worst_fwd, printed16 = 0.0, 0.0, []
+    for phi, pose, _ in _states(50, 5):
+        G = oc.model_chain_jacobians(robot, _q(robot, phi, pose))
+        for i in oc.CHAINS:
+            worst_inv = max(worst_inv, np.abs(G[i] - oc.paper_inverse(p, i, phi[i - 1])).max())
+            worst_fwd = max(worst_fwd, np.abs(np.linalg.inv(G[i]) - oc.paper_forward(p, i, phi[i - 1])).max())
+        diff = np.abs(G[2] - oc.paper_inverse(p, 2, phi[1], corrected=False))
+        printed16.append(diff)
+    assert worst_inv < 1e-9  # entries are O(1/r) = 40: relative 1e-11
+    assert worst_fwd < TOL
+    # eq (16) as printed differs in entry (1, 3) only, by l r cos(phi2) / (d r) = l cos(phi2) / d
+    d = np.array(printed16)
+    mask = np.zeros((3, 3), bool)
+    mask[0, 2] = True
+    assert d[:, ~mask].max() < 1e-9
+    assert d[:, 0, 2].max() > 1.0
+
+
+def test_bias_matches_eq49_plus_offset_link_terms(robot):
+    worst = 0.0
+    for phi, pose, nu in _states(100, 6):
+        h = robot.reduced(_q(robot, phi, pose), nu).h
+        ref = oc.paper_bias(robot.params, phi, nu) + oc.offset_link_correction(robot.params, phi, nu)
+        worst = max(worst, np.abs(h - ref).max())
+    assert worst < TOL
+
+
+def test_bias_matches_eq49_exactly_when_link_mass_centre_on_wheel_axis():
+    robot = Robot(oc.SPEC, {"p": 0.0})
+    for phi, pose, nu in _states(50, 7):
+        h = robot.reduced(_q(robot, phi, pose), nu).h
+        assert np.abs(h - oc.paper_bias(robot.params, phi, nu)).max() < TOL
+    # and with the default p the omitted terms are not negligible
+    robot = Robot(oc.SPEC)
+    phi, pose, nu = next(_states(1, 8))
+    h = robot.reduced(_q(robot, phi, pose), nu).h
+    assert np.abs(h - oc.paper_bias(robot.params, phi, nu)).max() > 1e-4
+
+
+def test_reduced_coriolis_consistent(robot):
+    eps = 1e-6
+    for phi, pose, nu in _states(20, 9):
+        q = _q(robot, phi, pose)
+        red = robot.reduced(q, nu, coriolis=True)
+        np.testing.assert_allclose(red.C @ nu, red.h - red.g, atol=1e-12)
+        qdot = red.v
+        Mdot = (robot.reduced(q + eps * qdot, nu).M - robot.reduced(q - eps * qdot, nu).M) / (2 * eps)
+        N = Mdot - 2 * red.C
+        # central differences of M_r = S^T M S with |S| ~ 1e3 (wheel rates per unit omega): noise ~1e-7
+        np.testing.assert_allclose(N + N.T, 0.0, atol=5e-6)
+        assert np.abs(N).max() > 1e-3  # not trivially zero

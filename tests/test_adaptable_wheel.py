@@ -137,3 +137,112 @@ def test_mass_matrix_spd(robot):
     red = robot.reduced(q, np.ones(robot.mobility))
     np.testing.assert_allclose(red.M, red.M.T, atol=1e-12)
     assert np.linalg.eigvalsh(red.M).min() > 0
+
+
+# --------------------------------------------------------------------------------------- inverse kinematics
+@pytest.mark.parametrize("name", ["mission1", "mission2"])
+def test_ik_converges_every_step(name, request, robot):
+    run = request.getfixturevalue(name)
+    assert len(run.t) == 501 and run.t[-1] == pytest.approx(5.0)
+    assert run.error.max() <= 1e-10
+    assert np.all((run.q >= 0) & (run.q <= np.pi))
+    # independent check: the core rolling contact (u = projected normal, p = c - R u) at the model configuration
+    r = Robot(aw.SPEC, {"terrain": run.mission.terrain})
+    worst = 0.0
+    for i in range(0, len(run.t), 5):
+        q = aw.model_configuration(r, run.commands[i], np.concatenate([run.beta[i], run.q[i]]))
+        worst = max(worst, np.max(np.abs(r.constraint_residual(q))))
+    assert worst < 1e-10
+
+
+def test_ik_yaw_follows_path_tangent(mission1):
+    """Eqs 18-23 with the body level: q_zd = direction of the path tangent of x = sin t, y = cos t, i.e. -t."""
+    np.testing.assert_allclose(mission1.yaw, -mission1.t, atol=1e-12)
+    # the CG is h_CG above the path point along the normal (eq 6)
+    from robotdyn.terrain import SineTerrain
+    terrain = SineTerrain(1 / 15, 0.5, 0.5)
+    for i in (0, 123, 400):
+        x, y = np.sin(mission1.t[i]), np.cos(mission1.t[i])
+        ground = np.array([x, y, np.sin(0.5 * (x + y)) / 15])
+        np.testing.assert_allclose(np.linalg.norm(mission1.cg[i] - ground), 0.15, atol=1e-14)
+
+
+def test_ik_mission2_constant_on_ramp(mission2):
+    """On a plane, moving along the level direction with the body level, the solution is the same at every step
+    and the radii follow the ramp: R_T = centre height - ground height under the (vertical) wheel."""
+    np.testing.assert_allclose(mission2.q, np.broadcast_to(mission2.q[0], mission2.q.shape), atol=1e-9)
+    n = np.array([0.0, 0.2, 1.0]) / np.sqrt(1.04)
+    cg = 0.15 * n  # path point at the origin, ramp z = -0.2 y
+    for k, yk in enumerate((-0.6, 0.6, 0.0)):
+        expected = cg[2] - (-0.2 * (cg[1] + yk))
+        assert mission2.RT[0, k] == pytest.approx(expected, abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    "cmd, wheel, limit",
+    [
+        (aw.Commands(0, 0, 0.2, 0, 0.15, 0), "wheel r", "q = 0 deg"),
+        (aw.Commands(0, 0, 0.2, 0.3, 0, 0), "wheel fl", "q = 0 deg"),
+        (aw.Commands(0, 0, 0.01), "wheel fr", "q = 180 deg"),
+    ],
+)
+def test_ik_out_of_range_names_wheel_and_limit(cmd, wheel, limit, robot):
+    from robotdyn.terrain import FlatTerrain
+    with pytest.raises(aw.MechanismRangeError) as exc:
+        aw.solve_ik(cmd, robot.params, FlatTerrain())
+    msg = str(exc.value)
+    assert wheel in msg and limit in msg and "0-180 deg" in msg and "\n" not in msg
+    assert isinstance(exc.value, RobotDynError)
+
+
+def test_ik_mission_out_of_range_reports_time():
+    with pytest.raises(aw.MechanismRangeError, match=r"mission1, t = 0.00 s: wheel \w+: .*0-180 deg"):
+        aw.run_mission("mission1", {"w": 0.1})
+
+
+# ------------------------------------------------------------------------------------------------ statics
+def test_statics_flat_lever_rule(robot):
+    """Flat ground, level body: the CG is midway between the front axle and the rear wheel, so the rear wheel
+    carries m g / 2 and each front wheel m g / 4 (not the m g / 3 of eq 35); no friction is needed."""
+    from robotdyn.terrain import FlatTerrain
+    p = robot.params
+    cmd = aw.Commands(0.0, 0.0, 0.15)
+    x, _, _ = aw.solve_ik(cmd, p, FlatTerrain())
+    res = aw.static_torques(cmd, x, p, FlatTerrain())
+    mg = 10 * 9.81
+    np.testing.assert_allclose(res.normal, [mg / 4, mg / 4, mg / 2], atol=1e-10)
+    np.testing.assert_allclose(res.friction, 0.0, atol=1e-10)
+    # eq 34 with the equal-share load of eq 35 gives eq 35 exactly
+    share = -0.5 * (mg / 3) * 0.3 * np.sin(x[3:] / 2) * np.cos(np.pi / 6)
+    np.testing.assert_allclose(aw.paper_torque_eq35(x[3:], p), share, rtol=1e-14)
+
+
+@pytest.mark.parametrize("name", ["mission1", "mission2"])
+def test_statics_equilibrium_cone_and_virtual_work(name, request):
+    run = request.getfixturevalue(name)
+    r = Robot(aw.SPEC, {"terrain": run.mission.terrain})
+    for i in (0, 77, 250, 500):
+        x = np.concatenate([run.beta[i], run.q[i]])
+        res = aw.static_torques(run.commands[i], x, r.params, r.terrain)
+        assert res.equilibrium < 1e-9
+        assert np.all(res.normal > 0) and np.all(res.ratio <= 1 + 1e-9)
+        # total force and moment about the CG, recomputed here
+        np.testing.assert_allclose(res.forces.sum(0), [0, 0, 98.1], atol=1e-9)
+        np.testing.assert_allclose(np.cross(res.contacts - run.cg[i], res.forces).sum(0), 0, atol=1e-9)
+        chk = aw.model_static_check(r, run.commands[i], x, res)
+        assert chk["residual"] < 1e-9  # the whole model is in equilibrium with these forces and torques
+        np.testing.assert_allclose(chk["tau_adjust"], res.torque, atol=1e-9)  # eq 34 = model
+        np.testing.assert_allclose(chk["tau_fd"], res.torque, atol=1e-6)  # eq 34 = finite-difference work
+
+
+def test_statics_friction_cone_enforced():
+    """A steep ramp with little friction: the KKT minimum leaves the cone, the optimiser must respect it or fail
+    with a one-line error."""
+    from robotdyn.statics import solve_contact_forces
+    pts = np.array([[0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.0, 0.0]])
+    n = np.array([0.0, -0.3, 1.0]) / np.sqrt(1.09)
+    nrm = np.tile(n, (3, 1))
+    ok = solve_contact_forces(pts, nrm, [0, 0, 98.1], [0, 0, 0], [0, 0, 0.2], mu=0.5)
+    assert np.all(ok.ratio <= 1 + 1e-9) and ok.equilibrium < 1e-9
+    with pytest.raises(RobotDynError, match="friction cones"):
+        solve_contact_forces(pts, nrm, [0, 0, 98.1], [0, 0, 0], [0, 0, 0.2], mu=0.2)

@@ -30,7 +30,9 @@ import numpy as np
 import pinocchio as pin
 from scipy.optimize import root
 
+from ..actuation import input_matrix
 from ..comparison import Comparison
+from ..constraint import KinematicState
 from ..errors import ConstraintError, InputError, RobotDynError
 from ..joint_coupling import JointCoupling
 from ..robot import MotorSpec, Parameter, Robot, RobotSpec
@@ -416,3 +418,129 @@ def run_mission(mission: Mission | str, params: dict | None = None, tol: float =
             out.contacts[i, k] = contact_frame(R, d, off[tag], tag, x[k], out.RT[i, k])[1]
         out.commands.append(cmd)
     return out
+
+
+# ------------------------------------------------------------------------------------------ statics (sec 5)
+def paper_torque_eq35(q, p: dict):
+    """Eq 35 as printed: :math:`t_i = -0.5\\,m g w \\sin(q_i/2)\\cos(\\pi/6) / 3` [N m] (flat-ground worst case)."""
+    return -0.5 * p["m"] * p["g"] * p["w"] * np.sin(0.5 * np.asarray(q)) * COS30 / 3.0
+
+
+@dataclass
+class StaticResult:
+    """Statics of one configuration by eqs 25-34.
+
+    Attributes:
+        torque: (3,) adjustment-motor torques t_i of eq 34 [N m] (fr, fl, r; the model's sign: q_i positive
+            shrinks the wheel, so holding the weight needs t_i < 0 like eq 35).
+        forces: (3, 3) contact forces on the robot, world frame [N] (eq 25).
+        along_u: (3,) :math:`F_i^{3i}(2)`, read as the component along the contact-to-centre line [N].
+        normal, friction, ratio: eq 27-30 quantities per wheel [N, N, -].
+        contacts, normals: (3, 3) contact points [m] and unit normals.
+        equilibrium: Residual of eq 25.
+        method: How the forces were found (``kkt`` closed form or ``slsqp``).
+    """
+
+    torque: np.ndarray
+    forces: np.ndarray
+    along_u: np.ndarray
+    normal: np.ndarray
+    friction: np.ndarray
+    ratio: np.ndarray
+    contacts: np.ndarray
+    normals: np.ndarray
+    equilibrium: float
+    method: str
+
+
+def static_torques(cmd: Commands, x: np.ndarray, p: dict, terrain: Terrain,
+                   extra_force=None, extra_moment=None, objective: str = "friction") -> StaticResult:
+    """Eqs 25-34 at an IK solution: contact forces by constrained optimisation, then virtual work.
+
+    The contacts must carry the weight m g acting at the CG (eq 25, read with the forces acting on the robot:
+    :math:`\\sum F_i = (0, 0, mg)`, :math:`\\sum V_{CG}^i \\times F_i = 0`), plus an optional extra wrench about
+    the CG (kinetostatics: minus the inertial forces). The free components are fixed by minimising the friction
+    forces subject to :math:`F_i\\cdot n_i \\ge 0` (eq 28) and :math:`|F_t| \\le \\mu F_n` (eq 30); then
+    eq 31 and eq 34, :math:`t_i = -0.5 F_i^{3i}(2)\\, w \\sin(q_i/2)\\cos(\\pi/6)`.
+    """
+    R_cg, d_cg = body_pose(cmd, terrain)
+    off = offsets(p)
+    pts, nrm, us = np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3))
+    for k, tag in enumerate(WHEELS):
+        RT = p["R_ru"] + radius_law(x[3 + k], p["w"])
+        R3, d3 = contact_frame(R_cg, d_cg, off[tag], tag, x[k], RT)
+        pts[k], nrm[k] = d3, terrain.normal(d3[0], d3[1])
+        us[k] = -_SIGN[tag] * R3[:, 1]  # eq 11: the centre is at -/+ R_T Y_3 from the contact point
+    force = np.array([0.0, 0.0, p["m"] * p["g"]])
+    moment = np.zeros(3)
+    if extra_force is not None:
+        force = force + np.asarray(extra_force, float)
+    if extra_moment is not None:
+        moment = moment + np.asarray(extra_moment, float)
+    cf = solve_contact_forces(pts, nrm, force, moment, d_cg, p["mu"], objective)
+    along = np.einsum("ij,ij->i", cf.forces, us)  # eq 31, second component (contact -> centre)
+    torque = along * radius_law_d(x[3:], p["w"])  # eq 34 (= eq 32 with eq 33)
+    return StaticResult(torque, cf.forces, along, cf.normal, cf.friction, cf.ratio, pts, nrm, cf.equilibrium,
+                        cf.method)
+
+
+def model_static_check(robot: Robot, cmd: Commands, x: np.ndarray, res: StaticResult) -> dict:
+    """Check eqs 25-34 against the Pinocchio model at the same configuration (independent of eq 34).
+
+    1. Generalised equilibrium of the whole model: :math:`g(q) = B\\tau + \\sum_i A_{w,i}^T F_i +
+       A_{eq1}^T\\mu` solved for the six motor torques and the three coupling forces, with :math:`A_{w,i}` the
+       world rows of wheel i's rolling contact (its material contact point's velocity, radius rate included).
+       The residual tests the contact forces against the model's gravity; the adjustment torques must equal
+       eq 34's.
+    2. Virtual work by finite differences: :math:`t_i = -F_i\\cdot\\partial p_i/\\partial q_i`, where
+       :math:`p_i(q_i)` is the material rim point at the contact (wheel-fixed direction), computed from the
+       model's kinematics with the radius coordinate set by the coupling, at :math:`q_i \\pm \\varepsilon`.
+
+    Returns:
+        dict with ``tau`` (6, model order of motors), ``residual``, ``tau_fd`` (3,).
+    """
+    if robot.params["lateral"] != "rolling":
+        raise InputError("model_static_check needs the rolling wheels (lateral=rolling)")
+    q = model_configuration(robot, cmd, x)
+    nv = robot.nq
+    kin = KinematicState(robot.model, robot.data, q, np.zeros(nv))
+    g = pin.computeGeneralizedGravity(robot.model, robot.data, q)
+    load = np.zeros(nv)
+    couplings, wheels = [], {}
+    for c in robot.constraints:
+        if isinstance(c, JointCoupling):
+            couplings.append(c.rows(kin).A[0])
+        else:
+            geo = c.contact(kin)
+            rows = c.rows(kin)
+            Aw = geo["E"] @ rows.A  # world rows (E orthonormal: rows = E^T A_w)
+            wheels[c.name] = (geo, Aw)
+    for k, tag in enumerate(WHEELS):
+        load += wheels[tag][1].T @ res.forces[k]
+    B = input_matrix(robot.motors, kin)
+    K = np.column_stack([B, np.array(couplings).T])
+    sol, *_ = np.linalg.lstsq(K, g - load, rcond=None)
+    residual = float(np.linalg.norm(K @ sol - (g - load)))
+    tau = sol[: B.shape[1]]
+    # virtual work by finite differences on the model's kinematics
+    eps = 1e-6
+    tau_fd = np.zeros(3)
+    coupling = {c.driver: c for c in robot.constraints if isinstance(c, JointCoupling)}
+    for k, tag in enumerate(WHEELS):
+        geo = wheels[tag][0]
+        u = geo["u"]
+        c_join = coupling[f"adjust_{tag}_joint"]
+        frame = robot.model.getFrameId(f"wheel_{tag}")
+
+        def rim_point(dq):
+            qq = q.copy()
+            qq[robot.coordinate_index(f"q_{tag}")] += dq
+            qq = c_join.solve_driven(qq)
+            pin.forwardKinematics(robot.model, robot.data, qq)
+            centre = pin.updateFramePlacement(robot.model, robot.data, frame).translation
+            return centre - (robot.params["R_ru"] + qq[robot.coordinate_index(f"Rch_{tag}")]) * u
+
+        tau_fd[k] = -res.forces[k] @ (rim_point(eps) - rim_point(-eps)) / (2 * eps)
+    names = [m.name for m in robot.motors]
+    return {"tau": dict(zip(names, tau)), "residual": residual, "tau_fd": tau_fd,
+            "tau_adjust": np.array([tau[names.index(f"adjust_{t}")] for t in WHEELS])}

@@ -155,3 +155,72 @@ def test_reduced_coriolis_consistent(robot):
         # central differences of M_r = S^T M S with |S| ~ 1e3 (wheel rates per unit omega): noise ~1e-7
         np.testing.assert_allclose(N + N.T, 0.0, atol=5e-6)
         assert np.abs(N).max() > 1e-3  # not trivially zero
+
+
+# ------------------------------------------------------------------------------------------ priority 3
+@pytest.fixture(scope="module")
+def noc():
+    return Robot(oc.noc_spec())
+
+
+def test_noc_singular_at_fig16_configuration(robot, noc):
+    phi = [0.0, 0.0, 0.0]  # Fig. 16: theta1' and theta2' rows coincide (both links along i, A1 and A2 at y = -a)
+    assert abs(np.linalg.det(oc.paper_noc_jacobians(robot.params, phi)[0])) < 1e-15
+    with pytest.raises(SingularConstraintError) as err:
+        noc.reduced(oc.steering_configuration(noc, phi), np.zeros(3))
+    assert "singular" in str(err.value) and "\n" not in str(err.value)
+    rep = oc.noc_report(robot, noc, phi)
+    assert rep["noc_M"] is None and rep["noc_error"]
+    assert np.all(np.isfinite(rep["op_M"])) and rep["op_condition"] < 1e3
+    np.testing.assert_allclose(rep["op_M"], oc.paper_inertia(robot.params, phi), atol=TOL)
+
+
+def test_noc_inertia_blows_up_near_singularity_operational_stays_finite(robot, noc):
+    p = robot.params
+    prev = None
+    for eps in (1e-1, 1e-2, 1e-3, 1e-4):
+        rep = oc.noc_report(robot, noc, [eps, 0.0, 0.0])
+        K = oc.paper_noc_map(p, [eps, 0.0, 0.0])
+        Kinv = np.linalg.inv(K)
+        ref = Kinv.T @ rep["op_M"] @ Kinv  # same kinetic energy in the NOC velocities
+        assert np.abs(rep["noc_M"] - ref).max() < 1e-9 * np.abs(ref).max()
+        big = np.abs(rep["noc_M"]).max()
+        if prev is not None:
+            assert 50 < big / prev < 200  # ~1/eps^2
+        prev = big
+        assert rep["op_condition"] < 1e3
+
+
+def test_noc_singular_set_matches_paper_det_Jp(robot, noc):
+    from scipy.optimize import brentq
+
+    rng = np.random.default_rng(11)
+    p = robot.params
+    found = 0
+    while found < 5:
+        phi12 = rng.uniform(-np.pi, np.pi, 2)
+        f = lambda t: np.linalg.det(oc.paper_noc_map(p, [*phi12, t]))
+        grid = np.linspace(-np.pi, np.pi, 73)
+        vals = [f(t) for t in grid]
+        for t0, t1, f0, f1 in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
+            if f0 * f1 < 0:
+                t = brentq(f, t0, t1, xtol=1e-15)
+                phi = [*phi12, t]
+                assert abs(np.linalg.det(oc.paper_noc_jacobians(p, phi)[0])) < 1e-12
+                with pytest.raises(SingularConstraintError):
+                    noc.reduced(oc.steering_configuration(noc, phi), np.zeros(3))
+                rep = oc.noc_report(robot, noc, [*phi12, t + 0.2])  # away from it: both fine
+                assert rep["noc_M"] is not None
+                found += 1
+                break
+
+
+def test_noc_dependent_rates_satisfy_eq_A7(robot):
+    p = robot.params
+    for phi, pose, nu in _states(20, 12):
+        Jp, Ja = oc.paper_noc_jacobians(p, phi)
+        G = oc.model_chain_jacobians(robot, _q(robot, phi, pose))
+        rates = {i: G[i] @ nu for i in oc.CHAINS}
+        dep = np.array([rates[1][0], rates[1][2], rates[2][0], rates[2][2], rates[3][0], rates[3][1]])
+        ind = np.array([rates[1][1], rates[2][1], rates[3][2]])
+        assert np.abs(Jp @ dep - Ja @ ind).max() < 1e-9

@@ -222,3 +222,45 @@ def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
         eta = jac[5] @ red.S
         out[i] = np.vstack([eta, red.S[robot.coordinate_index(f"theta{i}")], red.S[robot.coordinate_index(f"phi{i}")]])
     return out
+
+
+# ------------------------------------------------------------------------------- NOC singularity (sec 3.1)
+def paper_noc_jacobians(p: dict, phi) -> tuple[np.ndarray, np.ndarray]:
+    """J_p (6x6) and J_a (6x3) of eq (A7)-(A8) from the columns ig_j of eq (12)-(14).
+
+    Dependent rates (eta1', phi1', eta2', phi2', eta3', theta3'), independent (theta1', theta2', phi3'), eq (A9).
+    """
+    g = {i: paper_forward(p, i, phi[i - 1]) for i in CHAINS}
+    z = np.zeros(3)
+    Jp = np.block([[g[1][:, [0]], g[1][:, [2]], -g[2][:, [0]], -g[2][:, [2]], z[:, None], z[:, None]],
+                   [g[1][:, [0]], g[1][:, [2]], z[:, None], z[:, None], -g[3][:, [0]], -g[3][:, [1]]]])
+    Ja = np.block([[-g[1][:, [1]], g[2][:, [1]], z[:, None]], [-g[1][:, [1]], z[:, None], g[3][:, [2]]]])
+    return Jp, Ja
+
+
+def paper_noc_map(p: dict, phi) -> np.ndarray:
+    """K with (theta1', theta2', phi3') = K u': rows theta of eq (15), theta of eq (16), phi of eq (17).
+
+    The NOC model exists iff K is invertible (equivalently det J_p != 0); then its inertia is
+    K^-T I_uu* K^-1 (the same kinetic energy in other velocities).
+    """
+    return np.vstack([paper_inverse(p, 1, phi[0])[1], paper_inverse(p, 2, phi[1])[1], paper_inverse(p, 3, phi[2])[2]])
+
+
+def noc_report(robot: Robot, noc: Robot, phi) -> dict:
+    """Both formulations at one steering configuration: condition numbers and reduced inertias (NaN-free).
+
+    Returns:
+        dict with ``phi``, ``op_M`` (I_uu*, always finite), ``op_condition``, ``noc_M`` (``None`` when the NOC
+        projection refuses), ``noc_condition`` and ``noc_error`` (the one-line message, or ``None``).
+    """
+    q = steering_configuration(robot, phi)
+    red = robot.reduced(q, np.zeros(3))
+    out = {"phi": np.asarray(phi, float), "op_M": red.M, "op_condition": red.projection.condition,
+           "noc_M": None, "noc_condition": float("inf"), "noc_error": None}
+    try:
+        rn = noc.reduced(steering_configuration(noc, phi), np.zeros(3))
+        out["noc_M"], out["noc_condition"] = rn.M, rn.projection.condition
+    except SingularConstraintError as exc:
+        out["noc_error"], out["noc_condition"] = str(exc), exc.condition
+    return out

@@ -1,0 +1,185 @@
+"""Six-wheel robot with linkage suspension (Chen et al.): model, posture on terrain, paper comparison, dynamics.
+
+Independent references used here: closed-form geometry of the nominal posture, the rim of each wheel sampled and
+minimised against the terrain (not the contact code), frame placements read straight from Pinocchio for the loop
+closures (not the LoopClosure code), A S = 0, finite differences along a path, and energy balance.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.optimize import minimize_scalar
+
+from robotdyn.constraint import KinematicState
+from robotdyn.errors import ConstraintError, RobotDynError
+from robotdyn.posture import set_terrain, solve_posture
+from robotdyn.projection import project
+from robotdyn.robot import Robot
+from robotdyn.robots import linkage_suspension as ls
+from robotdyn.terrain import BumpTerrain, FlatTerrain, FunctionTerrain, RampTerrain, SineTerrain
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return Robot(ls.SPEC)
+
+
+def _random_terrain(rng, kind):
+    if kind == 0:
+        return SineTerrain(rng.uniform(0, 0.03), rng.uniform(-4, 4), rng.uniform(-4, 4), rng.uniform(0, 6))
+    if kind == 1:
+        return RampTerrain(rng.uniform(-0.3, 0.3), rng.uniform(-np.pi, np.pi))
+    return BumpTerrain(rng.uniform(-0.06, 0.06), rng.uniform(-0.4, 0.4), rng.uniform(0.1, 0.3))
+
+
+def _rim_gap(robot, q, terrain, frame, radius):
+    """Smallest height of the wheel's rim above the terrain, measured along z (sampled + refined rim angle)."""
+    pin.forwardKinematics(robot.model, robot.data, q)
+    pin.updateFramePlacements(robot.model, robot.data)
+    M = robot.data.oMf[robot.model.getFrameId(frame)]
+    c, e1, e3 = M.translation, M.rotation[:, 0], M.rotation[:, 2]  # wheel plane spanned by the link's x and z
+
+    def gap(a):
+        p = c + radius * (np.cos(a) * e1 + np.sin(a) * e3)
+        return p[2] - terrain.height(p[0], p[1])
+
+    grid = np.linspace(0, 2 * np.pi, 721)
+    a0 = grid[np.argmin([gap(a) for a in grid])]
+    res = minimize_scalar(gap, bounds=(a0 - 0.01, a0 + 0.01), method="bounded", options={"xatol": 1e-12})
+    return res.fun
+
+
+def _closure_errors(robot, q):
+    """Loop-closure errors straight from the frame placements (independent of robotdyn.loop_closure)."""
+    pin.forwardKinematics(robot.model, robot.data, q)
+    pin.updateFramePlacements(robot.model, robot.data)
+    oMf = robot.data.oMf
+    fid = robot.model.getFrameId
+    out = []
+    for side in "RL":
+        g, b = oMf[fid(f"guide_{side}")], oMf[fid(f"block_{side}")]
+        d = b.translation - g.translation
+        axis = g.rotation[:, 0]
+        out.append(np.linalg.norm(d - (d @ axis) * axis))  # block off the guide line
+        out.append(np.linalg.norm(g.rotation - b.rotation))  # block turned relative to the guide
+        out.append(np.linalg.norm(oMf[fid(f"ball_{side}")].translation - oMf[fid(f"rod_{side}_end")].translation))
+    return np.array(out)
+
+
+# ------------------------------------------------------------------------------------------ priority 1
+def test_model_loads_with_documented_dimensions(robot):
+    assert robot.nq == 25
+    assert robot.mobility == 2
+    assert robot.velocity_names == ["phi2_dot", "phi5_dot"]
+    for name in ("theta1", "theta2", "beta1", "beta2", "z", "pitch", "roll", "psi"):
+        robot.coordinate_index(name)
+    kinds = [type(c).__name__ for c in robot.constraints]
+    assert kinds.count("OmniWheel") == 4 and kinds.count("RollingWheel") == 2 and kinds.count("LoopClosure") == 4
+
+
+def test_flat_posture_matches_nominal_geometry(robot):
+    p = robot.params
+    th0 = p["theta0"]
+    guess = robot.neutral()
+    rng = np.random.default_rng(3)
+    free = [i for i, c in enumerate(robot.coordinates) if c not in ("x", "y", "yaw") and not c.startswith("phi")]
+    guess[free] += rng.uniform(-0.02, 0.02, len(free))
+    post = solve_posture(robot, {"x": 0.4, "y": -0.2, "yaw": 0.7}, guess)
+    q = dict(zip(robot.coordinates, post.q))
+    assert post.residual <= 1e-10
+    # closed form: all wheel centres at -(d1 + a5 cos theta0) in R, so z = r + d1 + a5 cos theta0
+    assert q["z"] == pytest.approx(p["r"] + p["d1"] + p["a5"] * np.cos(th0), abs=1e-10)
+    for name, value in (("pitch", 0), ("roll", 0), ("theta1", th0), ("theta2", th0), ("beta1", th0 + np.pi / 2),
+                        ("beta2", th0 + np.pi / 2), ("gamma1", 0), ("gamma2", 0), ("psi", 0)):
+        assert q[name] == pytest.approx(value, abs=1e-9), name
+    assert (q["x"], q["y"], q["yaw"]) == (0.4, -0.2, 0.7)
+
+
+def test_posture_on_random_terrains_closes_every_loop_and_touches(robot):
+    rng = np.random.default_rng(0)
+    worst_res, worst_rim, worst_loop, worst_AS, solved = 0.0, 0.0, 0.0, 0.0, 0
+    mobilities = set()
+    try:
+        for k in range(210):
+            terrain = _random_terrain(rng, k % 3)
+            set_terrain(robot, terrain)
+            x, y, yaw = rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-np.pi, np.pi)
+            guess = robot.neutral()
+            guess[robot.coordinate_index("z")] += terrain.height(x, y)
+            post = solve_posture(robot, {"x": x, "y": y, "yaw": yaw}, guess)
+            solved += 1
+            worst_res = max(worst_res, float(np.max(np.abs(robot.constraint_residual(post.q)))))
+            if k % 7 == 0:  # the independent checks are slower: every 7th sample
+                for i in range(1, 7):
+                    worst_rim = max(worst_rim, abs(_rim_gap(robot, post.q, terrain, f"wheel{i}", robot.params["r"])))
+                worst_loop = max(worst_loop, float(np.max(_closure_errors(robot, post.q))))
+                # mobility is 2 on laterally symmetric ground and 1 where the middle wheels are not coaxial
+                # (beta1 != beta2): A S = 0 with the automatic, rank-revealing choice of independent velocities
+                rows = robot.constraint_rows(KinematicState(robot.model, robot.data, post.q, np.zeros(robot.nq)))
+                proj = project(rows.A)
+                mobilities.add(proj.mobility)
+                worst_AS = max(worst_AS, float(np.max(np.abs(rows.A @ proj.S))))
+    finally:
+        set_terrain(robot, FlatTerrain())
+    assert solved == 210
+    assert worst_res <= 1e-10
+    assert worst_rim <= 1e-9  # every wheel's lowest rim point is on the surface (z-gap, independent sampling)
+    assert worst_loop <= 1e-9
+    assert worst_AS <= 1e-12
+    assert mobilities <= {1, 2}
+
+
+# ------------------------------------------------------------------------------------------ priority 2
+def _plateau(h, x0, x1, y0, y1, w):
+    """A smooth rectangular plateau of height h (product of tanh steps), with gradient and Hessian."""
+
+    def s(t, a, b):
+        ta, tb = np.tanh((t - a) / w), np.tanh((t - b) / w)
+        return (0.5 * (ta - tb), 0.5 * (tb**2 - ta**2) / w, (-ta * (1 - ta**2) + tb * (1 - tb**2)) / w**2)
+
+    def f(x, y):
+        return h * s(x, x0, x1)[0] * s(y, y0, y1)[0]
+
+    def grad(x, y):
+        sx, sy = s(x, x0, x1), s(y, y0, y1)
+        return h * np.array([sx[1] * sy[0], sx[0] * sy[1]])
+
+    def hess(x, y):
+        sx, sy = s(x, x0, x1), s(y, y0, y1)
+        return h * np.array([[sx[2] * sy[0], sx[1] * sy[1]], [sx[1] * sy[1], sx[0] * sy[2]]])
+
+    return FunctionTerrain(f, grad, hess)
+
+
+def test_plateau_under_one_wheel_within_travel_is_solved(robot):
+    terrain = _plateau(0.2, 0.22, 0.8, -0.8, -0.14, 0.02)  # 0.2 m block under the front-right wheel only
+    set_terrain(robot, terrain)
+    try:
+        post = solve_posture(robot, {"x": 0.0, "y": 0.0, "yaw": 0.0})
+        for i in range(1, 7):
+            assert abs(_rim_gap(robot, post.q, terrain, f"wheel{i}", robot.params["r"])) <= 1e-9
+    finally:
+        set_terrain(robot, FlatTerrain())
+    q = dict(zip(robot.coordinates, post.q))
+    assert q["theta1"] < q["theta2"]  # the differential: the right rocker lifts its front, the left one drops it
+
+
+def test_wall_taller_than_the_suspension_reach_is_an_error(robot):
+    # A 1 m wall under the front-right wheel: its centre would have to be 1 m above the middle wheel's, but the
+    # chain front wheel -> F -> D -> B2 -> middle wheel is at most 0.275 + 0.071 + 0.2 + 0.123 = 0.67 m long.
+    set_terrain(robot, _plateau(1.0, 0.22, 0.8, -0.8, -0.14, 0.02))
+    try:
+        with pytest.raises(ConstraintError, match="no posture found") as err:
+            solve_posture(robot, {"x": 0.0, "y": 0.0, "yaw": 0.0})
+    finally:
+        set_terrain(robot, FlatTerrain())
+    assert "\n" not in str(err.value)
+
+
+def test_posture_bad_input_is_one_line_error(robot):
+    with pytest.raises(RobotDynError, match="unknown coordinate"):
+        solve_posture(robot, {"heading": 0.0})
+    with pytest.raises(RobotDynError, match="finite"):
+        solve_posture(robot, {"x": float("nan")})

@@ -133,3 +133,105 @@ def test_out_of_range_joint_is_a_clear_error(robot, label, value):
     q[robot.coordinate_index(label)] = value
     with pytest.raises(InputError, match=rf"q\[{label}\] = .* outside its joint range"):
         robot.check_q(q)
+
+
+# ------------------------------------------------------------------------------------- forward kinematics
+from robotdyn.kinematics import check_pose, frame_names, frame_pose, is_rotation, position_ik, relative_pose  # noqa: E402
+
+_FK_NAMES = ["x", "y", "psi", "lambda_C", "theta1", "lambda2", "theta3", "theta4", "lambda6"]
+
+
+def _fk_values(rng):
+    return dict(x=rng.uniform(-3, 3), y=rng.uniform(-3, 3), psi=rng.uniform(-np.pi, np.pi),
+                lambda_C=rng.uniform(0, 0.37), theta1=rng.uniform(0, np.pi), lambda2=rng.uniform(0, 1.5),
+                theta3=rng.uniform(-np.pi, np.pi), theta4=rng.uniform(-np.pi, np.pi), lambda6=rng.uniform(0, 0.3))
+
+
+def test_fk_matches_htg_chain_and_eq2_except_the_R22_typo(robot):
+    rng = np.random.default_rng(10)
+    for _ in range(30):
+        vals = _fk_values(rng)
+        args = [vals[k] for k in _FK_NAMES]
+        T = frame_pose(robot, mm.state(robot, theta_mu=0.0, **vals), "X")
+        assert T == pytest.approx(mm.paper_htg_chain(robot.params, *args), abs=1e-12)
+        P = mm.paper_X_M(robot.params, *args)
+        mask = np.ones((4, 4), bool)
+        mask[1, 1] = False
+        assert T[mask] == pytest.approx(P[mask], abs=1e-12)
+        # the printed R22 = S_C C13; the chain gives S_C S13 (column 2 = z_4 = (C_C S13, S_C S13, -C13))
+        S13 = np.sin(vals["theta1"] + vals["theta3"])
+        assert T[1, 1] == pytest.approx(np.sin(vals["psi"]) * S13, abs=1e-12)
+
+
+def test_printed_eq2_is_not_a_rotation_in_general(robot):
+    P = mm.paper_X_M(robot.params, 0, 0, 0.7, 0.0, 1.0, 0.5, -0.4, 0.3, 0.1)
+    assert not is_rotation(P[:3, :3], 1e-3)
+
+
+def test_every_library_pose_is_a_proper_rotation(robot):
+    rng = np.random.default_rng(11)
+    frames = frame_names(robot)
+    assert {"C", "X", "E", "frame0", "CS1", "W_R"} <= set(frames)
+    for _ in range(5):
+        q = random_q(robot, rng, lift=True)
+        for f in frames:
+            T = frame_pose(robot, q, f)
+            R = T[:3, :3]
+            assert np.max(np.abs(R.T @ R - np.eye(3))) < 1e-12
+            assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-12)
+            assert T[3] == pytest.approx([0, 0, 0, 1])
+        Trel = relative_pose(robot, q, "X", "C")
+        assert is_rotation(Trel[:3, :3], 1e-12)
+
+
+def test_check_pose_rejects_the_printed_eq29():
+    with pytest.raises(RobotDynError, match="not a proper rotation"):
+        check_pose(mm.PRINTED["eq 29"])
+    check_pose(mm.PRINTED["eq 28"], tol=2e-4)  # 4-decimal rounding of a rotation
+
+
+@pytest.mark.parametrize("key", sorted(mm.PRINTED))
+def test_printed_transforms_entry_by_entry(robot, key):
+    """Eqs 27-31 with the parameters printed beside them: which entries the model reproduces."""
+    paper = mm.PRINTED[key]
+    model = mm.model_printed(robot, key)
+    assert is_rotation(model[:3, :3], 1e-12)
+    differs = {(i, j) for i in range(3) for j in range(4)
+               if abs(paper[i, j] - model[i, j]) > (5e-20 if 0 < abs(paper[i, j]) < 1e-10 else 5e-5)}
+    expected = {"eq 27": set(), "eq 28": set(), "eq 30": set(), "eq 29": {(2, 2)},  # R33 sign typo
+                "eq 31": {(0, 3), (1, 3), (2, 3)}}[key]  # position of the arm frame not reproduced
+    assert differs == expected
+    if key == "eq 29":
+        assert paper[2, 2] == pytest.approx(-model[2, 2], abs=5e-5)  # a sign flip
+        assert abs(np.linalg.det(paper[:3, :3])) < 1e-12  # printed matrix singular: columns 2 and 3 equal
+    else:
+        assert is_rotation(paper[:3, :3], 2e-4)
+
+
+def test_eq26_lift_matches_the_model_over_the_range(robot):
+    for th in np.linspace(-0.5, np.pi / 2, 25):
+        assert mm.model_lift(robot, th) == pytest.approx(mm.paper_delta_lambda(robot.params, th), abs=1e-12)
+    assert mm.model_lift(robot, np.pi / 2) + robot.params["lambda_C0"] == pytest.approx(0.52, abs=1e-12)  # eq 30
+
+
+def test_cli_fk_prints_a_proper_pose(capsys):
+    from robotdyn.cli import main
+
+    q = ["2", "2", str(np.pi / 4), "0.37", str(3 * np.pi / 4), "1.4", str(-np.pi / 2), str(np.pi / 2), "0.25", "0",
+         *(["1.5707963"] * 4), "0", "0"]
+    assert main(["fk", "mmr12_eod", "--q", *q, "--frame", "X", "--json"]) == 0
+    import json
+
+    data = json.loads(capsys.readouterr().out)
+    T = np.array(data["T"])
+    assert is_rotation(T[:3, :3], 1e-12)
+    assert T[:3, 3] == pytest.approx([2.8567, 2.8567, 1.3305], abs=5e-5)  # eq 29's printed position
+    assert main(["fk", "mmr12_eod", "--q", *q, "--frame", "C"]) == 0
+    assert "pose of 'C'" in capsys.readouterr().out
+    bad = list(q)
+    bad[5] = "-0.2"  # lambda2 < 0
+    assert main(["fk", "mmr12_eod", "--q", *bad, "--frame", "X"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "lambda2" in err and "outside its joint range" in err
+    assert main(["fk", "mmr12_eod", "--q", *q, "--frame", "nowhere"]) == 2
+    assert "no frame named 'nowhere'" in capsys.readouterr().err

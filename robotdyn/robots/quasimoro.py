@@ -209,3 +209,9 @@ def compare(robot: Robot | None = None, trajectory=None, states: int = 50, seed:
         note="paper reads +-0.0129 rad off its Fig. 5: 3 significant digits, so half a unit of the last digit",
     )
     return cmp
+
+
+def drift(robot: Robot, traj) -> float:
+    """Largest violation of the integrated constraint psi = rho (theta2 - theta1) (eq 11) along a run [rad]."""
+    rho = robot.params["rho"]
+    return float(np.max(np.abs(traj.column("psi") - rho * (traj.column("theta2") - traj.column("theta1")))))

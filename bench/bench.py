@@ -1,0 +1,96 @@
+"""make bench: speed of robotdyn's reduced model next to raw Pinocchio, for every registered robot, in one run.
+
+For each robot: the median time of one reduced-model evaluation (M_r, C_r nu + g_r, S, w = Sdot nu) next to
+Pinocchio's CRBA + RNEA on the same model, their ratio; for Quasimoro also the sympy-derived model lambdified
+with numpy (tests/oracles); and simulated seconds per wall-clock second of the robot's first scenario with the
+constraint drift at the end. This is a benchmark, not a test: it asserts nothing.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+import robotdyn  # noqa: E402
+from robotdyn.robots import module, names  # noqa: E402
+
+
+def timeit(fn, repeat: int = 7, number: int = 200) -> float:
+    """Median seconds per call over ``repeat`` batches of ``number`` calls."""
+    fn()
+    runs = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        for _ in range(number):
+            fn()
+        runs.append((time.perf_counter() - start) / number)
+    return statistics.median(runs)
+
+
+def state(robot, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    q = robot.neutral()
+    nu = 0.3 * rng.normal(size=robot.mobility)
+    return q, nu
+
+
+def main() -> None:
+    print(f"robotdyn {robotdyn.__version__}, pinocchio {pin.__version__}, numpy {np.__version__}")
+    print(f"{'robot':<20} {'n':>3} {'k':>3} {'reduced [us]':>13} {'CRBA+RNEA [us]':>15} {'ratio':>7}")
+    rows = []
+    for name in names():
+        try:
+            robot = robotdyn.load(name)
+            q, nu = state(robot)
+            robot.reduced(q, nu)
+        except Exception as exc:  # a robot that cannot be evaluated at its neutral state is reported, not fatal
+            print(f"{name:<20} skipped: {exc}")
+            continue
+        t_red = timeit(lambda: robot.reduced(q, nu))
+        v = np.zeros(robot.nq)
+        t_pin = timeit(lambda: (pin.crba(robot.model, robot.data, q), pin.rnea(robot.model, robot.data, q, v, v)),
+                       number=2000)
+        rows.append((name, robot, t_red))
+        print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3} {t_red * 1e6:>13.1f} {t_pin * 1e6:>15.2f} "
+              f"{t_red / t_pin:>7.0f}")
+
+    from oracles.quasimoro_sympy import quasimoro_reduced
+
+    robot = robotdyn.load("quasimoro")
+    q, nu = state(robot)
+    oracle = quasimoro_reduced({"g": robot.params["g"]})
+    qo = np.array([q[robot.coordinate_index(c)] for c in ("x", "y", "psi", "theta1", "theta2", "theta3")])
+    t_sym = timeit(lambda: (oracle.M_r(qo), oracle.h_r(qo, nu), oracle.g_r(qo), oracle.S(qo)))
+    t_red = timeit(lambda: robot.reduced(q, nu))
+    print(f"\nquasimoro: sympy-lambdified model {t_sym * 1e6:.1f} us vs robotdyn {t_red * 1e6:.1f} us "
+          f"(robotdyn {t_sym / t_red:.2f}x the speed of the lambdified oracle)")
+
+    print(f"\n{'robot / scenario':<36} {'sim [s]':>8} {'wall [s]':>9} {'sim/wall':>9} {'evals':>7} {'drift':>9}")
+    for name, robot, _ in rows:
+        mod = module(name)
+        scenarios = getattr(mod, "SCENARIOS", {})
+        if not scenarios:
+            continue
+        sc_name, sc = next(iter(scenarios.items()))
+        t_end = sc.t_end if name == "quasimoro" else min(sc.t_end, 2.0)
+        try:
+            traj = sc.run(robot, t_end=t_end, progress=False)
+        except Exception as exc:
+            print(f"{name + ' / ' + sc_name:<36} failed: {exc}")
+            continue
+        drift_fn = getattr(mod, "drift", None)
+        drift = drift_fn(robot, traj) if drift_fn else float(np.max(traj.residual))
+        wall = traj.stats["wall"]
+        print(f"{name + ' / ' + sc_name:<36} {t_end:>8.1f} {wall:>9.2f} {t_end / wall:>9.1f} "
+              f"{traj.stats['nfev']:>7d} {drift:>9.1e}")
+
+
+if __name__ == "__main__":
+    main()

@@ -235,3 +235,79 @@ def test_cli_fk_prints_a_proper_pose(capsys):
     assert err.count("\n") == 1 and "lambda2" in err and "outside its joint range" in err
     assert main(["fk", "mmr12_eod", "--q", *q, "--frame", "nowhere"]) == 2
     assert "no frame named 'nowhere'" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------------------- inverse kinematics
+@pytest.fixture(scope="module")
+def ik_cases(robot):
+    return mm.ik_cases(robot, n=4, seed=3)
+
+
+def test_numerical_ik_reaches_targets_in_the_manipulation_range(robot, ik_cases):
+    for case in ik_cases:
+        for sol in (case["platform"], case["free"]):
+            assert sol.success and sol.error < 1e-9
+            robot.check_q(sol.q)  # within the joint ranges
+            assert frame_pose(robot, sol.q, "E")[:3, 3] == pytest.approx(case["target"], abs=1e-9)
+        t = case["target"]
+        assert t[0] <= 2.5 and t[1] <= 2.5 and t[2] <= 1.5
+
+
+def test_eqs_3_10_11_reproduce_the_numerical_ik(robot, ik_cases):
+    p = robot.params
+    for case in ik_cases:
+        q = case["platform"].q
+        ik = mm.paper_ik(p, case["target"], case["arm"]["lambda2"], case["arm"]["theta1"], case["arm"]["theta3"])
+        assert ik["phi"] == pytest.approx(q[robot.coordinate_index("psi")], abs=1e-12)  # eq 3 (imposed)
+        assert ik["x_C"] == pytest.approx(q[robot.coordinate_index("x")], abs=1e-9)
+        assert ik["y_C"] == pytest.approx(q[robot.coordinate_index("y")], abs=1e-9)
+        # free IK: the heading always points from C at the target (eq 3 measured from C)
+        qf = case["free"].q
+        C = frame_pose(robot, qf, "C")[:3, 3]
+        phi = np.arctan2(case["target"][1] - C[1], case["target"][0] - C[0])
+        assert phi == pytest.approx(qf[robot.coordinate_index("psi")], abs=1e-8)
+
+
+def test_eqs_10_11_omit_the_load_offset_lambda6(robot, ik_cases):
+    case = ik_cases[0]
+    q = case["platform"].q.copy()
+    q[robot.coordinate_index("lambda6")] = 0.25
+    target_X = frame_pose(robot, q, "X")[:3, 3]
+    arm = case["arm"]
+    ik = mm.paper_ik(robot.params, target_X, arm["lambda2"], arm["theta1"], arm["theta3"])
+    miss = np.hypot(ik["x_C"] - q[robot.coordinate_index("x")], ik["y_C"] - q[robot.coordinate_index("y")])
+    assert miss == pytest.approx(0.25 * abs(np.sin(arm["theta1"] + arm["theta3"])), abs=1e-9)
+
+
+def test_eq4_is_the_interior_angle_only_without_l3(ik_cases):
+    r0 = robotdyn.load("mmr12_eod", {"l3": 0.0})
+    for case in mm.ik_cases(r0, n=3, seed=4):
+        q = case["free"].q
+        rel = case["target"] - frame_pose(r0, q, "frame0")[:3, 3]
+        th1, lam2, th3 = (q[r0.coordinate_index(c)] for c in ("theta1", "lambda2", "theta3"))
+        assert mm.paper_ik(r0.params, rel, lam2, th1, th3)["theta3"] == pytest.approx(np.pi - abs(th3), abs=1e-8)
+    # with the paper's l3 = 0.15 it misses (documented in the errata)
+    r = robotdyn.load("mmr12_eod")
+    case = ik_cases[0]
+    q = case["free"].q
+    rel = case["target"] - frame_pose(r, q, "frame0")[:3, 3]
+    th1, lam2, th3 = (q[r.coordinate_index(c)] for c in ("theta1", "lambda2", "theta3"))
+    assert abs(mm.paper_ik(r.params, rel, lam2, th1, th3)["theta3"] - (np.pi - abs(th3))) > 0.05
+
+
+def test_eq5_does_not_invert_the_model(robot, ik_cases):
+    """Eq 5 evaluated at exact model solutions does not return their lambda2, whatever d_z is measured from."""
+    worst = np.zeros(3)
+    for case in ik_cases:
+        q = case["free"].q
+        th1, lam2, th3 = (q[robot.coordinate_index(c)] for c in ("theta1", "lambda2", "theta3"))
+        z0 = frame_pose(robot, q, "frame0")[2, 3]
+        zC = frame_pose(robot, q, "C")[2, 3]
+        for k, dz in enumerate((case["target"][2] - z0, case["target"][2] - zC, case["target"][2])):
+            worst[k] = max(worst[k], abs(mm.paper_ik(robot.params, [0, 0, dz], lam2, th1, th3)["lambda2"] - lam2))
+    assert np.all(worst > 0.1)
+
+
+def test_ik_bad_target_is_a_clear_error(robot):
+    with pytest.raises(InputError, match="IK target"):
+        position_ik(robot, "E", [1.0, np.nan, 1.0], robot.neutral(), ["x", "y"])

@@ -365,6 +365,7 @@ class Viewer:
             base = _TERRAIN_LOW + s[:, None] * (_TERRAIN_HIGH - _TERRAIN_LOW)
         colors = np.repeat(base * (1.0 - 0.12 * parity[:, None]), 4, axis=0)
         self.vis["/Grid"].set_property("visible", False)
+        self.vis["/Axes"].set_property("scale", [self._size] * 3)  # meshcat world axes: 0.5 m -> half the robot size
         self.vis[f"{_ROOT}/terrain"].set_object(
             g.TriangularMeshGeometry(verts, faces, color=colors), g.MeshLambertMaterial(vertexColors=True)
         )

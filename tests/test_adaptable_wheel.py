@@ -246,3 +246,39 @@ def test_statics_friction_cone_enforced():
     assert np.all(ok.ratio <= 1 + 1e-9) and ok.equilibrium < 1e-9
     with pytest.raises(RobotDynError, match="friction cones"):
         solve_contact_forces(pts, nrm, [0, 0, 98.1], [0, 0, 0], [0, 0, 0.2], mu=0.2)
+
+
+# ------------------------------------------------------------------------------------------------ dynamics
+def test_dynamics_rates_match_ik_finite_differences(mission1):
+    """The constraint layer's adjustment rates (S nu, rolling + eq-1 coupling rows) equal the time derivative of
+    the paper's IK (independent route), and the model's force balance closes."""
+    d = aw.mission_dynamics(mission1, every=50)
+    np.testing.assert_allclose(d.qdot_model, d.qdot_fd, atol=1e-8)
+    assert d.residual.max() < 1e-9
+    assert np.all(d.ratio_dynamic <= 1 + 1e-9) and np.all(d.normal_dynamic > 0)
+
+
+@pytest.mark.parametrize("params", [{}, {"m_wheel": 0.5, "I_adjust": 0.01}])
+def test_dynamics_energy_balance(mission1, params):
+    """dE/dt (finite differences of Pinocchio's energy along the motion) = motor power + contact-force power."""
+    mm = aw.MissionModel(mission1, params)
+    h = 1e-4
+    for t in (0.7, 2.3, 4.1):
+        r = mm.at(t)
+        dE = (mm.at(t + h)["energy"] - mm.at(t - h)["energy"]) / (2 * h)
+        assert dE == pytest.approx(r["motor_power"] + r["contact_power"], abs=1e-6)
+
+
+def test_dynamics_at_rest_equals_statics():
+    """With the body at rest (zero path velocity) the kinetostatic route reproduces eqs 25-34."""
+    m = aw.Mission("rest", "", "rough", lambda t: (0.3, -0.2, 0.0, 0.0), t_end=0.05)
+    run = aw.run_mission(m)
+    d = aw.mission_dynamics(run)
+    np.testing.assert_allclose(d.tau_dynamic[:, 3:], d.tau_static, atol=1e-9)
+    assert d.lateral_slip.max() < 1e-12
+
+
+def test_mission1_needs_lateral_slip(mission1):
+    """Rolling without slipping forbids mission 1: each wheel slides sideways at about |yaw rate| * Lx."""
+    d = aw.mission_dynamics(mission1, every=100)
+    assert d.lateral_slip.min() > 0.5

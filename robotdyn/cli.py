@@ -22,6 +22,20 @@ def _load(args):
     from .robot import Robot
     from .robots import module
 
+    urdf, constraints = getattr(args, "urdf", None), getattr(args, "constraints", None)
+    if urdf is not None or constraints is not None:
+        if args.robot is not None:
+            raise RobotDynError(f"give either ROBOT ({args.robot!r}) or --urdf FILE --constraints FILE, not both")
+        if constraints is None:
+            raise RobotDynError("--urdf needs --constraints FILE (the wheels, closures and motors of the robot)")
+        from .constraint_file import read
+
+        mod = read(constraints, urdf, parse_assignments(args.xacro_arg, "--xacro-arg"))
+        robot = mod.robot(parse_assignments(args.param))
+        args.robot = robot.spec.name
+        return mod, robot
+    if args.robot is None:
+        raise RobotDynError("no robot given: expected ROBOT (robotdyn list) or --urdf FILE --constraints FILE")
     mod = module(args.robot)
     return mod, Robot(mod.SPEC, parse_assignments(args.param))
 
@@ -68,7 +82,7 @@ def cmd_info(args) -> int:
     info["scenarios"] = {k: s.description for k, s in getattr(mod, "SCENARIOS", {}).items()}
     lines = [
         f"{info['robot']}: {info['title']}",
-        f"paper: shared/papers/{info['paper']}",
+        *([f"paper: shared/papers/{info['paper']}"] if info["paper"] else []),
         f"coordinates q ({len(info['coordinates'])}): {', '.join(info['coordinates'])}   [m, rad]",
         f"independent velocities ({info['mobility']}): {', '.join(info['independent_velocities'])}",
         "parameters:",
@@ -222,7 +236,14 @@ def build_parser() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--json", action="store_true", help="machine-readable output")
     robot_args = argparse.ArgumentParser(add_help=False)
-    robot_args.add_argument("robot", metavar="ROBOT", help="robot name (robotdyn list)")
+    robot_args.add_argument("robot", metavar="ROBOT", nargs="?", default=None,
+                            help="robot name (robotdyn list); or describe your own with --urdf/--constraints")
+    robot_args.add_argument("--urdf", metavar="FILE",
+                            help="your robot's URDF/Xacro (a path or package://PKG/...; default: the file's urdf)")
+    robot_args.add_argument("--xacro-arg", action="append", default=[], metavar="NAME=VALUE",
+                            help="a xacro argument of --urdf (repeatable)")
+    robot_args.add_argument("--constraints", metavar="FILE",
+                            help="TOML constraint file: root, wheels, closures, motors (see examples/*.toml)")
     robot_args.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                             help="override a parameter (repeatable; robotdyn info ROBOT lists them)")
 

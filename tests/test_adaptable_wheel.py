@@ -282,3 +282,45 @@ def test_mission1_needs_lateral_slip(mission1):
     """Rolling without slipping forbids mission 1: each wheel slides sideways at about |yaw rate| * Lx."""
     d = aw.mission_dynamics(mission1, every=100)
     assert d.lateral_slip.min() > 0.5
+
+
+# ------------------------------------------------------------------------------------ scenario, compare, CLI
+def test_hold_scenario_stays_at_rest(robot):
+    sc = aw.SCENARIOS["hold"]
+    traj = sc.run(robot, t_end=0.5, n_out=11, progress=False)
+    assert np.abs(traj.nu).max() < 1e-8
+    np.testing.assert_allclose(traj.q[-1], traj.q[0], atol=1e-9)
+    assert traj.residual.max() < 1e-9
+    red = robot.reduced(traj.q[0], np.zeros(robot.mobility))
+    np.testing.assert_allclose(red.B @ sc.holding, red.g, atol=1e-10)
+
+
+def test_compare_verdicts(robot, mission1, mission2):
+    cmp = aw.compare(robot, {"mission1": mission1, "mission2": mission2})
+    rows = {r.quantity: r for r in cmp.rows}
+    assert rows["eq 24: max ||C|| over missions 1-2 (criterion 1e-5)"].verdict == "reproduced"
+    # eq 35 evaluated at Table 2's own angles does not give Table 2's torques (paper's internal inconsistency)
+    r = rows["Table 2: torque r, eq 35 at Table 2's angle [N m]"]
+    assert r.model == pytest.approx(0.5 * 98.1 * 0.3 * np.sin(np.radians(57.5)) * np.cos(np.pi / 6) / 3, abs=1e-12)
+    assert r.verdict == "differs"
+    assert rows["sec 7: max torque, mission 1, eq 35 [N m]"].verdict == "reproduced"
+
+
+def test_cli_ik(capsys, tmp_path):
+    import json
+
+    from robotdyn.cli import main
+    assert main(["ik", "adaptable_wheel", "--commands", "0.3", "0.2", "0.15", "0", "0", "0.1", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["error"] <= 1e-10
+    r = Robot(aw.SPEC)
+    q = np.array([data["model_q"][c] for c in r.coordinates])
+    assert np.max(np.abs(r.constraint_residual(q))) < 1e-10
+    assert main(["ik", "adaptable_wheel", "--commands", "0", "0", "0.35", "0", "0", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "wheel fr" in err and "q = 0 deg" in err
+    assert main(["ik", "adaptable_wheel", "--commands", "1", "2"]) == 2
+    assert "expected 6 values" in capsys.readouterr().err
+    csv = tmp_path / "m2.csv"
+    assert main(["ik", "adaptable_wheel", "--mission", "mission2", "--csv", str(csv)]) == 0
+    assert np.loadtxt(csv, delimiter=",", skiprows=1).shape == (501, 15)

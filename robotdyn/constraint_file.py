@@ -219,11 +219,19 @@ class ConstraintFile:
     def robot(self, params: dict | None = None, terrain: Terrain | None = None) -> Robot:
         """Build the robot; core errors are prefixed with the file name."""
         try:
-            return Robot(self.SPEC, params, terrain)
+            robot = Robot(self.SPEC, params, terrain)
         except ConstraintFileError:
             raise
         except RobotDynError as exc:
             raise ConstraintFileError(f"{self.path}: {exc}") from None
+        for i, sc in enumerate(self.SCENARIOS.values()):
+            for name in sc.nu0:
+                if name not in robot.velocity_names:
+                    raise ConstraintFileError(
+                        f"{self.path}: scenarios[{i}] ({sc.name}): nu0 {name[:-4]!r} is not an independent velocity; "
+                        f"expected one of {', '.join(v[:-4] for v in robot.velocity_names)}"
+                    )
+        return robot
 
 
 def read(
@@ -300,6 +308,9 @@ def read(
         params.append(Parameter(name, default, str(p.get("unit", "")), str(p.get("description", "")), choices,
                                 use_xacro))
     pvalues = {p.name: p.default for p in params}
+    for name in xargs:
+        if any(p.name == name and p.xacro for p in params):
+            r.fail("xacro_args", f"{name!r} is a parameter of this file; set it with --param {name}=VALUE")
     try:
         text = expand_xacro(desc, {**xargs, **{p.name: p.default for p in params if p.xacro}})
         tree = _Tree.parse(text, declared)

@@ -241,3 +241,91 @@ def test_section3_profile_and_travel(comparison, robot):
         robot.params["r"] * np.radians(300), rel=1e-6)
     assert comparison["sec 3.2: pivot-steering turns (two circles, Fig. 12)"].model == pytest.approx(
         robot.params["r"] * angle / robot.params["d5"] / (2 * np.pi), rel=1e-6)
+
+
+# ------------------------------------------------------------------------------------------ priority 5
+@pytest.fixture(scope="module")
+def bump_robot():
+    rob = Robot(ls.SPEC)
+    set_terrain(rob, BumpTerrain(0.05, 0.2, 0.15))
+    return rob
+
+
+def test_reduced_dynamics_on_the_bump(bump_robot):
+    rob = bump_robot
+    q = solve_posture(rob, {"x": 0.1, "y": 0.0, "yaw": 0.0}).q
+    # straight motion: a turn would break the left/right symmetry of the posture on this x-only bump, and there
+    # (beta1 != beta2) the non-coaxial middle wheels leave mobility 1 (see the errata)
+    nu = np.array([2.5, 2.5])
+    red = rob.reduced(q, nu, coriolis=True)
+    assert np.max(np.abs(red.rows.A @ red.S)) <= 1e-12
+    assert np.allclose(red.M, red.M.T, atol=1e-12) and np.min(np.linalg.eigvalsh(red.M)) > 0
+    # C_r nu + g_r is the bias h
+    assert np.allclose(red.C @ nu + red.g, red.h, atol=1e-10)
+    # g_r = dV/d(eps) along each admissible direction S e_k (central differences of Pinocchio's potential energy)
+    eps = 1e-5
+    for k in range(2):
+        vp = pin.computePotentialEnergy(rob.model, rob.data, q + eps * red.S[:, k])
+        vm = pin.computePotentialEnergy(rob.model, rob.data, q - eps * red.S[:, k])
+        assert (vp - vm) / (2 * eps) == pytest.approx(red.g[k], abs=1e-6)
+    # dM_r/dt - 2 C_r is skew-symmetric (dM_r/dt by central differences along q' = v)
+    h = 1e-6
+    Mp = rob.reduced(q + h * red.v, nu).M
+    Mm = rob.reduced(q - h * red.v, nu).M
+    N = (Mp - Mm) / (2 * h) - 2 * red.C
+    assert np.max(np.abs(N + N.T)) <= 1e-6 * max(1.0, np.max(np.abs(red.C)))
+
+
+def test_energy_conserved_torque_free_on_a_ramp():
+    from robotdyn.simulation import simulate
+
+    rob = Robot(ls.SPEC)
+    set_terrain(rob, RampTerrain(0.15, 0.6))  # slope across the robot's heading: it turns downhill
+    q0 = solve_posture(rob, {"x": 0.0, "y": 0.0, "yaw": 0.0}).q
+    traj = simulate(rob, 1.0, q0, np.array([2.0, 3.0]), None, n_out=21, rtol=1e-10, atol=1e-12, progress=False)
+    assert abs(traj.q[-1, rob.coordinate_index("yaw")]) > 0.1  # a non-trivial motion
+    assert np.ptp(traj.energy) <= 1e-7 * abs(traj.energy[0])
+    assert np.max(traj.residual) <= 1e-9
+
+
+def test_drift_term_matches_finite_differences_along_a_bump_run(bump_robot):
+    """A a + Adot v = 0 with a from central differences of v = S nu along a simulated torque-free run:
+    the error must fall as h^2 (ratio 4 per halving), i.e. vanish in the limit."""
+    from robotdyn.simulation import simulate
+
+    rob = bump_robot
+    q0 = solve_posture(rob, {"x": -0.1, "y": 0.0, "yaw": 0.0}).q
+    traj = simulate(rob, 0.2, q0, np.array([3.0, 3.0]), None, n_out=201, rtol=1e-11, atol=1e-13, progress=False)
+    assert np.ptp(traj.energy) <= 1e-9 * abs(traj.energy[0])  # torque-free over the bump
+    dt = traj.t[1] - traj.t[0]
+    V = np.array([rob.reduced(q, nu).v for q, nu in zip(traj.q, traj.nu)])
+    errors = {}
+    for step in (1, 2, 4):
+        worst, scale = 0.0, 0.0
+        for i in range(8, len(traj.t) - 8, 8):
+            a = (V[i + step] - V[i - step]) / (2 * step * dt)
+            rows = rob.constraint_rows(KinematicState(rob.model, rob.data, traj.q[i], V[i]))
+            worst = max(worst, float(np.max(np.abs(rows.A @ a + rows.Adot @ V[i]))))
+            scale = max(scale, float(np.max(np.abs(rows.Adot @ V[i]))))
+        errors[step] = worst
+    assert scale > 0.05  # the drift term is not trivially zero on the bump
+    assert errors[1] <= 1e-5 * scale
+    assert errors[2] / errors[1] == pytest.approx(4.0, rel=0.05)
+    assert errors[4] / errors[2] == pytest.approx(4.0, rel=0.05)
+
+
+def test_wheel_torques_over_the_bump_energy_balance(bump_robot):
+    from robotdyn.simulation import power, simulate
+
+    rob = bump_robot
+    q0 = solve_posture(rob, {"x": -0.1, "y": 0.0, "yaw": 0.0}).q
+
+    def tau(t, q, nu):
+        return np.array([0.5, 0.8, 0.5, 0.5, 0.8, 0.5])
+
+    traj = simulate(rob, 0.3, q0, np.array([3.0, 3.0]), tau, n_out=301, rtol=1e-10, atol=1e-12, progress=False)
+    P = power(rob, traj, tau)
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(traj.t))])
+    assert work[-1] > 1.0
+    assert np.max(np.abs(traj.energy - traj.energy[0] - work)) <= 1e-6 * work[-1]
+    assert np.max(traj.residual) <= 1e-9

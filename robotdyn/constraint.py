@@ -47,17 +47,32 @@ class KinematicState:
         self.model, self.data = model, data
         self.q = np.array(q, dtype=float)
         self.v = np.array(v, dtype=float)
-        pin.computeJointJacobiansTimeVariation(model, data, self.q, self.v)
+        self._moving = bool(np.any(self.v))
+        if self._moving:
+            pin.computeJointJacobiansTimeVariation(model, data, self.q, self.v)
+        else:  # at rest the time variation is zero: plain Jacobians are enough
+            pin.computeJointJacobians(model, data, self.q)
         pin.updateFramePlacements(model, data)
+        self._poses: dict[int, tuple[pin.SE3, np.ndarray]] = {}
         self._frames: dict[int, tuple[pin.SE3, np.ndarray, np.ndarray]] = {}
         self.geometry: dict = {}
 
     def with_velocity(self, v: np.ndarray) -> KinematicState:
-        """The same configuration at velocity ``v`` (recomputes the Jacobians' time variation, keeps
-        :attr:`geometry`)."""
+        """The same configuration at velocity ``v`` (recomputes the Jacobians' time variation, keeps the
+        configuration-level caches: frame placements, Jacobians and :attr:`geometry`)."""
         out = KinematicState(self.model, self.data, self.q, v)
+        out._poses = self._poses
         out.geometry = self.geometry
         return out
+
+    def pose(self, fid: int) -> tuple[pin.SE3, np.ndarray]:
+        """Placement and LOCAL_WORLD_ALIGNED Jacobian (6 x nv) of a frame (configuration-level, cached)."""
+        if fid not in self._poses:
+            self._poses[fid] = (
+                self.data.oMf[fid].copy(),
+                pin.getFrameJacobian(self.model, self.data, fid, LWA).copy(),
+            )
+        return self._poses[fid]
 
     def frame(self, fid: int) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
         """Placement, Jacobian (6 x nv) and its time derivative for a frame, in LOCAL_WORLD_ALIGNED.
@@ -67,9 +82,11 @@ class KinematicState:
         :math:`\\dot v = 0`.
         """
         if fid not in self._frames:
-            placement = self.data.oMf[fid].copy()
-            jac = pin.getFrameJacobian(self.model, self.data, fid, LWA).copy()
-            djac = pin.getFrameJacobianTimeVariation(self.model, self.data, fid, LWA).copy()
+            placement, jac = self.pose(fid)
+            if self._moving:
+                djac = pin.getFrameJacobianTimeVariation(self.model, self.data, fid, LWA).copy()
+            else:
+                djac = np.zeros_like(jac)
             self._frames[fid] = (placement, jac, djac)
         return self._frames[fid]
 
@@ -87,14 +104,15 @@ class ConstraintRows:
 
     Attributes:
         A: Constraint Jacobian, shape (k, nv).
-        Adot: Its time derivative along the motion, shape (k, nv); the drift term is ``Adot @ v``.
+        Adot: Its time derivative along the motion, shape (k, nv); the drift term is ``Adot @ v``
+            (``None`` when only the Jacobian was asked for).
         residual: Position residual of holonomic rows (0 on nonholonomic rows), shape (k,).
         holonomic: Which rows are holonomic, shape (k,).
         labels: A name for each row (constraint name and component).
     """
 
     A: np.ndarray
-    Adot: np.ndarray
+    Adot: np.ndarray | None
     residual: np.ndarray
     holonomic: np.ndarray
     labels: list[str]
@@ -106,7 +124,7 @@ class ConstraintRows:
             return ConstraintRows(np.zeros((0, nv)), np.zeros((0, nv)), np.zeros(0), np.zeros(0, bool), [])
         return ConstraintRows(
             np.vstack([p.A for p in parts]),
-            np.vstack([p.Adot for p in parts]),
+            None if any(p.Adot is None for p in parts) else np.vstack([p.Adot for p in parts]),
             np.concatenate([p.residual for p in parts]),
             np.concatenate([p.holonomic for p in parts]),
             [label for p in parts for label in p.labels],
@@ -122,8 +140,18 @@ class Constraint:
     name: str = "constraint"
 
     def rows(self, kin: KinematicState) -> ConstraintRows:
-        """The constraint's rows at the state held by ``kin``."""
+        """The constraint's rows at the state held by ``kin`` (A, Adot, residual, ...)."""
         raise NotImplementedError
+
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        """The rows without their time derivative (``Adot`` may be ``None``); only the configuration matters.
+        Subclasses override it when that is cheaper than :meth:`rows`."""
+        return self.rows(kin)
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        """The drift term :math:`\\dot A v` at the state of ``kin``. Subclasses override it when a vector
+        formula is cheaper than the matrix :math:`\\dot A`."""
+        return self.rows(kin).Adot @ kin.v
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(name={self.name!r})"

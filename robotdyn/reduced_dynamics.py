@@ -12,6 +12,7 @@ where :math:`C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, S\\nu, w)` (one RNEA call g
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,7 +38,8 @@ class ReducedDynamics:
         C: :math:`C_r` (k, k), only when requested (else ``None``).
         Sdot: :math:`\\dot S` (n, k), only with C.
         projection: The :class:`~robotdyn.projection.Projection` used.
-        rows: The stacked constraint rows at this state.
+        jacobian_rows: The stacked constraint rows without their time derivative (A, residual, labels).
+        rows: The stacked constraint rows at this state, ``Adot`` included (computed on first access).
     """
 
     M: np.ndarray
@@ -48,9 +50,17 @@ class ReducedDynamics:
     w: np.ndarray
     v: np.ndarray
     projection: Projection
-    rows: ConstraintRows
+    jacobian_rows: ConstraintRows
     C: np.ndarray | None = None
     Sdot: np.ndarray | None = None
+    _full_rows: ConstraintRows | Callable[[], ConstraintRows] | None = None
+
+    @property
+    def rows(self) -> ConstraintRows:
+        """All constraint rows at (q, v), with ``Adot``."""
+        if callable(self._full_rows):
+            self._full_rows = self._full_rows()
+        return self._full_rows
 
     def __repr__(self) -> str:
         return f"ReducedDynamics(k={self.M.shape[0]}, n={self.S.shape[0]}, motors={self.B.shape[1]})"
@@ -69,22 +79,25 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     model, data = robot.model, robot.data
     ind = robot.independent_indices if independent is None else independent
     kin0 = KinematicState(model, data, q, np.zeros(model.nv))
-    rows0 = robot.constraint_rows(kin0)
+    rows0 = ConstraintRows.stack([c.jacobian(kin0) for c in robot.constraints], model.nv)
     proj = project(rows0.A, ind, robot.velocity_labels, hint=robot._projection_hint)
     robot._projection_hint = proj
     v = proj.S @ nu
     kin = kin0.with_velocity(v)
-    rows = robot.constraint_rows(kin)
+    drift = np.concatenate([c.drift(kin) for c in robot.constraints]) if robot.constraints else np.zeros(0)
     B = input_matrix(robot.motors, kin)
-    w = proj.offset(rows.Adot @ v)
+    w = proj.offset(drift)
     S = proj.S
+    full_rows = lambda: robot.constraint_rows(kin)  # noqa: E731  (frames it needs are cached in kin)
+    if coriolis:
+        full_rows = full_rows()
     M = pin.crba(model, data, q)
     Mr = S.T @ M @ S
     g = pin.computeGeneralizedGravity(model, data, q)
     h = S.T @ pin.rnea(model, data, q, v, w)
-    out = ReducedDynamics(Mr, h, S.T @ g, S.T @ B, S, w, v, proj, rows)
+    out = ReducedDynamics(Mr, h, S.T @ g, S.T @ B, S, w, v, proj, rows0, _full_rows=full_rows)
     if coriolis:
-        Sdot = proj.Sdot(rows.Adot)
+        Sdot = proj.Sdot(full_rows.Adot)
         C = pin.computeCoriolisMatrix(model, data, q, v)
         out.C = S.T @ (M @ Sdot + C @ S)
         out.Sdot = Sdot

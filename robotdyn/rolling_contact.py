@@ -77,7 +77,7 @@ class RollingWheel(Constraint):
         key = (id(self), "geometry")
         if key in kin.geometry:
             return kin.geometry[key]
-        placement, _, _ = kin.frame(self.fid)
+        placement, _ = kin.pose(self.fid)
         c = placement.translation
         a = placement.rotation @ self.axis
         R = self.radius
@@ -158,13 +158,46 @@ class RollingWheel(Constraint):
         Edot = np.array([t1dot, t2dot, ndot]).T
         return dict(p=p, n=n, u=u, R=R, E=E, Edot=Edot, r=r, rdot=rdot, udot=udot, a=a, phi=phi, J=jac, dJ=djac)
 
+    def _world_jacobian(self, kin: KinematicState) -> tuple[np.ndarray, tuple]:
+        """:math:`A_w = J_c - [r]_\\times J_\\omega - u\\,\\partial R/\\partial q` (3 x nv, world rows), cached."""
+        key = (id(self), "Aw")
+        if key not in kin.geometry:
+            geo = self._geometry(kin)
+            _, jac = kin.pose(self.fid)
+            r = -geo[2] * geo[4]
+            Aw = jac[:3] - skew(r) @ jac[3:]
+            if self.radius_index is not None:
+                Aw[:, self.radius_index] -= geo[4]
+            kin.geometry[key] = (Aw, geo)
+        return kin.geometry[key]
+
+    def _labels(self) -> list[str]:
+        return [f"{self.name}.{s}" for s in self._row_names]
+
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        Aw, geo = self._world_jacobian(kin)
+        D = self._directions
+        holonomic = D[:, 2] != 0
+        return ConstraintRows(D @ (geo[9].T @ Aw), None, np.where(holonomic, geo[7], 0.0), holonomic, self._labels())
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        """:math:`\\dot A v = D(\\dot E^T s + E^T(a_c^0 + \\dot\\omega^0 \\times r + \\omega \\times \\dot r
+        - \\dot u \\dot R))` with :math:`s = A_w v` the velocity of the wheel's material point at the contact."""
+        g = self.contact(kin)
+        Aw, _ = self._world_jacobian(kin)
+        jac, djac, v = g["J"], g["dJ"], kin.v
+        s = Aw @ v
+        acc = djac[:3] @ v + cross(djac[3:] @ v, g["r"]) + cross(jac[3:] @ v, g["rdot"])
+        if self.radius_index is not None:
+            acc = acc - g["udot"] * v[self.radius_index]
+        return self._directions @ (g["Edot"].T @ s + g["E"].T @ acc)
+
     def rows(self, kin: KinematicState) -> ConstraintRows:
         g = self.contact(kin)
         jac, djac = g["J"], g["dJ"]
-        Aw = jac[:3] - skew(g["r"]) @ jac[3:]
+        Aw, _ = self._world_jacobian(kin)
         Awdot = djac[:3] - skew(g["rdot"]) @ jac[3:] - skew(g["r"]) @ djac[3:]
         if self.radius_index is not None:
-            Aw[:, self.radius_index] -= g["u"]
             Awdot[:, self.radius_index] -= g["udot"]
         D = self._directions  # rows: coefficients of (t1, t2, n)
         W = D @ g["E"].T
@@ -173,8 +206,7 @@ class RollingWheel(Constraint):
         Adot = Wdot @ Aw + W @ Awdot
         holonomic = D[:, 2] != 0
         residual = np.where(holonomic, g["phi"], 0.0)
-        labels = [f"{self.name}.{s}" for s in self._row_names]
-        return ConstraintRows(A, Adot, residual, holonomic, labels)
+        return ConstraintRows(A, Adot, residual, holonomic, self._labels())
 
 
 class OmniWheel(RollingWheel):
@@ -193,3 +225,11 @@ class OmniWheel(RollingWheel):
         self.roller_angle = float(roller_angle)
         ca, sa = np.cos(self.roller_angle), np.sin(self.roller_angle)
         self._directions = np.array([[ca, sa, 0.0], [0.0, 0.0, 1.0]])
+
+
+class SupportWheel(RollingWheel):
+    """A wheel that only touches the ground: the holonomic normal row, no tangential rows (a frictionless
+    support, e.g. a free castor or a skid whose friction is neglected). Arguments as :class:`RollingWheel`."""
+
+    _row_names = ("normal",)
+    _directions = np.array([[0.0, 0.0, 1.0]])

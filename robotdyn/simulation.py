@@ -121,9 +121,10 @@ def simulate(
         tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
         nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
         qdot = red.v
-        hol = red.rows.holonomic
+        rows = red.jacobian_rows
+        hol = rows.holonomic
         if stabilisation and hol.any():
-            qdot = qdot - stabilisation * np.linalg.lstsq(red.rows.A[hol], red.rows.residual[hol], rcond=None)[0]
+            qdot = qdot - stabilisation * np.linalg.lstsq(rows.A[hol], rows.residual[hol], rcond=None)[0]
         report(t)
         return np.concatenate([qdot, nudot])
 
@@ -139,9 +140,9 @@ def simulate(
     for i in range(len(sol.t)):
         red = robot.reduced(q[i], nu[i])
         energy[i] = robot.energy(q[i], red.v)
-        hol = red.rows.holonomic
-        if hol.any():
-            residual[i] = np.max(np.abs(red.rows.residual[hol]))
+        rows = red.jacobian_rows
+        if rows.holonomic.any():
+            residual[i] = np.max(np.abs(rows.residual[rows.holonomic]))
     stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol}
     return Trajectory(sol.t, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats)
 

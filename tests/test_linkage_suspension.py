@@ -329,3 +329,24 @@ def test_wheel_torques_over_the_bump_energy_balance(bump_robot):
     assert work[-1] > 1.0
     assert np.max(np.abs(traj.energy - traj.energy[0] - work)) <= 1e-6 * work[-1]
     assert np.max(traj.residual) <= 1e-9
+
+
+# ------------------------------------------------------------------------------------------ CLI
+def test_cli_posture_dump_and_errors(capsys):
+    import json
+
+    from robotdyn.cli import main
+
+    assert main(["linkage-posture", "--terrain", "bump", "--x", "0.1", "--v", "2", "2", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["residual"] <= 1e-10 and out["mobility"] == 2
+    M = np.array(out["M"])
+    assert np.allclose(M, M.T) and np.all(np.linalg.eigvalsh(M) > 0)
+    assert main(["linkage-posture", "--terrain", "nope"]) == 2
+    assert "unknown terrain" in capsys.readouterr().err
+    assert main(["dump", "linkage_suspension", "--q", *map(str, Robot(ls.SPEC).neutral()), "--v", "1", "1"]) == 0
+    assert "minimal coordinates: phi2_dot, phi5_dot" in capsys.readouterr().out
+    assert main(["simulate", "linkage_suspension", "--scenario", "ramp_free", "--t-end", "0.1", "--quiet",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert abs(out["energy_end"] - out["energy_start"]) <= 1e-7 * out["energy_start"]

@@ -7,12 +7,17 @@ Paper: "Kinematics Analysis and Simulation of Mobile Robot Based on Linkage Susp
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
 import numpy as np
 import pinocchio as pin
 
 from ..comparison import Comparison
 from ..constraint import KinematicState
 from ..robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from ..scenario import Scenario
+from ..terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
 
 THETA0 = np.pi / 3
 """Default nominal rocker angle theta0 [rad] (xacro default)."""
@@ -320,7 +325,6 @@ def rolling_comparison(cmp: Comparison, robot: Robot, states: int = 12, seed: in
     the wheel's absolute rate about its axle; then a straight run on flat ground with rollers at rho = 0.4 rad.
     """
     from ..posture import set_terrain, solve_posture
-    from ..terrain import BumpTerrain, FlatTerrain
 
     rng = np.random.default_rng(seed)
     rec = _Worst()
@@ -464,3 +468,109 @@ def compare(robot: Robot | None = None) -> Comparison:
     rolling_comparison(cmp, robot)
     section3_comparison(cmp, robot)
     return cmp
+
+
+# ---------------------------------------------------------------------------------- terrains, scenarios
+TERRAINS: dict[str, Callable[[], Terrain]] = {
+    "flat": lambda: FlatTerrain(),
+    "ramp": lambda: RampTerrain(0.15, 0.6),
+    "bump": lambda: BumpTerrain(0.05, 0.2, 0.15),
+    "sine": lambda: SineTerrain(0.02, 2 * np.pi / 0.8, 2 * np.pi / 1.3),
+}
+"""Example terrains: flat; a 15 % ramp rising towards heading 0.6 rad; a smooth 5 cm step at x = 0.2 m
+(tanh, width 0.15 m); a 2 cm sinusoid with wavelengths 0.8 m (x) and 1.3 m (y)."""
+
+SPEED_GAIN = 2.0
+"""Gain [N m s/rad] of the wheel-speed tracking torques of the section 3 scenarios."""
+
+
+@dataclass
+class TerrainScenario(Scenario):
+    """A scenario on a named terrain, starting from the posture solved at ``start`` (x, y, yaw)."""
+
+    terrain: str = "flat"
+    start: dict[str, float] = field(default_factory=lambda: {"x": 0.0, "y": 0.0, "yaw": 0.0})
+
+    def initial_state(self, robot) -> tuple[np.ndarray, np.ndarray]:
+        from ..posture import set_terrain, solve_posture
+
+        set_terrain(robot, TERRAINS[self.terrain]())
+        q0 = solve_posture(robot, self.start).q
+        nu0 = np.zeros(robot.mobility)
+        for label, value in self.nu0.items():
+            nu0[robot.velocity_names.index(label)] = value
+        return q0, nu0
+
+
+def _tracking(signs: tuple[float, float], profile: bool = True):
+    """Torques of the six wheel motors tracking the section 3 wheel-speed profile (right side signs[0], left
+    signs[1]) with gain SPEED_GAIN; nu = (phi2', phi5') are the right and left middle wheel speeds."""
+
+    def tau(t, q, nu):
+        ref = wheel_speed(t)[0] if profile else PEAK_SPEED
+        right = SPEED_GAIN * (signs[0] * ref - nu[0])
+        left = SPEED_GAIN * (signs[1] * ref - nu[1])
+        return np.array([right, right, right, left, left, left])
+
+    return tau
+
+
+SCENARIOS = {
+    "straight_line": TerrainScenario(
+        "straight_line", "sec 3.1: six wheel motors track the speed profile (0 / ramp to 300 deg/s / hold / ramp "
+        "down / rest), flat ground", PROFILE[-1], torque=_tracking((1.0, 1.0)), plot=["x", "phi2_dot"]),
+    "pivot_steering": TerrainScenario(
+        "pivot_steering", "sec 3.2: right wheels track -profile, left wheels +profile (pivot steering), flat ground",
+        PROFILE[-1], torque=_tracking((-1.0, 1.0)), plot=["yaw", "phi2_dot", "phi5_dot"]),
+    "bump": TerrainScenario(
+        "bump", "over a smooth 5 cm step at x = 0.2 m at 300 deg/s wheel speed held by the motors (torque inputs)",
+        2.2, torque=_tracking((1.0, 1.0), profile=False), terrain="bump", start={"x": -0.6, "y": 0.0, "yaw": 0.0},
+        nu0={"phi2_dot": float(PEAK_SPEED), "phi5_dot": float(PEAK_SPEED)},
+        plot=["z", "pitch", "theta1", "beta1", "phi2_dot"]),
+    "ramp_free": TerrainScenario(
+        "ramp_free", "torque-free, friction-free on a 15 % ramp across the heading (energy must stay constant)",
+        2.0, terrain="ramp", nu0={"phi2_dot": 2.0, "phi5_dot": 3.0}, plot=["x", "y", "yaw", "phi2_dot", "phi5_dot"]),
+}
+
+
+# ------------------------------------------------------------------------------------------------ CLI
+def _cmd_posture(args) -> int:
+    import json
+
+    from ..cli import _jsonable
+    from ..errors import InputError
+    from ..inputs import parse_assignments
+    from ..posture import set_terrain, solve_posture
+
+    if args.terrain not in TERRAINS:
+        raise InputError(f"unknown terrain {args.terrain!r}; expected one of {', '.join(TERRAINS)}")
+    robot = Robot(SPEC, parse_assignments(args.param))
+    set_terrain(robot, TERRAINS[args.terrain]())
+    post = solve_posture(robot, {"x": args.x, "y": args.y, "yaw": args.yaw})
+    out = {"terrain": repr(robot.terrain), "q": dict(zip(robot.coordinates, post.q)), "residual": post.residual,
+           "iterations": post.iterations}
+    text = [f"posture on {robot.terrain!r} at x = {args.x}, y = {args.y}, yaw = {args.yaw}: max residual "
+            f"{post.residual:.2e} after {post.iterations} Newton steps",
+            *(f"  {c:<8} {v: .10g}" for c, v in zip(robot.coordinates, post.q) if not c.startswith(("phi", "rod")))]
+    if args.v is not None:
+        nu = robot.check_nu([float(x) for x in args.v], "v")
+        red = robot.reduced(post.q, nu, coriolis=True)
+        out.update(M=red.M, C=red.C, g=red.g, B=red.B, mobility=red.projection.mobility)
+        names = robot.velocity_names
+        text += [f"reduced dynamics in {', '.join(names)}:", f"  M_r = {np.array2string(red.M, precision=8)}",
+                 f"  C_r = {np.array2string(red.C, precision=8)}", f"  g_r = {np.array2string(red.g, precision=8)}"]
+    print(json.dumps(out, indent=2, default=_jsonable) if args.json else "\n".join(text))
+    return 0
+
+
+def register_cli(subparsers, parents) -> None:
+    """``robotdyn linkage-posture``: the posture on an example terrain (and the reduced dynamics there)."""
+    p = subparsers.add_parser("linkage-posture", parents=[parents[0]],
+                              help="linkage_suspension: posture on a terrain (and M_r, C_r, g_r there)")
+    p.add_argument("--terrain", default="bump", help=f"one of {', '.join(TERRAINS)}")
+    p.add_argument("--x", type=float, default=0.0, help="body x [m]")
+    p.add_argument("--y", type=float, default=0.0, help="body y [m]")
+    p.add_argument("--yaw", type=float, default=0.0, help="body yaw [rad]")
+    p.add_argument("--v", nargs=2, help="independent velocities phi2' phi5' [rad/s]: also print M_r, C_r, g_r")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="override a parameter")
+    p.set_defaults(func=_cmd_posture)

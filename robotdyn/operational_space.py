@@ -26,10 +26,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
-import scipy.linalg
 
 from .actuation import input_matrix
-from .constraint import KinematicState
+from .constraint import ConstraintRows, KinematicState
 from .errors import DescriptionError, InputError, SingularConstraintError
 from .projection import MAX_CONDITION, independent_rows
 from .reduced_dynamics import ReducedDynamics
@@ -77,9 +76,15 @@ class FrameTwist:
         (kin.q, kin.v). In LOCAL axes :math:`\\dot J v` is the spatial acceleration's linear part, which is the time
         derivative of the body-axes velocity components (not the body components of the classical acceleration).
         """
-        J = pin.getFrameJacobian(kin.model, kin.data, self.fid, self.reference)
+        J = self.jacobian(kin)
+        if not np.any(kin.v):  # at rest the time variation is zero (and kin may not have computed it)
+            return J, np.zeros_like(J)
         dJ = pin.getFrameJacobianTimeVariation(kin.model, kin.data, self.fid, self.reference)
-        return J[self.select].copy(), dJ[self.select].copy()
+        return J, dJ[self.select].copy()
+
+    def jacobian(self, kin: KinematicState) -> np.ndarray:
+        """:math:`J_o` (k, n) at the configuration of ``kin`` (the most recent kinematics pass on its data)."""
+        return pin.getFrameJacobian(kin.model, kin.data, self.fid, self.reference)[self.select].copy()
 
 
 @dataclass
@@ -89,13 +94,13 @@ class OperationalProjection:
     Attributes:
         S: (n, k) with :math:`v = S\\nu`, :math:`AS = 0`, :math:`J_oS = I`.
         rows: Indices of the independent constraint rows used.
-        condition: Condition number of :math:`K = [A_r; J_o]`.
+        condition: 1-norm condition number of :math:`K = [A_r; J_o]`.
     """
 
     S: np.ndarray
     rows: np.ndarray
     condition: float
-    _lu: tuple = field(repr=False, default=None)
+    _inv: np.ndarray = field(repr=False, default=None)
 
     @property
     def mobility(self) -> int:
@@ -103,11 +108,11 @@ class OperationalProjection:
 
     def offset(self, drift: np.ndarray, Jdot_v: np.ndarray) -> np.ndarray:
         """:math:`w` with :math:`A w = -\\text{drift}` (drift = :math:`\\dot A v`) and :math:`J_o w = -\\dot J_o v`."""
-        return scipy.linalg.lu_solve(self._lu, -np.concatenate([drift[self.rows], Jdot_v]))
+        return -self._inv @ np.concatenate([drift[self.rows], Jdot_v])
 
     def Sdot(self, Adot: np.ndarray, Jdot: np.ndarray) -> np.ndarray:
         """:math:`\\dot S = -K^{-1}\\dot K S` (n, k)."""
-        return -scipy.linalg.lu_solve(self._lu, np.vstack([Adot[self.rows] @ self.S, Jdot @ self.S]))
+        return -self._inv @ np.vstack([Adot[self.rows] @ self.S, Jdot @ self.S])
 
 
 def project_operational(A: np.ndarray, J: np.ndarray, names: list[str] | None = None) -> OperationalProjection:
@@ -127,17 +132,26 @@ def project_operational(A: np.ndarray, J: np.ndarray, names: list[str] | None = 
             f"(n = {n}, rank A = {rows.size}); expected exactly the mobility"
         )
     K = np.vstack([A[rows], J])
-    cond = float(np.linalg.cond(K))
+    try:
+        Kinv = np.linalg.inv(K)
+        cond = float(np.abs(K).sum(axis=0).max() * np.abs(Kinv).sum(axis=0).max())  # 1-norm condition number
+    except np.linalg.LinAlgError:
+        cond = float("inf")
     if not np.isfinite(cond) or cond > MAX_CONDITION:
         raise SingularConstraintError(
             f"the operational velocities ({', '.join(names)}) do not determine the motion here: [A; J] singular "
             f"(condition number {cond:.3g})",
             condition=cond,
         )
-    lu = scipy.linalg.lu_factor(K)
-    rhs = np.zeros((n, k))
-    rhs[rows.size:] = np.eye(k)
-    return OperationalProjection(scipy.linalg.lu_solve(lu, rhs), rows, cond, lu)
+    return OperationalProjection(Kinv[:, rows.size:].copy(), rows, cond, Kinv)
+
+
+def operational_projection(robot, twist: FrameTwist, q: np.ndarray) -> OperationalProjection:
+    """Only the projection (S, condition) at configuration q: one kinematics pass, no dynamics."""
+    kin = KinematicState(robot.model, robot.data, np.asarray(q, float), np.zeros(robot.model.nv))
+    J = twist.jacobian(kin)
+    A = ConstraintRows.stack([c.jacobian(kin) for c in robot.constraints], robot.model.nv).A
+    return project_operational(A, J, twist.names)
 
 
 def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
@@ -152,22 +166,25 @@ def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
     q = np.asarray(q, float)
     nu = np.asarray(nu, float)
     kin0 = KinematicState(model, data, q, np.zeros(model.nv))
-    rows0 = robot.constraint_rows(kin0)
-    J, _ = twist.rows(kin0)
+    rows0 = ConstraintRows.stack([c.jacobian(kin0) for c in robot.constraints], model.nv)
+    J = twist.jacobian(kin0)
     proj = project_operational(rows0.A, J, twist.names)
     S = proj.S
     v = S @ nu
-    kin = KinematicState(model, data, q, v)
-    rows = robot.constraint_rows(kin)
-    _, Jdot = twist.rows(kin)
+    kin = kin0.with_velocity(v)
+    _, Jdot = twist.rows(kin)  # before the constraints touch the shared data
+    drift = np.concatenate([c.drift(kin) for c in robot.constraints]) if robot.constraints else np.zeros(0)
     B = input_matrix(robot.motors, kin)
-    w = proj.offset(rows.Adot @ v, Jdot @ v)
+    w = proj.offset(drift, Jdot @ v)
+    full_rows = lambda: robot.constraint_rows(kin)  # noqa: E731  (computed on first access)
+    if coriolis:
+        full_rows = full_rows()
     M = pin.crba(model, data, q)
     g = pin.computeGeneralizedGravity(model, data, q)
     h = S.T @ pin.rnea(model, data, q, v, w)
-    out = ReducedDynamics(S.T @ M @ S, h, S.T @ g, S.T @ B, S, w, v, proj, rows)
+    out = ReducedDynamics(S.T @ M @ S, h, S.T @ g, S.T @ B, S, w, v, proj, rows0, _full_rows=full_rows)
     if coriolis:
-        Sdot = proj.Sdot(rows.Adot, Jdot)
+        Sdot = proj.Sdot(full_rows.Adot, Jdot)
         C = pin.computeCoriolisMatrix(model, data, q, v)
         out.C = S.T @ (M @ Sdot + C @ S)
         out.Sdot = Sdot
@@ -204,6 +221,10 @@ class OperationalModel:
     def __repr__(self) -> str:
         return f"OperationalModel({self.twist!r})"
 
+    def projection(self, robot, q) -> OperationalProjection:
+        """S(q) only (cheaper than :meth:`reduce` when no dynamics is needed, e.g. kinematic integration)."""
+        return operational_projection(robot, self.twist, q)
+
     def reduce(self, robot, q, nu, coriolis: bool = False) -> ReducedDynamics:
         nu = np.asarray(nu, float)
         if nu.shape != (len(self.names),):
@@ -211,5 +232,5 @@ class OperationalModel:
         return reduce_operational(robot, self.twist, q, nu, coriolis)
 
 
-__all__ = ["FrameTwist", "OperationalProjection", "project_operational", "reduce_operational",
+__all__ = ["FrameTwist", "OperationalProjection", "project_operational", "operational_projection", "reduce_operational",
            "OperationalVelocities", "OperationalModel"]

@@ -224,3 +224,66 @@ def test_noc_dependent_rates_satisfy_eq_A7(robot):
         dep = np.array([rates[1][0], rates[1][2], rates[2][0], rates[2][2], rates[3][0], rates[3][1]])
         ind = np.array([rates[1][1], rates[2][1], rates[3][2]])
         assert np.abs(Jp @ dep - Ja @ ind).max() < 1e-9
+
+
+# ------------------------------------------------------------------------------------------ priority 4
+def test_beta_profile_is_eq61():
+    T = 60.0
+    a3, a4, a5 = 20 * np.pi / 60**3, -30 * np.pi / 60**4, 12 * np.pi / 60**5  # the paper's coefficients
+    t = np.linspace(0, T, 37)
+    b, bd, bdd = oc.beta_profile(t, T)
+    np.testing.assert_allclose(b, a3 * t**3 + a4 * t**4 + a5 * t**5, atol=1e-13)
+    np.testing.assert_allclose(bd, 3 * a3 * t**2 + 4 * a4 * t**3 + 5 * a5 * t**4, atol=1e-13)
+    np.testing.assert_allclose(bdd, 6 * a3 * t + 12 * a4 * t**2 + 20 * a5 * t**3, atol=1e-13)
+    assert abs(b[-1] - 2 * np.pi) < 1e-12 and abs(bd[-1]) < 1e-12 and abs(bd[0]) < 1e-15
+
+
+@pytest.mark.parametrize("kind", ["circle", "ellipse"])
+def test_path_twist_is_body_frame_derivative_of_pose(kind):
+    t = np.linspace(0.5, oc.CIRCLE["T"] - 0.5 if kind == "circle" else oc.ELLIPSE["T"] - 0.5, 23)
+    dt = 1e-5
+    st, sp, sm = (oc.path_state(kind, x) for x in (t, t + dt, t - dt))
+    dpose = (sp["pose"] - sm["pose"]) / (2 * dt)
+    psi = st["pose"][:, 2]
+    vb = np.stack([np.cos(psi) * dpose[:, 0] + np.sin(psi) * dpose[:, 1],
+                   -np.sin(psi) * dpose[:, 0] + np.cos(psi) * dpose[:, 1], dpose[:, 2]], axis=1)
+    np.testing.assert_allclose(st["nu"], vb, atol=1e-8)
+    np.testing.assert_allclose(st["nudot"], (sp["nu"] - sm["nu"]) / (2 * dt), atol=1e-8)
+    assert np.abs(st["nu"][:, 0]).max() < 1e-15  # moving along +j
+
+
+def test_steady_steering_zeroes_the_model_steering_rates(robot):
+    rng = np.random.default_rng(13)
+    idx = [robot.coordinate_index(f"phi{i}") for i in oc.CHAINS]
+    for _ in range(10):
+        u = rng.normal(size=3) * [1, 1, 0.5]
+        for trailing in (True, False):
+            phi = oc.steady_steering(robot.params, u, trailing)
+            v = robot.reduced(oc.steering_configuration(robot, phi), u).v
+            assert np.abs(v[idx]).max() < 1e-10
+
+
+@pytest.mark.parametrize("kind, t_end", [("circle", 12.0), ("ellipse", 8.0)])
+def test_inverse_dynamics_power_balance(robot, kind, t_end):
+    pl = oc.plan(robot, kind, n=25, t_end=t_end, rtol=1e-10)
+    ix = [robot.coordinate_index(c) for c in ("x", "y", "psi")]
+    assert np.abs(pl["q"][:, ix] - pl["pose"]).max() < 1e-6  # integrated twist reproduces the prescribed path
+    F = oc.operational_forces(robot, pl)
+    power = np.einsum("ij,ij->i", F, pl["nu"])
+    dt = 1e-3
+    for k, t in enumerate(pl["t"][1:-1], start=1):
+        ep = oc.kinetic_energy(robot, pl["sol"].sol(t + dt), oc.path_state(kind, t + dt)["nu"])
+        em = oc.kinetic_energy(robot, pl["sol"].sol(t - dt), oc.path_state(kind, t - dt)["nu"])
+        assert abs((ep - em) / (2 * dt) - power[k]) < 1e-6 * np.abs(power).max() + 1e-9
+    assert np.abs(power).max() > 1e-3
+
+
+def test_circle_scenario_feedforward_follows_plan(robot):
+    from robotdyn.simulation import power
+
+    sc = oc.SCENARIOS["circle"]
+    tr = sc.run(robot, t_end=4.0, n_out=9, progress=False)
+    st = oc.path_state("circle", tr.t)
+    assert np.abs(tr.nu - st["nu"]).max() < 1e-7
+    P = power(robot, tr, sc.torque_law(robot))
+    assert np.all(np.diff(tr.energy) > 0) and P.max() > 0

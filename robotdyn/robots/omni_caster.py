@@ -27,6 +27,7 @@ from ..comparison import Comparison
 from ..errors import InputError, SingularConstraintError
 from ..operational_space import OperationalVelocities
 from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from ..scenario import Scenario
 
 CHAINS = (1, 2, 3)
 NU_NAMES = ["v_cx", "v_cy", "omega"]
@@ -264,3 +265,190 @@ def noc_report(robot: Robot, noc: Robot, phi) -> dict:
     except SingularConstraintError as exc:
         out["noc_error"], out["noc_condition"] = str(exc), exc.condition
     return out
+
+
+# ------------------------------------------------------------------------------------ trajectories (sec 5)
+CIRCLE = {"R": 5.0, "T": 60.0}
+"""Section 5: circular path of radius 5 m in 60 s (Figs. 5-12)."""
+ELLIPSE = {"A": 3.0, "B": 1.0, "T": 30.0}
+"""Section 5: elliptic path with radii 3 m and 1 m in 30 s (Figs. 13-15)."""
+
+
+def beta_profile(t, T: float, total: float = 2 * np.pi) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Eq (61): beta(t) = a3 t^3 + a4 t^4 + a5 t^5, rest to rest from 0 to ``total`` in T s.
+
+    With total = 2 pi and T = 60 s the coefficients are the paper's a3 = 20 pi / 60^3, a4 = -30 pi / 60^4,
+    a5 = 12 pi / 60^5. Returns (beta, beta', beta'') [rad, rad/s, rad/s^2]; constant outside [0, T].
+    """
+    s = np.clip(np.asarray(t, float) / T, 0.0, 1.0)
+    inside = (np.asarray(t, float) >= 0) & (np.asarray(t, float) <= T)
+    b = total * (10 * s**3 - 15 * s**4 + 6 * s**5)
+    bd = total * (30 * s**2 - 60 * s**3 + 30 * s**4) / T * inside
+    bdd = total * (60 * s - 180 * s**2 + 120 * s**3) / T**2 * inside
+    return b, bd, bdd
+
+
+def path_state(kind: str, t, params: dict | None = None) -> dict:
+    """Prescribed platform motion of section 5 at time(s) t.
+
+    Assumptions (the paper leaves them open; Fig. 5 is not legible): the platform moves along its own +j axis
+    (the printed with-wheel inertia, large in y, implies wheels rolling along j), counter-clockwise, from the
+    origin with heading psi = 0; on the circle i points radially outward and psi = beta (the paper: "beta, the
+    angle between the global X-axis and the local unit vector i"), centre (-R, 0); on the ellipse
+    C = (A (cos beta - 1), B sin beta) with j along the tangent (psi = tangent angle - pi/2) and beta from eq (61)
+    with T = 30 s.
+
+    Returns:
+        dict with ``pose`` (x, y, psi), ``nu`` = u' = (v_cx, v_cy, omega) in body axes and ``nudot`` = u''
+        (time derivative of the body components), each (..., 3).
+    """
+    t = np.asarray(t, float)
+    if kind == "circle":
+        c = {**CIRCLE, **(params or {})}
+        R = c["R"]
+        b, bd, bdd = beta_profile(t, c["T"])
+        pose = np.stack([-R + R * np.cos(b), R * np.sin(b), b], axis=-1)
+        nu = np.stack([0 * b, R * bd, bd], axis=-1)
+        nudot = np.stack([0 * b, R * bdd, bdd], axis=-1)
+    elif kind == "ellipse":
+        c = {**ELLIPSE, **(params or {})}
+        A, B = c["A"], c["B"]
+        b, bd, bdd = beta_profile(t, c["T"])
+        sb, cb = np.sin(b), np.cos(b)
+        q2 = A**2 * sb**2 + B**2 * cb**2
+        speed = np.sqrt(q2)  # ds/dbeta
+        dspeed = (A**2 - B**2) * sb * cb / speed
+        kappa = A * B / q2  # dpsi/dbeta
+        dkappa = -A * B * 2 * (A**2 - B**2) * sb * cb / q2**2
+        tangent = np.unwrap(np.arctan2(B * cb, -A * sb), axis=-1) if b.ndim else np.arctan2(B * cb, -A * sb)
+        psi = tangent - np.pi / 2
+        pose = np.stack([A * (cb - 1), B * sb, psi], axis=-1)
+        nu = np.stack([0 * b, speed * bd, kappa * bd], axis=-1)
+        nudot = np.stack([0 * b, dspeed * bd**2 + speed * bdd, dkappa * bd**2 + kappa * bdd], axis=-1)
+    else:
+        raise InputError(f"unknown path {kind!r}; expected 'circle' or 'ellipse'")
+    return {"pose": pose, "nu": nu, "nudot": nudot}
+
+
+def steady_steering(p: dict, u, trailing: bool = True) -> np.ndarray:
+    """Steering angles (phi1, phi2, phi3) [rad] at which every steering rate vanishes for the body twist u.
+
+    Geometry (independent of the model's Jacobians): the wheel centre O_i = A_i + d e_i must move along e_i
+    (e_i the unit vector A_i -> O_i, at angle -phi_i in platform axes), i.e. (v_A x e)_z = omega d. ``trailing``
+    picks the root with the wheel behind its steering axis (a passive caster's stable alignment).
+    """
+    vx, vy, w = np.asarray(u, float)
+    out = np.zeros(3)
+    for i in CHAINS:
+        ax, ay = _anchor(p, i)
+        Ax, Ay = -ax, -ay  # A_i in platform axes (A_iC = -A_i)
+        vA = np.array([vx - w * Ay, vy + w * Ax])
+        speed = np.hypot(*vA)
+        if speed <= abs(w) * p["d"]:
+            raise InputError(f"no steady steering for caster {i}: |v_A| = {speed:.3g} <= |omega| d; the "
+                             "instantaneous centre lies inside the caster's circle")
+        gamma = np.arctan2(vA[1], vA[0])
+        delta = np.arcsin(w * p["d"] / speed)
+        alpha = gamma + np.pi - delta if trailing else gamma + delta
+        out[i - 1] = np.angle(np.exp(-1j * alpha))
+    return out
+
+
+def plan(robot: Robot, kind: str, n: int = 301, params: dict | None = None, rtol: float = 1e-10,
+         t_end: float | None = None) -> dict:
+    """The section-5 manoeuvre integrated through the model's kinematics (the paper integrates eq 15-17).
+
+    Initial steering: :func:`steady_steering` for the body twist direction at t = 0+ (the circle's then stays
+    constant: the paper's "keeps the original configuration"). q' = S(q) u'(t) is integrated with
+    ``solve_ivp`` (DOP853); the platform pose that results must equal the prescribed one (checked in the tests).
+
+    Returns:
+        dict with ``t`` (n,), ``q`` (n, nq), ``nu``, ``nudot`` (n, 3), ``pose`` (n, 3, prescribed), ``sol`` (dense).
+        ``t_end`` (default T) stops early (a section of the manoeuvre).
+    """
+    from scipy.integrate import solve_ivp
+
+    c = {**(CIRCLE if kind == "circle" else ELLIPSE), **(params or {})}
+    T = c["T"]
+    direction = path_state(kind, 0.5 * T, params)["nu"]
+    if kind == "ellipse":  # direction of the twist at the start (curvature A/B^2 at beta = 0)
+        direction = np.array([0.0, c["B"], c["A"] / c["B"]])
+    q0 = steering_configuration(robot, steady_steering(robot.params, direction))
+
+    def rhs(t, q):
+        return robot.operational.projection(robot, q).S @ path_state(kind, t, params)["nu"]
+
+    t_end = T if t_end is None else t_end
+    sol = solve_ivp(rhs, (0.0, t_end), q0, method="LSODA", rtol=rtol, atol=rtol, dense_output=True)
+    t = np.linspace(0.0, t_end, n)
+    st = path_state(kind, t, params)
+    return {"t": t, "q": sol.sol(t).T, "nu": st["nu"], "nudot": st["nudot"], "pose": st["pose"], "sol": sol,
+            "kind": kind, "params": c}
+
+
+def operational_forces(robot: Robot, pl: dict) -> np.ndarray:
+    """Eq (47) along a plan: T_u = I_uu* u'' + u'^T P_uuu* u' (F_x, F_y [N], M_z [N m]) at each sample (n, 3)."""
+    out = np.zeros((len(pl["t"]), 3))
+    for k in range(len(pl["t"])):
+        red = robot.reduced(pl["q"][k], pl["nu"][k])
+        out[k] = red.M @ pl["nudot"][k] + red.h
+    return out
+
+
+def kinetic_energy(robot: Robot, q: np.ndarray, nu: np.ndarray) -> float:
+    """Kinetic energy [J] of the whole mechanism (Pinocchio, full velocities v = S nu)."""
+    return robot.energy(q, robot.reduced(q, nu).v) - robot.energy(q, np.zeros(robot.nq))
+
+
+def wheel_mass_params(total: float, m_pl: float) -> dict:
+    """Parameters for the paper's sweep: three wheels of total mass ``total`` (each a disc of radius r:
+    axle inertia m r^2 / 2, diametral m r^2 / 4 -- Table 2's values at 0.5 kg), platform mass ``m_pl``;
+    offset links as Table 2."""
+    r = SPEC.parameter("r").default
+    m = total / 3.0
+    return {"m_pl": m_pl, "m_wheel": m, "I_wheel_axle": m * r**2 / 2, "I_wheel_diam": m * r**2 / 4}
+
+
+class PathScenario(Scenario):
+    """A section-5 path followed by feed-forward motor torques (inverse dynamics of the model, eq 47).
+
+    The six motors (three drives, three steering) produce T_u = B_r tau; tau is the least-squares (minimum-norm)
+    solution of B_r(q) tau = I_uu*(q) u''(t) + u'^T P_uuu*(q) u' at the simulated state, so the platform
+    twist follows the plan while the casters self-align kinematically. Initial steering: :func:`steady_steering`.
+    """
+
+    def __init__(self, kind: str, description: str, t_end: float) -> None:
+        super().__init__(kind, description, t_end, plot=list(NU_NAMES))
+        self.kind = kind
+
+    def initial_state(self, robot) -> tuple[np.ndarray, np.ndarray]:
+        c = CIRCLE if self.kind == "circle" else ELLIPSE
+        u = np.array([0.0, c["R"], 1.0]) if self.kind == "circle" else np.array([0.0, c["B"], c["A"] / c["B"]])
+        return steering_configuration(robot, steady_steering(robot.params, u)), np.zeros(3)
+
+    def torque_law(self, robot):
+        """tau(t, q, nu) for ``robot``."""
+        def torque(t, q, nu):
+            red = robot.reduced(q, nu)
+            T_u = red.M @ path_state(self.kind, t)["nudot"] + red.h
+            return np.linalg.lstsq(red.B, T_u, rcond=None)[0]
+        return torque
+
+    def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
+        from ..simulation import simulate
+
+        q0, nu0 = self.initial_state(robot)
+        t_end = self.t_end if t_end is None else t_end
+        n_out = n_out or max(2, int(round(self.n_out * t_end / self.t_end)))
+        kwargs.setdefault("method", "LSODA")
+        kwargs.setdefault("rtol", 1e-9)
+        kwargs.setdefault("atol", 1e-9)
+        return simulate(robot, t_end, q0, nu0, self.torque_law(robot), n_out=n_out, **kwargs)
+
+
+SCENARIOS = {
+    "circle": PathScenario("circle", "sec 5: circle R = 5 m in 60 s, beta of eq 61, feed-forward torques "
+                           "(inverse dynamics), body moving along +j", CIRCLE["T"]),
+    "ellipse": PathScenario("ellipse", "sec 5: ellipse 3 m x 1 m in 30 s, beta of eq 61, feed-forward torques, "
+                            "j along the tangent", ELLIPSE["T"]),
+}

@@ -13,6 +13,7 @@ local server (``Viewer.url``) and mirrors every command to it, for interactive u
 
 Animations use meshcat's (three.js) keyframe animations, so they play in the browser in real time: a trajectory
 sample at time t [s] becomes a key at frame ``(t - t0) * fps``, which three.js plays at ``frame / fps`` seconds.
+An export opened as ``page.html#t=1.5`` shows the animation paused at 1.5 s (the controls menu resumes it).
 
 World frame: z up, metres. The camera looks at the world origin (meshcat 0.3.2 cannot move the orbit target).
 
@@ -156,6 +157,14 @@ for (var i = 0; i < robotdyn_commands.length; i++) {{
   viewer.handle_command_bytearray(b);
 }}
 console.log("robotdyn: applied " + robotdyn_commands.length + " scene commands");
+// page.html#t=SECONDS opens an animation paused at that time
+var robotdyn_t = /[#&]t=([-+0-9.eE]+)/.exec(location.hash);
+if (robotdyn_t && viewer.animator.actions.length > 0) {{
+  viewer.animator.pause();
+  viewer.animator.seek(parseFloat(robotdyn_t[1]));
+  viewer.animator.display_progress(parseFloat(robotdyn_t[1]));
+  console.log("robotdyn: animation paused at t = " + parseFloat(robotdyn_t[1]) + " s");
+}}
 </script>
 </body>
 </html>
@@ -384,6 +393,7 @@ class Viewer:
         """
         q = self._check_q(q)
         self.q = q.copy()
+        self._reach = float(np.linalg.norm(self._geometry_points(q).mean(axis=0)))
         self._pin.display(q)
         for path, T in self.placements(q).items():
             if not path.startswith(self._visual_prefix):
@@ -391,19 +401,22 @@ class Viewer:
 
     def set_camera(self, direction=(1.0, 1.3, 0.9), distance: float | None = None) -> None:
         """Place the camera along ``direction`` (world frame) from the world origin, at ``distance`` [m]
-        (default: 2.6 times the robot's size, so it fills about half the view). It looks at the origin."""
+        (default: 2.6 times the robot's size plus the largest distance of the robot's centre from the origin in
+        the configuration displayed or the animation, so the robot stays in view). It looks at the origin.
+        :meth:`display` does not move the camera (call this again after it); :meth:`animate` re-frames it unless
+        told not to."""
         d = np.asarray(direction, dtype=float)
         if d.shape != (3,) or not np.all(np.isfinite(d)) or np.linalg.norm(d) == 0:
             raise InputError(f"camera direction {np.asarray(direction).tolist()}; expected a non-zero 3-vector")
         if distance is None:
-            centre_dist = float(np.linalg.norm(self._geometry_points(self.q).mean(axis=0)))
-            distance = 2.6 * self._size + centre_dist
+            distance = 2.6 * self._size + self._reach
         p = d / np.linalg.norm(d) * float(distance)
         self.camera_position = p
         # meshcat's camera node is rotated (three.js y up): world (x, y, z) is (x, z, -y) there
         self.vis["/Cameras/default/rotated/<object>"].set_property("position", [p[0], p[2], -p[1]])
 
-    def animate(self, trajectory, fps: float = 30.0, play: bool = True, repetitions: int = 1) -> None:
+    def animate(self, trajectory, fps: float = 30.0, play: bool = True, repetitions: int = 1,
+                reframe: bool = True) -> None:
         """Animate a trajectory in real time (meshcat keyframe animation; the controls menu has play/pause, a
         time scrubber and a time scale).
 
@@ -414,6 +427,7 @@ class Viewer:
                 times t0 + k / fps (and the last sample time).
             play: Start playing when the page opens.
             repetitions: How many times it plays.
+            reframe: Move the camera (:meth:`set_camera`) so the whole motion stays in view.
         """
         mc = _meshcat()
         if isinstance(trajectory, tuple):
@@ -437,6 +451,10 @@ class Viewer:
                 for path, T in self.placements(qk).items():
                     frame[path].set_transform(T)
         self.display(Qs[0])
+        self._reach = max(float(np.linalg.norm(self._geometry_points(np.asarray(qk)).mean(axis=0)))
+                          for qk in Qs[:: max(1, len(Qs) // 50)].tolist() + [Qs[-1]])
+        if reframe:
+            self.set_camera()
         self.vis.set_animation(anim, play=play, repetitions=repetitions)
 
     @staticmethod

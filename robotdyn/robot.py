@@ -25,7 +25,7 @@ from .inputs import as_vector
 from .loop_closure import LoopClosure
 from .projection import auto_independent
 from .reduced_dynamics import ReducedDynamics, reduce
-from .rolling_contact import OmniWheel, RollingWheel
+from .rolling_contact import OmniWheel, RollingWheel, SupportWheel
 from .terrain import FlatTerrain, Terrain
 
 
@@ -211,8 +211,10 @@ class Robot:
         kw["terrain"] = self.terrain
         if w.kind == "omni":
             return OmniWheel(self.description, w.frame, self._value(w.radius), self._value(w.roller_angle), **kw)
+        if w.kind == "support":
+            return SupportWheel(self.description, w.frame, self._value(w.radius), **kw)
         if w.kind != "standard":
-            raise InputError(f"wheel {w.frame!r}: kind {w.kind!r}; expected 'standard' or 'omni'")
+            raise InputError(f"wheel {w.frame!r}: kind {w.kind!r}; expected 'standard', 'omni' or 'support'")
         return RollingWheel(self.description, w.frame, self._value(w.radius), **kw)
 
     # ------------------------------------------------------------------------------------------ coordinates

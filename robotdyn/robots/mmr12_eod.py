@@ -21,6 +21,7 @@ and the comparison.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 import numpy as np
 
@@ -380,3 +381,224 @@ def register_cli(subparsers, parents) -> None:
     from ..kinematics import register_fk_cli
 
     register_fk_cli(subparsers, parents)
+
+
+# ------------------------------------------------------------------------------------- control scenarios
+LOOK_AHEAD = 0.565
+"""Distance [m] of the controlled point P ahead of C on the platform's axis: the output of the linearising
+feedback (C itself cannot be: a differential drive's axle centre has a singular decoupling matrix); the paper's
+"ideal diameter of 1,130 mm" (sec 2.11 a) is read as the circle P sweeps when the platform turns on the spot."""
+
+GAINS = {"kp": 4.0, "kd": 4.0, "damping": 2.0}
+"""Eq 25 gains K_p [1/s^2], K_d [1/s] (not printed in the paper: critically damped, natural frequency 2 rad/s)."""
+
+
+def _quintic(t: float, T: float, a, b) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A rest-to-rest quintic from a to b over [0, T] (value, rate, acceleration)."""
+    a, b = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
+    s = min(max(t / T, 0.0), 1.0)
+    inside = 0.0 < t < T
+    p = 10 * s**3 - 15 * s**4 + 6 * s**5
+    dp = (30 * s**2 - 60 * s**3 + 30 * s**4) / T if inside else 0.0
+    ddp = (60 * s - 180 * s**2 + 120 * s**3) / T**2 if inside else 0.0
+    return a + (b - a) * p, (b - a) * dp, (b - a) * ddp
+
+
+def table4_reference(name: str, omega: float = 0.5) -> Callable:
+    """Table 4's platform references as t -> (p_d, p_d', p_d'') of the controlled point [m]:
+    ``orientation`` (turning about the centre x = y = 0: P on a circle of radius LOOK_AHEAD at omega rad/s),
+    ``straight`` (x = 30, y = t), ``sinusoid`` (x = 40 cos 0.25t + 2.5t, y = 30 sin 0.25t)."""
+    L = LOOK_AHEAD
+    if name == "orientation":
+        return lambda t: (L * np.array([np.cos(omega * t), np.sin(omega * t)]),
+                          L * omega * np.array([-np.sin(omega * t), np.cos(omega * t)]),
+                          -L * omega**2 * np.array([np.cos(omega * t), np.sin(omega * t)]))
+    if name == "straight":
+        return lambda t: (np.array([30.0, t]), np.array([0.0, 1.0]), np.zeros(2))
+    if name == "sinusoid":
+        return lambda t: (np.array([40 * np.cos(0.25 * t) + 2.5 * t, 30 * np.sin(0.25 * t)]),
+                          np.array([-10 * np.sin(0.25 * t) + 2.5, 7.5 * np.cos(0.25 * t)]),
+                          np.array([-2.5 * np.cos(0.25 * t), -1.875 * np.sin(0.25 * t)]))
+    raise InputError(f"unknown Table 4 trajectory {name!r}; expected orientation, straight or sinusoid")
+
+
+def _hold_task(robot: Robot, labels, q0):
+    from ..control import CoordinateTask, hold
+
+    return CoordinateTask(list(labels), hold([q0[robot.coordinate_index(c)] for c in labels]))
+
+
+def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
+    """Eqs 23-25 for a Table 4 trajectory: P tracks the reference, every other actuated joint holds its value."""
+    from ..control import LinearisingController, PointTask
+
+    q0 = robot.neutral() if q0 is None else q0
+    others = [c for c in ACTUATED if c not in ("theta_R", "theta_L")]
+    tasks = [PointTask("C", table4_reference(name), offset=(LOOK_AHEAD, 0.0, 0.0), axes=(0, 1)),
+             _hold_task(robot, others, q0)]
+    return LinearisingController(robot, tasks, **GAINS)
+
+
+def platform_initial(robot: Robot, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Start on the reference: P at p_d(0), heading along p_d'(0) (or along +x at rest), wheels rolling at the
+    reference speed (at rest for the orientation task)."""
+    pd, vd, _ = table4_reference(name)(0.0)
+    speed = float(np.linalg.norm(vd))
+    psi = float(np.arctan2(vd[1], vd[0])) if name != "orientation" else 0.0
+    c = pd - LOOK_AHEAD * np.array([np.cos(psi), np.sin(psi)])
+    q0 = state(robot, x=c[0], y=c[1], psi=psi)
+    nu0 = np.zeros(robot.mobility)
+    if name != "orientation":
+        for w in ("theta_R_dot", "theta_L_dot"):
+            nu0[robot.velocity_names.index(w)] = speed / robot.params["lambda_C0"]
+    return q0, nu0
+
+
+MANIPULATION_TARGET = np.array([2.0, 2.0, 1.5])
+"""Sec 3 / Fig. 9: the target on the wall at x = 2, y = 2, z = 1.5 m (robot placed at 45 degrees)."""
+
+
+def manipulation_goal(robot: Robot, q0: np.ndarray | None = None):
+    """A final configuration putting E on MANIPULATION_TARGET: numerical IK over (x, y, theta3) with the heading
+    kept and the boom raised to theta1 = 2.7 rad, lambda2 = 1.1 m (inside the joint ranges)."""
+    from ..kinematics import position_ik
+
+    q0 = manipulation_initial(robot)[0] if q0 is None else q0
+    guess = q0.copy()
+    guess[robot.coordinate_index("theta1")] = 2.7
+    guess[robot.coordinate_index("lambda2")] = 1.1
+    return position_ik(robot, "E", MANIPULATION_TARGET, guess, ["x", "y", "theta3"])
+
+
+def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float = 10.0):
+    """End effector E to MANIPULATION_TARGET along a rest-to-rest quintic over T s (primary output, eq 25); arms,
+    theta4 and the load hold; in the null space, (theta1, lambda2, theta3) follow quintics to the IK goal posture
+    so that the joints stay in range and the platform drives the rest."""
+    from ..control import CoordinateTask, LinearisingController, PointTask
+    from ..kinematics import frame_pose
+
+    q0 = manipulation_initial(robot)[0] if q0 is None else q0
+    start = frame_pose(robot, q0, "E")[:3, 3]
+    goal = manipulation_goal(robot, q0)
+    if not goal.success:
+        raise InputError(f"manipulation target {MANIPULATION_TARGET.tolist()} not reachable (IK error {goal.error:.3g} m)")
+    arm = list(MANIPULATOR[:3])
+    idx = [robot.coordinate_index(c) for c in arm]
+    ref = lambda t: _quintic(t, T, start, MANIPULATION_TARGET)  # noqa: E731
+    posture = lambda t: _quintic(t, T, q0[idx], goal.q[idx])  # noqa: E731
+    held = [*(f"theta_C{i}" for i in _ARMS), "theta4", *LOAD]
+    return LinearisingController(robot, [PointTask("E", ref), _hold_task(robot, held, q0)],
+                                 secondary=[CoordinateTask(arm, posture)], **GAINS)
+
+
+def manipulation_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """At the origin, heading 45 degrees towards the wall target, arm in the neutral posture, at rest."""
+    return state(robot, psi=np.pi / 4), np.zeros(robot.mobility)
+
+
+# ------------------------------------------------------------------------------------------- lifting
+LIFT_END = 1.54
+"""Final arm angle [rad] of the lifting run: just short of pi/2, where d lambda_C / d theta_C = 0 (a dead point
+of the arms: the constraint block is singular there); lambda_C0 + Delta lambda_C = 0.5198 m (eq 30: 0.52)."""
+
+
+def lift_spec(spec: RobotSpec = SPEC) -> RobotSpec:
+    """The robot standing on its four lifting-arm tip wheels (frictionless supports, normal rows only), drive
+    wheels in the air: the lifting configuration of sec 2.11 d (Fig. 5)."""
+    return dataclasses.replace(
+        spec,
+        name=f"{spec.name}_lifting",
+        wheels=[Wheel(f"CS{i}", "r", axis=(0.0, 0.0, 1.0), kind="support", name=f"tip{i}") for i in _ARMS],
+        independent=["x", "y", "psi", "theta_R", "theta_L", "theta_C1", *MANIPULATOR, *LOAD],
+    )
+
+
+def lift_robot(robot: Robot | None = None) -> Robot:
+    """The lifting configuration of ``robot`` (same parameters)."""
+    params = robot.params if robot is not None else None
+    return Robot(lift_spec(robot.spec if robot is not None else SPEC), params)
+
+
+def contact_angle(p: dict) -> float:
+    """Arm angle [rad] at which the tip wheels touch the ground with the drive wheels still on it (eq 1 = 0)."""
+    return float(np.arcsin((p["lambda_C0"] - p["r"]) / p["l_cs1"]))
+
+
+def lifting_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """All four arms at the contact angle, lambda_C = 0, at rest."""
+    th = contact_angle(robot.params)
+    return state(robot, lambda_C=0.0, **{f"theta_C{i}": th for i in _ARMS}), np.zeros(robot.mobility)
+
+
+def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
+    """Arm 1 (the others follow through the contacts) along a quintic from the contact angle to ``end`` in T s,
+    the manipulator, load and wheels hold; x, y, psi are unactuated (free on frictionless tips)."""
+    from ..control import CoordinateTask, LinearisingController
+
+    q0 = lifting_initial(robot)[0]
+    th0 = contact_angle(robot.params)
+    tasks = [CoordinateTask(["theta_C1"], lambda t: _quintic(t, T, th0, end)),
+             _hold_task(robot, [*MANIPULATOR, *LOAD, "theta_R", "theta_L"], q0)]
+    return LinearisingController(robot, tasks, controlled=["theta_R", "theta_L", "theta_C1", *MANIPULATOR, *LOAD],
+                                 **GAINS)
+
+
+# ------------------------------------------------------------------------------------------- climbing
+def climbing_balance(robot: Robot, slope: float, mu: float | None = None) -> dict[str, float]:
+    """Static force balance on a slope (sec 2.11 e): F_climb = m g (sin psi + mu cos psi).
+
+    The gravity part is also taken from the model: the platform on a plane inclined by ``slope`` [rad] along its
+    heading is the flat-ground model with gravity tilted by the slope, and the reduced gravity of the two
+    wheel coordinates, (g_R + g_L) / R, is the force the wheels must push with to hold the robot (no climbing in the
+    simulator: the planar root keeps the platform parallel to the ground; rolling resistance mu N is not modelled).
+
+    Returns:
+        ``mass`` [kg], ``F_paper`` = m g (sin + mu cos) [N], ``F_gravity_paper`` = m g sin [N],
+        ``F_gravity_model`` [N], ``wheel_torque`` = F_paper R / 2 per drive wheel [N m].
+    """
+    import pinocchio as pin
+
+    if not np.isfinite(slope) or abs(slope) >= np.pi / 2:
+        raise InputError(f"slope = {slope} rad; expected |slope| < pi/2")
+    mu = robot.params["mu"] if mu is None else mu
+    g = robot.params["g"]
+    m = float(pin.computeTotalMass(robot.model))
+    saved = robot.model.gravity.linear.copy()
+    try:
+        robot.model.gravity.linear = g * np.array([-np.sin(slope), 0.0, -np.cos(slope)])
+        red = robot.reduced(state(robot, psi=0.0), np.zeros(robot.mobility))
+    finally:
+        robot.model.gravity.linear = saved
+    iR, iL = robot.velocity_names.index("theta_R_dot"), robot.velocity_names.index("theta_L_dot")
+    R = robot.params["lambda_C0"]
+    F = m * g * (np.sin(slope) + mu * np.cos(slope))
+    return {"mass": m, "F_paper": F, "F_gravity_paper": m * g * np.sin(slope),
+            "F_gravity_model": float((red.g[iR] + red.g[iL]) / R), "wheel_torque": F * R / 2}
+
+
+# ------------------------------------------------------------------------------------------- scenarios
+def _scenarios() -> dict:
+    from ..control import ControlledScenario
+
+    out = {}
+    for name, desc in (
+        ("orientation", "Table 4 task 1: turning about its centre (P on a 0.565 m circle at 0.5 rad/s), from rest"),
+        ("straight", "Table 4 task 2: straight line x = 30 m, y = t, started on the reference"),
+        ("sinusoid", "Table 4: x = 40 cos 0.25t + 2.5t, y = 30 sin 0.25t, started on the reference"),
+    ):
+        out[name] = ControlledScenario(
+            name, desc + " (eqs 23-25, 200 s)", 200.0, n_out=2001, plot=["x", "y", "psi"],
+            make_controller=lambda robot, name=name: platform_controller(robot, name, platform_initial(robot, name)[0]),
+            initial=lambda robot, name=name: platform_initial(robot, name))
+    out["manipulation"] = ControlledScenario(
+        "manipulation", "sec 3 / Fig. 9: end effector E to the wall target (2, 2, 1.5) m in 10 s (eqs 23-25)", 15.0,
+        n_out=301, plot=["x", "y", "theta1", "lambda2", "theta3"],
+        make_controller=lambda robot: manipulation_controller(robot), initial=manipulation_initial)
+    out["lifting"] = ControlledScenario(
+        "lifting", "sec 2.11 d: the four arms lift the platform from 0.15 to 0.52 m in 5 s (robot on the arm tips)",
+        6.0, n_out=121, plot=["lambda_C", "theta_C1", "theta_C2"],
+        adapt_robot=lift_robot, make_controller=lambda robot: lifting_controller(robot), initial=lifting_initial)
+    return out
+
+
+SCENARIOS = _scenarios()

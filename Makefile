@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench venv clean
+.PHONY: demo test bench venv clean chromium
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,8 +22,14 @@ demo: $(STAMP)
 	mkdir -p out
 	$(PY) -m robotdyn simulate quasimoro --scenario rectilinear --t-end 10 --csv out/quasimoro_rectilinear.csv --plot out/quasimoro_rectilinear.png
 
+## make chromium: Debian's chromium for the browser tests (tests/test_browser.py), installed if missing
+## (ROBOTDYN_SKIP_BROWSER=1 skips both the install and those tests)
+chromium:
+	@[ "$$ROBOTDYN_SKIP_BROWSER" = 1 ] || command -v chromium >/dev/null 2>&1 || { SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y chromium; }
+
 ## make test: install, then run the whole test suite, notebooks included
-test: $(STAMP)
+test: $(STAMP) chromium
 	$(PY) -m pytest -q tests
 	$(PY) -m pytest -q --nbmake notebooks
 

@@ -287,3 +287,86 @@ def test_circle_scenario_feedforward_follows_plan(robot):
     assert np.abs(tr.nu - st["nu"]).max() < 1e-7
     P = power(robot, tr, sc.torque_law(robot))
     assert np.all(np.diff(tr.energy) > 0) and P.max() > 0
+
+
+# ------------------------------------------------------------------------------------------ priority 5-6
+def test_impact_matches_eq60_and_restitution(robot):
+    from robotdyn.impulse import impact
+
+    rng = np.random.default_rng(21)
+    for phi, pose, nu in _states(20, 22):
+        M = robot.reduced(_q(robot, phi, pose), np.zeros(3)).M
+        n = rng.normal(size=3)
+        n /= np.linalg.norm(n)
+        if n @ nu >= 0:
+            nu = -nu
+        e = rng.uniform(0, 1)
+        res = impact(M, n, nu, e)
+        assert abs(res.magnitude - oc.paper_impulse(M, n, nu, e)) < 1e-12 * abs(res.magnitude)
+        assert abs(res.normal_after + e * res.normal_before) < 1e-12  # Newton's law on the normal velocity
+        # momentum: M (nu+ - nu-) = F n; tangential (M-orthogonal) part unchanged: kinetic energy loss >= 0
+        np.testing.assert_allclose(M @ res.delta_nu, res.magnitude * n, atol=1e-12)
+        assert 0.5 * res.nu_after @ M @ res.nu_after <= 0.5 * nu @ M @ nu + 1e-12
+
+
+def test_impact_bad_input():
+    from robotdyn.impulse import impact
+
+    M = np.eye(3)
+    for args in [(M, [0, 0, 0], [-1, 0, 0], 0.8), (M, [1, 0, 0], [-1, 0, 0], 1.5), (M, [1, 0], [-1, 0, 0], 0.5),
+                 (M, [1, 0, 0], [1, 0, 0], 0.5), (M, [1, 0, 0], [np.nan, 0, 0], 0.5)]:
+        with pytest.raises(InputError):
+            impact(*args)
+
+
+def test_impulse_ellipses(robot, bare):
+    curves = oc.impulse_ellipses(robot, samples=721)
+    assert set(curves) == {"fig16", "fig17", "fig18", "fig19"}
+    for name, (ang, mag) in curves.items():
+        assert np.all(np.isfinite(mag)) and mag.min() > 0
+    # Fig. 18: uniform; Figs. 16, 17: the largest impulse along the wheels' rolling direction
+    _, mag = curves["fig18"]
+    assert mag.max() / mag.min() - 1 < 1e-7
+    assert curves["fig16"][1].max() / curves["fig16"][1].min() > 1.3
+    for name, roll in (("fig16", 0.0), ("fig17", 135.0)):
+        ang, mag = curves[name]
+        assert abs(np.degrees(ang[np.argmax(mag)]) % 180 - roll) < 0.5
+    # without wheel dynamics always a circle of radius (1 + e) m_pl
+    for ang, mag in oc.impulse_ellipses(bare).values():
+        np.testing.assert_allclose(mag, 1.8 * 5.0, rtol=1e-12)
+
+
+def test_cli_impulse(capsys):
+    import json
+
+    from robotdyn.cli import main
+
+    assert main(["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "-1", "0", "0", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    robot = Robot(oc.SPEC)
+    M = robot.reduced(robot.neutral(), np.zeros(3)).M
+    assert abs(out["impulse"] - oc.paper_impulse(M, [-1, 0, 0], [1, 0, 0], 0.8)) < 1e-12
+    assert main(["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "1", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("robotdyn: error:") and err.count("\n") == 1
+    assert main(["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "1", "0", "0", "--e", "-1"]) == 2
+    assert main(["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "1", "0", "0", "--v", "1", "0", "0"]) == 2
+
+
+def test_cli_dump_and_compare(capsys):
+    from robotdyn.cli import main
+
+    assert main(["dump", "omni_caster", "--q", *["0.3"] * 9, "--v", "0.1", "0.2", "0.3"]) == 0
+    assert "v_cx" in capsys.readouterr().out
+    assert main(["compare", "omni_caster"]) == 0
+    table = capsys.readouterr().out
+    assert "eq 48" in table and "reproduced" in table
+
+
+def test_compare_verdicts(robot):
+    cmp = oc.compare(robot, states=20)
+    verdict = {r.quantity.split(":")[0]: r.verdict for r in cmp.rows}
+    assert verdict["eq 48"] == "reproduced"
+    assert verdict["eq 16 as printed"] == "differs"
+    assert verdict["eq 49 + derived offset-link terms (worst deviation)"] == "reproduced"
+    assert verdict["sec 5 printed with-wheel I_uu*"] == "differs"

@@ -452,3 +452,178 @@ SCENARIOS = {
     "ellipse": PathScenario("ellipse", "sec 5: ellipse 3 m x 1 m in 30 s, beta of eq 61, feed-forward torques, "
                             "j along the tangent", ELLIPSE["T"]),
 }
+
+
+# ------------------------------------------------------------------------------------ impulse (sec 4, Figs 16-19)
+IMPULSE_CONFIGS = {"fig16": (0.0, 0.0, 0.0), "fig17": (45.0, 45.0, 45.0), "fig18": (240.0, 120.0, 0.0),
+                   "fig19": (60.0, 135.0, 315.0)}
+"""Steering angles (phi1, phi2, phi3) [deg] of Figs. 16-19."""
+RESTITUTION = 0.8
+"""Coefficient of restitution of section 5's impulse study."""
+
+
+def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, samples: int = 361) -> dict:
+    """The impulse curves of Figs. 16-19: |F(a)| for unit-speed head-on impacts of the platform centre.
+
+    Returns:
+        {figure: (angles [rad], magnitudes [N s])} for :data:`IMPULSE_CONFIGS`.
+    """
+    from ..impulse import impulse_curve
+
+    out = {}
+    for name, deg in IMPULSE_CONFIGS.items():
+        M = robot.reduced(steering_configuration(robot, np.radians(deg)), np.zeros(3)).M
+        out[name] = impulse_curve(M, e, speed, (0, 1), samples)
+    return out
+
+
+def _cmd_impulse(args) -> int:
+    from ..cli import _emit, _load
+    from ..impulse import impact
+    from ..inputs import as_vector
+
+    _, robot = _load(args)
+    q = robot.check_q(args.q)
+    robot.check_constraints(q)
+    n = as_vector(args.direction, robot.mobility, "--direction", robot.velocity_names)
+    red = robot.reduced(q, np.zeros(robot.mobility))
+    if args.v is not None:
+        nu = robot.check_nu(args.v, "--v")
+    else:
+        if not (np.isfinite(args.speed) and args.speed > 0):
+            raise InputError(f"--speed {args.speed}; expected a positive speed")
+        nn = np.linalg.norm(n)
+        nu = (-args.speed * n / nn if nn > 0 else n) + 0.0  # + 0.0: no negative zeros in the output
+    res = impact(red.M, n, nu, args.e)
+    names = robot.velocity_names
+    out = {"robot": args.robot, "q": q, "direction": res.direction, "e": args.e, "nu_before": nu,
+           "impulse": res.magnitude, "effective_mass": res.effective_mass, "delta_nu": res.delta_nu,
+           "nu_after": res.nu_after, "normal_before": res.normal_before, "normal_after": res.normal_after}
+    text = [f"impulse along n = ({', '.join(f'{x:.6g}' for x in res.direction)}) in ({', '.join(names)}), "
+            f"e = {args.e:g} (Chung et al. eq 60):",
+            f"  F = {res.magnitude:.10g} N s   (effective mass {res.effective_mass:.10g} kg)",
+            f"  normal velocity {res.normal_before:.6g} -> {res.normal_after:.6g}",
+            *(f"  {nm:>8}: {a: .8g} -> {b: .8g}  (jump {c: .8g})"
+              for nm, a, b, c in zip(names, nu, res.nu_after, res.delta_nu))]
+    _emit(args, out, "\n".join(text))
+    return 0
+
+
+def register_cli(subparsers, parents) -> None:
+    """``robotdyn impulse ROBOT --q ... --direction ... [--e 0.8] [--speed 1 | --v ...]``."""
+    p = subparsers.add_parser("impulse", parents=parents,
+                              help="impulse of a frictionless impact on a fixed surface (eq 60 of Chung et al.)")
+    p.add_argument("--q", nargs="+", required=True, help="natural coordinates, in the order info lists them")
+    p.add_argument("--direction", nargs="+", required=True,
+                   help="surface normal n in the minimal coordinates (pointing from the surface to the robot)")
+    p.add_argument("--e", type=float, default=RESTITUTION, help="coefficient of restitution (default 0.8)")
+    p.add_argument("--speed", type=float, default=1.0, help="head-on approach speed along -n (default 1)")
+    p.add_argument("--v", nargs="+", help="velocity before impact in the minimal coordinates (instead of --speed)")
+    p.set_defaults(func=_cmd_impulse)
+
+
+# ------------------------------------------------------------------------------------------ comparison
+PRINTED_WITH_WHEELS = np.array([[5.4329, 0.0537, -0.00078], [0.0537, 7.5379, 0.0107], [-0.00078, 0.0107, 0.0397]])
+"""The with-wheel I_uu* printed in section 5 "at a configuration" (no configuration given)."""
+PRINTED_NO_WHEELS = np.diag([5.0, 5.0, 0.025])
+"""The no-wheel I_uu* printed in section 5."""
+
+
+def fit_printed_matrix(p: dict, free: tuple[str, ...] = (), starts: int = 60, seed: int = 0) -> dict:
+    """Least-squares search for steering angles (and optionally parameters ``free``) reproducing the printed
+    with-wheel I_uu* (6 independent entries) through the eq-48 transcription.
+
+    Returns:
+        dict with ``phi`` [rad], ``params`` (the fitted free ones), ``residual`` (entries, printed - fit) and
+        ``max_abs`` (largest |residual|).
+    """
+    from scipy.optimize import least_squares
+
+    iu = np.triu_indices(3)
+
+    def res(x):
+        pp = dict(p)
+        pp.update(zip(free, x[3:]))
+        return (paper_inertia(pp, x[:3]) - PRINTED_WITH_WHEELS)[iu]
+
+    rng = np.random.default_rng(seed)
+    best = None
+    for _ in range(starts):
+        x0 = np.r_[rng.uniform(-np.pi, np.pi, 3), [p[k] * rng.uniform(0.2, 4.0) for k in free]]
+        lb = np.r_[[-np.inf] * 3, [0.0] * len(free)]
+        s = least_squares(res, x0, bounds=(lb, np.inf))
+        if best is None or s.cost < best.cost:
+            best = s
+    r = res(best.x)
+    return {"phi": np.angle(np.exp(1j * best.x[:3])), "params": dict(zip(free, best.x[3:])), "residual": r,
+            "max_abs": float(np.abs(r).max())}
+
+
+def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Comparison:
+    """The paper's closed forms and printed numbers against the model (see ``docs/errata/omni_caster.md``).
+
+    Closed forms are compared at ``states`` random steering configurations (random pose too); each such row shows
+    the worst entry and uses a tolerance of 1e-10 (relative to the entries' scale for eq 15-17, whose entries
+    are O(1/r)).
+    """
+    robot = robot or Robot(SPEC)
+    p = robot.params
+    rng = np.random.default_rng(seed)
+    cmp = Comparison("Omni caster platform (Chung, Yi, Kim, Han): paper vs model")
+    worst = {k: 0.0 for k in ("I48", "G15", "G12", "G16p", "P49", "P49c")}
+    scale = 1.0 / min(p["d"], p["r"])
+    for _ in range(states):
+        phi = rng.uniform(-np.pi, np.pi, 3)
+        nu = rng.normal(size=3)
+        q = steering_configuration(robot, phi, *rng.uniform(-5, 5, 3))
+        red = robot.reduced(q, nu)
+        worst["I48"] = max(worst["I48"], np.abs(red.M - paper_inertia(p, phi)).max())
+        G = model_chain_jacobians(robot, q)
+        for i in CHAINS:
+            worst["G15"] = max(worst["G15"], np.abs(G[i] - paper_inverse(p, i, phi[i - 1])).max() / scale)
+            worst["G12"] = max(worst["G12"], np.abs(np.linalg.inv(G[i]) - paper_forward(p, i, phi[i - 1])).max())
+        worst["G16p"] = max(worst["G16p"], np.abs(G[2] - paper_inverse(p, 2, phi[1], corrected=False)).max() / scale)
+        worst["P49"] = max(worst["P49"], np.abs(red.h - paper_bias(p, phi, nu)).max())
+        worst["P49c"] = max(worst["P49c"], np.abs(red.h - paper_bias(p, phi, nu)
+                                                   - offset_link_correction(p, phi, nu)).max())
+    n = f"max over {states} random configurations"
+    cmp.add("eq 48: I_uu* (worst entry deviation)", 0.0, worst["I48"], 1e-10, n)
+    cmp.add("eq 12-14: G_phi^u (worst entry deviation)", 0.0, worst["G12"], 1e-10, n)
+    cmp.add("eq 15-17 (eq 16 corrected): G_u^phi (worst deviation x min(d, r))", 0.0, worst["G15"], 1e-10, n)
+    cmp.add("eq 16 as printed: G_u^phi of chain 2 (worst deviation x min(d, r))", 0.0, worst["G16p"], 1e-10,
+            "entry (1,3): printed +l/2 r cos(phi2), should be -l/2 r cos(phi2) (errata)")
+    cmp.add("eq 49 with P_phiphiphi* = 0: u'^T P_uuu* u' (worst deviation, |u'| ~ 1)", 0.0, worst["P49"], 1e-10,
+            "eq 43's constant inertia omits the offset link's velocity products when p != 0 (errata)")
+    cmp.add("eq 49 + derived offset-link terms (worst deviation)", 0.0, worst["P49c"], 1e-10, n)
+    bare = Robot(SPEC, {**robot.params, **NO_WHEELS})
+    Mb = bare.reduced(steering_configuration(bare, rng.uniform(-np.pi, np.pi, 3)), np.zeros(3)).M
+    for k, lab in enumerate(("xx", "yy", "omega omega")):
+        cmp.add(f"sec 5 printed no-wheel I_uu* {lab}", PRINTED_NO_WHEELS[k, k], Mb[k, k], 5e-4,
+                "printed to 3 decimals; eq 50 with m_pl = 5 kg, b = 0.1 m")
+    M = robot.reduced(robot.neutral(), np.zeros(3)).M
+    cmp.add("sec 5 printed with-wheel I_uu*: trace of xy block (steering-invariant)",
+            PRINTED_WITH_WHEELS[0, 0] + PRINTED_WITH_WHEELS[1, 1], M[0, 0] + M[1, 1], 5e-4,
+            "invariant under steering: no configuration reproduces the printed matrix with Table 1-2 values")
+    fit = fit_printed_matrix(p, starts=20)
+    cmp.add("sec 5 printed with-wheel I_uu*: best fit over steering angles (max |residual|)", 0.0, fit["max_abs"],
+            5e-4, "phi = (" + ", ".join(f"{np.degrees(x):.1f}" for x in fit["phi"]) + ") deg")
+    from ..impulse import impulse_curve
+
+    for name, deg in IMPULSE_CONFIGS.items():
+        Mi = robot.reduced(steering_configuration(robot, np.radians(deg)), np.zeros(3)).M
+        ang, mag = impulse_curve(Mi, RESTITUTION, 1.0, (0, 1), 721)
+        if name == "fig18":
+            cmp.add("Fig. 18 (240, 120, 0) deg: impulse curve max/min (paper: uniform)", 1.0, mag.max() / mag.min(),
+                    1e-7, "links tangential, 120-degree symmetry; 1 to 1e-15 with l = b sqrt(3), Table 1's "
+                    "rounded l = 0.173 breaks it at 1e-8")
+        elif name in ("fig16", "fig17"):
+            roll = (-np.radians(deg[0])) % np.pi  # the wheels' rolling direction (all links parallel)
+            peak = ang[np.argmax(mag)] % np.pi
+            cmp.add(f"Fig. {name[3:]} {deg} deg: direction of largest impulse [deg] (paper: moving direction)",
+                    np.degrees(roll), np.degrees(peak), 0.5, "rolling direction of the (parallel) wheels")
+    noc = Robot(noc_spec(), robot.params)
+    rep = noc_report(robot, noc, np.radians(IMPULSE_CONFIGS["fig16"]))
+    Jp, _ = paper_noc_jacobians(p, np.zeros(3))
+    cmp.add("sec 3.1: det J_p at Fig. 16 configuration (0,0,0) vs model NOC 1/condition", abs(np.linalg.det(Jp)),
+            1.0 / rep["noc_condition"], 1e-12, "NOC singular (SingularConstraintError); I_uu* finite")
+    return cmp

@@ -350,3 +350,17 @@ def test_cli_posture_dump_and_errors(capsys):
                  "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert abs(out["energy_end"] - out["energy_start"]) <= 1e-7 * out["energy_start"]
+
+
+def test_suspension_keeps_six_contacts_where_a_rigid_chassis_lifts_wheels(robot):
+    set_terrain(robot, ls.side_bump())
+    try:
+        post = solve_posture(robot, {"x": 0.5, "y": 0.0, "yaw": 0.0})
+        rigid = ls.rigid_chassis_posture(robot, 0.5)
+        gaps_susp, gaps_rigid = ls.contact_gaps(robot, post.q), ls.contact_gaps(robot, rigid)
+    finally:
+        set_terrain(robot, FlatTerrain())
+    assert np.max(np.abs(gaps_susp)) <= 1e-10
+    assert np.min(gaps_rigid) >= -1e-6  # resting, not sinking
+    assert np.sum(gaps_rigid <= 1e-5) >= 3  # on at least three wheels
+    assert np.max(gaps_rigid) > 0.03  # and with wheels lifted by centimetres

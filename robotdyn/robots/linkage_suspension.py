@@ -574,3 +574,69 @@ def register_cli(subparsers, parents) -> None:
     p.add_argument("--v", nargs=2, help="independent velocities phi2' phi5' [rad/s]: also print M_r, C_r, g_r")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="override a parameter")
     p.set_defaults(func=_cmd_posture)
+
+
+# ------------------------------------------------------------------------------ posture vs rigid chassis
+def side_bump(height: float = 0.06, x0: float = 0.0, length: float = 0.5, width: float = 0.12,
+              side_width: float = 0.04) -> Terrain:
+    """A smooth plateau of ``height`` [m] for x in [x0, x0 + length] under the right-hand wheels only (y < 0):
+    :math:`z = h\\,s(x)\\,\\tfrac12(1 - \\tanh(y / w_y))`, s a tanh plateau of ramp width ``width``."""
+    from ..terrain import FunctionTerrain
+
+    bx = BumpTerrain(height, x0, width, length)
+
+    def lat(y):
+        t = np.tanh(y / side_width)
+        return 0.5 * (1 - t), -0.5 * (1 - t * t) / side_width, t * (1 - t * t) / side_width**2
+
+    def f(x, y):
+        return bx.height(x, 0.0) * lat(y)[0]
+
+    def grad(x, y):
+        ly = lat(y)
+        return np.array([bx.gradient(x, 0.0)[0] * ly[0], bx.height(x, 0.0) * ly[1]])
+
+    def hess(x, y):
+        ly = lat(y)
+        fx, fxx = bx.gradient(x, 0.0)[0], bx.hessian(x, 0.0)[0, 0]
+        return np.array([[fxx * ly[0], fx * ly[1]], [fx * ly[1], bx.height(x, 0.0) * ly[2]]])
+
+    return FunctionTerrain(f, grad, hess)
+
+
+def contact_gaps(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Signed distance-like contact residuals of the six wheels (> 0: off the ground) [m]."""
+    kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
+    return np.array([c.rows(kin).residual[-1] for c in robot.constraints if c.name.startswith("wheel")])
+
+
+def rigid_chassis_posture(robot: Robot, x: float, y: float = 0.0, yaw: float = 0.0) -> np.ndarray:
+    """Posture of the same robot with its suspension locked at the nominal angles, resting on the terrain:
+    the lowest body height (minimum potential energy) over (z, pitch, roll) with no wheel below the surface.
+
+    Returns:
+        q with the suspension coordinates at their neutral values.
+    """
+    from scipy.optimize import minimize
+
+    from ..errors import ConstraintError
+
+    q = robot.neutral()
+    idx = [robot.coordinate_index(c) for c in ("z", "pitch", "roll")]
+    for c, v in (("x", x), ("y", y), ("yaw", yaw)):
+        q[robot.coordinate_index(c)] = v
+    q[idx[0]] += max(robot.terrain.height(x, y), 0.0) + 0.2
+
+    def full(p):
+        qq = q.copy()
+        qq[idx] = p
+        return qq
+
+    def com_z(p):
+        return pin.centerOfMass(robot.model, robot.data, full(p))[2]
+
+    res = minimize(com_z, q[idx], method="SLSQP", constraints=[{"type": "ineq", "fun": lambda p: contact_gaps(
+        robot, full(p))}], options={"ftol": 1e-12, "maxiter": 200})
+    if not res.success:
+        raise ConstraintError(f"rigid-chassis posture not found at x = {x}: {res.message}")
+    return full(res.x)

@@ -250,3 +250,30 @@ def test_cli_bad_wheel_is_one_line(tmp_path, capsys):
 
 def test_errors_are_robotdyn_errors():
     assert issubclass(ConstraintFileError, RobotDynError)
+
+
+def test_xacro_args_reach_the_description(tmp_path, capsys):
+    """--xacro-arg rho=0.4 (not a parameter of the file) sets the track l = r/rho of the Quasimoro xacro."""
+    path = write(tmp_path, BASE)
+    for rho in (0.5, 0.4):
+        robot = load_robot(path, xacro_args={"rho": str(rho)})
+        pin.framesForwardKinematics(robot.model, robot.data, robot.neutral())
+        y = robot.data.oMf[robot.model.getFrameId("wheel_A")].translation[1]
+        assert y == pytest.approx(0.3 / rho / 2, abs=1e-12)
+    assert main(["info", "--constraints", str(path), "--xacro-arg", "rho=0.4", "--json"]) == 0
+
+
+def test_terrain_and_wheel_kinds(tmp_path):
+    from robotdyn.rolling_contact import OmniWheel, RollingWheel
+    from robotdyn.terrain import RampTerrain
+
+    text = BASE.replace('name = "B"', 'name = "B"\nkind = "omni"\nroller_angle = 0.7').replace(
+        'name = "A"', 'name = "A"\nkind = "caster"') + '\n[terrain]\nkind = "ramp"\nslope = 0.1\n'
+    robot = load_robot(write(tmp_path, text))
+    assert isinstance(robot.terrain, RampTerrain) and robot.terrain.slope == 0.1
+    a, b = robot.constraints
+    assert type(a) is RollingWheel and isinstance(b, OmniWheel) and b.roller_angle == 0.7
+    msg = error_of(write(tmp_path, BASE + '\n[terrain]\nkind = "ramp"\nslop = 0.1\n', "t.toml"))
+    assert "terrain (ramp)" in msg and "did you mean 'slope'" in msg
+    msg = error_of(write(tmp_path, BASE.replace('radius = "r"', 'radius = "r"\nroller_angle = 0.1'), "u.toml"))
+    assert "roller_angle is only meaningful for kind = 'omni'" in msg

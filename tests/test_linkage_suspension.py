@@ -168,7 +168,7 @@ def test_plateau_under_one_wheel_within_travel_is_solved(robot):
 
 def test_wall_taller_than_the_suspension_reach_is_an_error(robot):
     # A 1 m wall under the front-right wheel: its centre would have to be 1 m above the middle wheel's, but the
-    # chain front wheel -> F -> D -> B2 -> middle wheel is at most 0.275 + 0.071 + 0.2 + 0.123 = 0.67 m long.
+    # chain front wheel -> F -> D -> B2 -> middle wheel is at most 0.266 + 0.071 + 0.2 + 0.123 = 0.66 m long.
     set_terrain(robot, _plateau(1.0, 0.22, 0.8, -0.8, -0.14, 0.02))
     try:
         with pytest.raises(ConstraintError, match="no posture found") as err:

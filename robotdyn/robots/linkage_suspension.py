@@ -443,9 +443,17 @@ def centroid_circle_radius(run: dict[str, np.ndarray]) -> float:
 
 
 def section3_comparison(cmp: Comparison, robot: Robot) -> dict[str, dict]:
-    """Section 3: straight line and pivot steering under the wheel-speed profile (Figs. 6-12)."""
-    straight = kinematic_run(robot, (1.0, 1.0))
-    pivot = kinematic_run(robot, (-1.0, 1.0))
+    """Section 3: straight line and pivot steering under the wheel-speed profile (Figs. 6-12), on flat ground
+    (the paper's XOZ plane)."""
+    from ..posture import set_terrain
+
+    old = robot.terrain
+    set_terrain(robot, FlatTerrain())
+    try:
+        straight = kinematic_run(robot, (1.0, 1.0))
+        pivot = kinematic_run(robot, (-1.0, 1.0))
+    finally:
+        set_terrain(robot, old)
     speed = np.linalg.norm(straight["vcom"], axis=1)
     travel = straight["com"][-1] - straight["com"][0]
     cmp.add("sec 3.1: peak centroid speed [m/s] (Fig. 8)", 0.73, speed.max(), 0.005,

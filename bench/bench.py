@@ -72,6 +72,19 @@ def main() -> None:
     print(f"\nquasimoro: sympy-lambdified model {t_sym * 1e6:.1f} us vs robotdyn {t_red * 1e6:.1f} us "
           f"(robotdyn {t_sym / t_red:.2f}x the speed of the lambdified oracle)")
 
+    from robotdyn.batch import evaluate
+
+    rng = np.random.default_rng(1)
+    N = 2000
+    Q = np.tile(q, (N, 1))
+    Q[:, robot.coordinate_index("theta3")] = rng.uniform(-1, 1, N)
+    NU = rng.normal(size=(N, robot.mobility))
+    for processes in (1, 2):
+        start = time.perf_counter()
+        evaluate(robot, Q, NU, processes=processes)
+        wall = time.perf_counter() - start
+        print(f"quasimoro batch API: {N} states with {processes} process(es): {N / wall:,.0f} states/s")
+
     print(f"\n{'robot / scenario':<36} {'sim [s]':>8} {'wall [s]':>9} {'sim/wall':>9} {'evals':>7} {'drift':>9}")
     for name, robot, _ in rows:
         mod = module(name)

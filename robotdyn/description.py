@@ -221,8 +221,9 @@ def lock_joints(model: pin.Model, visual: pin.GeometryModel, locked: dict[str, f
     """
     ids, q_ref = [], np.zeros(model.nq)
     for name, value in locked.items():
-        if name not in list(model.names)[1:]:
-            raise DescriptionError(f"locked joint {name!r} does not exist; joints are {', '.join(list(model.names)[1:])}")
+        names = list(model.names)[1:]
+        if name not in names:
+            raise DescriptionError(f"locked joint {name!r} does not exist; joints are {', '.join(names)}")
         jid = int(model.getJointId(name))
         i = int(model.joints[jid].idx_q)
         lo, hi = model.lowerPositionLimit[i], model.upperPositionLimit[i]

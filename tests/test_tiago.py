@@ -21,6 +21,7 @@ import pytest
 from oracles import diff_drive_sympy as oracle
 
 from robotdyn.constraint_file import read
+from robotdyn.errors import RobotDynError
 from robotdyn.simulation import simulate
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -221,3 +222,13 @@ def test_arm_moving_energy_is_conserved_without_torques(tiago_arm):
     # it did move: the arm joints and the heading changed
     assert abs(traj.column("arm_1_joint")[-1] - q0[tiago_arm.coordinate_index("arm_1_joint")]) > 0.1
     assert abs(traj.column("psi")[-1]) > 0.01
+
+
+def test_locked_value_outside_the_joint_range_is_one_line(tmp_path):
+    path = tmp_path / "tiago_bad.toml"
+    path.write_text((EXAMPLES / "tiago.toml").read_text().replace("torso_lift_joint = 0.15", "torso_lift_joint = 0.5"))
+    with pytest.raises(RobotDynError) as info:
+        read(path).robot()
+    msg = str(info.value)
+    assert "\n" not in msg and msg.startswith(str(path))
+    assert "locked joint 'torso_lift_joint' = 0.5 is outside its range [0, 0.35]" in msg

@@ -311,3 +311,112 @@ def test_eq5_does_not_invert_the_model(robot, ik_cases):
 def test_ik_bad_target_is_a_clear_error(robot):
     with pytest.raises(InputError, match="IK target"):
         position_ik(robot, "E", [1.0, np.nan, 1.0], robot.neutral(), ["x", "y"])
+
+
+# ---------------------------------------------------------------------------------- lifting and climbing
+@pytest.fixture(scope="module")
+def lifting_run(robot):
+    return mm.SCENARIOS["lifting"].run(robot, progress=False)
+
+
+def test_lifting_follows_eq26_and_reaches_052(lifting_run):
+    traj = lifting_run
+    rob = traj.stats["robot"]
+    lam = traj.column("lambda_C")
+    th = traj.q[:, [rob.coordinate_index(f"theta_C{i}") for i in mm._ARMS]]
+    ref = np.array([mm.paper_delta_lambda(rob.params, a) for a in th[:, 0]])
+    assert np.max(np.abs(lam - ref)) < 1e-7  # eq 1 / 26 along the whole lift (model's contact constraints)
+    assert np.max(np.abs(th - th[:, :1])) < 1e-7  # the four arms move together
+    assert lam[0] + rob.params["lambda_C0"] == pytest.approx(0.15, abs=1e-12)
+    assert lam[-1] + rob.params["lambda_C0"] == pytest.approx(0.52, abs=5e-4)  # eq 30 (dead point at pi/2)
+    assert np.max(np.abs(traj.q[:, [rob.coordinate_index(c) for c in ("x", "y", "psi")]])) < 1e-9
+    assert np.max(traj.residual) < 1e-7
+
+
+def test_lifting_energy_balance(lifting_run):
+    traj = lifting_run
+    rob, ctrl = traj.stats["robot"], traj.stats["controller"]
+    P = power(rob, traj, ctrl)
+    work = np.trapezoid(P, traj.t) if hasattr(np, "trapezoid") else np.trapz(P, traj.t)
+    gain = traj.energy[-1] - traj.energy[0]
+    assert gain > 0.9 * 98.7 * 9.81 * 0.36  # about m g times the lift of most of the mass
+    assert gain == pytest.approx(work, rel=2e-3)  # trapezoid rule on 121 samples
+
+
+def test_lift_configuration_dead_point_is_singular(robot):
+    lr = mm.lift_robot(robot)
+    q = mm.state(lr, lambda_C=0.37, **{f"theta_C{i}": np.pi / 2 for i in mm._ARMS})
+    with pytest.raises(RobotDynError, match=r"rank A = 1\); expected exactly the mobility"):
+        lr.reduced(q, np.zeros(lr.mobility))  # all four tip rows reduce to lambda_C' = 0: a change of mobility
+    q = mm.state(lr, lambda_C=0.3699, **{f"theta_C{i}": np.arcsin(0.3699 / 0.44 - 1e-12 + 0.07 / 0.44) for i in mm._ARMS})
+    assert lr.reduced(q, np.zeros(lr.mobility)).projection.condition > 30  # ill-conditioned near it
+
+
+def test_climbing_balance_gravity_part_from_the_model(robot):
+    for deg in (5.0, 20.0, 35.0):
+        out = mm.climbing_balance(robot, np.radians(deg))
+        m, g = pin.computeTotalMass(robot.model), robot.params["g"]
+        assert out["mass"] == pytest.approx(98.7, rel=1e-12)
+        assert out["F_gravity_model"] == pytest.approx(m * g * np.sin(np.radians(deg)), rel=1e-10)
+        assert out["F_paper"] == pytest.approx(m * g * (np.sin(np.radians(deg)) + 0.1 * np.cos(np.radians(deg))))
+    assert robot.model.gravity.linear == pytest.approx([0, 0, -9.81])  # restored
+    with pytest.raises(InputError, match="slope"):
+        mm.climbing_balance(robot, 2.0)
+
+
+# ------------------------------------------------------------------------------------------------ control
+def test_feedback_linearisation_gives_nudot_equal_u(robot):
+    """Eqs 23-24: with tau = S^T M S (u - f2) the reduced model's accelerations are exactly u."""
+    rng = np.random.default_rng(20)
+    ctrl = mm.platform_controller(robot, "sinusoid")
+    for _ in range(5):
+        q = random_q(robot, rng)
+        nu = rng.normal(size=robot.mobility)
+        u, tau = ctrl.command(1.0, q, nu)
+        assert robot.forward_dynamics(q, nu, tau) == pytest.approx(u, abs=1e-9 * (1 + np.max(np.abs(u))))
+
+
+@pytest.mark.parametrize("name, t_end, bound", [("straight", 2.0, 1e-6), ("sinusoid", 2.0, 1e-6),
+                                                ("orientation", 3.0, 0.06)])
+def test_table4_tracking_is_bounded(robot, name, t_end, bound):
+    from robotdyn.control import tracking_errors
+
+    traj = mm.SCENARIOS[name].run(robot, t_end=t_end, n_out=31, rtol=1e-7, atol=1e-9, progress=False)
+    err = tracking_errors(traj.stats["controller"], traj)
+    assert err["max"] < bound
+    assert err["rms"] >= err["mean"]
+    if name == "orientation":  # started from rest: an initial error that decays (eq 25, critically damped)
+        assert err["final"] < 0.5 * err["max"]
+        assert np.max(np.hypot(traj.column("x"), traj.column("y"))) < 0.1  # C stays near the centre
+    others = [c for c in mm.ACTUATED if c not in ("theta_R", "theta_L")]
+    idx = [robot.coordinate_index(c) for c in others]
+    assert np.max(np.abs(traj.q[:, idx] - traj.q[0, idx])) < 1e-6  # held joints held
+
+
+def test_manipulation_reaches_the_target_in_range(robot):
+    from robotdyn.control import tracking_errors
+
+    traj = mm.SCENARIOS["manipulation"].run(robot, t_end=3.0, n_out=31, rtol=1e-7, atol=1e-9, progress=False)
+    err = tracking_errors(traj.stats["controller"], traj)
+    assert err["max"] < 1e-6
+    for q in traj.q:
+        robot.check_q(q)
+    goal = mm.manipulation_goal(robot)
+    assert goal.success and frame_pose(robot, goal.q, "E")[:3, 3] == pytest.approx(mm.MANIPULATION_TARGET, abs=1e-9)
+
+
+def test_cli_simulate_and_compare(capsys):
+    from robotdyn.cli import main
+
+    assert main(["simulate", "mmr12_eod", "--scenario", "straight", "--t-end", "0.5", "--quiet", "--json"]) == 0
+    import json
+
+    data = json.loads(capsys.readouterr().out)
+    assert data["final"]["y"] == pytest.approx(0.5 - mm.LOOK_AHEAD, abs=1e-6)  # P on y = t, C behind it by L
+    assert data["final"]["x"] == pytest.approx(30.0, abs=1e-6)
+    assert main(["compare", "mmr12_eod", "--json"]) == 0
+    rows = {r["quantity"]: r for r in json.loads(capsys.readouterr().out)["rows"]}
+    assert rows["eq 29 [3,3]"]["verdict"] == "differs"
+    assert rows["eq 2 X_M[2,2] (as printed)"]["verdict"] == "differs"
+    assert rows["eq 30 [3,4]"]["verdict"] == "reproduced"
+    assert main(["simulate", "mmr12_eod", "--scenario", "nope", "--quiet"]) == 2

@@ -166,6 +166,23 @@ def test_animation_keys_are_at_the_trajectory_times(robots):
             assert np.allclose(rot, ref[:3, :3], atol=1e-9)
 
 
+def test_long_animation_is_capped_at_max_keys_and_keeps_its_duration(robots):
+    """A 100 s run with max_keys=50: at most 50 keys per track, at a uniform rate, the last at 100 s."""
+    robot = robots("quasimoro")
+    t = np.linspace(0.0, 100.0, 11)
+    Q = np.tile(robot.neutral(), (11, 1))
+    Q[:, robot.coordinate_index("x")] = 0.01 * t
+    viewer = Viewer(robot)
+    viewer.animate((t, Q), fps=30, max_keys=50)
+    (anim,) = [c for c in decode(viewer.static_html()) if c["type"] == "set_animation"]
+    for a in anim["animations"]:
+        fps = a["clip"]["fps"]
+        for track in a["clip"]["tracks"]:
+            times = np.array([k["time"] for k in track["keys"]]) / fps
+            assert 2 <= len(times) <= 50
+            assert abs(times[-1] - 100.0) < 1e-9 and np.allclose(np.diff(times), 100.0 / 49, rtol=1e-9)
+
+
 def test_animation_of_a_scenario_lasts_as_long_as_the_simulation(robots):
     """A simulated scenario's animation ends at the simulated t_end, starting from its q0."""
     robot = robots("quasimoro")

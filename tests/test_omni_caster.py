@@ -238,18 +238,21 @@ def test_beta_profile_is_eq61():
     assert abs(b[-1] - 2 * np.pi) < 1e-12 and abs(bd[-1]) < 1e-12 and abs(bd[0]) < 1e-15
 
 
-@pytest.mark.parametrize("kind", ["circle", "ellipse"])
-def test_path_twist_is_body_frame_derivative_of_pose(kind):
+@pytest.mark.parametrize("kind, heading", [("circle", None), ("ellipse", "tangent"), ("ellipse", "fixed")])
+def test_path_twist_is_body_frame_derivative_of_pose(kind, heading):
     t = np.linspace(0.5, oc.CIRCLE["T"] - 0.5 if kind == "circle" else oc.ELLIPSE["T"] - 0.5, 23)
     dt = 1e-5
-    st, sp, sm = (oc.path_state(kind, x) for x in (t, t + dt, t - dt))
+    par = {"heading": heading} if heading else None
+    st, sp, sm = (oc.path_state(kind, x, par) for x in (t, t + dt, t - dt))
     dpose = (sp["pose"] - sm["pose"]) / (2 * dt)
     psi = st["pose"][:, 2]
     vb = np.stack([np.cos(psi) * dpose[:, 0] + np.sin(psi) * dpose[:, 1],
                    -np.sin(psi) * dpose[:, 0] + np.cos(psi) * dpose[:, 1], dpose[:, 2]], axis=1)
     np.testing.assert_allclose(st["nu"], vb, atol=1e-8)
     np.testing.assert_allclose(st["nudot"], (sp["nu"] - sm["nu"]) / (2 * dt), atol=1e-8)
-    assert np.abs(st["nu"][:, 0]).max() < 1e-15  # moving along +j
+    if heading != "fixed":
+        assert np.abs(st["nu"][:, 0]).max() < 1e-15  # moving along +j
+    np.testing.assert_allclose(st["pose"][0], 0.0, atol=1e-3)  # starts near the origin (t = 0.5 s)
 
 
 def test_steady_steering_zeroes_the_model_steering_rates(robot):
@@ -263,17 +266,18 @@ def test_steady_steering_zeroes_the_model_steering_rates(robot):
             assert np.abs(v[idx]).max() < 1e-10
 
 
-@pytest.mark.parametrize("kind, t_end", [("circle", 12.0), ("ellipse", 8.0)])
-def test_inverse_dynamics_power_balance(robot, kind, t_end):
-    pl = oc.plan(robot, kind, n=25, t_end=t_end, rtol=1e-10)
+@pytest.mark.parametrize("kind, t_end, par", [("circle", 12.0, None), ("ellipse", 8.0, None),
+                                              ("ellipse", 8.0, {"heading": "fixed"})])
+def test_inverse_dynamics_power_balance(robot, kind, t_end, par):
+    pl = oc.plan(robot, kind, n=25, t_end=t_end, rtol=1e-10, params=par)
     ix = [robot.coordinate_index(c) for c in ("x", "y", "psi")]
     assert np.abs(pl["q"][:, ix] - pl["pose"]).max() < 1e-6  # integrated twist reproduces the prescribed path
     F = oc.operational_forces(robot, pl)
     power = np.einsum("ij,ij->i", F, pl["nu"])
     dt = 1e-3
     for k, t in enumerate(pl["t"][1:-1], start=1):
-        ep = oc.kinetic_energy(robot, pl["sol"].sol(t + dt), oc.path_state(kind, t + dt)["nu"])
-        em = oc.kinetic_energy(robot, pl["sol"].sol(t - dt), oc.path_state(kind, t - dt)["nu"])
+        ep = oc.kinetic_energy(robot, pl["sol"].sol(t + dt), oc.path_state(kind, t + dt, par)["nu"])
+        em = oc.kinetic_energy(robot, pl["sol"].sol(t - dt), oc.path_state(kind, t - dt, par)["nu"])
         assert abs((ep - em) / (2 * dt) - power[k]) < 1e-6 * np.abs(power).max() + 1e-9
     assert np.abs(power).max() > 1e-3
 
@@ -370,3 +374,14 @@ def test_compare_verdicts(robot):
     assert verdict["eq 16 as printed"] == "differs"
     assert verdict["eq 49 + derived offset-link terms (worst deviation)"] == "reproduced"
     assert verdict["sec 5 printed with-wheel I_uu*"] == "differs"
+
+
+def test_circle_wheel_mass_sweep_affects_y_and_moment_not_x(robot):
+    # sec 5, Figs. 10-12: with the wheels rolling along j, their lateral (x) inertia is taken by the ground
+    pl = oc.plan(robot, "circle", n=13, t_end=30.0, rtol=1e-9)
+    forces = [oc.operational_forces(Robot(oc.SPEC, oc.wheel_mass_params(total, 5.0)), pl) for total in (0, 1.5, 3)]
+    peaks = np.array([np.abs(F).max(axis=0) for F in forces])
+    assert abs(peaks[2, 0] / peaks[0, 0] - 1) < 1e-6
+    assert peaks[2, 1] / peaks[0, 1] > 1.5 and peaks[2, 2] / peaks[0, 2] > 2.0
+    # linear in the wheel mass (the model is linear in the inertial parameters)
+    np.testing.assert_allclose(forces[1], 0.5 * (forces[0] + forces[2]), atol=1e-12)

@@ -270,8 +270,9 @@ def noc_report(robot: Robot, noc: Robot, phi) -> dict:
 # ------------------------------------------------------------------------------------ trajectories (sec 5)
 CIRCLE = {"R": 5.0, "T": 60.0}
 """Section 5: circular path of radius 5 m in 60 s (Figs. 5-12)."""
-ELLIPSE = {"A": 3.0, "B": 1.0, "T": 30.0}
-"""Section 5: elliptic path with radii 3 m and 1 m in 30 s (Figs. 13-15)."""
+ELLIPSE = {"A": 3.0, "B": 1.0, "T": 30.0, "heading": "tangent"}
+"""Section 5: elliptic path with radii 3 m and 1 m in 30 s (Figs. 13-15); heading ``"tangent"`` (j along the
+path) or ``"fixed"`` (pure translation, psi = 0): the paper does not say which."""
 
 
 def beta_profile(t, T: float, total: float = 2 * np.pi) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -295,8 +296,8 @@ def path_state(kind: str, t, params: dict | None = None) -> dict:
     (the printed with-wheel inertia, large in y, implies wheels rolling along j), counter-clockwise, from the
     origin with heading psi = 0; on the circle i points radially outward and psi = beta (the paper: "beta, the
     angle between the global X-axis and the local unit vector i"), centre (-R, 0); on the ellipse
-    C = (A (cos beta - 1), B sin beta) with j along the tangent (psi = tangent angle - pi/2) and beta from eq (61)
-    with T = 30 s.
+    C = (A (cos beta - 1), B sin beta), beta from eq (61) with T = 30 s, and either j along the tangent
+    (``heading="tangent"``, psi = tangent angle - pi/2, default) or a fixed heading psi = 0 (``"fixed"``).
 
     Returns:
         dict with ``pose`` (x, y, psi), ``nu`` = u' = (v_cx, v_cy, omega) in body axes and ``nudot`` = u''
@@ -315,6 +316,14 @@ def path_state(kind: str, t, params: dict | None = None) -> dict:
         A, B = c["A"], c["B"]
         b, bd, bdd = beta_profile(t, c["T"])
         sb, cb = np.sin(b), np.cos(b)
+        if c["heading"] == "fixed":
+            z = 0 * b
+            pose = np.stack([A * (cb - 1), B * sb, z], axis=-1)
+            nu = np.stack([-A * sb * bd, B * cb * bd, z], axis=-1)
+            nudot = np.stack([-A * cb * bd**2 - A * sb * bdd, -B * sb * bd**2 + B * cb * bdd, z], axis=-1)
+            return {"pose": pose, "nu": nu, "nudot": nudot}
+        if c["heading"] != "tangent":
+            raise InputError(f"ellipse heading {c['heading']!r}; expected 'tangent' or 'fixed'")
         q2 = A**2 * sb**2 + B**2 * cb**2
         speed = np.sqrt(q2)  # ds/dbeta
         dspeed = (A**2 - B**2) * sb * cb / speed
@@ -372,7 +381,7 @@ def plan(robot: Robot, kind: str, n: int = 301, params: dict | None = None, rtol
     T = c["T"]
     direction = path_state(kind, 0.5 * T, params)["nu"]
     if kind == "ellipse":  # direction of the twist at the start (curvature A/B^2 at beta = 0)
-        direction = np.array([0.0, c["B"], c["A"] / c["B"]])
+        direction = np.array([0.0, c["B"], c["A"] / c["B"] if c["heading"] == "tangent" else 0.0])
     q0 = steering_configuration(robot, steady_steering(robot.params, direction))
 
     def rhs(t, q):

@@ -54,39 +54,18 @@ class Terrain:
         return f"{type(self).__name__}()"
 
 
-class FlatTerrain(Terrain):
-    """The horizontal plane :math:`z = h`."""
-
-    def __init__(self, height: float = 0.0) -> None:
-        self.h = float(height)
-
-    def height(self, x: float, y: float) -> float:
-        return self.h
-
-    def gradient(self, x: float, y: float) -> np.ndarray:
-        return np.zeros(2)
-
-    def hessian(self, x: float, y: float) -> np.ndarray:
-        return np.zeros((2, 2))
-
-    @property
-    def is_flat(self) -> bool:
-        return True
-
-    def __repr__(self) -> str:
-        return f"FlatTerrain(height={self.h})"
-
-
 class RampTerrain(Terrain):
-    """An inclined plane :math:`z = s (x\\cos\\alpha + y\\sin\\alpha)` of slope ``s`` rising along heading alpha."""
+    """An inclined plane :math:`z = h + s (x\\cos\\alpha + y\\sin\\alpha)` of slope ``s`` rising along heading
+    alpha [rad], at height ``h`` [m] above the origin."""
 
-    def __init__(self, slope: float, heading: float = 0.0) -> None:
+    def __init__(self, slope: float, heading: float = 0.0, height: float = 0.0) -> None:
         self.slope = float(slope)
         self.heading = float(heading)
+        self.h = float(height)
         self._g = self.slope * np.array([np.cos(self.heading), np.sin(self.heading)])
 
     def height(self, x: float, y: float) -> float:
-        return float(self._g @ (x, y))
+        return self.h + float(self._g[0] * x + self._g[1] * y)
 
     def gradient(self, x: float, y: float) -> np.ndarray:
         return self._g.copy()
@@ -99,7 +78,17 @@ class RampTerrain(Terrain):
         return True
 
     def __repr__(self) -> str:
-        return f"RampTerrain(slope={self.slope}, heading={self.heading})"
+        return f"RampTerrain(slope={self.slope}, heading={self.heading}, height={self.h})"
+
+
+class FlatTerrain(RampTerrain):
+    """The horizontal plane :math:`z = h`."""
+
+    def __init__(self, height: float = 0.0) -> None:
+        super().__init__(0.0, 0.0, height)
+
+    def __repr__(self) -> str:
+        return f"FlatTerrain(height={self.h})"
 
 
 class BumpTerrain(Terrain):

@@ -345,6 +345,10 @@ def compare(robot: Robot | None = None, states: int = 50, seed: int = 0) -> Comp
         ortho, det = _defects(paper[:3, :3])
         cmp.add(f"{key}: det R of the printed matrix", det + 1.0, 1.0, 1e-3,
                 note=f"max|R^T R - I| of the printed matrix = {ortho:.3g}")
+    # climbing (sec 2.11 e): the gravity part of F_climb from the model on a 20 degree slope
+    bal = climbing_balance(robot, np.radians(20.0))
+    cmp.add("sec 2.11 e: m g sin(psi) at psi = 20 deg [N]", bal["F_gravity_paper"], bal["F_gravity_model"], 1e-9,
+            note=f"model: wheel forces holding the robot, tilted gravity; m = {bal['mass']:.4g} kg (assumed masses)")
     # inverse kinematics
     for k, case in enumerate(ik_cases(robot)):
         target, arm = case["target"], case["arm"]

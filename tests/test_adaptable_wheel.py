@@ -324,3 +324,47 @@ def test_cli_ik(capsys, tmp_path):
     csv = tmp_path / "m2.csv"
     assert main(["ik", "adaptable_wheel", "--mission", "mission2", "--csv", str(csv)]) == 0
     assert np.loadtxt(csv, delimiter=",", skiprows=1).shape == (501, 15)
+
+
+# ------------------------------------------------------------------------------ forward dynamics and singularity
+@pytest.mark.parametrize("params", [{}, {"m_wheel": 0.4, "I_adjust": 0.002}])
+def test_energy_balance_forward_simulation(params):
+    """Rolling without slipping on a gentle ramp: energy conserved without torques, and E(t) - E(0) = work of the
+    motors with torques (Simpson quadrature of the motor power)."""
+    from scipy.integrate import cumulative_simpson
+
+    from robotdyn.simulation import power, simulate
+    r = Robot(aw.SPEC, {"terrain": "ramp", "ramp_slope": 0.05, **params})
+    cmd = aw.Commands(0.3, -0.2, 0.15)
+    x, _, _ = aw.solve_ik(cmd, r.params, r.terrain)
+    q0 = aw.model_configuration(r, cmd, x)
+    nu0 = np.random.default_rng(0).normal(size=r.mobility) * 0.3
+    free = simulate(r, 0.05, q0, nu0, None, n_out=11, progress=False)
+    assert np.ptp(free.energy) < 1e-8 and free.residual.max() < 1e-9
+    red = r.reduced(q0, np.zeros(r.mobility))
+    hold, *_ = np.linalg.lstsq(red.B, red.g, rcond=None)
+    tau = lambda t, q, nu: hold * (1 + 0.05 * np.sin(5 * t))  # noqa: E731
+    tr = simulate(r, 0.3, q0, nu0, tau, n_out=301, progress=False)
+    work = cumulative_simpson(power(r, tr, tau), x=tr.t, initial=0)
+    assert abs(work[-1]) > 0.5
+    np.testing.assert_allclose(tr.energy - tr.energy[0], work, atol=1e-8)
+
+
+def test_front_radii_singularity():
+    """Three fixed parallel axles: with equal front radii on flat ground the two front lateral rows coincide
+    (rank 11, the core reports the mismatch); the smallest singular value grows linearly with the difference."""
+    from robotdyn.errors import SingularConstraintError
+    from robotdyn.terrain import FlatTerrain
+    r = Robot(aw.SPEC, {"terrain": "flat"})
+    ratios = []
+    for roll in (0.0, 0.01, 0.1):
+        cmd = aw.Commands(0, 0, 0.15, roll, 0, 0)
+        x, _, _ = aw.solve_ik(cmd, r.params, FlatTerrain())
+        q = aw.model_configuration(r, cmd, x)
+        s = np.linalg.svd(r.constraint_rows(KinematicState(r.model, r.data, q, np.zeros(15))).A, compute_uv=False)
+        ratios.append(s[-1] / s[0])
+        if roll == 0.0:
+            assert np.sum(s > 1e-9 * s[0]) == 11
+            with pytest.raises(SingularConstraintError):
+                r.reduced(q, np.zeros(r.mobility))
+    assert ratios[2] / ratios[1] == pytest.approx(10, rel=0.05)

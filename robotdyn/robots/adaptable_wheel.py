@@ -92,6 +92,10 @@ def _coupling_factory(tag: str) -> Callable[[Robot], JointCoupling]:
 
 
 _Q0 = 2 * np.pi / 3
+_NEUTRAL_Q = {"fr": 1.9, "fl": 2.3, "r": _Q0}
+"""Adjustment angles of the neutral configuration. The front radii differ on purpose: with equal front radii the
+lateral rows of the two front wheels coincide on flat ground (a kinematic singularity, see the errata), and the
+automatic choice of independent velocities is made at the neutral configuration."""
 SPEC = RobotSpec(
     name="adaptable_wheel",
     title="Tricycle with adaptable-radius wheels on rough terrain (Mardani & Ebrahimi 2016)",
@@ -129,8 +133,8 @@ SPEC = RobotSpec(
     terrain=_terrain,
     neutral={
         "z": 0.02 + radius_law(_Q0, 0.3),
-        **{f"q_{t}": _Q0 for t in WHEELS},
-        **{f"Rch_{t}": radius_law(_Q0, 0.3) for t in WHEELS},
+        **{f"q_{t}": _NEUTRAL_Q[t] for t in WHEELS},
+        **{f"Rch_{t}": radius_law(_NEUTRAL_Q[t], 0.3) for t in WHEELS},
     },
 )
 

@@ -50,6 +50,10 @@ def _check(M, n, e: float) -> tuple[np.ndarray, np.ndarray]:
     k = M.shape[0] if M.ndim == 2 else -1
     if M.ndim != 2 or M.shape[1] != k or not np.all(np.isfinite(M)):
         raise InputError(f"inertia matrix of shape {M.shape}; expected a finite square matrix")
+    try:
+        np.linalg.cholesky(0.5 * (M + M.T))
+    except np.linalg.LinAlgError:
+        raise InputError("inertia matrix is not positive definite (massless mechanism?); no impulse defined") from None
     if n.shape != (k,) or not np.all(np.isfinite(n)):
         raise InputError(f"impact direction has {n.size} values; expected {k} finite numbers")
     norm = float(np.linalg.norm(n))

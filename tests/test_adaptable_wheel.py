@@ -368,3 +368,32 @@ def test_front_radii_singularity():
             with pytest.raises(SingularConstraintError):
                 r.reduced(q, np.zeros(r.mobility))
     assert ratios[2] / ratios[1] == pytest.approx(10, rel=0.05)
+
+
+def test_cli_compare_simulate_and_errors(capsys):
+    import json
+
+    from robotdyn.cli import main
+    assert main(["compare", "adaptable_wheel", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["rows"]
+    assert {r["verdict"] for r in rows} == {"reproduced", "differs"}
+    assert main(["simulate", "adaptable_wheel", "--scenario", "hold", "--t-end", "0.2", "--quiet", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert abs(out["energy_end"] - out["energy_start"]) < 1e-9
+    assert main(["ik", "adaptable_wheel", "--param", "L_reading=third", "--commands", "0", "0", "0.15", "0", "0",
+                 "0"]) == 2
+    assert "expected one of half, full" in capsys.readouterr().err
+    assert main(["ik", "adaptable_wheel", "--commands", "0", "0", "-0.1", "0", "0", "0"]) == 2
+    assert "positive height" in capsys.readouterr().err
+
+
+def test_generic_modules_reject_bad_input(robot):
+    from robotdyn.statics import solve_contact_forces
+    with pytest.raises(RobotDynError, match="driven and driver"):
+        JointCoupling(robot.description, "adjust_fr_joint", "adjust_fr_joint", np.cos, np.sin, np.cos)
+    with pytest.raises(RobotDynError, match="no joint"):
+        JointCoupling(robot.description, "nope", "adjust_fr_joint", np.cos, np.sin, np.cos)
+    with pytest.raises(RobotDynError, match="mu"):
+        solve_contact_forces(np.zeros((3, 3)), np.tile([0, 0, 1.0], (3, 1)), [0, 0, 1], [0, 0, 0], [0, 0, 0], 0.0)
+    with pytest.raises(RobotDynError, match="expected two"):
+        solve_contact_forces(np.zeros((3, 2)), np.zeros((3, 3)), [0, 0, 1], [0, 0, 0], [0, 0, 0], 1.0)

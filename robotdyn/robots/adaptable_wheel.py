@@ -277,6 +277,12 @@ def solve_ik(cmd: Commands, p: dict, terrain: Terrain, guess: np.ndarray | None 
                     "gives at its limit q = 180 deg (adjustment range 0-180 deg)")
     if err > tol:
         raise ConstraintError(f"inverse kinematics did not converge: ||C|| = {err:.3g} > {tol:g} ({sol.message})")
+    off = offsets(p)
+    for k, tag in enumerate(WHEELS):  # eq 14 also holds at the top of the rim: keep the contact below the centre
+        R3, d3 = contact_frame(R_cg, d_cg, off[tag], tag, x[k], p["R_ru"] + radius_law(x[3 + k], p["w"]))
+        if (d_cg + R_cg @ off[tag] - d3) @ terrain.normal(d3[0], d3[1]) <= 0:
+            raise ConstraintError(f"wheel {tag}: the solution found touches the surface with the top of the rim "
+                                  f"(beta = {np.degrees(x[k]):.1f} deg); expected a wheel standing on the surface")
     return x, err, int(sol.nfev)
 
 

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import re
 import subprocess
+from dataclasses import dataclass
 import sys
 import urllib.request
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +17,7 @@ import umsgpack
 
 import robotdyn
 from oracles.urdf_fk import UrdfVisuals
+from robotdyn.cli import main
 from robotdyn.errors import InputError
 from robotdyn.robots import names
 from robotdyn.terrain import FlatTerrain, SineTerrain
@@ -243,11 +246,26 @@ def test_static_html_is_self_contained(robots):
     assert not re.search(r"(src|href)\s*=\s*[\"'](https?:)?//", page)
 
 
-def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "robotdyn", *args], capture_output=True, text=True, timeout=120)
+@dataclass
+class Run:
+    returncode: int
+    stdout: str
+    stderr: str
 
 
-def test_cli_view_exports_html(tmp_path):
+@pytest.fixture
+def run_cli(capsys):
+    """``robotdyn ARGS`` in-process (the console script's main: same parsing, errors and exit codes)."""
+
+    def run(*args):
+        code = main(list(args))
+        out, err = capsys.readouterr()
+        return Run(code, out, err)
+
+    return run
+
+
+def test_cli_view_exports_html(tmp_path, run_cli):
     out = tmp_path / "q.html"
     res = run_cli("view", "quasimoro", "--scenario", "pure_rotation", "--t-end", "0.3", "--quiet", "--html", str(out))
     assert res.returncode == 0, res.stderr
@@ -268,7 +286,7 @@ def test_cli_view_exports_html(tmp_path):
     (["--scenario", "rectilinear", "--t-end", "-1"], "--t-end -1; expected a positive duration"),
     (["--param", "r=abc"], "parameter r = 'abc' is not a number"),
 ])
-def test_cli_view_bad_input(tmp_path, args, message):
+def test_cli_view_bad_input(tmp_path, args, message, run_cli):
     res = run_cli("view", "quasimoro", *args, "--html", str(tmp_path / "x.html"))
     assert res.returncode == 2
     assert res.stderr.count("\n") == 1 and message in res.stderr and "Traceback" not in res.stderr
@@ -285,3 +303,51 @@ def test_live_viewer_serves_the_page(robots):
     finally:
         viewer.close()
     assert proc.poll() is not None and viewer.url is None
+
+
+def test_cli_view_live_serves_until_interrupted():
+    """Without --html, `robotdyn view` prints the live URL, serves the page, and stops cleanly on Ctrl-C."""
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-m", "robotdyn", "view", "quasimoro", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        lines = []
+        while not (lines and lines[-1].startswith("}")):
+            line = proc.stdout.readline()
+            assert line, proc.stderr.read()
+            lines.append(line)
+        info = __import__("json").loads("".join(lines))
+        assert info["url"].startswith("http://127.0.0.1:") and info["html"] is None
+        with urllib.request.urlopen(info["url"], timeout=10) as resp:
+            assert resp.status == 200
+        servers = children(proc.pid)
+        assert servers, "the meshcat server should be a child process of robotdyn view"
+    finally:
+        proc.send_signal(signal.SIGINT)
+        code = proc.wait(timeout=20)
+    err = proc.stderr.read()
+    assert code == 0 and "Traceback" not in err, err
+    alive = [pid for pid in servers if running(pid)]
+    assert not alive, f"meshcat server(s) {alive} left running"
+
+
+def running(pid: int) -> bool:
+    """Whether a process exists and is not a zombie (Linux /proc)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
+def children(pid: int) -> list[int]:
+    """PIDs whose parent is ``pid`` (Linux /proc)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out

@@ -3,6 +3,20 @@
 Paper: "Kinematics Analysis and Simulation of Mobile Robot Based on Linkage Suspension"
 (``shared/papers/chen_linkage_suspension_six_wheel.txt``). Description: ``urdf/linkage_suspension.urdf.xacro``
 (the mechanism, our reading of Figs. 1-3, and the dimensions, our own: the paper prints none).
+
+Coordinates: floating root (x, y, z, yaw, pitch, roll) of the body frame R (origin at the body's centre of gravity,
+x forward, z up); theta1/theta2 the right/left rocker angles about +y_R (Table 1's theta1: the back arm points at
+(-sin theta, -cos theta) in the x-z plane); beta1/beta2 the bogie (rear linkage) angles about -y_R (Table 1's beta1,
+bogie level at beta = theta + pi/2); gamma, sigma the front rod and slider block angles; psi the suspension link;
+rod*_x, rod*_y the connecting rods' universal joints; phi1..phi6 the wheel spins about +y (forward rolling positive),
+wheels 1-3 right (front, middle, rear), 4-6 left. Independent velocities: the middle wheel spins (phi2', phi5').
+
+Omni wheels: ``OmniWheel(roller_angle=rho)``; the constrained direction at the contact is x of eq (2)'s frame H
+(x_A rotated by rho towards the axle), so the model's roller angle is the paper's rho (0 for the paper's 90-degree
+omni wheels, the default).
+
+This module holds the parameters, the paper's transcribed closed forms (Table 1, eqs 1-4, 9-10, section 3), the
+comparison against the model, example terrains, scenarios and the ``linkage-posture`` CLI subcommand.
 """
 
 from __future__ import annotations

@@ -21,7 +21,6 @@ eqs 25-34 (:func:`static_torques`), with the contact forces from :func:`robotdyn
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
@@ -233,9 +232,15 @@ def _needed_radius(R_cg, d_cg, p, terrain, tag, beta0: float) -> float:
     """The radius R_T [m] wheel ``tag`` would need (eqs 12, 14 solved for (beta, R_T): always well posed)."""
     off = offsets(p)[tag]
     RT0 = float(d_cg[2] - terrain.height(*(d_cg + R_cg @ off)[:2]))
-    sol = root(lambda z: wheel_constraints(R_cg, d_cg, off, tag, z[0], z[1], terrain), [beta0, RT0],
-               method="hybr", options={"xtol": 1e-14})
+    fun = partial(_wheel_rt, R_cg=R_cg, d_cg=d_cg, offset=off, tag=tag, terrain=terrain)
+    sol = root(fun, [beta0, RT0], method="hybr", options={"xtol": 1e-14})
+    if np.linalg.norm(fun(sol.x)) > 1e-8:
+        raise ConstraintError(f"wheel {tag}: cannot touch the surface with any radius at these commands")
     return float(sol.x[1])
+
+
+def _wheel_rt(z, R_cg, d_cg, offset, tag, terrain):
+    return wheel_constraints(R_cg, d_cg, offset, tag, z[0], z[1], terrain)
 
 
 def solve_ik(cmd: Commands, p: dict, terrain: Terrain, guess: np.ndarray | None = None,
@@ -371,11 +376,6 @@ class IKRun:
     commands: list = field(default_factory=list)
 
 
-def mission_params(robot_params: dict, mission: Mission) -> dict:
-    """The parameters with the mission's terrain selected."""
-    return {**robot_params, "terrain": mission.terrain}
-
-
 def yaw_update(qz: float, path_angle_change: float, R_cg: np.ndarray, dqx: float, dqy: float) -> float:
     """Eqs 18-23 over one step: :math:`\\Delta q_{zd} = (\\Delta q_{path} - R_{CG}^0(3,1{:}2)[\\Delta q_{xd},
     \\Delta q_{yd}]) / R_{CG}^0(3,3)` (eq 22 times dt; q_path is the path tangent's direction, eq 18)."""
@@ -394,8 +394,10 @@ def run_mission(mission: Mission | str, params: dict | None = None, tol: float =
         if mission not in MISSIONS:
             raise InputError(f"unknown mission {mission!r}; expected one of {', '.join(MISSIONS)}")
         mission = MISSIONS[mission]
-    base = {p.name: p.convert(p.default) for p in SPEC.parameters}
-    p = {**base, **(params or {}), "terrain": mission.terrain}
+    p = {q.name: q.convert(q.default) for q in SPEC.parameters}
+    for name, value in (params or {}).items():
+        p[name] = SPEC.parameter(name).convert(value)
+    p["terrain"] = mission.terrain
     terrain = _terrain(p)
     t = np.arange(0.0, mission.t_end + 0.5 * mission.dt, mission.dt)
     n = len(t)

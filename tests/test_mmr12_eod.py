@@ -71,6 +71,29 @@ def test_Mr_symmetric_positive_definite(robot):
         assert np.linalg.eigvalsh(red.M).min() > 0
 
 
+def test_Mr_and_gr_from_energies(robot):
+    """M_r by polarisation of Pinocchio's kinetic energy (body velocities, not CRBA) at v = S nu; g_r as the
+    directional derivative of the potential energy (mass centres' heights, not RNEA) along the columns of S."""
+    rng = np.random.default_rng(4)
+    model, data = robot.model, robot.data
+    for _ in range(5):
+        q = random_q(robot, rng)
+        red = robot.reduced(q, np.zeros(robot.mobility))
+        S, k = red.S, robot.mobility
+
+        def T(nu):
+            return pin.computeKineticEnergy(model, data, q, S @ nu)
+
+        E = np.eye(k)
+        M = np.array([[T(E[i] + E[j]) - T(E[i]) - T(E[j]) if i != j else 2 * T(E[i]) for j in range(k)]
+                      for i in range(k)])
+        assert M == pytest.approx(red.M, abs=1e-10 * np.max(np.abs(red.M)))
+        eps = 1e-6
+        g = np.array([(pin.computePotentialEnergy(model, data, q + eps * S[:, i])
+                       - pin.computePotentialEnergy(model, data, q - eps * S[:, i])) / (2 * eps) for i in range(k)])
+        assert g == pytest.approx(red.g, abs=1e-6 * max(1.0, np.max(np.abs(red.g))))
+
+
 def test_reduced_dynamics_matches_kkt_forward_dynamics(robot):
     """Eq 22 (projection path) vs Pinocchio's constrained forward dynamics (KKT with J = A, gamma = Adot v)."""
     rng = np.random.default_rng(2)

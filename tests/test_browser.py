@@ -56,6 +56,7 @@ class Pair:
     meta: dict = field(default_factory=dict)
     images: tuple = ()
     error: str = ""
+    srcdoc: bool = False  # the scenes run in iframes with srcdoc (their console source is about:srcdoc)
 
 
 def _exports(root: Path) -> dict[str, Pair]:
@@ -88,6 +89,13 @@ def _exports(root: Path) -> dict[str, Pair]:
     page = viewer.save(root / "animation.html").name
     pairs["@animation"] = Pair("@animation", f"{page}#t=2.5", f"{page}#t=1.0", meta={
         "camera": viewer.camera_position, "points": UrdfVisuals(robot).points(robot.neutral())})
+    # what a notebook shows: Viewer._repr_html_ (the export in an iframe's srcdoc) inside a page
+    viewer = Viewer(robot)
+    (root / "notebook.html").write_text(f"<!DOCTYPE html><html><body style='margin: 0; overflow: hidden'>{viewer._repr_html_()}</body></html>")
+    viewer.show("robot", False)
+    (root / "notebook_hidden.html").write_text(f"<!DOCTYPE html><html><body style='margin: 0; overflow: hidden'>{viewer._repr_html_()}</body></html>")
+    pairs["@notebook"] = Pair("@notebook", "notebook.html", "notebook_hidden.html", srcdoc=True, meta={
+        "camera": viewer.camera_position, "points": UrdfVisuals(robot).points(robot.neutral())})
     return pairs
 
 
@@ -117,7 +125,10 @@ def gallery(chromium, tmp_path_factory) -> dict[str, Pair]:
         for i, p in enumerate(group):
             tile = img[i * TILE[1] : (i + 1) * TILE[1]]
             p.images = (tile[:, : TILE[0]], tile[:, TILE[0] :])
-            for f in {p.left.split("#")[0], p.right.split("#")[0]}:
+            if p.srcdoc:
+                if len(re.findall(r'"robotdyn: applied \d+ scene commands", source: about:srcdoc', log)) < 2:
+                    p.error += "the scene scripts in the srcdoc iframes did not run; "
+            for f in [] if p.srcdoc else {p.left.split("#")[0], p.right.split("#")[0]}:
                 if not re.search(rf'"robotdyn: applied \d+ scene commands", source: \S*/{re.escape(f)}[ #]', log):
                     p.error += f"the scene script of {f} did not run; "
             bad = [line for line in log.splitlines() if "Uncaught" in line and (p.left in line or p.right in line)]
@@ -140,9 +151,10 @@ def changed(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.abs(a - b).sum(axis=2) > THRESHOLD
 
 
-def project(points: np.ndarray, camera: np.ndarray) -> np.ndarray:
-    """Pixel coordinates (u right, v down) of world points seen from ``camera`` looking at the origin."""
-    w, h = TILE
+def project(points: np.ndarray, camera: np.ndarray, size: tuple[int, int] = TILE) -> np.ndarray:
+    """Pixel coordinates (u right, v down) of world points seen from ``camera`` looking at the origin, in a
+    viewport of ``size`` pixels."""
+    w, h = size
     f = -camera / np.linalg.norm(camera)
     s = np.cross(f, [0.0, 0.0, 1.0])
     s /= np.linalg.norm(s)
@@ -188,3 +200,11 @@ def test_animation_time_base_in_the_browser(gallery):
     (keys read as seconds at 30 fps, or frames at 1 fps) fails one of the two."""
     late, early, meta = rendered(gallery, "@animation")
     assert_robot_where_expected(changed(early, late), project(meta["points"], meta["camera"]), "animation")
+
+
+def test_notebook_inline_display_shows_the_robot(gallery):
+    """The viewer's notebook rendering (the export in an iframe's srcdoc) shows the robot where it projects.
+    The inline iframe is 420 px high and as wide as its 400 px tile, so the projection uses that size."""
+    shown, hidden, meta = rendered(gallery, "@notebook")
+    mask = changed(shown, hidden)
+    assert_robot_where_expected(mask, project(meta["points"], meta["camera"], size=(TILE[0], 420)), "notebook")

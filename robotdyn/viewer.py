@@ -191,6 +191,9 @@ class Viewer:
 
     Attributes:
         robot: The robot.
+        vis: The underlying ``meshcat.Visualizer`` (for adding your own objects; they are exported too).
+        q: The configuration last displayed (natural coordinates).
+        fps: Keyframe rate of the last animation [1/s].
         url: The live viewer's address (``None`` without ``live``).
         tile: Edge [m] of the ground's checker tiles (about 0.4 times the robot's size, rounded to 1, 2 or 5).
         camera_position: Where :meth:`set_camera` put the camera (world frame, m); it looks at the origin with
@@ -199,6 +202,8 @@ class Viewer:
 
     def __init__(self, robot, live: bool = False, contacts: bool = True, frames: bool = False,
                  extent: float | None = None) -> None:
+        if extent is not None and not (np.isfinite(extent) and extent >= 0):
+            raise InputError(f"extent = {extent}; expected a terrain margin >= 0 in m")
         mc = _meshcat()
         from pinocchio.visualize import MeshcatVisualizer  # lazy: imports trimesh (~0.65 s)
 
@@ -233,6 +238,7 @@ class Viewer:
             if f.type == pin.FrameType.BODY and not f.name.startswith("robotdyn_")
         ]
         self._extent = extent
+        self.fps = 0.0
         self.q = robot.neutral()
         self._size = self._robot_size(self.q)
         self.tile = _nice(0.4 * self._size)
@@ -292,7 +298,7 @@ class Viewer:
         for fid in self._frame_ids:
             out[f"{_ROOT}/frames/{self.model.frames[fid].name}"] = self.data.oMf[fid].homogeneous
         if self._markers:
-            kin = KinematicState(self.robot.model, self.robot.data, q, np.zeros(self.model.nv))
+            kin = KinematicState(self.model, self.data, q, np.zeros(self.model.nv))
             for m in self._markers:
                 c = m.constraint.contact(kin)
                 T = np.eye(4)

@@ -386,3 +386,16 @@ def test_circle_wheel_mass_sweep_affects_y_and_moment_not_x(robot):
     assert peaks[2, 1] / peaks[0, 1] > 1.5 and peaks[2, 2] / peaks[0, 2] > 2.0
     # linear in the wheel mass (the model is linear in the inertial parameters)
     np.testing.assert_allclose(forces[1], 0.5 * (forces[0] + forces[2]), atol=1e-12)
+
+
+def test_acceleration_offset_matches_finite_differences(robot):
+    # w = S' nu along q' = S nu: independent of Pinocchio's Jacobian time variation and of the wheel drift terms
+    eps = 1e-6
+    for phi, pose, nu in _states(10, 31):
+        q = _q(robot, phi, pose)
+        red = robot.reduced(q, nu, coriolis=True)
+        v = red.v
+        fd = (robot.reduced(q + eps * v, nu).v - robot.reduced(q - eps * v, nu).v) / (2 * eps)
+        scale = np.abs(fd).max()
+        assert np.abs(red.w - fd).max() < 1e-7 * scale
+        assert np.abs(red.Sdot @ nu - fd).max() < 1e-7 * scale

@@ -362,23 +362,26 @@ class Viewer:
             Z = np.array([[terrain.height(x, y) for y in ys] for x in xs], dtype=float)
         if not np.all(np.isfinite(Z)):
             raise InputError(f"terrain {terrain!r} has non-finite heights in x [{x0:g}, {x1:g}], y [{y0:g}, {y1:g}] m")
-        # every cell has its own four vertices, so that it can have a flat colour
         i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
         i, j = i.ravel(), j.ravel()
-        corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
-        verts = np.stack([np.column_stack([xs[a], ys[b], Z[a, b]]) for a, b in corners], axis=1).reshape(-1, 3)
-        k = 4 * np.arange(i.size)
-        faces = np.concatenate([np.column_stack([k, k + 1, k + 2]), np.column_stack([k, k + 2, k + 3])])
-        cx, cy = 0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1])
-        parity = (np.floor(cx / tile) + np.floor(cy / tile)) % 2
         if flat:
-            base = np.tile(_GROUND, (i.size, 1))
+            # few large cells: each has its own four vertices, so that it has a flat checker colour
+            corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
+            verts = np.stack([np.column_stack([xs[a], ys[b], Z[a, b]]) for a, b in corners], axis=1).reshape(-1, 3)
+            k = 4 * np.arange(i.size)
+            parity = (np.floor(0.5 * (xs[i] + xs[i + 1]) / tile) + np.floor(0.5 * (ys[j] + ys[j + 1]) / tile)) % 2
+            colors = np.repeat(_GROUND * (1.0 - 0.12 * parity[:, None]), 4, axis=0)
+            faces = np.concatenate([np.column_stack([k, k + 1, k + 2]), np.column_stack([k, k + 2, k + 3])])
         else:
-            zc = 0.25 * (Z[i, j] + Z[i + 1, j] + Z[i + 1, j + 1] + Z[i, j + 1])
+            # many small cells: shared vertices (a third of the size), colour by height and checker tile
+            X, Y = np.meshgrid(xs, ys, indexing="ij")
+            verts = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+            k = i * (ny + 1) + j
+            faces = np.concatenate([np.column_stack([k, k + ny + 1, k + ny + 2]), np.column_stack([k, k + ny + 2, k + 1])])
             span = np.ptp(Z)
-            s = (zc - Z.min()) / span if span > 0 else np.zeros(i.size)
-            base = _TERRAIN_LOW + s[:, None] * (_TERRAIN_HIGH - _TERRAIN_LOW)
-        colors = np.repeat(base * (1.0 - 0.12 * parity[:, None]), 4, axis=0)
+            h = (Z.ravel() - Z.min()) / span if span > 0 else np.zeros(Z.size)
+            parity = (np.floor((X.ravel() + 1e-9) / tile) + np.floor((Y.ravel() + 1e-9) / tile)) % 2
+            colors = (_TERRAIN_LOW + h[:, None] * (_TERRAIN_HIGH - _TERRAIN_LOW)) * (1.0 - 0.12 * parity[:, None])
         self.vis["/Grid"].set_property("visible", False)
         self.vis["/Axes"].set_property("scale", [self._size] * 3)  # meshcat world axes: 0.5 m -> half the robot size
         self.vis[f"{_ROOT}/terrain"].set_object(

@@ -351,3 +351,28 @@ def children(pid: int) -> list[int]:
         if int(fields[1]) == pid:
             out.append(int(stat.parent.name))
     return out
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_every_robot_animates_its_first_scenario(name, robots):
+    """0.2 s of the robot's first scenario: one clip per visual, lasting 0.2 s, first and last keys at the
+    trajectory's first and last poses (yourdfpy)."""
+    from robotdyn.robots import module
+
+    scenarios = getattr(module(name), "SCENARIOS", {})
+    if not scenarios:
+        pytest.skip(f"{name} has no scenario")
+    robot = robots(name)
+    traj = next(iter(scenarios.values())).run(robot, t_end=0.2, progress=False)
+    viewer = Viewer(robot)
+    viewer.animate(traj)
+    (anim,) = [c for c in decode(viewer.static_html()) if c["type"] == "set_animation"]
+    clips = {a["path"]: a["clip"] for a in anim["animations"]}
+    fk = UrdfVisuals(robot)
+    first, last = fk.visuals(traj.q[0]), fk.visuals(traj.q[-1])
+    for i, g in enumerate(robot.description.visual.geometryObjects):
+        clip = clips[f"/meshcat/robotdyn/robot/visuals/{g.name}"]
+        keys = {tr["name"]: tr["keys"] for tr in clip["tracks"]}[".position"]
+        assert abs(keys[-1]["time"] / clip["fps"] - (traj.t[-1] - traj.t[0])) < 1e-12
+        assert np.allclose(keys[0]["value"], first[visual_key(robot, i)][0][:3, 3], atol=1e-9)
+        assert np.allclose(keys[-1]["value"], last[visual_key(robot, i)][0][:3, 3], atol=1e-9)

@@ -111,7 +111,7 @@ def computed_torque(red, nudot: np.ndarray, controlled: np.ndarray | None = None
 
 @dataclass
 class LinearisingController:
-    """Eqs: computed torque on the reduced model plus PD output feedback (see the module docstring).
+    """Computed torque on the reduced model plus PD output feedback (see the module docstring).
 
     Attributes:
         robot: The robot (its reduced model is the controller's model).

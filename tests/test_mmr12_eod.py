@@ -443,3 +443,30 @@ def test_cli_simulate_and_compare(capsys):
     assert rows["eq 2 X_M[2,2] (as printed)"]["verdict"] == "differs"
     assert rows["eq 30 [3,4]"]["verdict"] == "reproduced"
     assert main(["simulate", "mmr12_eod", "--scenario", "nope", "--quiet"]) == 2
+
+
+def test_point_task_jacobian_and_drift_by_finite_differences(robot):
+    """y'' = J a + Jdot v for the look-ahead point, against the second difference of its position along the
+    curve q(t) = q + v t + a t^2 / 2 (natural coordinates: q'' = a)."""
+    from robotdyn.constraint import KinematicState
+    from robotdyn.control import PointTask, hold
+
+    task = PointTask("link3", hold([0.0, 0.0, 0.0]), offset=(0.1, -0.05, 0.2))
+    rng = np.random.default_rng(30)
+    for _ in range(5):
+        q = random_q(robot, rng)
+        q[robot.coordinate_index("theta1")] = np.clip(q[robot.coordinate_index("theta1")], 0.3, 2.8)
+        q[robot.coordinate_index("lambda2")] = np.clip(q[robot.coordinate_index("lambda2")], 0.3, 1.2)
+        v = rng.normal(size=robot.nq)
+        a = rng.normal(size=robot.nq)
+        kin = KinematicState(robot.model, robot.data, q, v)
+        y, J, drift = task.evaluate(robot, kin)
+        h = 1e-4
+
+        def pos(t):
+            qt = q + v * t + 0.5 * a * t * t
+            k = KinematicState(robot.model, robot.data, qt, np.zeros(robot.nq))
+            return task.evaluate(robot, k)[0]
+
+        assert (pos(h) - pos(-h)) / (2 * h) == pytest.approx(J @ v, abs=1e-6)
+        assert (pos(h) - 2 * y + pos(-h)) / h**2 == pytest.approx(J @ a + drift, abs=1e-4)

@@ -376,3 +376,15 @@ def test_every_robot_animates_its_first_scenario(name, robots):
         assert abs(keys[-1]["time"] / clip["fps"] - (traj.t[-1] - traj.t[0])) < 1e-12
         assert np.allclose(keys[0]["value"], first[visual_key(robot, i)][0][:3, 3], atol=1e-9)
         assert np.allclose(keys[-1]["value"], last[visual_key(robot, i)][0][:3, 3], atol=1e-9)
+
+
+def test_cli_view_of_a_constraint_file_robot(tmp_path, run_cli):
+    """A robot described by the user (URDF + TOML constraint file) is viewed like a registered one."""
+    out = tmp_path / "own.html"
+    res = run_cli("view", "--constraints", str(Path(__file__).resolve().parent.parent / "examples" / "quasimoro.toml"),
+                  "--html", str(out))
+    assert res.returncode == 0, res.stderr
+    cmds = decode(out.read_text())
+    visuals = {c["path"] for c in cmds if c["type"] == "set_object" and "/robotdyn/robot/visuals/" in c["path"]}
+    contacts = {c["path"] for c in cmds if c["type"] == "set_object" and "/robotdyn/contacts/" in c["path"]}
+    assert len(visuals) >= 3 and len(contacts) >= 2, (visuals, contacts)

@@ -408,7 +408,7 @@ class Viewer:
             if not path.startswith(self._visual_prefix):
                 self.vis[path].set_transform(T)
 
-    def set_camera(self, direction=(1.0, 1.3, 0.9), distance: float | None = None) -> None:
+    def set_camera(self, direction=(1.4, 1.0, 0.8), distance: float | None = None) -> None:
         """Place the camera along ``direction`` (world frame) from the world origin, at ``distance`` [m]
         (default: 2.6 times the robot's size plus the largest distance of the robot's centre from the origin in
         the configuration displayed or the animation, so the robot stays in view). It looks at the origin.

@@ -305,3 +305,6 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("robotdyn: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
+        sys.stderr.close()
+        return 0

@@ -9,7 +9,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-def _unit(name: str) -> str:
+def _unit(traj, name: str) -> str:
+    """The column's unit as the trajectory records it (from the joint types), else a guess from the name."""
+    if name in getattr(traj, "units", {}):
+        return traj.units[name]
     base = name[:-4] if name.endswith("_dot") else name
     unit = "m" if base in ("x", "y", "z") else "rad"
     return unit + ("/s" if name.endswith("_dot") else "")
@@ -46,7 +49,7 @@ def plot_trajectory(
             ax.plot(traj.t[mask], y[mask], lw=1.2, label="robotdyn")
             for value, label in (references or {}).get(name, []):
                 ax.axhline(value, color="C3", ls="--", lw=1.0, label=label)
-            ax.set_ylabel(f"{name} [{_unit(name)}]")
+            ax.set_ylabel(f"{name} [{_unit(traj, name)}]")
             ax.grid(alpha=0.3)
             if i == len(columns) - 1:
                 ax.set_xlabel("t [s]")

@@ -228,6 +228,17 @@ class Robot:
         """Number of independent velocities."""
         return len(self.velocity_names)
 
+    @property
+    def units(self) -> dict[str, str]:
+        """Unit of each coordinate and velocity by name: m and m/s for prismatic joints, rad and rad/s otherwise
+        (operational velocities are listed as given by their model)."""
+        out = {}
+        for label, joint in zip(self.coordinates, self.description.joint_names):
+            jid = self.model.getJointId(joint)
+            unit = "m" if "P" in self.model.joints[jid].shortname().replace("JointModel", "") else "rad"
+            out[label], out[f"{label}_dot"] = unit, f"{unit}/s"
+        return out
+
     def coordinate_index(self, label: str) -> int:
         """Index of a coordinate by its display name or joint name."""
         if label in self.coordinates:

@@ -36,6 +36,7 @@ class Trajectory:
         residual: Largest holonomic residual at each time (N,).
         coordinates, velocity_names: Column names.
         stats: Integrator statistics (nfev, wall time).
+        units: Unit of each column by name (m, rad, m/s, rad/s).
     """
 
     t: np.ndarray
@@ -46,6 +47,7 @@ class Trajectory:
     coordinates: list[str]
     velocity_names: list[str]
     stats: dict = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
 
     def __repr__(self) -> str:
         return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"
@@ -144,7 +146,8 @@ def simulate(
         if rows.holonomic.any():
             residual[i] = np.max(np.abs(rows.residual[rows.holonomic]))
     stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol}
-    return Trajectory(sol.t, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats)
+    return Trajectory(sol.t, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
+                      robot.units)
 
 
 def power(robot, traj: Trajectory, torque: TorqueFunction | None) -> np.ndarray:

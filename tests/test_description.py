@@ -67,3 +67,12 @@ def test_error_messages_are_one_line(tmp_path):
     with pytest.raises(DescriptionError) as err:
         build_description(expand_xacro(bad))
     assert "\n" not in str(err.value)
+
+
+def test_units_follow_joint_types():
+    import robotdyn
+
+    units = robotdyn.load("quasimoro").units
+    assert units["x"] == "m" and units["psi"] == "rad" and units["theta1_dot"] == "rad/s"
+    units = robotdyn.load("mmr12_eod").units
+    assert units["lambda2"] == "m" and units["lambda2_dot"] == "m/s" and units["theta1"] == "rad"

@@ -57,6 +57,7 @@ class Pair:
     images: tuple = ()
     error: str = ""
     srcdoc: bool = False  # the scenes run in iframes with srcdoc (their console source is about:srcdoc)
+    png: str = ""  # the screenshot of the page holding this pair
 
 
 def _exports(root: Path) -> dict[str, Pair]:
@@ -120,11 +121,12 @@ def gallery(chromium, tmp_path_factory) -> dict[str, Pair]:
         k, group = job
         page = _page(group, root / f"gallery{k}.html")
         png = root / f"gallery{k}.png"
-        log = screenshot(page, png, (2 * TILE[0], TILE[1] * len(group)), BUDGET_MS, chromium=chromium)
+        log = screenshot(page, png, (2 * TILE[0], TILE[1] * len(group)), BUDGET_MS, chromium=chromium, timeout=180)
         img = np.asarray(Image.open(png).convert("RGB"), dtype=int)
         for i, p in enumerate(group):
             tile = img[i * TILE[1] : (i + 1) * TILE[1]]
             p.images = (tile[:, : TILE[0]], tile[:, TILE[0] :])
+            p.png = str(png)
             if p.srcdoc:
                 if len(re.findall(r'"robotdyn: applied \d+ scene commands", source: about:srcdoc', log)) < 2:
                     p.error += "the scene scripts in the srcdoc iframes did not run; "
@@ -144,7 +146,7 @@ def gallery(chromium, tmp_path_factory) -> dict[str, Pair]:
 def rendered(gallery, label: str) -> tuple[np.ndarray, np.ndarray, dict]:
     p = gallery[label]
     assert not p.error, p.error
-    return p.images[0], p.images[1], p.meta
+    return p.images[0], p.images[1], {**p.meta, "png": p.png}
 
 
 def changed(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -181,15 +183,15 @@ def assert_robot_where_expected(mask: np.ndarray, uv: np.ndarray, label: str, ma
 @pytest.mark.parametrize("name", names())
 def test_robot_is_visible_where_its_geometry_projects(name, gallery):
     shown, hidden, meta = rendered(gallery, name)
-    assert_robot_where_expected(changed(shown, hidden), project(meta["points"], meta["camera"]), name)
+    assert_robot_where_expected(changed(shown, hidden), project(meta["points"], meta["camera"]), f"{name} ({meta['png']})")
 
 
 def test_terrain_mesh_is_visible(gallery):
     """A curved terrain (0.05 sin(2x + y)) is drawn: hiding it changes a third of the image or more, and the
     pixels it covers are terrain-coloured (green to sand: red and green above blue), not sky."""
-    shown, hidden, _ = rendered(gallery, "@terrain")
+    shown, hidden, meta = rendered(gallery, "@terrain")
     mask = changed(shown, hidden)
-    assert mask.mean() > 0.33, mask.mean()
+    assert mask.mean() > 0.33, (mask.mean(), meta["png"])
     r, g, b = (shown[mask][:, i].mean() for i in range(3))
     assert r > b and g > b, (r, g, b)
 
@@ -199,7 +201,7 @@ def test_animation_time_base_in_the_browser(gallery):
     Opened paused at 1.0 s (page.html#t=1.0) the robot is at its start; at 2.5 s it is gone. A wrong time base
     (keys read as seconds at 30 fps, or frames at 1 fps) fails one of the two."""
     late, early, meta = rendered(gallery, "@animation")
-    assert_robot_where_expected(changed(early, late), project(meta["points"], meta["camera"]), "animation")
+    assert_robot_where_expected(changed(early, late), project(meta["points"], meta["camera"]), f"animation ({meta['png']})")
 
 
 def test_notebook_inline_display_shows_the_robot(gallery):
@@ -207,4 +209,5 @@ def test_notebook_inline_display_shows_the_robot(gallery):
     The inline iframe is 420 px high and as wide as its 400 px tile, so the projection uses that size."""
     shown, hidden, meta = rendered(gallery, "@notebook")
     mask = changed(shown, hidden)
-    assert_robot_where_expected(mask, project(meta["points"], meta["camera"], size=(TILE[0], 420)), "notebook")
+    assert_robot_where_expected(mask, project(meta["points"], meta["camera"], size=(TILE[0], 420)),
+                                f"notebook ({meta['png']})")

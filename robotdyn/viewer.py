@@ -442,12 +442,12 @@ class Viewer:
                 arc, so a body turning more than half a turn between keys needs a higher rate.
         """
         mc = _meshcat()
-        if isinstance(trajectory, tuple):
-            t, Q = trajectory
-        else:
-            t, Q = trajectory.t, trajectory.q
-        t = np.asarray(t, dtype=float)
-        Q = np.asarray(Q, dtype=float)
+        try:
+            t, Q = (trajectory.t, trajectory.q) if hasattr(trajectory, "q") else trajectory
+            t = np.asarray(t, dtype=float)
+            Q = np.asarray(Q, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("trajectory: expected a Trajectory or a pair (t, q) of numeric arrays") from None
         if t.ndim != 1 or Q.shape != (len(t), self.model.nq) or len(t) < 2:
             raise InputError(f"trajectory: t {t.shape}, q {Q.shape}; expected N >= 2 times and an N x {self.model.nq} q")
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(Q)) and np.all(np.diff(t) > 0)):

@@ -235,6 +235,8 @@ def test_layers_toggle_and_bad_input_is_one_line(robots):
         viewer.display([0.0, 1.0])
     with pytest.raises(InputError, match="expected finite q and strictly increasing"):
         viewer.animate((np.array([0.0, 0.0]), np.zeros((2, 6))))
+    with pytest.raises(InputError, match="expected a Trajectory or a pair"):
+        viewer.animate("run.csv")
     with pytest.raises(InputError, match="fps"):
         viewer.animate((np.array([0.0, 1.0]), np.zeros((2, 6))), fps=0)
 

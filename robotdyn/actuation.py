@@ -50,14 +50,20 @@ class Motor:
         if self.rid is None:
             col[self.index] = 1.0
             return col
-        axis = kin.joint_axis(self.jid)
-        j_child = pin.getJointJacobian(kin.model, kin.data, self.jid, pin.LOCAL_WORLD_ALIGNED)[3:]
+        jac = pin.getJointJacobian(kin.model, kin.data, self.jid, pin.LOCAL_WORLD_ALIGNED)
+        ang = jac[3:, self.index]
+        axis = ang if np.linalg.norm(ang) > 0.5 else jac[:3, self.index]  # as KinematicState.joint_axis
+        j_child = jac[3:]
         _, j_reaction, _ = kin.frame(self.rid)
         return (j_child - j_reaction[3:]).T @ axis
 
 
 def input_matrix(motors: list[Motor], kin: KinematicState) -> np.ndarray:
     """Stack the motors' columns into B (nv, n_motors)."""
-    if not motors:
-        return np.zeros((kin.model.nv, 0))
-    return np.column_stack([m.column(kin) for m in motors])
+    B = np.zeros((kin.model.nv, len(motors)))
+    for j, m in enumerate(motors):
+        if m.rid is None:  # the usual joint motor: a unit column, no kinematics needed
+            B[m.index, j] = 1.0
+        else:
+            B[:, j] = m.column(kin)
+    return B

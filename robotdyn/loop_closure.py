@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from .constraint import Constraint, ConstraintRows, KinematicState, skew
+from .constraint import Constraint, ConstraintRows, KinematicState, cross, skew
 from .errors import DescriptionError
 
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -76,3 +76,35 @@ class LoopClosure(Constraint):
         sel = self._sel
         labels = [f"{self.name}.{c}" for c in self.components]
         return ConstraintRows(A[sel], Adot[sel], residual[sel], np.ones(len(sel), bool), labels)
+
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        """The rows and residuals without :math:`\\dot A` (configuration only)."""
+        M1, J1 = kin.pose(self.f1)
+        M2, J2 = kin.pose(self.f2)
+        R1T = M1.rotation.T
+        d = M2.translation - M1.translation
+        K = J2 - J1
+        K[:3] += skew(d) @ J1[3:]
+        A = (R1T @ K.reshape(2, 3, -1)).reshape(6, -1)
+        residual = np.concatenate([R1T @ d, pin.log3(R1T @ M2.rotation)])
+        sel = self._sel
+        labels = [f"{self.name}.{c}" for c in self.components]
+        return ConstraintRows(A[sel], None, residual[sel], np.ones(len(sel), bool), labels)
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        """:math:`\\dot A v` from the frames' velocities and :math:`\\dot J v` (3-vectors, no matrix :math:`\\dot A`)."""
+        M1, J1, dJ1 = kin.frame(self.f1)
+        M2, J2, dJ2 = kin.frame(self.f2)
+        v = kin.v
+        V1, V2 = J1 @ v, J2 @ v
+        a1, a2 = dJ1 @ v, dJ2 @ v
+        d = M2.translation - M1.translation
+        w1 = V1[3:]
+        ddot = V2[:3] - V1[:3]
+        kt = ddot + cross(d, w1)
+        dkt = a2[:3] - a1[:3] + cross(ddot, w1) + cross(d, a1[3:])
+        kr = V2[3:] - V1[3:]
+        dkr = a2[3:] - a1[3:]
+        R1T = M1.rotation.T
+        out = np.concatenate([R1T @ (dkt - cross(w1, kt)), R1T @ (dkr - cross(w1, kr))])
+        return out[self._sel]

@@ -12,7 +12,7 @@ Time derivative: from :math:`\\dot A S + A \\dot S = 0` with a zero independent 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
@@ -66,6 +66,7 @@ class Projection:
     rows: np.ndarray
     condition: float
     Ad_inv: np.ndarray | None = None
+    _layout: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def mobility(self) -> int:
@@ -87,13 +88,23 @@ class Projection:
         return w
 
 
-def _build(A, independent, dependent, rows, names) -> Projection:
+def _layout(n: int, independent: np.ndarray, dependent: np.ndarray, rows: np.ndarray) -> tuple:
+    """Index helpers of a choice of independent velocities and rows (reused by projections built from a hint):
+    S with its identity block set, and the index tuples of the dependent and independent blocks of A."""
+    S0 = np.zeros((n, n - rows.size))
+    S0[independent, np.arange(independent.size)] = 1.0
+    return S0, np.ix_(rows, dependent), np.ix_(rows, independent)
+
+
+def _build(A, independent, dependent, rows, names, layout: tuple | None = None) -> Projection:
     n = A.shape[1]
-    S = np.zeros((n, n - rows.size))
-    S[independent, np.arange(independent.size)] = 1.0
+    if layout is None:
+        layout = _layout(n, independent, dependent, rows)
+    S0, ix_dep, ix_ind = layout
+    S = S0.copy()
     if rows.size == 0:
-        return Projection(S, independent, dependent, rows, 1.0, None)
-    Ad = A[np.ix_(rows, dependent)]
+        return Projection(S, independent, dependent, rows, 1.0, None, layout)
+    Ad = A[ix_dep]
     try:
         Ad_inv = np.linalg.inv(Ad)
         cond = float(np.abs(Ad).sum(axis=0).max() * np.abs(Ad_inv).sum(axis=0).max())
@@ -106,8 +117,8 @@ def _build(A, independent, dependent, rows, names) -> Projection:
             "independent velocities or move away from this singular configuration",
             condition=cond,
         )
-    S[dependent] = -Ad_inv @ A[np.ix_(rows, independent)]
-    return Projection(S, independent, dependent, rows, cond, Ad_inv)
+    S[dependent] = -Ad_inv @ A[ix_ind]
+    return Projection(S, independent, dependent, rows, cond, Ad_inv, layout)
 
 
 def project(
@@ -133,7 +144,7 @@ def project(
     names = names or [f"v{i}" for i in range(n)]
     if hint is not None and (independent is None or np.array_equal(hint.independent, independent)):
         try:
-            proj = _build(A, hint.independent, hint.dependent, hint.rows, names)
+            proj = _build(A, hint.independent, hint.dependent, hint.rows, names, hint._layout)
         except SingularConstraintError:
             proj = None
         scale = max(1.0, float(np.abs(A).max())) if A.size else 1.0

@@ -21,6 +21,7 @@ import pinocchio as pin
 from .actuation import input_matrix
 from .constraint import ConstraintRows, KinematicState
 from .projection import Projection, project
+from .rolling_contact import WheelGroup, groupable
 
 
 @dataclass
@@ -66,6 +67,92 @@ class ReducedDynamics:
         return f"ReducedDynamics(k={self.M.shape[0]}, n={self.S.shape[0]}, motors={self.B.shape[1]})"
 
 
+class ConstraintSet:
+    """A robot's constraints evaluated together: the rolling wheels in one vectorised
+    :class:`~robotdyn.rolling_contact.WheelGroup` pass, the others one by one; rows stacked in the order of
+    ``constraints`` (the same rows as stacking each constraint's own :meth:`~robotdyn.constraint.Constraint.jacobian`
+    and :meth:`~robotdyn.constraint.Constraint.drift`).
+
+    Args:
+        constraints: The constraints, in row order.
+        nv: Number of velocities.
+    """
+
+    def __init__(self, constraints, nv: int) -> None:
+        self.constraints = tuple(constraints)
+        self.nv = nv
+        wheels = [c for c in self.constraints if groupable(c)]
+        self.group = WheelGroup(wheels) if wheels else None
+        self.others = [c for c in self.constraints if not groupable(c)]
+        self._order: dict[tuple[int, ...], np.ndarray | None] = {}
+
+    def _permutation(self, counts: tuple[int, ...]) -> np.ndarray | None:
+        """Row permutation from [wheel group rows, other constraints' rows] to constraint order (None: identity)."""
+        if counts not in self._order:
+            sizes = {}
+            start = 0
+            if self.group is not None:
+                for w in self.group.wheels:
+                    k = w._directions.shape[0]
+                    sizes[id(w)] = np.arange(start, start + k)
+                    start += k
+            for c, k in zip(self.others, counts):
+                sizes[id(c)] = np.arange(start, start + k)
+                start += k
+            perm = np.concatenate([sizes[id(c)] for c in self.constraints]) if self.constraints else np.zeros(0, int)
+            self._order[counts] = None if np.array_equal(perm, np.arange(perm.size)) else perm
+        return self._order[counts]
+
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        """All rows without their time derivative, stacked in constraint order."""
+        parts = [c.jacobian(kin) for c in self.others]
+        if self.group is not None:
+            parts.insert(0, self.group.jacobian(kin))
+        rows = ConstraintRows.stack(parts, self.nv) if len(parts) != 1 else parts[0]
+        perm = self._permutation(tuple(p.A.shape[0] for p in parts[1 if self.group is not None else 0:]))
+        if perm is not None:
+            rows = ConstraintRows(rows.A[perm], None, rows.residual[perm], rows.holonomic[perm],
+                                  [rows.labels[i] for i in perm])
+        return rows
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        """All drift terms :math:`\\dot A v`, stacked in constraint order."""
+        parts = [c.drift(kin) for c in self.others]
+        counts = tuple(len(p) for p in parts)
+        if self.group is not None:
+            parts.insert(0, self.group.drift(kin))
+        if not parts:
+            return np.zeros(0)
+        out = np.concatenate(parts) if len(parts) != 1 else parts[0]
+        perm = self._permutation(counts)
+        return out if perm is None else out[perm]
+
+
+def constraint_set(robot) -> ConstraintSet:
+    """The robot's :class:`ConstraintSet` (built once, rebuilt if ``robot.constraints`` was changed)."""
+    cset = getattr(robot, "_constraint_set", None)
+    if cset is None or len(cset.constraints) != len(robot.constraints) or any(
+        a is not b for a, b in zip(cset.constraints, robot.constraints)
+    ):
+        cset = ConstraintSet(robot.constraints, robot.model.nv)
+        robot._constraint_set = cset
+    return cset
+
+
+def velocity(robot, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, ConstraintRows]:
+    """Only :math:`v = S(q)\\nu` and the constraint rows at q (one kinematics pass, no dynamics): the same ``v`` and
+    ``jacobian_rows`` as :func:`reduce` (or the robot's operational reduction) at a fraction of the cost."""
+    if getattr(robot, "operational", None) is not None:
+        red = robot.reduced(q, nu)
+        return red.v, red.jacobian_rows
+    model = robot.model
+    kin0 = KinematicState(model, robot.data, q, np.zeros(model.nv))
+    rows0 = constraint_set(robot).jacobian(kin0)
+    proj = project(rows0.A, robot.independent_indices, robot.velocity_labels, hint=robot._projection_hint)
+    robot._projection_hint = proj
+    return proj.S @ np.asarray(nu, float), rows0
+
+
 def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
     """Evaluate the reduced model of ``robot`` at (q, nu).
 
@@ -78,13 +165,14 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     """
     model, data = robot.model, robot.data
     ind = robot.independent_indices if independent is None else independent
+    cset = constraint_set(robot)
     kin0 = KinematicState(model, data, q, np.zeros(model.nv))
-    rows0 = ConstraintRows.stack([c.jacobian(kin0) for c in robot.constraints], model.nv)
+    rows0 = cset.jacobian(kin0)
     proj = project(rows0.A, ind, robot.velocity_labels, hint=robot._projection_hint)
     robot._projection_hint = proj
     v = proj.S @ nu
     kin = kin0.with_velocity(v)
-    drift = np.concatenate([c.drift(kin) for c in robot.constraints]) if robot.constraints else np.zeros(0)
+    drift = cset.drift(kin)
     B = input_matrix(robot.motors, kin)
     w = proj.offset(drift)
     S = proj.S

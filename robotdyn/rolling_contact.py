@@ -22,8 +22,9 @@ from t1 towards t2 (0 for a 90-degree omni wheel whose rollers leave the lateral
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
-from .constraint import Constraint, ConstraintRows, KinematicState, cross, skew
+from .constraint import LWA, Constraint, ConstraintRows, KinematicState, cross, skew
 from .errors import ConstraintError, DescriptionError
 from .terrain import FlatTerrain, Terrain
 
@@ -233,3 +234,204 @@ class SupportWheel(RollingWheel):
 
     _row_names = ("normal",)
     _directions = np.array([[0.0, 0.0, 1.0]])
+
+
+_EPS = np.zeros((3, 3, 3))
+_EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
+_EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
+_I3 = np.eye(3)
+
+
+def _vcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (m, 3) arrays."""
+    return np.einsum("ijk,mj,mk->mi", _EPS, a, b)
+
+
+def _vdot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot products of (m, 3) arrays, shape (m, 1)."""
+    return np.einsum("mi,mi->m", a, b)[:, None]
+
+
+def groupable(constraint) -> bool:
+    """Whether :class:`WheelGroup` reproduces ``constraint``'s rows (a wheel class that does not override the
+    contact model)."""
+    cls = type(constraint)
+    return (
+        isinstance(constraint, RollingWheel)
+        and cls.jacobian is RollingWheel.jacobian
+        and cls.drift is RollingWheel.drift
+        and cls._geometry is RollingWheel._geometry
+        and cls._world_jacobian is RollingWheel._world_jacobian
+    )
+
+
+class WheelGroup:
+    """Several rolling wheels evaluated together in one vectorised pass (arrays of shape (m, 3), (m, 3, nv)).
+
+    Gives the same rows as the wheels' own :meth:`RollingWheel.jacobian` and :meth:`RollingWheel.drift`
+    (same formulas, see the module docstring), stacked in the order of ``wheels``, with a few dozen numpy calls
+    for the whole group instead of per wheel. Wheels on a plane (``terrain.is_flat``, a
+    :class:`~robotdyn.terrain.RampTerrain`) get their contact geometry vectorised too; on other terrains the
+    contact point of each wheel is found by :meth:`RollingWheel._geometry` (an iteration on the terrain).
+
+    Args:
+        wheels: The wheels (instances for which :func:`groupable` holds).
+    """
+
+    def __init__(self, wheels: list[RollingWheel]) -> None:
+        from .terrain import RampTerrain
+
+        self.wheels = list(wheels)
+        m = len(self.wheels)
+        self.fids = [w.fid for w in self.wheels]
+        self.axis = np.array([w.axis for w in self.wheels])
+        self.R0 = np.array([w.radius for w in self.wheels])[:, None]
+        self.radial = np.array([i for i, w in enumerate(self.wheels) if w.radius_index is not None], dtype=int)
+        self.radial_index = np.array([self.wheels[i].radius_index for i in self.radial], dtype=int)
+        terrains = {id(w.terrain) for w in self.wheels}
+        first = self.wheels[0].terrain
+        self.plane = len(terrains) == 1 and isinstance(first, RampTerrain) and first.is_flat
+        if self.plane:
+            self.terrain = first
+            self.n = np.tile(first.normal(0.0, 0.0), (m, 1))
+            grad = first.gradient(0.0, 0.0)
+            self.grad = grad
+            self.slope_norm = np.sqrt(1.0 + grad @ grad)
+        self.curved = not all(w.terrain.is_flat for w in self.wheels)
+        self.Dpad = np.zeros((m, 3, 3))
+        keep, labels, holonomic = [], [], []
+        for i, w in enumerate(self.wheels):
+            D = w._directions
+            self.Dpad[i, : D.shape[0]] = D
+            keep += [3 * i + j for j in range(D.shape[0])]
+            labels += w._labels()
+            holonomic += list(D[:, 2] != 0)
+        self.keep = np.array(keep, dtype=int)
+        self.labels = labels
+        self.holonomic = np.array(holonomic, dtype=bool)
+
+    def __repr__(self) -> str:
+        return f"WheelGroup({[w.name for w in self.wheels]})"
+
+    def _geometry(self, kin: KinematicState) -> dict:
+        """Configuration-level geometry of all wheels (cached in ``kin.geometry``)."""
+        key = (id(self), "geometry")
+        if key in kin.geometry:
+            return kin.geometry[key]
+        m, nv = len(self.fids), kin.model.nv
+        J = np.empty((m, 6, nv))
+        if self.plane:
+            rot = np.empty((m, 3, 3))
+            c = np.empty((m, 3))
+            model, data = kin.model, kin.data
+            for i, f in enumerate(self.fids):  # straight from Pinocchio's data (kin is its latest pass)
+                J[i] = pin.getFrameJacobian(model, data, f, LWA)
+                placement = data.oMf[f]
+                rot[i] = placement.rotation
+                c[i] = placement.translation
+            a = (rot @ self.axis[:, :, None])[:, :, 0]
+            R = self.R0.copy()
+            if self.radial.size:
+                R[self.radial, 0] += kin.q[self.radial_index]
+                bad = np.flatnonzero(R[:, 0] <= 0)
+                if bad.size:
+                    w = self.wheels[bad[0]]
+                    raise ConstraintError(
+                        f"wheel {w.name!r}: radius {R[bad[0], 0]:.6g} m is not positive at this configuration"
+                    )
+            n = self.n
+            wv = n - _vdot(n, a) * a
+            nw = np.sqrt(_vdot(wv, wv))
+            flat = np.flatnonzero(nw[:, 0] < 1e-9)
+            if flat.size:
+                raise ConstraintError(
+                    f"wheel {self.wheels[flat[0]].name!r}: the axle is parallel to the ground normal (wheel lying "
+                    "flat); expected a wheel standing on the terrain"
+                )
+            u = wv / nw
+            p = c - R * u
+            ter = self.terrain
+            phi = (p[:, 2] - ter.h - p[:, :2] @ ter._g) / self.slope_norm
+            N = None
+            c1 = _vcross(a, n)
+            nc1 = np.sqrt(_vdot(c1, c1))
+            t1 = c1 / nc1
+            E = np.stack([t1, _vcross(n, t1), n], axis=2)
+        else:
+            geos = [w._geometry(kin) for w in self.wheels]  # (c, a, R, n, u, p, nw, phi, N, E, nc1)
+            for i, f in enumerate(self.fids):
+                J[i] = kin.pose(f)[1]
+            c, a, n, u, p = (np.array([g[i] for g in geos]) for i in (0, 1, 3, 4, 5))
+            R = np.array([[g[2]] for g in geos])
+            nw = np.array([[g[6]] for g in geos])
+            phi = np.array([g[7] for g in geos])
+            N = None if not self.curved else np.array([np.zeros((3, 3)) if g[8] is None else g[8] for g in geos])
+            E = np.array([g[9] for g in geos])
+            nc1 = np.array([[g[10]] for g in geos])
+        r = -R * u
+        Aw = J[:, :3] - _skews(r) @ J[:, 3:]
+        if self.radial.size:
+            Aw[self.radial, :, self.radial_index] -= u[self.radial]
+        ET = E.transpose(0, 2, 1)
+        W = self.Dpad @ ET
+        A = (W @ Aw).reshape(-1, Aw.shape[2])[self.keep]
+        residual = np.where(self.holonomic, np.repeat(phi, 3)[self.keep], 0.0)
+        out = dict(J=J, a=a, R=R, n=n, u=u, nw=nw, N=N, E=E, ET=ET, nc1=nc1, r=r, Aw=Aw, A=A, residual=residual)
+        kin.geometry[key] = out
+        return out
+
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        """The stacked rows of all wheels (as :meth:`RollingWheel.jacobian`, ``Adot`` is ``None``)."""
+        geo = self._geometry(kin)
+        return ConstraintRows(geo["A"], None, geo["residual"], self.holonomic, self.labels)
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        """The stacked drift terms :math:`\\dot A v` of all wheels (as :meth:`RollingWheel.drift`)."""
+        geo = self._geometry(kin)
+        v = kin.v
+        if not kin._moving:
+            return np.zeros(self.keep.size)
+        J, a, R, n, u, nw, E, ET = (geo[k] for k in ("J", "a", "R", "n", "u", "nw", "E", "ET"))
+        dJ = np.empty_like(J)
+        for i, f in enumerate(self.fids):  # kin is the latest pass on its data (as for KinematicState.frame)
+            dJ[i] = pin.getFrameJacobianTimeVariation(kin.model, kin.data, f, LWA)
+        Jv = J @ v
+        cdot, omega = Jv[:, :3], Jv[:, 3:]
+        dJv = dJ @ v
+        adot = _vcross(omega, a)
+        rhs_const = -_vdot(n, adot) * a - _vdot(n, a) * adot
+        Rdot = np.zeros_like(R)
+        if self.radial.size:
+            Rdot[self.radial, 0] = v[self.radial_index]
+        if self.curved:
+            P = (_I3 - u[:, :, None] * u[:, None, :]) / nw[:, :, None]
+            N = geo["N"]
+            Qa = _I3 - a[:, :, None] * a[:, None, :]
+            QaN = Qa @ N
+            K = _I3 + R[:, :, None] * (P @ QaN)
+            rhs = (P @ ((QaN @ (cdot - Rdot * u)[:, :, None])[:, :, 0] + rhs_const)[:, :, None])
+            udot = np.linalg.solve(K, rhs)[:, :, 0]
+            ndot = (N @ (cdot - R * udot - Rdot * u)[:, :, None])[:, :, 0]
+        else:  # plane: P = (I - u u^T) / |w| applied to a vector, the normal is constant
+            udot = (rhs_const - u * _vdot(u, rhs_const)) / nw
+            ndot = None
+        r = geo["r"]
+        rdot = -R * udot - Rdot * u if self.radial.size else -R * udot
+        t1 = E[:, :, 0]
+        c1dot = _vcross(adot, n) if ndot is None else _vcross(adot, n) + _vcross(a, ndot)
+        t1dot = (c1dot - t1 * _vdot(t1, c1dot)) / geo["nc1"]
+        if ndot is None:
+            EdotT = np.stack([t1dot, _vcross(n, t1dot), np.zeros_like(t1dot)], axis=1)
+        else:
+            EdotT = np.stack([t1dot, _vcross(ndot, t1) + _vcross(n, t1dot), ndot], axis=1)
+        s = (geo["Aw"] @ v)
+        acc = dJv[:, :3] + _vcross(dJv[:, 3:], r) + _vcross(omega, rdot)
+        if self.radial.size:
+            acc = acc - udot * Rdot
+        d3 = (EdotT @ s[:, :, None] + ET @ acc[:, :, None])
+        return (self.Dpad @ d3).reshape(-1)[self.keep]
+
+
+def _skews(x: np.ndarray) -> np.ndarray:
+    """Cross-product matrices of the rows of an (m, 3) array, shape (m, 3, 3)."""
+    return np.einsum("ijk,mj->mik", _EPS, x)

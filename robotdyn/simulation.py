@@ -20,6 +20,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .errors import RobotDynError
+from .reduced_dynamics import velocity
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
@@ -125,7 +126,7 @@ def simulate(
         qdot = red.v
         rows = red.jacobian_rows
         hol = rows.holonomic
-        if stabilisation and hol.any():
+        if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
             qdot = qdot - stabilisation * np.linalg.lstsq(rows.A[hol], rows.residual[hol], rcond=None)[0]
         report(t)
         return np.concatenate([qdot, nudot])
@@ -140,9 +141,8 @@ def simulate(
     energy = np.empty(len(sol.t))
     residual = np.zeros(len(sol.t))
     for i in range(len(sol.t)):
-        red = robot.reduced(q[i], nu[i])
-        energy[i] = robot.energy(q[i], red.v)
-        rows = red.jacobian_rows
+        v, rows = velocity(robot, q[i], nu[i])  # the reduced model's v and rows, without its dynamics
+        energy[i] = robot.energy(q[i], v)
         if rows.holonomic.any():
             residual[i] = np.max(np.abs(rows.residual[rows.holonomic]))
     stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol}

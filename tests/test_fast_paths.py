@@ -1,0 +1,58 @@
+"""The vectorised evaluation paths against the per-constraint rows they replace, on every registered robot.
+
+:class:`robotdyn.reduced_dynamics.ConstraintSet` (rolling wheels in one :class:`~robotdyn.rolling_contact.WheelGroup`
+pass, loop closures through their vector drift) must give the same Jacobian rows, residuals and drift terms as
+stacking each constraint's full :meth:`rows` (whose ``Adot`` is checked against finite differences in the core
+tests), at states off the constraint manifold too (the formulas do not assume A v = 0).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robotdyn
+from robotdyn.constraint import ConstraintRows, KinematicState
+from robotdyn.reduced_dynamics import constraint_set, velocity
+from robotdyn.robots import names
+
+
+@pytest.fixture(scope="module", params=names())
+def robot(request):
+    return robotdyn.load(request.param)
+
+
+def test_constraint_set_matches_per_constraint_rows(robot):
+    rng = np.random.default_rng(7)
+    cset = constraint_set(robot)
+    for trial in range(4):
+        q = robot.neutral() + (0.0 if trial == 0 else 0.02) * rng.normal(size=robot.nq)
+        v = rng.normal(size=robot.nq)
+        ref_kin = KinematicState(robot.model, robot.data, q, v)
+        ref = ConstraintRows.stack([c.rows(ref_kin) for c in robot.constraints], robot.nq)
+        ref_drift = ref.Adot @ v
+        kin = KinematicState(robot.model, robot.data, q, v)
+        rows = cset.jacobian(kin)
+        drift = cset.drift(kin)
+        scale = 1.0 + np.abs(ref.A).max()
+        assert rows.labels == ref.labels
+        assert np.array_equal(rows.holonomic, ref.holonomic)
+        assert np.abs(rows.A - ref.A).max() <= 1e-13 * scale
+        assert np.abs(rows.residual - ref.residual).max() <= 1e-13
+        assert np.abs(drift - ref_drift).max() <= 1e-12 * (1.0 + np.abs(ref_drift).max())
+
+
+def test_at_rest_drift_is_zero(robot):
+    kin = KinematicState(robot.model, robot.data, robot.neutral(), np.zeros(robot.nq))
+    assert not np.any(constraint_set(robot).drift(kin))
+
+
+def test_velocity_matches_reduce(robot):
+    rng = np.random.default_rng(3)
+    q = robot.neutral()
+    nu = rng.normal(size=robot.mobility)
+    red = robot.reduced(q, nu)
+    v, rows = velocity(robot, q, nu)
+    assert np.abs(v - red.v).max() <= 1e-14 * (1.0 + np.abs(red.v).max())
+    assert np.array_equal(rows.A, red.jacobian_rows.A)
+    assert np.abs(red.rows.A @ v).max() <= 1e-12 * (1.0 + np.abs(v).max())

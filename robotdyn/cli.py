@@ -1,4 +1,5 @@
-"""Command-line interface: ``robotdyn list | info | dump | simulate | compare`` (every command has ``--json``).
+"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view`` plus robot-specific commands
+(every command has ``--json``).
 
 Robot modules may add their own subcommands by defining ``register_cli(subparsers, parents)``; each such
 subcommand sets ``func(args) -> int``.

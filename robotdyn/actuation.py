@@ -52,9 +52,9 @@ class Motor:
             return col
         jac = pin.getJointJacobian(kin.model, kin.data, self.jid, pin.LOCAL_WORLD_ALIGNED)
         ang = jac[3:, self.index]
-        axis = ang if np.linalg.norm(ang) > 0.5 else jac[:3, self.index]  # as KinematicState.joint_axis
+        axis = ang if ang @ ang > 0.25 else jac[:3, self.index]  # as KinematicState.joint_axis (|ang| > 0.5)
         j_child = jac[3:]
-        _, j_reaction, _ = kin.frame(self.rid)
+        _, j_reaction = kin.pose(self.rid)
         return (j_child - j_reaction[3:]).T @ axis
 
 

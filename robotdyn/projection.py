@@ -142,7 +142,9 @@ def project(
     """
     n = A.shape[1]
     names = names or [f"v{i}" for i in range(n)]
-    if hint is not None and (independent is None or np.array_equal(hint.independent, independent)):
+    if hint is not None and (
+        independent is None or independent is hint.independent or np.array_equal(hint.independent, independent)
+    ):
         try:
             proj = _build(A, hint.independent, hint.dependent, hint.rows, names, hint._layout)
         except SingularConstraintError:

@@ -21,7 +21,10 @@ import pinocchio as pin
 from .actuation import input_matrix
 from .constraint import ConstraintRows, KinematicState
 from .projection import Projection, project
-from .rolling_contact import WheelGroup, groupable
+from .loop_closure import LoopGroup
+from .loop_closure import groupable as groupable_loop
+from .rolling_contact import WheelGroup
+from .rolling_contact import groupable as groupable_wheel
 
 
 @dataclass
@@ -69,7 +72,8 @@ class ReducedDynamics:
 
 class ConstraintSet:
     """A robot's constraints evaluated together: the rolling wheels in one vectorised
-    :class:`~robotdyn.rolling_contact.WheelGroup` pass, the others one by one; rows stacked in the order of
+    :class:`~robotdyn.rolling_contact.WheelGroup` pass, the loop closures in one
+    :class:`~robotdyn.loop_closure.LoopGroup` pass, the others one by one; rows stacked in the order of
     ``constraints`` (the same rows as stacking each constraint's own :meth:`~robotdyn.constraint.Constraint.jacobian`
     and :meth:`~robotdyn.constraint.Constraint.drift`).
 
@@ -81,20 +85,25 @@ class ConstraintSet:
     def __init__(self, constraints, nv: int) -> None:
         self.constraints = tuple(constraints)
         self.nv = nv
-        wheels = [c for c in self.constraints if groupable(c)]
-        self.group = WheelGroup(wheels) if wheels else None
-        self.others = [c for c in self.constraints if not groupable(c)]
+        self.groups = []
+        wheels = [c for c in self.constraints if groupable_wheel(c)]
+        if wheels:
+            self.groups.append((WheelGroup(wheels), wheels))
+        loops = [c for c in self.constraints if groupable_loop(c)]
+        if loops:
+            self.groups.append((LoopGroup(loops), loops))
+        grouped = {id(c) for _, members in self.groups for c in members}
+        self.others = [c for c in self.constraints if id(c) not in grouped]
         self._order: dict[tuple[int, ...], np.ndarray | None] = {}
 
     def _permutation(self, counts: tuple[int, ...]) -> np.ndarray | None:
-        """Row permutation from [wheel group rows, other constraints' rows] to constraint order (None: identity)."""
+        """Row permutation from [groups' rows, other constraints' rows] to constraint order (None: identity)."""
         if counts not in self._order:
             sizes = {}
             start = 0
-            if self.group is not None:
-                for w in self.group.wheels:
-                    k = w._directions.shape[0]
-                    sizes[id(w)] = np.arange(start, start + k)
+            for group, members in self.groups:
+                for c, k in zip(members, group.row_counts):
+                    sizes[id(c)] = np.arange(start, start + k)
                     start += k
             for c, k in zip(self.others, counts):
                 sizes[id(c)] = np.arange(start, start + k)
@@ -105,11 +114,10 @@ class ConstraintSet:
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
         """All rows without their time derivative, stacked in constraint order."""
-        parts = [c.jacobian(kin) for c in self.others]
-        if self.group is not None:
-            parts.insert(0, self.group.jacobian(kin))
+        others = [c.jacobian(kin) for c in self.others]
+        parts = [group.jacobian(kin) for group, _ in self.groups] + others
         rows = ConstraintRows.stack(parts, self.nv) if len(parts) != 1 else parts[0]
-        perm = self._permutation(tuple(p.A.shape[0] for p in parts[1 if self.group is not None else 0:]))
+        perm = self._permutation(tuple(p.A.shape[0] for p in others))
         if perm is not None:
             rows = ConstraintRows(rows.A[perm], None, rows.residual[perm], rows.holonomic[perm],
                                   [rows.labels[i] for i in perm])
@@ -117,14 +125,12 @@ class ConstraintSet:
 
     def drift(self, kin: KinematicState) -> np.ndarray:
         """All drift terms :math:`\\dot A v`, stacked in constraint order."""
-        parts = [c.drift(kin) for c in self.others]
-        counts = tuple(len(p) for p in parts)
-        if self.group is not None:
-            parts.insert(0, self.group.drift(kin))
+        others = [c.drift(kin) for c in self.others]
+        parts = [group.drift(kin) for group, _ in self.groups] + others
         if not parts:
             return np.zeros(0)
         out = np.concatenate(parts) if len(parts) != 1 else parts[0]
-        perm = self._permutation(counts)
+        perm = self._permutation(tuple(len(p) for p in others))
         return out if perm is None else out[perm]
 
 
@@ -176,7 +182,8 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     B = input_matrix(robot.motors, kin)
     w = proj.offset(drift)
     S = proj.S
-    full_rows = lambda: robot.constraint_rows(kin)  # noqa: E731  (frames it needs are cached in kin)
+    # all rows with Adot, on first access: a fresh kinematics pass, since data may hold another state by then
+    full_rows = lambda: robot.constraint_rows(KinematicState(model, data, q, v))  # noqa: E731
     if coriolis:
         full_rows = full_rows()
     M = pin.crba(model, data, q)

@@ -21,10 +21,15 @@ from t1 towards t2 (0 for a 90-degree omni wheel whose rollers leave the lateral
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pinocchio as pin
 
 from .constraint import LWA, Constraint, ConstraintRows, KinematicState, cross, skew
+from .constraint import skews as _skews
+from .constraint import vcross as _vcross
+from .constraint import vdot as _vdot
 from .errors import ConstraintError, DescriptionError
 from .terrain import FlatTerrain, Terrain
 
@@ -236,20 +241,7 @@ class SupportWheel(RollingWheel):
     _directions = np.array([[0.0, 0.0, 1.0]])
 
 
-_EPS = np.zeros((3, 3, 3))
-_EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
-_EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
 _I3 = np.eye(3)
-
-
-def _vcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross products of (m, 3) arrays."""
-    return np.einsum("ijk,mj,mk->mi", _EPS, a, b)
-
-
-def _vdot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise dot products of (m, 3) arrays, shape (m, 1)."""
-    return np.einsum("mi,mi->m", a, b)[:, None]
 
 
 def groupable(constraint) -> bool:
@@ -293,9 +285,11 @@ class WheelGroup:
         self.plane = len(terrains) == 1 and isinstance(first, RampTerrain) and first.is_flat
         if self.plane:
             self.terrain = first
-            self.n = np.tile(first.normal(0.0, 0.0), (m, 1))
+            self.n0 = first.normal(0.0, 0.0)
+            self.n = np.tile(self.n0, (m, 1))
+            self.Kn = skew(self.n0)
             grad = first.gradient(0.0, 0.0)
-            self.grad = grad
+            self.height_row = np.array([-grad[0], -grad[1], 1.0])  # p_z - (f(p) - h) = height_row . p
             self.slope_norm = np.sqrt(1.0 + grad @ grad)
         self.curved = not all(w.terrain.is_flat for w in self.wheels)
         self.Dpad = np.zeros((m, 3, 3))
@@ -307,11 +301,32 @@ class WheelGroup:
             labels += w._labels()
             holonomic += list(D[:, 2] != 0)
         self.keep = np.array(keep, dtype=int)
+        self.row_wheel = self.keep // 3
+        self.row_counts = [w._directions.shape[0] for w in self.wheels]
         self.labels = labels
         self.holonomic = np.array(holonomic, dtype=bool)
 
     def __repr__(self) -> str:
         return f"WheelGroup({[w.name for w in self.wheels]})"
+
+    def tile(self, count: int) -> WheelGroup:
+        """The group repeated ``count`` times (the same wheels at ``count`` states, stacked state by state), for
+        evaluations vectorised over states; only for a plane group without radius joints."""
+        if not self.plane or self.radial.size:
+            raise ValueError("only wheel groups on a plane without radius joints can be tiled")
+        m = len(self.wheels)
+        out = copy.copy(self)
+        out.wheels = self.wheels * count
+        out.fids = self.fids * count
+        out.axis = np.tile(self.axis, (count, 1))
+        out.R0 = np.tile(self.R0, (count, 1))
+        out.n = np.tile(self.n0, (count * m, 1))
+        out.Dpad = np.tile(self.Dpad, (count, 1, 1))
+        out.keep = (self.keep[None, :] + 3 * m * np.arange(count)[:, None]).reshape(-1)
+        out.row_wheel = out.keep // 3
+        out.holonomic = np.tile(self.holonomic, count)
+        out.labels = self.labels * count
+        return out
 
     def _geometry(self, kin: KinematicState) -> dict:
         """Configuration-level geometry of all wheels (cached in ``kin.geometry``)."""
@@ -329,56 +344,72 @@ class WheelGroup:
                 placement = data.oMf[f]
                 rot[i] = placement.rotation
                 c[i] = placement.translation
-            a = (rot @ self.axis[:, :, None])[:, :, 0]
             R = self.R0.copy()
             if self.radial.size:
                 R[self.radial, 0] += kin.q[self.radial_index]
-                bad = np.flatnonzero(R[:, 0] <= 0)
-                if bad.size:
-                    w = self.wheels[bad[0]]
-                    raise ConstraintError(
-                        f"wheel {w.name!r}: radius {R[bad[0], 0]:.6g} m is not positive at this configuration"
-                    )
-            n = self.n
-            wv = n - _vdot(n, a) * a
-            nw = np.sqrt(_vdot(wv, wv))
-            flat = np.flatnonzero(nw[:, 0] < 1e-9)
-            if flat.size:
-                raise ConstraintError(
-                    f"wheel {self.wheels[flat[0]].name!r}: the axle is parallel to the ground normal (wheel lying "
-                    "flat); expected a wheel standing on the terrain"
-                )
-            u = wv / nw
-            p = c - R * u
-            ter = self.terrain
-            phi = (p[:, 2] - ter.h - p[:, :2] @ ter._g) / self.slope_norm
-            N = None
-            c1 = _vcross(a, n)
-            nc1 = np.sqrt(_vdot(c1, c1))
-            t1 = c1 / nc1
-            E = np.stack([t1, _vcross(n, t1), n], axis=2)
+            geo = self._plane_contact(rot, c, R)
         else:
             geos = [w._geometry(kin) for w in self.wheels]  # (c, a, R, n, u, p, nw, phi, N, E, nc1)
             for i, f in enumerate(self.fids):
                 J[i] = kin.pose(f)[1]
-            c, a, n, u, p = (np.array([g[i] for g in geos]) for i in (0, 1, 3, 4, 5))
-            R = np.array([[g[2]] for g in geos])
-            nw = np.array([[g[6]] for g in geos])
-            phi = np.array([g[7] for g in geos])
-            N = None if not self.curved else np.array([np.zeros((3, 3)) if g[8] is None else g[8] for g in geos])
+            a, n, u = (np.array([g[i] for g in geos]) for i in (1, 3, 4))
             E = np.array([g[9] for g in geos])
-            nc1 = np.array([[g[10]] for g in geos])
-        r = -R * u
+            geo = dict(
+                a=a, n=n, u=u, na=None, E=E, ET=E.transpose(0, 2, 1),
+                R=np.array([[g[2]] for g in geos]),
+                nw=np.array([[g[6]] for g in geos]),
+                phi=np.array([g[7] for g in geos]),
+                N=None if not self.curved else np.array([np.zeros((3, 3)) if g[8] is None else g[8] for g in geos]),
+                nc1=np.array([[g[10]] for g in geos]),
+            )
+        out = self._rows(geo, J)
+        kin.geometry[key] = out
+        return out
+
+    def _plane_contact(self, rot: np.ndarray, c: np.ndarray, R: np.ndarray) -> dict:
+        """Contact geometry on the plane from the wheel frames' rotations (m, 3, 3), centres (m, 3) and radii
+        (m, 1)."""
+        m = len(c)
+        bad = np.flatnonzero(R[:, 0] <= 0) if self.radial.size else ()
+        if len(bad):
+            raise ConstraintError(
+                f"wheel {self.wheels[bad[0]].name!r}: radius {R[bad[0], 0]:.6g} m is not positive at this "
+                "configuration"
+            )
+        a = (rot @ self.axis[:, :, None])[:, :, 0]
+        na = a @ self.n0  # the normal is constant: products with it are matrix products
+        wv = self.n0 - na[:, None] * a
+        nw = np.sqrt(_vdot(wv, wv))
+        if nw.min() < 1e-9:
+            flat = np.flatnonzero(nw[:, 0] < 1e-9)
+            raise ConstraintError(
+                f"wheel {self.wheels[flat[0]].name!r}: the axle is parallel to the ground normal (wheel lying "
+                "flat); expected a wheel standing on the terrain"
+            )
+        u = wv / nw
+        p = c - R * u
+        phi = (p @ self.height_row - self.terrain.h) / self.slope_norm
+        c1 = a @ self.Kn  # a x n
+        nc1 = np.sqrt(_vdot(c1, c1))
+        t1 = c1 / nc1
+        ET = np.empty((m, 3, 3))
+        ET[:, 0] = t1
+        ET[:, 1] = t1 @ self.Kn.T  # n x t1
+        ET[:, 2] = self.n0
+        n = self.n if m == len(self.n) else np.broadcast_to(self.n0, (m, 3))
+        return dict(a=a, R=R, n=n, na=na, u=u, nw=nw, N=None, E=ET.transpose(0, 2, 1), ET=ET, nc1=nc1, phi=phi)
+
+    def _rows(self, geo: dict, J: np.ndarray) -> dict:
+        """Adds the world rows ``Aw`` (m, 3, nv), the stacked rows ``A`` and their ``residual`` to ``geo``."""
+        u = geo["u"]
+        r = -geo["R"] * u
         Aw = J[:, :3] - _skews(r) @ J[:, 3:]
         if self.radial.size:
             Aw[self.radial, :, self.radial_index] -= u[self.radial]
-        ET = E.transpose(0, 2, 1)
-        W = self.Dpad @ ET
-        A = (W @ Aw).reshape(-1, Aw.shape[2])[self.keep]
-        residual = np.where(self.holonomic, np.repeat(phi, 3)[self.keep], 0.0)
-        out = dict(J=J, a=a, R=R, n=n, u=u, nw=nw, N=N, E=E, ET=ET, nc1=nc1, r=r, Aw=Aw, A=A, residual=residual)
-        kin.geometry[key] = out
-        return out
+        A = ((self.Dpad @ geo["ET"]) @ Aw).reshape(-1, Aw.shape[2])[self.keep]
+        residual = np.where(self.holonomic, geo["phi"][self.row_wheel], 0.0)
+        geo.update(J=J, r=r, Aw=Aw, A=A, residual=residual)
+        return geo
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
         """The stacked rows of all wheels (as :meth:`RollingWheel.jacobian`, ``Adot`` is ``None``)."""
@@ -391,18 +422,25 @@ class WheelGroup:
         v = kin.v
         if not kin._moving:
             return np.zeros(self.keep.size)
-        J, a, R, n, u, nw, E, ET = (geo[k] for k in ("J", "a", "R", "n", "u", "nw", "E", "ET"))
+        J = geo["J"]
         dJ = np.empty_like(J)
         for i, f in enumerate(self.fids):  # kin is the latest pass on its data (as for KinematicState.frame)
             dJ[i] = pin.getFrameJacobianTimeVariation(kin.model, kin.data, f, LWA)
-        Jv = J @ v
-        cdot, omega = Jv[:, :3], Jv[:, 3:]
-        dJv = dJ @ v
-        adot = _vcross(omega, a)
-        rhs_const = -_vdot(n, adot) * a - _vdot(n, a) * adot
-        Rdot = np.zeros_like(R)
+        Rdot = np.zeros_like(geo["R"])
         if self.radial.size:
             Rdot[self.radial, 0] = v[self.radial_index]
+        return self._drift(geo, J @ v, dJ @ v, geo["Aw"] @ v, Rdot)
+
+    def _drift(self, geo: dict, Jv: np.ndarray, dJv: np.ndarray, s: np.ndarray, Rdot: np.ndarray) -> np.ndarray:
+        """The drift terms from the frames' twists ``Jv`` (m, 6), ``dJv`` (m, 6), the contact points' velocities
+        ``s`` = Aw v (m, 3) and the radius rates (m, 1)."""
+        a, R, n, u, nw, E, ET = (geo[k] for k in ("a", "R", "n", "u", "nw", "E", "ET"))
+        cdot, omega = Jv[:, :3], Jv[:, 3:]
+        adot = _vcross(omega, a)
+        if geo["na"] is None:
+            rhs_const = -_vdot(n, adot) * a - _vdot(n, a) * adot
+        else:
+            rhs_const = -(adot @ self.n0)[:, None] * a - geo["na"][:, None] * adot
         if self.curved:
             P = (_I3 - u[:, :, None] * u[:, None, :]) / nw[:, :, None]
             N = geo["N"]
@@ -418,20 +456,20 @@ class WheelGroup:
         r = geo["r"]
         rdot = -R * udot - Rdot * u if self.radial.size else -R * udot
         t1 = E[:, :, 0]
-        c1dot = _vcross(adot, n) if ndot is None else _vcross(adot, n) + _vcross(a, ndot)
+        plane = geo["na"] is not None
+        if ndot is None:
+            c1dot = adot @ self.Kn if plane else _vcross(adot, n)
+        else:
+            c1dot = _vcross(adot, n) + _vcross(a, ndot)
         t1dot = (c1dot - t1 * _vdot(t1, c1dot)) / geo["nc1"]
         if ndot is None:
-            EdotT = np.stack([t1dot, _vcross(n, t1dot), np.zeros_like(t1dot)], axis=1)
+            EdotT = np.zeros((len(a), 3, 3))
+            EdotT[:, 0] = t1dot
+            EdotT[:, 1] = t1dot @ self.Kn.T if plane else _vcross(n, t1dot)
         else:
             EdotT = np.stack([t1dot, _vcross(ndot, t1) + _vcross(n, t1dot), ndot], axis=1)
-        s = (geo["Aw"] @ v)
         acc = dJv[:, :3] + _vcross(dJv[:, 3:], r) + _vcross(omega, rdot)
         if self.radial.size:
             acc = acc - udot * Rdot
         d3 = (EdotT @ s[:, :, None] + ET @ acc[:, :, None])
         return (self.Dpad @ d3).reshape(-1)[self.keep]
-
-
-def _skews(x: np.ndarray) -> np.ndarray:
-    """Cross-product matrices of the rows of an (m, 3) array, shape (m, 3, 3)."""
-    return np.einsum("ijk,mj->mik", _EPS, x)

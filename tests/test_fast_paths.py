@@ -56,3 +56,32 @@ def test_velocity_matches_reduce(robot):
     assert np.abs(v - red.v).max() <= 1e-14 * (1.0 + np.abs(red.v).max())
     assert np.array_equal(rows.A, red.jacobian_rows.A)
     assert np.abs(red.rows.A @ v).max() <= 1e-12 * (1.0 + np.abs(v).max())
+
+
+def test_batch_vectorised_equals_one_by_one(robot):
+    from robotdyn.batch import _evaluate_loop, evaluate
+
+    rng = np.random.default_rng(5)
+    N = 12
+    Q = np.tile(robot.neutral(), (N, 1))
+    if not robot.spec.closures:  # loop closures would be violated by a random perturbation
+        Q += 1e-3 * rng.normal(size=Q.shape)
+    NU = rng.normal(size=(N, robot.mobility))
+    batch = evaluate(robot, Q, NU, processes=1)
+    for name, ref in zip(("M", "h", "g", "B", "S"), _evaluate_loop(robot, Q, NU, 0)):
+        got = getattr(batch, name)
+        assert got.shape == ref.shape
+        assert np.abs(got - ref).max() <= 1e-12 * (1.0 + np.abs(ref).max()), name
+
+
+def test_batch_singular_state_is_named(robot):
+    from robotdyn.batch import evaluate
+    from robotdyn.errors import SingularConstraintError
+
+    if robot.spec.name != "quasimoro":
+        pytest.skip("one robot suffices")
+    rob = robotdyn.load("quasimoro")
+    rob.independent_indices = np.array([rob.coordinate_index(c) for c in ("x", "y", "theta3")])
+    Q = np.tile(rob.neutral(), (3, 1))
+    with pytest.raises(SingularConstraintError, match="state 0"):
+        evaluate(rob, Q, np.zeros((3, 3)), processes=1)

@@ -28,10 +28,10 @@ import numpy as np
 import pinocchio as pin
 
 from .actuation import input_matrix
-from .constraint import ConstraintRows, KinematicState
+from .constraint import KinematicState
 from .errors import DescriptionError, InputError, SingularConstraintError
 from .projection import MAX_CONDITION, independent_rows
-from .reduced_dynamics import ReducedDynamics
+from .reduced_dynamics import ReducedDynamics, constraint_set
 
 COMPONENTS = ("vx", "vy", "vz", "wx", "wy", "wz")
 """Twist components: linear velocity of the frame origin, then angular velocity."""
@@ -150,7 +150,7 @@ def operational_projection(robot, twist: FrameTwist, q: np.ndarray) -> Operation
     """Only the projection (S, condition) at configuration q: one kinematics pass, no dynamics."""
     kin = KinematicState(robot.model, robot.data, np.asarray(q, float), np.zeros(robot.model.nv))
     J = twist.jacobian(kin)
-    A = ConstraintRows.stack([c.jacobian(kin) for c in robot.constraints], robot.model.nv).A
+    A = constraint_set(robot).jacobian(kin).A
     return project_operational(A, J, twist.names)
 
 
@@ -166,17 +166,17 @@ def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
     q = np.asarray(q, float)
     nu = np.asarray(nu, float)
     kin0 = KinematicState(model, data, q, np.zeros(model.nv))
-    rows0 = ConstraintRows.stack([c.jacobian(kin0) for c in robot.constraints], model.nv)
+    rows0 = constraint_set(robot).jacobian(kin0)
     J = twist.jacobian(kin0)
     proj = project_operational(rows0.A, J, twist.names)
     S = proj.S
     v = S @ nu
     kin = kin0.with_velocity(v)
     _, Jdot = twist.rows(kin)  # before the constraints touch the shared data
-    drift = np.concatenate([c.drift(kin) for c in robot.constraints]) if robot.constraints else np.zeros(0)
+    drift = constraint_set(robot).drift(kin)
     B = input_matrix(robot.motors, kin)
     w = proj.offset(drift, Jdot @ v)
-    full_rows = lambda: robot.constraint_rows(kin)  # noqa: E731  (computed on first access)
+    full_rows = lambda: robot.constraint_rows(KinematicState(model, data, q, v))  # noqa: E731  (fresh pass)
     if coriolis:
         full_rows = full_rows()
     M = pin.crba(model, data, q)

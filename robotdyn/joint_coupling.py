@@ -67,6 +67,18 @@ class JointCoupling(Constraint):
         residual = np.array([self.residual(kin.q)])
         return ConstraintRows(A, Adot, residual, np.ones(1, bool), [f"{self.name}.coupling"])
 
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        """The row and residual without :math:`\\dot A` (the law's second derivative is not evaluated)."""
+        A = np.zeros((1, self.nv))
+        A[0, self.i] = 1.0
+        A[0, self.j] -= float(self.dlaw(float(kin.q[self.j])))
+        return ConstraintRows(A, None, np.array([self.residual(kin.q)]), np.ones(1, bool), [f"{self.name}.coupling"])
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        """:math:`\\dot A v = -f''(q_r)\\dot q_r^2`."""
+        vr = float(kin.v[self.j])
+        return np.array([-float(self.ddlaw(float(kin.q[self.j]))) * vr * vr])
+
     def solve_driven(self, q: np.ndarray) -> np.ndarray:
         """A copy of q with the driven coordinate set so that the residual vanishes (exact: the law is explicit)."""
         out = np.array(q, dtype=float)

@@ -47,6 +47,19 @@ def _pivoted_qr(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.diag(qr).copy(), jpvt - 1
 
 
+def solve(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """:math:`A^{-1}B` for a small square A by LAPACK ``dgesv``: the routine ``numpy.linalg.solve`` and
+    ``numpy.linalg.inv`` (B = I) call, with the same numbers, without their wrapper's overhead.
+
+    Raises:
+        numpy.linalg.LinAlgError: A is exactly singular.
+    """
+    _, _, X, info = scipy.linalg.lapack.dgesv(A, B)
+    if info != 0:
+        raise np.linalg.LinAlgError("Singular matrix" if info > 0 else f"illegal value in argument {-info} of dgesv")
+    return X
+
+
 def independent_rows(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
     """Indices of a maximal set of linearly independent rows of ``A`` (rank-revealing QR with pivoting)."""
     if A.shape[0] == 0:
@@ -128,8 +141,8 @@ def _build(A, independent, dependent, rows, names, layout: tuple | None = None) 
         return Projection(S, independent, dependent, rows, 1.0, None, layout)
     Ad = A[ix_dep]
     try:
-        Ad_inv = np.linalg.inv(Ad)
-        cond = float(np.abs(Ad).sum(axis=0).max() * np.abs(Ad_inv).sum(axis=0).max())
+        Ad_inv = solve(Ad, np.eye(len(Ad)))
+        cond = float(abs(Ad).sum(axis=0).max() * abs(Ad_inv).sum(axis=0).max())
     except np.linalg.LinAlgError:
         cond = float("inf")
     if not np.isfinite(cond) or cond > MAX_CONDITION:
@@ -171,8 +184,8 @@ def project(
             proj = _build(A, hint.independent, hint.dependent, hint.rows, names, hint._layout)
         except SingularConstraintError:
             proj = None
-        scale = max(1.0, float(np.abs(A).max())) if A.size else 1.0
-        if proj is not None and (A.size == 0 or np.abs(A @ proj.S).max() <= 1e-10 * scale):
+        scale = max(1.0, float(abs(A).max())) if A.size else 1.0
+        if proj is not None and (A.size == 0 or abs(A @ proj.S).max() <= 1e-10 * scale):
             return proj
     rows = independent_rows(A)
     if independent is None:

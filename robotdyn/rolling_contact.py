@@ -302,6 +302,7 @@ class WheelGroup:
             holonomic += list(D[:, 2] != 0)
         self.keep = np.array(keep, dtype=int)
         self.row_wheel = self.keep // 3
+        self.all_rows = bool(np.array_equal(self.Dpad, np.broadcast_to(_I3, self.Dpad.shape)))
         self.row_counts = [w._directions.shape[0] for w in self.wheels]
         self.labels = labels
         self.holonomic = np.array(holonomic, dtype=bool)
@@ -406,7 +407,10 @@ class WheelGroup:
         Aw = J[:, :3] - _skews(r) @ J[:, 3:]
         if self.radial.size:
             Aw[self.radial, :, self.radial_index] -= u[self.radial]
-        A = ((self.Dpad @ geo["ET"]) @ Aw).reshape(-1, Aw.shape[2])[self.keep]
+        if self.all_rows:  # three rows per wheel: D = I
+            A = (geo["ET"] @ Aw).reshape(-1, Aw.shape[2])
+        else:
+            A = ((self.Dpad @ geo["ET"]) @ Aw).reshape(-1, Aw.shape[2])[self.keep]
         residual = np.where(self.holonomic, geo["phi"][self.row_wheel], 0.0)
         geo.update(J=J, r=r, Aw=Aw, A=A, residual=residual)
         return geo
@@ -472,4 +476,6 @@ class WheelGroup:
         if self.radial.size:
             acc = acc - udot * Rdot
         d3 = (EdotT @ s[:, :, None] + ET @ acc[:, :, None])
+        if self.all_rows:
+            return d3.reshape(-1)
         return (self.Dpad @ d3).reshape(-1)[self.keep]

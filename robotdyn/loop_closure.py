@@ -133,10 +133,15 @@ class LoopGroup:
         self.labels = [f"{c.name}.{k}" for c in self.closures for k in c.components]
         self.holonomic = np.ones(self.keep.size, bool)
         self.row_counts = [c._sel.size for c in self.closures]
+        self._built = [c._sel for c in self.closures]
         self.rotational = [i for i, c in enumerate(self.closures) if np.any(c._sel >= 3)]
 
     def __repr__(self) -> str:
         return f"LoopGroup({[c.name for c in self.closures]})"
+
+    def current(self) -> bool:
+        """Whether the closures still select the components this group was built with."""
+        return all(c._sel is sel for c, sel in zip(self.closures, self._built))
 
     def tile(self, count: int) -> LoopGroup:
         """The group repeated ``count`` times (the same closures at ``count`` states, stacked state by state)."""

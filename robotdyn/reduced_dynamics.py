@@ -96,6 +96,13 @@ class ConstraintSet:
         self.others = [c for c in self.constraints if id(c) not in grouped]
         self._order: dict[tuple[int, ...], np.ndarray | None] = {}
 
+    def current(self, constraints) -> bool:
+        """Whether this set still describes ``constraints`` (the same objects, and the wheels still on the terrain
+        and with the radius they had, e.g. after :func:`robotdyn.posture.set_terrain` changed them in place)."""
+        if len(constraints) != len(self.constraints) or any(a is not b for a, b in zip(constraints, self.constraints)):
+            return False
+        return all(group.current() for group, _ in self.groups)
+
     def _permutation(self, counts: tuple[int, ...]) -> np.ndarray | None:
         """Row permutation from [groups' rows, other constraints' rows] to constraint order (None: identity)."""
         if counts not in self._order:
@@ -137,9 +144,7 @@ class ConstraintSet:
 def constraint_set(robot) -> ConstraintSet:
     """The robot's :class:`ConstraintSet` (built once, rebuilt if ``robot.constraints`` was changed)."""
     cset = getattr(robot, "_constraint_set", None)
-    if cset is None or len(cset.constraints) != len(robot.constraints) or any(
-        a is not b for a, b in zip(cset.constraints, robot.constraints)
-    ):
+    if cset is None or not cset.current(robot.constraints):
         cset = ConstraintSet(robot.constraints, robot.model.nv)
         robot._constraint_set = cset
     return cset

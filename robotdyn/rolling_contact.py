@@ -302,6 +302,7 @@ class WheelGroup:
             holonomic += list(D[:, 2] != 0)
         self.keep = np.array(keep, dtype=int)
         self.row_wheel = self.keep // 3
+        self._built = [(w.terrain, w.radius, w.axis, w._directions) for w in self.wheels]
         self.all_rows = bool(np.array_equal(self.Dpad, np.broadcast_to(_I3, self.Dpad.shape)))
         self.row_counts = [w._directions.shape[0] for w in self.wheels]
         self.labels = labels
@@ -309,6 +310,13 @@ class WheelGroup:
 
     def __repr__(self) -> str:
         return f"WheelGroup({[w.name for w in self.wheels]})"
+
+    def current(self) -> bool:
+        """Whether the wheels still have the terrain, radius, axle and rows this group was built with."""
+        return all(
+            w.terrain is t and w.radius == r and w.axis is ax and w._directions is D
+            for w, (t, r, ax, D) in zip(self.wheels, self._built)
+        )
 
     def tile(self, count: int) -> WheelGroup:
         """The group repeated ``count`` times (the same wheels at ``count`` states, stacked state by state), for

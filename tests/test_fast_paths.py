@@ -85,3 +85,24 @@ def test_batch_singular_state_is_named(robot):
     Q = np.tile(rob.neutral(), (3, 1))
     with pytest.raises(SingularConstraintError, match="state 0"):
         evaluate(rob, Q, np.zeros((3, 3)), processes=1)
+
+
+def test_terrain_changed_in_place_is_seen():
+    from robotdyn.posture import set_terrain
+    from robotdyn.terrain import RampTerrain
+
+    rob = robotdyn.load("mmr12_eod")
+    q = rob.neutral()
+    v = np.random.default_rng(2).normal(size=rob.nq)
+    rob.reduced(q, np.zeros(rob.mobility))  # builds the constraint set on the flat ground
+    flat = constraint_set(rob).jacobian(KinematicState(rob.model, rob.data, q, v))
+    set_terrain(rob, RampTerrain(0.2, 0.4, -0.3))
+    kin = KinematicState(rob.model, rob.data, q, v)
+    rows, drift = constraint_set(rob).jacobian(kin), constraint_set(rob).drift(kin)
+    ref_kin = KinematicState(rob.model, rob.data, q, v)
+    ref = ConstraintRows.stack([c.rows(ref_kin) for c in rob.constraints], rob.nq)
+    assert np.abs(rows.A - ref.A).max() <= 1e-13
+    assert np.abs(rows.residual - ref.residual).max() <= 1e-13
+    assert np.abs(drift - ref.Adot @ v).max() <= 1e-12
+    assert np.abs(rows.residual).max() > 0.1  # the wheels are now off the lowered ramp
+    assert not np.allclose(rows.A, flat.A)

@@ -22,6 +22,7 @@ from t1 towards t2 (0 for a 90-degree omni wheel whose rollers leave the lateral
 from __future__ import annotations
 
 import copy
+import math
 
 import numpy as np
 import pinocchio as pin
@@ -303,6 +304,14 @@ class WheelGroup:
         self.keep = np.array(keep, dtype=int)
         self.row_wheel = self.keep // 3
         self._built = [(w.terrain, w.radius, w.axis, w._directions) for w in self.wheels]
+        self._axes = [tuple(w.axis.tolist()) for w in self.wheels]  # Python floats for the scalar path
+        self._radii = [float(w.radius) for w in self.wheels]
+        self._D = [None if w._directions.shape == (3, 3) and np.array_equal(w._directions, _I3)
+                   else w._directions.tolist() for w in self.wheels]
+        if self.plane:
+            self._n0 = tuple(self.n0.tolist())
+            self._height_row = tuple(self.height_row.tolist())
+            self._slope_norm = float(self.slope_norm)
         self.all_rows = bool(np.array_equal(self.Dpad, np.broadcast_to(_I3, self.Dpad.shape)))
         self.row_counts = [w._directions.shape[0] for w in self.wheels]
         self.labels = labels
@@ -344,7 +353,9 @@ class WheelGroup:
             return kin.geometry[key]
         m, nv = len(self.fids), kin.model.nv
         J = np.empty((m, 6, nv))
-        if self.plane:
+        if self.plane and not self.radial.size:
+            geo = self._plane_contact_scalar(kin, J)
+        elif self.plane:
             rot = np.empty((m, 3, 3))
             c = np.empty((m, 3))
             model, data = kin.model, kin.data
@@ -374,6 +385,77 @@ class WheelGroup:
         out = self._rows(geo, J)
         kin.geometry[key] = out
         return out
+
+    def _plane_contact_scalar(self, kin: KinematicState, J: np.ndarray) -> dict:
+        """:meth:`_plane_contact` for one state, wheel by wheel in Python floats (3-vectors are cheaper as floats
+        than as numpy arrays); fills the frame Jacobians ``J`` (m, 6, nv) from Pinocchio's data."""
+        model, data = kin.model, kin.data
+        n0 = self._n0
+        hr0, hr1, hr2 = self._height_row
+        h, sn = float(self.terrain.h), self._slope_norm
+        wheels = []
+        for i, (f, (x0, x1, x2), R) in enumerate(zip(self.fids, self._axes, self._radii)):
+            J[i] = pin.getFrameJacobian(model, data, f, LWA)  # kin is the latest pass on its data
+            placement = data.oMf[f]
+            (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = placement.rotation.tolist()
+            c0, c1_, c2 = placement.translation.tolist()
+            a = (r00 * x0 + r01 * x1 + r02 * x2, r10 * x0 + r11 * x1 + r12 * x2, r20 * x0 + r21 * x1 + r22 * x2)
+            na = a[0] * n0[0] + a[1] * n0[1] + a[2] * n0[2]
+            w0, w1, w2 = n0[0] - na * a[0], n0[1] - na * a[1], n0[2] - na * a[2]
+            nw = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+            if nw < 1e-9:
+                raise ConstraintError(
+                    f"wheel {self.wheels[i].name!r}: the axle is parallel to the ground normal (wheel lying "
+                    "flat); expected a wheel standing on the terrain"
+                )
+            u = (w0 / nw, w1 / nw, w2 / nw)
+            p0, p1, p2 = c0 - R * u[0], c1_ - R * u[1], c2 - R * u[2]
+            phi = (p0 * hr0 + p1 * hr1 + p2 * hr2 - h) / sn
+            k0, k1, k2 = a[1] * n0[2] - a[2] * n0[1], a[2] * n0[0] - a[0] * n0[2], a[0] * n0[1] - a[1] * n0[0]
+            nc1 = math.sqrt(k0 * k0 + k1 * k1 + k2 * k2)
+            t1 = (k0 / nc1, k1 / nc1, k2 / nc1)
+            t2 = (n0[1] * t1[2] - n0[2] * t1[1], n0[2] * t1[0] - n0[0] * t1[2], n0[0] * t1[1] - n0[1] * t1[0])
+            wheels.append((a, na, nw, u, phi, nc1, t1, t2, R))
+        ET = np.array([(w[6], w[7], n0) for w in wheels])
+        return dict(
+            scalar=wheels, a=None, R=self.R0, n=self.n, na=None, u=np.array([w[3] for w in wheels]), nw=None, N=None,
+            E=ET.transpose(0, 2, 1), ET=ET, nc1=None, phi=np.array([w[4] for w in wheels]),
+        )
+
+    def _drift_scalar(self, geo: dict, Jv: np.ndarray, dJv: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """:meth:`_drift` for one state of plane wheels without radius joints, wheel by wheel in Python floats."""
+        n0 = self._n0
+        out = []
+        for (a, na, nw, u, _, nc1, t1, t2, R), jv, djv, sv, D in zip(
+            geo["scalar"], Jv.tolist(), dJv.tolist(), s.tolist(), self._D
+        ):
+            o0, o1, o2 = jv[3], jv[4], jv[5]
+            ad0, ad1, ad2 = o1 * a[2] - o2 * a[1], o2 * a[0] - o0 * a[2], o0 * a[1] - o1 * a[0]  # a' = w x a
+            nad = ad0 * n0[0] + ad1 * n0[1] + ad2 * n0[2]
+            q0, q1, q2 = -nad * a[0] - na * ad0, -nad * a[1] - na * ad1, -nad * a[2] - na * ad2
+            uq = u[0] * q0 + u[1] * q1 + u[2] * q2
+            ud0, ud1, ud2 = (q0 - u[0] * uq) / nw, (q1 - u[1] * uq) / nw, (q2 - u[2] * uq) / nw  # u' = P q
+            rd0, rd1, rd2 = -R * ud0, -R * ud1, -R * ud2  # r' = -R u'
+            r0, r1, r2 = -R * u[0], -R * u[1], -R * u[2]
+            k0, k1, k2 = ad1 * n0[2] - ad2 * n0[1], ad2 * n0[0] - ad0 * n0[2], ad0 * n0[1] - ad1 * n0[0]  # a' x n
+            tk = t1[0] * k0 + t1[1] * k1 + t1[2] * k2
+            e0, e1, e2 = (k0 - t1[0] * tk) / nc1, (k1 - t1[1] * tk) / nc1, (k2 - t1[2] * tk) / nc1  # t1'
+            f0, f1, f2 = n0[1] * e2 - n0[2] * e1, n0[2] * e0 - n0[0] * e2, n0[0] * e1 - n0[1] * e0  # t2' = n x t1'
+            b0, b1, b2 = djv[3], djv[4], djv[5]
+            acc0 = djv[0] + (b1 * r2 - b2 * r1) + (o1 * rd2 - o2 * rd1)
+            acc1 = djv[1] + (b2 * r0 - b0 * r2) + (o2 * rd0 - o0 * rd2)
+            acc2 = djv[2] + (b0 * r1 - b1 * r0) + (o0 * rd1 - o1 * rd0)
+            s0, s1, s2 = sv
+            d = (
+                (e0 * s0 + e1 * s1 + e2 * s2) + (t1[0] * acc0 + t1[1] * acc1 + t1[2] * acc2),
+                (f0 * s0 + f1 * s1 + f2 * s2) + (t2[0] * acc0 + t2[1] * acc1 + t2[2] * acc2),
+                n0[0] * acc0 + n0[1] * acc1 + n0[2] * acc2,
+            )
+            if D is None:
+                out.extend(d)
+            else:
+                out.extend(row[0] * d[0] + row[1] * d[1] + row[2] * d[2] for row in D)
+        return np.array(out)
 
     def _plane_contact(self, rot: np.ndarray, c: np.ndarray, R: np.ndarray) -> dict:
         """Contact geometry on the plane from the wheel frames' rotations (m, 3, 3), centres (m, 3) and radii
@@ -438,6 +520,8 @@ class WheelGroup:
         dJ = np.empty_like(J)
         for i, f in enumerate(self.fids):  # kin is the latest pass on its data (as for KinematicState.frame)
             dJ[i] = pin.getFrameJacobianTimeVariation(kin.model, kin.data, f, LWA)
+        if "scalar" in geo:
+            return self._drift_scalar(geo, J @ v, dJ @ v, geo["Aw"] @ v)
         Rdot = np.zeros_like(geo["R"])
         if self.radial.size:
             Rdot[self.radial, 0] = v[self.radial_index]

@@ -71,8 +71,8 @@ class ReducedDynamics:
 
 
 class ConstraintSet:
-    """A robot's constraints evaluated together: the rolling wheels in one vectorised
-    :class:`~robotdyn.rolling_contact.WheelGroup` pass, the loop closures in one
+    """A robot's constraints evaluated together: the rolling wheels in one
+    :class:`~robotdyn.rolling_contact.WheelGroup` pass, the loop closures in one vectorised
     :class:`~robotdyn.loop_closure.LoopGroup` pass, the others one by one; rows stacked in the order of
     ``constraints`` (the same rows as stacking each constraint's own :meth:`~robotdyn.constraint.Constraint.jacobian`
     and :meth:`~robotdyn.constraint.Constraint.drift`).

@@ -259,13 +259,16 @@ def groupable(constraint) -> bool:
 
 
 class WheelGroup:
-    """Several rolling wheels evaluated together in one vectorised pass (arrays of shape (m, 3), (m, 3, nv)).
+    """Several rolling wheels evaluated together (arrays of shape (m, 3), (m, 3, nv)).
 
     Gives the same rows as the wheels' own :meth:`RollingWheel.jacobian` and :meth:`RollingWheel.drift`
     (same formulas, see the module docstring), stacked in the order of ``wheels``, with a few dozen numpy calls
-    for the whole group instead of per wheel. Wheels on a plane (``terrain.is_flat``, a
-    :class:`~robotdyn.terrain.RampTerrain`) get their contact geometry vectorised too; on other terrains the
-    contact point of each wheel is found by :meth:`RollingWheel._geometry` (an iteration on the terrain).
+    for the whole group instead of ~80 per wheel. On a plane (``terrain.is_flat``, a
+    :class:`~robotdyn.terrain.RampTerrain`) without radius joints the 3-vector geometry and drift of one state are
+    computed wheel by wheel in Python floats (cheaper than numpy calls on 3-vectors) and only the (3, nv) rows
+    in numpy; with radius joints, and for many states at once (:meth:`tile`, the batch API), the same formulas
+    run vectorised over wheels; on other terrains the contact point of each wheel is found by
+    :meth:`RollingWheel._geometry` (an iteration on the terrain) and the rest is vectorised.
 
     Args:
         wheels: The wheels (instances for which :func:`groupable` holds).

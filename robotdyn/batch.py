@@ -65,7 +65,9 @@ def _evaluate_vectorised(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> t
     k = robot.mobility
     cset = constraint_set(robot)
     groups = [(g.tile(N), g) for g, _ in cset.groups]
-    reaction = any(m.rid is not None for m in robot.motors)
+    reacting = [(j, m) for j, m in enumerate(robot.motors) if m.rid is not None]
+    Jjoint = np.empty((N, len(reacting), 6, n))  # Jacobians of the reacting motors' joints and reaction bodies
+    Jreact = np.empty((N, len(reacting), 6, n))
     Ms, G = np.empty((N, n, n)), np.empty((N, n))
     B = np.empty((N, n, len(robot.motors)))
     frames = []  # per group: arrays of Jacobians, rotations, origins for all states
@@ -73,9 +75,11 @@ def _evaluate_vectorised(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> t
         fids = g.fids if isinstance(g, WheelGroup) else [f for pair in zip(g.f1, g.f2) for f in pair]
         frames.append((fids, np.empty((N, len(fids), 6, n)), np.empty((N, len(fids), 3, 3)), np.empty((N, len(fids), 3))))
     zero = np.zeros(n)
+    B0 = input_matrix(robot.motors, KinematicState(model, data, Q[0], zero))  # reacting columns: set below
     for i in range(N):  # pass 1: configuration-level kinematics and dynamics
         q = Q[i]
-        kin = KinematicState(model, data, q, zero)
+        pin.computeJointJacobians(model, data, q)  # what KinematicState(q, 0) runs
+        pin.updateFramePlacements(model, data)
         for fids, J, rot, pos in frames:
             Ji, roti, posi = J[i], rot[i], pos[i]
             for j, f in enumerate(fids):
@@ -83,12 +87,16 @@ def _evaluate_vectorised(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> t
                 placement = data.oMf[f]
                 roti[j] = placement.rotation
                 posi[j] = placement.translation
-        if reaction or i == 0:
-            B[i] = input_matrix(robot.motors, kin)
-        else:
-            B[i] = B[0]
+        for r, (_, m) in enumerate(reacting):
+            Jjoint[i, r] = pin.getJointJacobian(model, data, m.jid, LWA)
+            Jreact[i, r] = pin.getFrameJacobian(model, data, m.rid, LWA)
         Ms[i] = pin.crba(model, data, q)
         G[i] = pin.computeGeneralizedGravity(model, data, q)
+    B[:] = B0
+    for r, (j, m) in enumerate(reacting):  # Motor.column for all states: (J_w,child - J_w,reaction)^T axis
+        ang, lin = Jjoint[:, r, 3:, m.index], Jjoint[:, r, :3, m.index]
+        axis = np.where((np.einsum("ni,ni->n", ang, ang) > 0.25)[:, None], ang, lin)
+        B[:, :, j] = ((Jjoint[:, r, 3:] - Jreact[:, r, 3:]).transpose(0, 2, 1) @ axis[:, :, None])[:, :, 0]
     A_parts, geos = [], []
     for (tiled, g), (fids, J, rot, pos) in zip(groups, frames):
         nf = len(fids)

@@ -93,40 +93,48 @@ class RollingWheel(Constraint):
             if R <= 0:
                 raise ConstraintError(f"wheel {self.name!r}: radius {R:.6g} m is not positive at this configuration")
         terrain = self.terrain
-        n = terrain.normal(c[0], c[1])
+        flat = terrain.is_flat
+        # the fixed-point iteration on 3-vectors in Python floats (cheaper than numpy calls on 3-vectors)
+        a0, a1, a2 = a.tolist()
+        c0, c1_, c2 = c.tolist()
+        Rf = float(R)
+        n0, n1, n2 = terrain.normal(c0, c1_).tolist()
         for _ in range(100):
-            w = n - (n @ a) * a
-            nw = np.sqrt(w @ w)
+            na = n0 * a0 + n1 * a1 + n2 * a2
+            w0, w1, w2 = n0 - na * a0, n1 - na * a1, n2 - na * a2
+            nw = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
             if nw < 1e-9:
                 raise ConstraintError(
                     f"wheel {self.name!r}: the axle is parallel to the ground normal (wheel lying flat); "
                     "expected a wheel standing on the terrain"
                 )
-            u = w / nw
-            p = c - R * u
-            if terrain.is_flat:
+            u0, u1, u2 = w0 / nw, w1 / nw, w2 / nw
+            p0, p1, p2 = c0 - Rf * u0, c1_ - Rf * u1, c2 - Rf * u2
+            if flat:
                 break
-            n_new = terrain.normal(p[0], p[1])
-            change = n_new - n
-            n = n_new
-            if change @ change < 1e-30:
-                w = n - (n @ a) * a
-                nw = np.sqrt(w @ w)
-                u = w / nw
-                p = c - R * u
+            m0, m1, m2 = terrain.normal(p0, p1).tolist()
+            d0, d1, d2 = m0 - n0, m1 - n1, m2 - n2
+            n0, n1, n2 = m0, m1, m2
+            if d0 * d0 + d1 * d1 + d2 * d2 < 1e-30:
+                na = n0 * a0 + n1 * a1 + n2 * a2
+                w0, w1, w2 = n0 - na * a0, n1 - na * a1, n2 - na * a2
+                nw = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+                u0, u1, u2 = w0 / nw, w1 / nw, w2 / nw
+                p0, p1, p2 = c0 - Rf * u0, c1_ - Rf * u1, c2 - Rf * u2
                 break
         else:
             raise ConstraintError(
                 f"wheel {self.name!r}: the contact point did not converge; the terrain is curved more sharply "
                 "than the wheel (expected terrain curvature radius > wheel radius)"
             )
+        n, u, p = np.array([n0, n1, n2]), np.array([u0, u1, u2]), np.array([p0, p1, p2])
         grad = terrain.gradient(p[0], p[1])
         phi = (p[2] - terrain.height(p[0], p[1])) / np.sqrt(1.0 + grad @ grad)
         N = None if terrain.is_flat else terrain.normal_derivative(p[0], p[1])
-        c1 = cross(a, n)
-        nc1 = np.sqrt(c1 @ c1)
-        t1 = c1 / nc1
-        E = np.array([t1, cross(n, t1), n]).T
+        k0, k1, k2 = a1 * n2 - a2 * n1, a2 * n0 - a0 * n2, a0 * n1 - a1 * n0  # a x n
+        nc1 = math.sqrt(k0 * k0 + k1 * k1 + k2 * k2)
+        t0, t1, t2 = k0 / nc1, k1 / nc1, k2 / nc1
+        E = np.array([[t0, n1 * t2 - n2 * t1, n0], [t1, n2 * t0 - n0 * t2, n1], [t2, n0 * t1 - n1 * t0, n2]])
         out = (c, a, R, n, u, p, nw, phi, N, E, nc1)
         kin.geometry[key] = out
         return out

@@ -68,7 +68,7 @@ class KinematicState:
         self.model, self.data = model, data
         self.q = np.array(q, dtype=float)
         self.v = np.array(v, dtype=float)
-        self._moving = bool(np.any(self.v))
+        self._moving = bool(self.v.any())
         if self._moving:
             pin.computeJointJacobiansTimeVariation(model, data, self.q, self.v)
         else:  # at rest the time variation is zero: plain Jacobians are enough

@@ -74,12 +74,10 @@ def test_batch_vectorised_equals_one_by_one(robot):
         assert np.abs(got - ref).max() <= 1e-12 * (1.0 + np.abs(ref).max()), name
 
 
-def test_batch_singular_state_is_named(robot):
+def test_batch_singular_state_is_named():
     from robotdyn.batch import evaluate
     from robotdyn.errors import SingularConstraintError
 
-    if robot.spec.name != "quasimoro":
-        pytest.skip("one robot suffices")
     rob = robotdyn.load("quasimoro")
     rob.independent_indices = np.array([rob.coordinate_index(c) for c in ("x", "y", "theta3")])
     Q = np.tile(rob.neutral(), (3, 1))

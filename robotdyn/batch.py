@@ -169,12 +169,17 @@ def _evaluate_vectorised(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> t
     St = S.transpose(0, 2, 1)
     M, h, g, Br = St @ Ms @ S, (St @ H[:, :, None])[:, :, 0], (St @ G[:, :, None])[:, :, 0], St @ B
     for i in np.flatnonzero(bad):  # another choice of rows, or singular (raises, naming the state)
-        try:
-            red = robot.reduced(Q[i], NU[i])
-        except SingularConstraintError as exc:
-            raise SingularConstraintError(f"state {offset + i}: {exc}", exc.condition) from None
+        red = _reduced_named(robot, Q[i], NU[i], offset + i)
         M[i], h[i], g[i], Br[i], S[i] = red.M, red.h, red.g, red.B, red.S
     return M, h, g, Br, S
+
+
+def _reduced_named(robot, q: np.ndarray, nu: np.ndarray, index: int):
+    """``robot.reduced(q, nu)``, with a singular state's index in the error message."""
+    try:
+        return robot.reduced(q, nu)
+    except SingularConstraintError as exc:
+        raise SingularConstraintError(f"state {index}: {exc}", exc.condition) from None
 
 
 def _evaluate_chunk(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> tuple[np.ndarray, ...]:
@@ -191,10 +196,7 @@ def _evaluate_loop(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> tuple[n
     B = np.empty((N, k, len(robot.motors)))
     S = np.empty((N, robot.nq, k))
     for i in range(N):
-        try:
-            red = robot.reduced(Q[i], NU[i])
-        except SingularConstraintError as exc:
-            raise SingularConstraintError(f"state {offset + i}: {exc}", exc.condition) from None
+        red = _reduced_named(robot, Q[i], NU[i], offset + i)
         M[i], h[i], g[i], B[i], S[i] = red.M, red.h, red.g, red.B, red.S
     return M, h, g, B, S
 

@@ -21,7 +21,7 @@ from .constraint import LWA, KinematicState
 from .errors import RobotDynError, SingularConstraintError
 from .projection import MAX_CONDITION, project
 from .reduced_dynamics import constraint_set
-from .rolling_contact import WheelGroup
+from .wheel_group import WheelGroup
 
 _WORKER_ROBOT = None
 
@@ -57,7 +57,7 @@ def _vectorisable(robot) -> bool:
 def _evaluate_vectorised(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> tuple[np.ndarray, ...]:
     """All states at once: three Python loops of Pinocchio calls per state (kinematics, CRBA and gravity at q;
     Jacobian time variation at (q, v); RNEA), the constraint geometry, projection and drift vectorised over
-    states with the group formulas of :class:`~robotdyn.rolling_contact.WheelGroup` and
+    states with the group formulas of :class:`~robotdyn.wheel_group.WheelGroup` and
     :class:`~robotdyn.loop_closure.LoopGroup`. States where the projection of the first state does not apply
     (other independent rows needed, or singular) are evaluated one by one by :meth:`Robot.reduced`."""
     model, data = robot.model, robot.data

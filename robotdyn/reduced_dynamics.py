@@ -23,8 +23,8 @@ from .constraint import ConstraintRows, KinematicState
 from .projection import Projection, project
 from .loop_closure import LoopGroup
 from .loop_closure import groupable as groupable_loop
-from .rolling_contact import WheelGroup
-from .rolling_contact import groupable as groupable_wheel
+from .wheel_group import WheelGroup
+from .wheel_group import groupable as groupable_wheel
 
 
 @dataclass
@@ -72,7 +72,7 @@ class ReducedDynamics:
 
 class ConstraintSet:
     """A robot's constraints evaluated together: the rolling wheels in one
-    :class:`~robotdyn.rolling_contact.WheelGroup` pass, the loop closures in one vectorised
+    :class:`~robotdyn.wheel_group.WheelGroup` pass, the loop closures in one vectorised
     :class:`~robotdyn.loop_closure.LoopGroup` pass, the others one by one; rows stacked in the order of
     ``constraints`` (the same rows as stacking each constraint's own :meth:`~robotdyn.constraint.Constraint.jacobian`
     and :meth:`~robotdyn.constraint.Constraint.drift`).

@@ -1,6 +1,6 @@
 """The vectorised evaluation paths against the per-constraint rows they replace, on every registered robot.
 
-:class:`robotdyn.reduced_dynamics.ConstraintSet` (rolling wheels in one :class:`~robotdyn.rolling_contact.WheelGroup`
+:class:`robotdyn.reduced_dynamics.ConstraintSet` (rolling wheels in one :class:`~robotdyn.wheel_group.WheelGroup`
 pass, loop closures through their vector drift) must give the same Jacobian rows, residuals and drift terms as
 stacking each constraint's full :meth:`rows` (whose ``Adot`` is checked against finite differences in the core
 tests), at states off the constraint manifold too (the formulas do not assume A v = 0).

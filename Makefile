@@ -17,7 +17,7 @@ venv: $(STAMP)
 ## make demo: install, then compute the Quasimoro's reduced dynamics, compare it with the paper and simulate
 demo: $(STAMP)
 	$(PY) -m robotdyn info quasimoro
-	$(PY) -m robotdyn dump quasimoro --q 0 0 0 0.3 0 0 --v 1.0 0.5 0.2 --a 0.1 0.2 0.3
+	$(PY) -m robotdyn dump quasimoro --q 0 0 0 0 0 0.3 --v 1.0 0.5 0.2 --a 0.1 0.2 0.3
 	$(PY) -m robotdyn compare quasimoro
 	mkdir -p out
 	$(PY) -m robotdyn simulate quasimoro --scenario rectilinear --t-end 10 --csv out/quasimoro_rectilinear.csv --plot out/quasimoro_rectilinear.png

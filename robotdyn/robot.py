@@ -98,7 +98,7 @@ class RobotSpec:
         root: ``"fixed"``, ``"planar"`` or ``"floating"``.
         parameters: The physical parameters with defaults and units.
         wheels, closures, motors: The constraint and actuator declarations.
-        labels: Display name of a coordinate for a joint name (e.g. ``wheel_A_joint -> theta1``).
+        labels: Display name of a coordinate for a joint name (e.g. ``wheel_left_joint -> theta_L``).
         independent: Coordinate labels whose velocities are the independent ones (``None``: automatic).
         terrain: A terrain, or a function of the parameter values returning one (default: flat z = 0).
         paper: The paper's file name in ``shared/papers``.

@@ -29,7 +29,7 @@ default = 0.3
 
 [[wheels]]
 name = "A"
-joint = "wheel_A_joint"
+joint = "theta1"
 radius = "r"
 
 [[wheels]]
@@ -76,7 +76,7 @@ def test_spec_fields_from_file():
     assert isinstance(spec, robotdyn.RobotSpec)
     assert [w.frame for w in spec.wheels] == ["wheel_A", "wheel_B"]  # the joint entry resolves to its child link
     assert [w.axis for w in spec.wheels] == [(0.0, 1.0, 0.0)] * 2  # default axle: the spin joint's axis
-    assert [(m.joint, m.reaction) for m in spec.motors] == [("wheel_A_joint", "body"), ("wheel_B_joint", "body")]
+    assert [(m.joint, m.reaction) for m in spec.motors] == [("theta1", "body"), ("theta2", "body")]
     assert {p.name: p.xacro for p in spec.parameters}["g"] is False
     assert {p.name: p.xacro for p in spec.parameters}["rho"] is True
 
@@ -84,16 +84,16 @@ def test_spec_fields_from_file():
 # -------------------------------------------------------------------------------------- generic options
 def test_locked_joint_equals_the_full_model_restricted(tmp_path):
     """Locking theta3 = 0.3: M and the bias of the locked tree are the full tree's at theta3 = 0.3, restricted."""
-    locked = load_robot(write(tmp_path, BASE + '\n[locked]\nbody_joint = 0.3\n'))
+    locked = load_robot(write(tmp_path, BASE + '\n[locked]\ntheta3 = 0.3\n'))
     full = load_robot(write(tmp_path, BASE, "full.toml"))
-    assert "body_joint" not in locked.coordinates and locked.mobility == 2
+    assert "theta3" not in locked.coordinates and locked.mobility == 2
     keep = [full.coordinate_index(c) for c in locked.coordinates]
     rng = np.random.default_rng(3)
     for _ in range(5):
         ql, vl = rng.normal(size=locked.nq), rng.normal(size=locked.nq)
         qf, vf = np.zeros(full.nq), np.zeros(full.nq)
         qf[keep], vf[keep] = ql, vl
-        qf[full.coordinate_index("body_joint")] = 0.3
+        qf[full.coordinate_index("theta3")] = 0.3
         Mf = pin.crba(full.model, full.data, qf)
         bf = pin.rnea(full.model, full.data, qf, vf, np.zeros(full.nq))
         Ml = pin.crba(locked.model, locked.data, ql)
@@ -112,23 +112,23 @@ def test_massless_link(tmp_path):
 def test_glob_lock_and_scenario(tmp_path):
     text = BASE + '''
 [locked]
-"body_*" = -0.2
+"theta[3-9]" = -0.2
 
 [[motors]]
 name = "mA"
-joint = "wheel_A_joint"
+joint = "theta1"
 
 [[scenarios]]
 name = "push"
 t_end = 0.5
 torque = [0.1]
-nu0 = { wheel_B_joint = 1.0 }
+nu0 = { theta2 = 1.0 }
 '''
     cf = read(write(tmp_path, text))
-    assert cf.SPEC.locked == {"body_joint": -0.2}
+    assert cf.SPEC.locked == {"theta3": -0.2}
     robot = cf.robot()
     q0, nu0 = cf.SCENARIOS["push"].initial_state(robot)
-    assert nu0[robot.velocity_names.index("wheel_B_joint_dot")] == 1.0
+    assert nu0[robot.velocity_names.index("theta2_dot")] == 1.0
 
 
 # ---------------------------------------------------------------------------------------------- errors
@@ -140,8 +140,8 @@ def test_unknown_keys(tmp_path):
 
 
 def test_wheel_joint_that_does_not_exist(tmp_path):
-    msg = error_of(write(tmp_path, BASE.replace('joint = "wheel_A_joint"', 'joint = "wheel_C_joint"')))
-    assert "wheels[0] (A)" in msg and "no joint named 'wheel_C_joint'" in msg and "did you mean" in msg
+    msg = error_of(write(tmp_path, BASE.replace('joint = "theta1"', 'joint = "theta4"')))
+    assert "wheels[0] (A)" in msg and "no joint named 'theta4'" in msg and "did you mean" in msg
 
 
 def test_frame_name_typo(tmp_path):
@@ -171,7 +171,7 @@ def test_closure_between_frames_of_the_same_body(tmp_path):
     msg = error_of(write(tmp_path, text))
     assert "closures[0] (loop)" in msg and "same rigid body" in msg
     # locking a joint merges bodies too
-    text = "locked = { body_joint = 0.0 }\n" + BASE + '\n[[closures]]\nframe1 = "axle"\nframe2 = "body_com"\n'
+    text = "locked = { theta3 = 0.0 }\n" + BASE + '\n[[closures]]\nframe1 = "axle"\nframe2 = "body_com"\n'
     msg = error_of(write(tmp_path, text))
     assert "closures[0]" in msg and "same rigid body" in msg
 
@@ -184,7 +184,7 @@ def test_zero_length_axis(tmp_path):
 @pytest.mark.parametrize(
     "change, expected",
     [
-        (('joint = "wheel_A_joint"', 'joint = "axle_height"'), "is fixed"),  # a fixed caster is not a wheel
+        (('joint = "theta1"', 'joint = "axle_height"'), "is fixed"),  # a fixed caster is not a wheel
         (('root = "planar"', 'root = "planr"'), "did you mean 'planar'"),
         (("[[wheels]]\nname = \"B\"", "[[wheels]]\nname = \"B\"\nkind = \"omny\""), "did you mean 'omni'"),
         (('radius = "r"', 'radius = "R"'), "radius 'R' is not a parameter"),
@@ -242,7 +242,7 @@ def test_cli_errors_are_one_line(capsys, argv, expected):
 
 
 def test_cli_bad_wheel_is_one_line(tmp_path, capsys):
-    path = write(tmp_path, BASE.replace('joint = "wheel_A_joint"', 'joint = "wheel_C_joint"'))
+    path = write(tmp_path, BASE.replace('joint = "theta1"', 'joint = "theta4"'))
     assert main(["info", "--constraints", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and str(path) in err and "wheels[0] (A)" in err

@@ -164,8 +164,8 @@ def test_steady_amplitude_against_linearised_closed_form(quasimoro):
 
 def test_pure_rotation_keeps_body_level_and_centre_fixed(quasimoro):
     traj = qm.SCENARIOS["pure_rotation"].run(quasimoro, t_end=3.0, progress=False)
-    for name in ("x", "y", "theta3"):
-        assert np.max(np.abs(traj.column(name))) < 1e-12
+    for name in ("x", "y", "theta3"):  # exactly zero; what remains is round-off at the integrator's atol (1e-12)
+        assert np.max(np.abs(traj.column(name))) < 1e-10
     assert np.allclose(traj.column("theta1"), -traj.column("theta2"), atol=1e-12)
     # eq 11: psi = rho (theta2 - theta1)
     rho = quasimoro.params["rho"]

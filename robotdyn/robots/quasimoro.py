@@ -40,8 +40,7 @@ SPEC = RobotSpec(
         Parameter("g", 9.81, "m/s^2", "gravitational acceleration (the paper does not print it)", xacro=False),
     ],
     wheels=[Wheel("wheel_A", "r", name="wheel_A"), Wheel("wheel_B", "r", name="wheel_B")],
-    motors=[MotorSpec("m1", "wheel_A_joint", reaction="body"), MotorSpec("m2", "wheel_B_joint", reaction="body")],
-    labels={"wheel_A_joint": "theta1", "wheel_B_joint": "theta2", "body_joint": "theta3"},
+    motors=[MotorSpec("m1", "theta1", reaction="body"), MotorSpec("m2", "theta2", reaction="body")],
     independent=["theta1", "theta2", "theta3"],
 )
 

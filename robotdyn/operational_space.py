@@ -31,7 +31,7 @@ from .actuation import input_matrix
 from .constraint import KinematicState
 from .errors import DescriptionError, InputError, SingularConstraintError
 from .projection import MAX_CONDITION, independent_rows
-from .reduced_dynamics import ReducedDynamics, constraint_set
+from .reduced_dynamics import ReducedDynamics, assemble, constraint_set
 
 COMPONENTS = ("vx", "vy", "vz", "wx", "wy", "wz")
 """Twist components: linear velocity of the frame origin, then angular velocity."""
@@ -176,19 +176,7 @@ def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
     drift = constraint_set(robot).drift(kin)
     B = input_matrix(robot.motors, kin)
     w = proj.offset(drift, Jdot @ v)
-    full_rows = lambda: robot.constraint_rows(KinematicState(model, data, q, v))  # noqa: E731  (fresh pass)
-    if coriolis:
-        full_rows = full_rows()
-    M = pin.crba(model, data, q)
-    g = pin.computeGeneralizedGravity(model, data, q)
-    h = S.T @ pin.rnea(model, data, q, v, w)
-    out = ReducedDynamics(S.T @ M @ S, h, S.T @ g, S.T @ B, S, w, v, proj, rows0, _full_rows=full_rows)
-    if coriolis:
-        Sdot = proj.Sdot(full_rows.Adot, Jdot)
-        C = pin.computeCoriolisMatrix(model, data, q, v)
-        out.C = S.T @ (M @ Sdot + C @ S)
-        out.Sdot = Sdot
-    return out
+    return assemble(robot, q, proj, rows0, v, w, B, coriolis, lambda Adot: proj.Sdot(Adot, Jdot))
 
 
 @dataclass

@@ -23,7 +23,6 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from .constraint import KinematicState
 from .errors import ConstraintError, InputError, RobotDynError
 from .terrain import Terrain
 
@@ -59,8 +58,7 @@ def set_terrain(robot, terrain: Terrain) -> None:
 
 
 def _holonomic(robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
-    rows = robot.constraint_rows(kin)
+    rows = robot.rows_at(q)
     hol = rows.holonomic
     return rows.residual[hol], rows.A[hol], [lab for lab, h in zip(rows.labels, hol) if h]
 

@@ -150,18 +150,49 @@ def constraint_set(robot) -> ConstraintSet:
     return cset
 
 
+def _project_at(robot, q: np.ndarray, independent) -> tuple[KinematicState, ConstraintRows, Projection]:
+    """Kinematics at rest, the stacked rows without their derivative and the projection at q (the projection
+    becomes the robot's hint for the next state)."""
+    model = robot.model
+    kin0 = KinematicState(model, robot.data, q, np.zeros(model.nv))
+    rows0 = constraint_set(robot).jacobian(kin0)
+    proj = project(rows0.A, independent, robot.velocity_labels, hint=robot._projection_hint)
+    robot._projection_hint = proj
+    return kin0, rows0, proj
+
+
 def velocity(robot, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, ConstraintRows]:
     """Only :math:`v = S(q)\\nu` and the constraint rows at q (one kinematics pass, no dynamics): the same ``v`` and
     ``jacobian_rows`` as :func:`reduce` (or the robot's operational reduction) at a fraction of the cost."""
     if getattr(robot, "operational", None) is not None:
         red = robot.reduced(q, nu)
         return red.v, red.jacobian_rows
-    model = robot.model
-    kin0 = KinematicState(model, robot.data, q, np.zeros(model.nv))
-    rows0 = constraint_set(robot).jacobian(kin0)
-    proj = project(rows0.A, robot.independent_indices, robot.velocity_labels, hint=robot._projection_hint)
-    robot._projection_hint = proj
+    _, rows0, proj = _project_at(robot, q, robot.independent_indices)
     return proj.S @ np.asarray(nu, float), rows0
+
+
+def assemble(robot, q: np.ndarray, proj, rows0: ConstraintRows, v: np.ndarray, w: np.ndarray, B: np.ndarray,
+             coriolis: bool, sdot: Callable[[np.ndarray], np.ndarray]) -> ReducedDynamics:
+    """The dynamics shared by every reduction, once S, v = S nu, w and B are known:
+    :math:`M_r = S^TMS`, :math:`C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, v, w)`, :math:`g_r`, :math:`B_r`, and with
+    ``coriolis`` :math:`C_r = S^T(M\\dot S + CS)`, :math:`\\dot S` = ``sdot(Adot)``.
+    """
+    model, data = robot.model, robot.data
+    S = proj.S
+    # all rows with Adot, on first access: a fresh kinematics pass, since data may hold another state by then
+    full_rows = lambda: robot.constraint_rows(KinematicState(model, data, q, v))  # noqa: E731
+    if coriolis:
+        full_rows = full_rows()
+    M = pin.crba(model, data, q)
+    g = pin.computeGeneralizedGravity(model, data, q)
+    h = S.T @ pin.rnea(model, data, q, v, w)
+    out = ReducedDynamics(S.T @ M @ S, h, S.T @ g, S.T @ B, S, w, v, proj, rows0, _full_rows=full_rows)
+    if coriolis:
+        Sdot = sdot(full_rows.Adot)
+        C = pin.computeCoriolisMatrix(model, data, q, v)
+        out.C = S.T @ (M @ Sdot + C @ S)
+        out.Sdot = Sdot
+    return out
 
 
 def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
@@ -174,31 +205,10 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
         coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`).
         independent: Override of the independent velocity indices.
     """
-    model, data = robot.model, robot.data
     ind = robot.independent_indices if independent is None else independent
-    cset = constraint_set(robot)
-    kin0 = KinematicState(model, data, q, np.zeros(model.nv))
-    rows0 = cset.jacobian(kin0)
-    proj = project(rows0.A, ind, robot.velocity_labels, hint=robot._projection_hint)
-    robot._projection_hint = proj
+    kin0, rows0, proj = _project_at(robot, q, ind)
     v = proj.S @ nu
     kin = kin0.with_velocity(v)
-    drift = cset.drift(kin)
+    drift = constraint_set(robot).drift(kin)
     B = input_matrix(robot.motors, kin)
-    w = proj.offset(drift)
-    S = proj.S
-    # all rows with Adot, on first access: a fresh kinematics pass, since data may hold another state by then
-    full_rows = lambda: robot.constraint_rows(KinematicState(model, data, q, v))  # noqa: E731
-    if coriolis:
-        full_rows = full_rows()
-    M = pin.crba(model, data, q)
-    Mr = S.T @ M @ S
-    g = pin.computeGeneralizedGravity(model, data, q)
-    h = S.T @ pin.rnea(model, data, q, v, w)
-    out = ReducedDynamics(Mr, h, S.T @ g, S.T @ B, S, w, v, proj, rows0, _full_rows=full_rows)
-    if coriolis:
-        Sdot = proj.Sdot(full_rows.Adot)
-        C = pin.computeCoriolisMatrix(model, data, q, v)
-        out.C = S.T @ (M @ Sdot + C @ S)
-        out.Sdot = Sdot
-    return out
+    return assemble(robot, q, proj, rows0, v, proj.offset(drift), B, coriolis, proj.Sdot)

@@ -188,8 +188,7 @@ class Robot:
         if spec.independent is not None:
             self.independent_indices = np.array([self.coordinate_index(c) for c in spec.independent], dtype=int)
         else:
-            kin = KinematicState(self.model, self.data, self.neutral(), np.zeros(self.model.nv))
-            self.independent_indices = auto_independent(self.constraint_rows(kin).A)
+            self.independent_indices = auto_independent(self.rows_at(self.neutral()).A)
         self.velocity_names = [self.velocity_labels[i] for i in self.independent_indices]
         self._projection_hint = None  # the last projection, whose row choice the next one tries first
         self.operational = spec.operational.build(self.description) if spec.operational is not None else None
@@ -279,16 +278,18 @@ class Robot:
         """All constraint rows at the state of ``kin``."""
         return ConstraintRows.stack([c.rows(kin) for c in self.constraints], self.model.nv)
 
+    def rows_at(self, q) -> ConstraintRows:
+        """All constraint rows at configuration q (at rest, so ``Adot`` is zero)."""
+        return self.constraint_rows(KinematicState(self.model, self.data, q, np.zeros(self.model.nv)))
+
     def constraint_residual(self, q) -> np.ndarray:
         """Position residuals of the holonomic constraint rows at q (m, rad)."""
-        kin = KinematicState(self.model, self.data, q, np.zeros(self.model.nv))
-        rows = self.constraint_rows(kin)
+        rows = self.rows_at(q)
         return rows.residual[rows.holonomic]
 
     def check_constraints(self, q, tol: float = 1e-6) -> None:
         """Raise :class:`ConstraintError` if q violates a holonomic constraint by more than ``tol``."""
-        kin = KinematicState(self.model, self.data, q, np.zeros(self.model.nv))
-        rows = self.constraint_rows(kin)
+        rows = self.rows_at(q)
         if rows.residual.size and np.max(np.abs(rows.residual)) > tol:
             i = int(np.argmax(np.abs(rows.residual)))
             raise ConstraintError(

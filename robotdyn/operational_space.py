@@ -31,6 +31,7 @@ from .actuation import input_matrix
 from .constraint import KinematicState
 from .errors import DescriptionError, InputError, SingularConstraintError
 from .projection import MAX_CONDITION, independent_rows
+from .compiled import compiled_model
 from .reduced_dynamics import ReducedDynamics, assemble, constraint_set
 
 COMPONENTS = ("vx", "vy", "vz", "wx", "wy", "wz")
@@ -165,10 +166,17 @@ def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
     model, data = robot.model, robot.data
     q = np.asarray(q, float)
     nu = np.asarray(nu, float)
+    fast = None if coriolis else compiled_model(robot)
+    if fast is not None:
+        out = fast.reduced(q, nu)
+        if out is not None:
+            return out
     kin0 = KinematicState(model, data, q, np.zeros(model.nv))
     rows0 = constraint_set(robot).jacobian(kin0)
     J = twist.jacobian(kin0)
     proj = project_operational(rows0.A, J, twist.names)
+    if fast is not None:
+        fast.select(proj)
     S = proj.S
     v = S @ nu
     kin = kin0.with_velocity(v)

@@ -19,6 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from .actuation import input_matrix
+from .compiled import compiled_model
 from .constraint import ConstraintRows, KinematicState
 from .projection import Projection, project
 from .loop_closure import LoopGroup
@@ -196,17 +197,25 @@ def assemble(robot, q: np.ndarray, proj, rows0: ConstraintRows, v: np.ndarray, w
 
 
 def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
-    """Evaluate the reduced model of ``robot`` at (q, nu).
+    """Evaluate the reduced model of ``robot`` at (q, nu): by the robot's compiled model
+    (:mod:`robotdyn.compiled`) where it serves the robot, else (and to choose the projection's rows) in Python.
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot`.
         q: Natural coordinates (n,), already validated.
         nu: Independent velocities (k,).
-        coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`).
+        coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`; the Python path).
         independent: Override of the independent velocity indices.
     """
     ind = robot.independent_indices if independent is None else independent
+    fast = None if coriolis else compiled_model(robot)
+    if fast is not None:
+        out = fast.reduced(q, nu, ind)
+        if out is not None:
+            return out
     kin0, rows0, proj = _project_at(robot, q, ind)
+    if fast is not None:
+        fast.select(proj)
     v = proj.S @ nu
     kin = kin0.with_velocity(v)
     drift = constraint_set(robot).drift(kin)

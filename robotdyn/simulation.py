@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .compiled import Fallback, compiled_model
 from .errors import RobotDynError
 from .projection import solve
 from .reduced_dynamics import velocity
@@ -119,10 +120,19 @@ def simulate(
     zero_tau = np.zeros(len(robot.motors))
     report = _Progress(t_end, progress)
 
+    fast = compiled_model(robot)
+
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         q, nu = y[:n], y[n:]
-        red = robot.reduced(q, nu)
         tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
+        if fast is not None and fast.ready:
+            try:  # the whole right-hand side in one compiled call (robotdyn.compiled)
+                out = fast.rhs(q, nu, tau, stabilisation)
+                report(t)
+                return out
+            except Fallback:
+                pass
+        red = robot.reduced(q, nu)
         nudot = solve(red.M, red.B @ tau - red.h)  # numpy.linalg.solve's LAPACK call, without its overhead
         qdot = red.v
         rows = red.jacobian_rows

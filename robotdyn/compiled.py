@@ -1,0 +1,265 @@
+"""The reduced model in one compiled call per state: the fast path of :mod:`robotdyn.reduced_dynamics`.
+
+:class:`CompiledModel` evaluates :math:`M_r = S^TMS`, :math:`h = C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, S\\nu, w)`,
+:math:`g_r`, :math:`B_r`, :math:`S` and :math:`w = \\dot S\\nu` with the formulas of the Python reference
+(:mod:`robotdyn.rolling_contact` on a plane, :mod:`robotdyn.loop_closure`, :mod:`robotdyn.projection`,
+:mod:`robotdyn.operational_space`, :mod:`robotdyn.actuation`) in C++ (``robotdyn/_compiled.cpp``), on a copy of
+the robot's Pinocchio model rebuilt joint by joint and checked against it when built (M, g and RNEA at a random
+state). Pinocchio's own C++ algorithms do the rigid-body work; only the Python call overhead is saved.
+
+It serves robots whose constraints are rolling wheels (standard, omni, support) on a plane without radius joints
+and loop closures, with independent velocities that are a selection of v or a frame twist
+(:class:`~robotdyn.operational_space.OperationalVelocities`); :func:`why_not` names what keeps another robot on
+the Python path. The row choice of the projection is the Python path's (its last projection); where that choice
+stops working (a singular block, rows that no longer span, a wheel lying flat) the evaluation falls back to the
+Python path, which re-chooses or raises its usual error. ``ROBOTDYN_COMPILED=0`` in the environment, or
+:func:`use_compiled` ``(False)``, turns the fast path off. ``tests/test_compiled.py`` checks every output against
+the Python path on every robot.
+"""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+
+import numpy as np
+
+from .constraint import ConstraintRows, KinematicState
+from .loop_closure import LoopClosure
+from .loop_closure import groupable as groupable_loop
+from .projection import Projection
+from .rolling_contact import RollingWheel
+from .terrain import RampTerrain
+from .wheel_group import groupable as groupable_wheel
+
+try:
+    from . import _compiled
+    from ._compiled import Fallback
+except ImportError:  # built without a C++ compiler: the Python path serves every robot
+    _compiled = None
+
+    class Fallback(RuntimeError):
+        """The compiled path cannot decide here (never raised without the extension)."""
+
+_ENABLED = os.environ.get("ROBOTDYN_COMPILED", "1") != "0"
+_KINDS = {"RX": "RX", "RY": "RY", "RZ": "RZ", "PX": "PX", "PY": "PY", "PZ": "PZ",
+          "RevoluteUnaligned": "RU", "PrismaticUnaligned": "PU"}
+SELF_CHECK_TOL = 1e-9
+"""Relative tolerance of the check of the rebuilt model against the robot's Pinocchio model."""
+
+
+def available() -> bool:
+    """Whether the compiled extension was built (it needs a C++ compiler at install time)."""
+    return _compiled is not None
+
+
+def enabled() -> bool:
+    """Whether :func:`robotdyn.reduced_dynamics.reduce` uses the fast path when a robot allows it."""
+    return _ENABLED and _compiled is not None
+
+
+@contextmanager
+def use_compiled(flag: bool):
+    """Turn the fast path on or off inside a ``with`` block (e.g. to compare it with the Python path)."""
+    global _ENABLED
+    old, _ENABLED = _ENABLED, bool(flag)
+    try:
+        yield
+    finally:
+        _ENABLED = old
+
+
+def why_not(robot) -> str | None:
+    """Why ``robot`` cannot use the compiled path (``None``: it can)."""
+    if _compiled is None:
+        return "the compiled extension robotdyn._compiled was not built"
+    for i in range(1, robot.model.njoints):
+        kind = robot.model.joints[i].shortname().replace("JointModel", "")
+        if kind not in _KINDS:
+            return f"joint {robot.model.names[i]!r} of type {kind} is not compiled"
+    planes = set()
+    for c in robot.constraints:
+        if isinstance(c, RollingWheel) and groupable_wheel(c):
+            if c.radius_index is not None:
+                return f"wheel {c.name!r} has a radius joint"
+            if not (isinstance(c.terrain, RampTerrain) and c.terrain.is_flat):
+                return f"wheel {c.name!r} rolls on {c.terrain!r}, not a plane"
+            planes.add(id(c.terrain))
+        elif not (isinstance(c, LoopClosure) and groupable_loop(c)):
+            return f"constraint {c!r} is not compiled"
+    if len(planes) > 1:
+        return "the wheels roll on different terrains"
+    op = getattr(robot, "operational", None)
+    if op is not None and not hasattr(op, "twist"):
+        return f"operational velocities {op!r} are not compiled"
+    return None
+
+
+def _placement(M) -> np.ndarray:
+    return np.hstack([M.rotation, M.translation[:, None]])
+
+
+class CompiledModel:
+    """A robot's reduced model as one C++ object (build with :func:`compiled_model`).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` for which :func:`why_not` is ``None``.
+
+    Raises:
+        RuntimeError: The rebuilt model differs from the robot's Pinocchio model (a bug, never silent).
+    """
+
+    def __init__(self, robot) -> None:
+        model = robot.model
+        self.robot = robot
+        self.constraints = list(robot.constraints)
+        kinds, parents, placements, axes, inertias = [], [], [], [], []
+        for i in range(1, model.njoints):
+            joint = model.joints[i]
+            kinds.append(_KINDS[joint.shortname().replace("JointModel", "")])
+            parents.append(int(model.parents[i]))
+            placements.append(_placement(model.jointPlacements[i]))
+            extracted = joint.extract()
+            axes.append(np.asarray(getattr(extracted, "axis", np.zeros(3)), float))
+            Y = model.inertias[i]
+            I = Y.inertia
+            inertias.append(np.array([Y.mass, *Y.lever, I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]]))
+        ev = _compiled.Evaluator(kinds, parents, placements, axes, inertias, np.asarray(model.gravity.linear, float))
+        frames: dict[int, int] = {}
+
+        def frame(fid: int) -> int:
+            if fid not in frames:
+                f = model.frames[fid]
+                frames[fid] = ev.add_frame(int(f.parentJoint), _placement(f.placement))
+            return frames[fid]
+
+        terrain = None
+        for c in self.constraints:
+            if isinstance(c, RollingWheel):
+                terrain = c.terrain
+                ev.add_wheel(frame(c.fid), np.asarray(c.axis, float), float(c.radius), np.asarray(c._directions, float))
+            else:
+                ev.add_closure(frame(c.f1), frame(c.f2), [int(s) for s in c._sel])
+        if terrain is not None:
+            grad = terrain.gradient(0.0, 0.0)
+            ev.set_plane(terrain.normal(0.0, 0.0), np.array([-grad[0], -grad[1], 1.0]), float(terrain.h),
+                         float(np.sqrt(1.0 + grad @ grad)))
+        for m in robot.motors:
+            ev.add_motor(int(m.index), int(m.jid), -1 if m.rid is None else frame(m.rid))
+        self.operational = getattr(robot, "operational", None)
+        if self.operational is not None:
+            tw = self.operational.twist
+            self._op = (frame(tw.fid), [int(s) for s in tw.select], tw.axes == "local")
+        self.ev = ev
+        rows = robot.rows_at(robot.neutral())
+        self.labels, self.holonomic = rows.labels, rows.holonomic
+        self._check_model()
+        self._hint = None
+
+    def __repr__(self) -> str:
+        return f"CompiledModel({self.robot.spec.name!r}, nv={self.ev.nv}, rows={self.ev.nrows})"
+
+    def _check_model(self) -> None:
+        """The rebuilt model must give Pinocchio's M, g and RNEA of the robot's model at a random state."""
+        import pinocchio as pin
+
+        model, data = self.robot.model, self.robot.model.createData()
+        rng = np.random.default_rng(0)
+        q, v, a = (rng.uniform(-1.0, 1.0, model.nv) for _ in range(3))
+        M, g, tau = self.ev.full(q, v, a)
+        ref_M = pin.crba(model, data, q)
+        ref_M = np.triu(ref_M) + np.triu(ref_M, 1).T
+        ref_g = pin.computeGeneralizedGravity(model, data, q)
+        ref_tau = pin.rnea(model, data, q, v, a)
+        for name, x, ref in (("M", M, ref_M), ("g", g, ref_g), ("RNEA", tau, ref_tau)):
+            err = float(np.max(np.abs(x - ref))) / max(1.0, float(np.max(np.abs(ref))))
+            if not err <= SELF_CHECK_TOL:
+                raise RuntimeError(f"compiled model of {self.robot.spec.name}: {name} differs from Pinocchio's by {err:.3g}")
+
+    @property
+    def ready(self) -> bool:
+        """Whether a projection was chosen (by the Python path's first evaluation), so :meth:`rhs` can run."""
+        return self._hint is not None
+
+    def select(self, proj) -> None:
+        """Use the row choice (and independent velocities) of a Python projection from now on."""
+        if proj is self._hint:
+            return
+        if self.operational is not None:
+            frame, select, local = self._op
+            self.ev.set_operational([int(r) for r in proj.rows], frame, select, local)
+        else:
+            self.ev.set_selection([int(r) for r in proj.rows], [int(i) for i in proj.independent],
+                                  [int(i) for i in proj.dependent])
+        self._hint = proj
+
+    def evaluate(self, q: np.ndarray, nu: np.ndarray) -> tuple:
+        """The raw outputs at (q, nu): ``(M_r, h, g_r, B_r, S, w, v, A, residual, condition, inverse)``, with
+        ``inverse`` :math:`A_d^{-1}` (or :math:`K^{-1}` for operational velocities).
+
+        Raises:
+            robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
+        """
+        return self.ev.evaluate(q, nu)
+
+    def reduced(self, q: np.ndarray, nu: np.ndarray, independent: np.ndarray | None = None):
+        """The :class:`~robotdyn.reduced_dynamics.ReducedDynamics` at (q, nu), or ``None`` where the Python path
+        must decide (then call :meth:`select` with its projection): no projection chosen yet, other
+        ``independent`` velocity indices than the chosen ones, or a :meth:`evaluate` fallback."""
+        hint = self._hint
+        if hint is None or (independent is not None and independent is not getattr(hint, "independent", None)
+                            and not np.array_equal(independent, hint.independent)):
+            return None
+        try:
+            M, h, g, B, S, w, v, A, residual, cond, inv = self.ev.evaluate(q, nu)
+        except Fallback:
+            return None
+        from .reduced_dynamics import ReducedDynamics
+
+        if self.operational is not None:
+            from .operational_space import OperationalProjection
+
+            proj = OperationalProjection(S, hint.rows, cond, inv)
+        else:
+            proj = Projection(S, hint.independent, hint.dependent, hint.rows, cond,
+                              inv if hint.rows.size else None, hint._layout)
+        rows0 = ConstraintRows(A, None, residual, self.holonomic, self.labels)
+        robot = self.robot
+        full_rows = lambda: robot.constraint_rows(KinematicState(robot.model, robot.data, q, v))  # noqa: E731
+        return ReducedDynamics(M, h, g, B, S, w, v, proj, rows0, _full_rows=full_rows)
+
+    def rhs(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray, stabilisation: float) -> np.ndarray:
+        """:math:`(\\dot q, \\dot\\nu)` of :func:`robotdyn.simulation.simulate`'s ODE in one call.
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        return self.ev.rhs(q, nu, tau, stabilisation)
+
+    def evaluate_many(self, Q: np.ndarray, NU: np.ndarray) -> tuple:
+        """Many states in one call: ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n),
+        B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path."""
+        N, n = Q.shape
+        k = NU.shape[1]
+        M, h, g, S, w, B, failed = self.ev.evaluate_many(np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float))
+        return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
+
+
+def compiled_model(robot) -> CompiledModel | None:
+    """The robot's :class:`CompiledModel` (built once; rebuilt when its constraints, their terrain or radius, or
+    the model's gravity change), or ``None`` when the fast path is off or :func:`why_not` gives a reason."""
+    if not enabled():
+        return None
+    cached = getattr(robot, "_compiled_model", None)
+    gravity = robot.model.gravity.linear
+    if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
+        getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r for c, (t, r) in zip(robot.constraints, cached[2])
+    ):
+        return cached[3]
+    fast = CompiledModel(robot) if why_not(robot) is None else None
+    state = [(getattr(c, "terrain", None), getattr(c, "radius", None)) for c in robot.constraints]
+    robot._compiled_model = (list(robot.constraints), gravity.copy(), state, fast)
+    return fast
+
+
+__all__ = ["Fallback", "CompiledModel", "compiled_model", "why_not", "available", "enabled", "use_compiled"]

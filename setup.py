@@ -1,0 +1,48 @@
+"""Build of robotdyn's optional C++ extension ``robotdyn._compiled`` (everything else is in pyproject.toml).
+
+The extension uses Pinocchio's C++ headers as installed by the ``pin`` wheel (its ``cmeel.prefix``), Eigen from
+``cmeel-eigen`` and pybind11; all three are build requirements in pyproject.toml. Without a C++ compiler the build
+of the extension is skipped (``optional``) and robotdyn runs on its Python path alone.
+"""
+
+import sys
+import sysconfig
+from pathlib import Path
+
+from setuptools import Extension, setup
+
+
+def _prefix_include(marker: str) -> list[str]:
+    """The ``cmeel.prefix/include`` directories (of the build environment) that contain ``marker``."""
+    roots = [Path(p) for p in sys.path if p] + [Path(sysconfig.get_paths()["purelib"])]
+    return sorted({str(r / "cmeel.prefix" / "include") for r in roots if (r / "cmeel.prefix" / "include" / marker).exists()})
+
+
+def _extension() -> list[Extension]:
+    try:
+        import pybind11
+    except ImportError:
+        return []
+    pinocchio, eigen = _prefix_include("pinocchio"), _prefix_include("eigen3")
+    if not pinocchio or not eigen:
+        return []
+    return [
+        Extension(
+            "robotdyn._compiled",
+            ["robotdyn/_compiled.cpp"],
+            include_dirs=[pybind11.get_include(), *pinocchio, *(str(Path(e) / "eigen3") for e in eigen)],
+            define_macros=[
+                ("NDEBUG", None),
+                ("BOOST_MPL_LIMIT_LIST_SIZE", "30"),  # as Pinocchio's CMake config requires
+                ("BOOST_MPL_LIMIT_VECTOR_SIZE", "30"),
+                ("BOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", None),
+                ("BOOST_FUSION_INVOKE_MAX_ARITY", "12"),
+            ],
+            extra_compile_args=["-std=c++17", "-O2", "-g0", "-fvisibility=hidden", "-w"],
+            language="c++",
+            optional=True,
+        )
+    ]
+
+
+setup(ext_modules=_extension())

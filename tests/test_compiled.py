@@ -657,3 +657,97 @@ def test_compute_views(robot):
     fast.select(py.projection)
     for name, x in zip(FIELDS, _compute_views(fast, *states[2])):
         assert close(x, getattr(py, name)) <= TOL, name
+
+
+# ------------------------------------------------------------------------------------------ later changes, more
+def test_cosine_coupling_named_or_equal():
+    """A JointCoupling with a CosineLaw on mmr12 (one velocity less): named by why_not, or compiled and equal."""
+    jc = pytest.importorskip("robotdyn.joint_coupling")
+    if not hasattr(jc, "CosineLaw"):
+        pytest.skip("no CosineLaw in robotdyn.joint_coupling")
+    rob = robotdyn.load("mmr12_eod")
+    coupling = jc.JointCoupling(rob.description, "theta3_joint", "theta1_joint", jc.CosineLaw(0.3, 1.5, 0.2, -0.1))
+    rob.constraints.append(coupling)
+    i3 = rob.coordinates.index("theta3")
+    rob.independent_indices = np.array([i for i in rob.independent_indices if i != i3])
+    rob.velocity_names = [rob.velocity_labels[i] for i in rob.independent_indices]
+    reason = why_not(rob)
+    if reason is not None:
+        assert "coupling" in reason.lower() or "JointCoupling" in reason
+        return
+    rng = np.random.default_rng(61)
+    for i in range(6):
+        q, nu = random_state(rob, rng, 0.5)
+        ref = compare_at(rob, q, nu, f"(mmr12 with a cosine coupling, state {i})")
+        assert ref is not None and ref.M.shape == (11, 11)
+        assert abs(ref.jacobian_rows.residual[-1]) > 1e-3  # the coupling is violated: its residual is compared
+        tau = rng.normal(size=len(rob.motors))
+        want, red = python_rhs(rob, q, nu, tau, 10.0)
+        assert close(compiled_model(rob).rhs(q, nu, tau, 10.0), want) <= 1e-10
+
+
+def test_radius_change_rebuilds():
+    """A wheel radius changed in place (as a parameter study would): a new compiled model, the new numbers."""
+    rob = robotdyn.load("quasimoro")
+    rng = np.random.default_rng(67)
+    q, nu = random_state(rob, rng, 0.5)
+    before = compare_at(rob, q, nu)
+    fast = compiled_model(rob)
+    wheel = next(c for c in rob.constraints if hasattr(c, "radius"))
+    wheel.radius = 1.2 * wheel.radius
+    assert compiled_model(rob) is not fast
+    after = compare_at(rob, q, nu, "(after a radius change)")
+    assert close(after.S, before.S) > 1e-3
+
+
+def test_other_independent_velocities_use_the_python_choice():
+    """Changing robot.independent_indices after the fast path chose its rows: the results follow the new choice."""
+    rob = robotdyn.load("mmr12_eod")
+    rng = np.random.default_rng(71)
+    q, nu = random_state(rob, rng, 0.3)
+    compare_at(rob, q, nu)
+    fast = compiled_model(rob)
+    old = rob.independent_indices
+    assert fast.reduced(q, nu, old.copy()) is not None  # the same indices, another array: still fast
+    # swap one independent wheel velocity for the planar heading rate
+    new = old.copy()
+    new[0] = rob.coordinates.index("psi")
+    assert fast.reduced(q, nu, new) is None
+    rob.independent_indices = new
+    rob.velocity_names = [rob.velocity_labels[i] for i in new]
+    got = rob.reduced(q, nu)
+    ref = _python(rob, q, nu)
+    assert_same(got, ref, "(new independent velocities)")
+    assert np.array_equal(got.S[new], np.eye(len(new)))
+    compare_at(rob, *random_state(rob, rng, 0.3), "(new independent velocities, compiled)")
+
+
+def test_coriolis_request_takes_the_python_path(robot):
+    """coriolis=True needs C_r (the Python path); its M, h, ... equal the compiled ones."""
+    rng = np.random.default_rng(73)
+    q, nu = random_state(robot, rng, 0.3)
+    fast_red = compare_at(robot, q, nu)
+    full = robot.reduced(q, nu, coriolis=True)
+    assert full.C is not None
+    assert_same(robot.reduced(q, nu), full)
+    # C_r nu + g_r = h (the bias from one RNEA call)
+    assert close(full.C @ nu + full.g, fast_red.h) <= 1e-10
+
+
+def test_simulate_energy_conserved_operational():
+    """omni_caster (operational velocities, compiled rhs) without torques: energy conserved."""
+    from robotdyn.simulation import simulate
+
+    rob = robotdyn.load("omni_caster")
+    q0 = rob.neutral()
+    nu0 = np.array([0.3, -0.2, 0.5])
+    rob.reduced(q0, nu0)
+    fast = compiled_model(rob)
+    spy = _Spy(fast, "rhs")
+    try:
+        traj = simulate(rob, 3.0, q0, nu0, None, n_out=301, progress=False)
+    finally:
+        spy.remove()
+    assert spy.served == spy.calls > 0
+    assert np.abs(traj.energy - traj.energy[0]).max() / abs(traj.energy[0]) < 1e-8
+    assert np.ptp(traj.q[:, 0]) > 0.1

@@ -1,7 +1,8 @@
 """make bench: speed of robotdyn's reduced model next to raw Pinocchio, for every registered robot, in one run.
 
-For each robot: the median time of one reduced-model evaluation (M_r, C_r nu + g_r, S, w = Sdot nu) next to
-Pinocchio's CRBA + RNEA on the same model, their ratio; for Quasimoro also the sympy-derived model lambdified
+For each robot: the median time of one reduced-model evaluation (M_r, C_r nu + g_r, g_r, S, w = Sdot nu) -- by
+the compiled model (robotdyn.compiled, views of its buffers), by robot.reduced (the full ReducedDynamics object) and
+by the Python path -- next to Pinocchio's CRBA + RNEA on the same model, their ratios; for Quasimoro also the sympy-derived model lambdified
 with numpy (tests/oracles); and simulated seconds per wall-clock second of the robot's first scenario with the
 constraint drift at the end (for Quasimoro also DOP853 at rtol 1e-8 and LSODA at rtol 1e-10, each with its
 deviation from the default DOP853 rtol 1e-10 run); the batch API next to robot.reduced in a loop. This is a benchmark, not a test: it asserts nothing.
@@ -20,6 +21,7 @@ import pinocchio as pin
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import robotdyn  # noqa: E402
+from robotdyn.compiled import available, compiled_model, use_compiled, why_not  # noqa: E402
 from robotdyn.robots import module, names  # noqa: E402
 
 
@@ -43,8 +45,11 @@ def state(robot, seed: int = 0):
 
 
 def main() -> None:
-    print(f"robotdyn {robotdyn.__version__}, pinocchio {pin.__version__}, numpy {np.__version__}")
-    print(f"{'robot':<20} {'n':>3} {'k':>3} {'reduced [us]':>13} {'CRBA+RNEA [us]':>15} {'ratio':>7}")
+    print(f"robotdyn {robotdyn.__version__}, pinocchio {pin.__version__}, numpy {np.__version__}, "
+          f"compiled fast path: {'built' if available() else 'NOT built'}")
+    print("times per evaluation of (M_r, C_r nu + g_r, g_r, S, Sdot nu) [us]; ratio = time / (CRBA + RNEA)")
+    print(f"{'robot':<20} {'n':>3} {'k':>3} {'CRBA+RNEA':>10} {'compiled':>9} {'ratio':>6} {'reduced()':>10} "
+          f"{'ratio':>6} {'Python path':>12} {'ratio':>6}")
     rows = []
     for name in names():
         try:
@@ -54,13 +59,18 @@ def main() -> None:
         except Exception as exc:  # a robot that cannot be evaluated at its neutral state is reported, not fatal
             print(f"{name:<20} skipped: {exc}")
             continue
-        t_red = timeit(lambda: robot.reduced(q, nu))
         v = np.zeros(robot.nq)
         t_pin = timeit(lambda: (pin.crba(robot.model, robot.data, q), pin.rnea(robot.model, robot.data, q, v, v)),
                        number=2000)
+        fast = compiled_model(robot)
+        t_fast = timeit(lambda: fast.compute(q, nu), number=2000) if fast is not None else float("nan")
+        t_red = timeit(lambda: robot.reduced(q, nu), number=1000)
+        with use_compiled(False):
+            t_py = timeit(lambda: robot.reduced(q, nu))
         rows.append((name, robot, t_red))
-        print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3} {t_red * 1e6:>13.1f} {t_pin * 1e6:>15.2f} "
-              f"{t_red / t_pin:>7.0f}")
+        print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3} {t_pin * 1e6:>10.2f} {t_fast * 1e6:>9.2f} "
+              f"{t_fast / t_pin:>6.1f} {t_red * 1e6:>10.2f} {t_red / t_pin:>6.1f} {t_py * 1e6:>12.1f} {t_py / t_pin:>6.0f}"
+              + ("" if fast is not None else f"   (not compiled: {why_not(robot)})"))
 
     from oracles.quasimoro_sympy import quasimoro_reduced
 
@@ -69,9 +79,11 @@ def main() -> None:
     oracle = quasimoro_reduced({"g": robot.params["g"]})
     qo = np.array([q[robot.coordinate_index(c)] for c in ("x", "y", "psi", "theta1", "theta2", "theta3")])
     t_sym = timeit(lambda: (oracle.M_r(qo), oracle.h_r(qo, nu), oracle.g_r(qo), oracle.S(qo)))
+    fast = compiled_model(robot)
+    t_fast = timeit(lambda: fast.compute(q, nu), number=2000) if fast is not None else float("nan")
     t_red = timeit(lambda: robot.reduced(q, nu))
-    print(f"\nquasimoro: sympy-lambdified model {t_sym * 1e6:.1f} us vs robotdyn {t_red * 1e6:.1f} us "
-          f"(robotdyn {t_sym / t_red:.2f}x the speed of the lambdified oracle)")
+    print(f"\nquasimoro: sympy-lambdified model {t_sym * 1e6:.1f} us; robotdyn compiled {t_fast * 1e6:.2f} us "
+          f"({t_sym / t_fast:.1f}x faster), robot.reduced {t_red * 1e6:.1f} us ({t_sym / t_red:.1f}x faster)")
 
     from robotdyn.batch import evaluate
 
@@ -85,11 +97,13 @@ def main() -> None:
         robot.reduced(Q[i], NU[i])
     wall = time.perf_counter() - start
     print(f"quasimoro one by one (robot.reduced in a loop): {N} states: {N / wall:,.0f} states/s")
-    for processes in (1, 2):
-        start = time.perf_counter()
-        evaluate(robot, Q, NU, processes=processes)
-        wall = time.perf_counter() - start
-        print(f"quasimoro batch API: {N} states with {processes} process(es): {N / wall:,.0f} states/s")
+    for label, flag in (("compiled", True), ("Python path", False)):
+        with use_compiled(flag):
+            for processes in (1, 2):
+                start = time.perf_counter()
+                evaluate(robot, Q, NU, processes=processes)
+                wall = time.perf_counter() - start
+                print(f"quasimoro batch API ({label}): {N} states with {processes} process(es): {N / wall:,.0f} states/s")
 
     print(f"\n{'robot / scenario':<36} {'sim [s]':>8} {'wall [s]':>9} {'sim/wall':>9} {'evals':>7} {'drift':>9}")
     for name, robot, _ in rows:
@@ -110,8 +124,14 @@ def main() -> None:
         print(f"{name + ' / ' + sc_name:<36} {t_end:>8.1f} {wall:>9.2f} {t_end / wall:>9.1f} "
               f"{traj.stats['nfev']:>7d} {drift:>9.1e}")
         if name == "quasimoro":  # other integrator settings, and how far each strays from the default run
-            for label, kw in (("DOP853 rtol 1e-8", dict(rtol=1e-8, atol=1e-10)), ("LSODA rtol 1e-10", dict(method="LSODA"))):
-                other = sc.run(robot, t_end=t_end, progress=False, **kw)
+            start = time.perf_counter()
+            sc.run(robot, t_end=t_end, progress=False)
+            print(f"{'  whole simulate() call':<36} {t_end:>8.1f} {time.perf_counter() - start:>9.2f}")
+            for label, kw, flag in (("DOP853 rtol 1e-8", dict(rtol=1e-8, atol=1e-10), True),
+                                    ("LSODA rtol 1e-10", dict(method="LSODA"), True),
+                                    ("DOP853, Python path", {}, False)):
+                with use_compiled(flag):
+                    other = sc.run(robot, t_end=t_end, progress=False, **kw)
                 dev = float(np.max(np.abs(other.q - traj.q)))
                 wall = other.stats["wall"]
                 print(f"{'  ' + label:<36} {t_end:>8.1f} {wall:>9.2f} {t_end / wall:>9.1f} {other.stats['nfev']:>7d} "

@@ -1,8 +1,10 @@
 // robotdyn._compiled: the reduced model evaluated in one compiled call (see robotdyn/compiled.py).
 //
 // Same formulas as the Python reference, in the same order:
-//   rolling contact on a plane  robotdyn/rolling_contact.py (per wheel), robotdyn/wheel_group.py (fast path)
+//   rolling contact             robotdyn/rolling_contact.py (per wheel), robotdyn/wheel_group.py (fast path)
+//   terrains                    robotdyn/terrain.py (plane/ramp, sine, bump)
 //   loop closures               robotdyn/loop_closure.py
+//   joint couplings             robotdyn/joint_coupling.py (cosine laws)
 //   projection                  robotdyn/projection.py (_build: S = P [I; -Ad^-1 Ai], w = -Ad^-1 drift)
 //   operational velocities      robotdyn/operational_space.py (K = [A_r; J_o], K S = [0; I])
 //   motors                      robotdyn/actuation.py
@@ -46,8 +48,63 @@ struct Fallback : std::runtime_error {
 struct Wheel {
   int frame;       // index into Evaluator::frames
   Vector3d axis;   // axle in the wheel frame (unit)
-  double radius;   // m
-  MatrixXd D;      // (nd, 3) rows as coefficients of (t1, t2, n)
+  double radius;   // m (plus q[radius_index] when radius_index >= 0)
+  int radius_index;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3> D;  // (nd, 3) rows as coefficients of (t1, t2, n)
+};
+
+struct Coupling {  // q[i] = amplitude cos(rate q[j] + phase) + offset
+  int i, j;
+  double amplitude, rate, phase, offset;
+};
+
+// z = f(x, y): 0 plane h + gx x + gy y; 1 sine a sin(kx x + ky y + phase); 2 smooth step(s) (tanh), as terrain.py
+struct Terrain {
+  int kind = 0;
+  double c[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+  bool flat() const { return kind == 0; }
+  void step(double x, double x0, double& f, double& fx, double& fxx) const {
+    const double h = c[0], w = c[2];
+    const double t = std::tanh((x - x0) / w), s = 1.0 - t * t;
+    f = 0.5 * h * (1 + t);
+    fx = 0.5 * h * s / w;
+    fxx = -h * t * s / (w * w);
+  }
+  // height, gradient and Hessian at (x, y)
+  void eval(double x, double y, double& f, Eigen::Vector2d& g, Eigen::Matrix2d& H) const {
+    if (kind == 0) {
+      f = c[0] + c[1] * x + c[2] * y;
+      g << c[1], c[2];
+      H.setZero();
+    } else if (kind == 1) {
+      const double arg = c[1] * x + c[2] * y + c[3];
+      f = c[0] * std::sin(arg);
+      const double co = c[0] * std::cos(arg);
+      g << co * c[1], co * c[2];
+      const double si = -c[0] * std::sin(arg);
+      H << si * c[1] * c[1], si * c[1] * c[2], si * c[2] * c[1], si * c[2] * c[2];
+    } else {
+      double fx, fxx;
+      step(x, c[1], f, fx, fxx);
+      if (!std::isnan(c[3])) {
+        double f2, fx2, fxx2;
+        step(x, c[1] + c[3], f2, fx2, fxx2);
+        f -= f2;
+        fx -= fx2;
+        fxx -= fxx2;
+      }
+      g << fx, 0.0;
+      H << fxx, 0.0, 0.0, 0.0;
+    }
+  }
+  Vector3d normal(double x, double y) const {
+    double f;
+    Eigen::Vector2d g;
+    Eigen::Matrix2d H;
+    eval(x, y, f, g, H);
+    Vector3d m(-g[0], -g[1], 1.0);
+    return m / m.norm();
+  }
 };
 
 struct Closure {
@@ -61,8 +118,9 @@ struct Motor {
   int reaction;  // index into frames, -1: the joint's parent (a unit column)
 };
 
-struct Geometry {  // configuration-level quantities of one wheel on the plane
-  Vector3d a, u, t1, t2;
+struct Geometry {  // configuration-level quantities of one wheel
+  Vector3d a, u, n, t1, t2;
+  Matrix3d N;  // dn/dp on a curved terrain
   double na, nw, nc1, R;
 };
 
@@ -102,6 +160,7 @@ class Evaluator {
     model_.gravity.linear(gravity);
     nv_ = model_.nv;
     data_ = pin::Data(model_);
+    zero_.setZero(nv_);
   }
 
   // ----------------------------------------------------------------------------------------------- set-up
@@ -113,21 +172,26 @@ class Evaluator {
     data_ = pin::Data(model_);
     return static_cast<int>(frames_.size()) - 1;
   }
-  void set_plane(const Vector3d& normal, const Vector3d& height_row, double h, double slope_norm) {
-    n0_ = normal;
-    height_row_ = height_row;
-    h_ = h;
-    slope_norm_ = slope_norm;
+  void set_terrain(int kind, const std::vector<double>& c) {
+    if (kind < 0 || kind > 2 || c.size() > 5) throw std::invalid_argument("unknown terrain");
+    terrain_.kind = kind;
+    for (size_t i = 0; i < c.size(); ++i) terrain_.c[i] = c[i];
   }
-  void add_wheel(int frame, const Vector3d& axis, double radius, const MatrixXd& D) {
+  void add_wheel(int frame, const Vector3d& axis, double radius, int radius_index, const MatrixXd& D) {
+    if (D.cols() != 3 || D.rows() < 1 || D.rows() > 3) throw std::invalid_argument("wheel rows must be (1..3, 3)");
     order_.emplace_back(0, static_cast<int>(wheels_.size()));
-    wheels_.push_back(Wheel{frame, axis, radius, D});
+    wheels_.push_back(Wheel{frame, axis, radius, radius_index, D});
     for (int r = 0; r < D.rows(); ++r) holonomic_.push_back(D(r, 2) != 0.0);
   }
   void add_closure(int f1, int f2, const std::vector<int>& select) {
     order_.emplace_back(1, static_cast<int>(closures_.size()));
     closures_.push_back(Closure{f1, f2, select});
     for (size_t r = 0; r < select.size(); ++r) holonomic_.push_back(true);
+  }
+  void add_coupling(int i, int j, double amplitude, double rate, double phase, double offset) {
+    order_.emplace_back(2, static_cast<int>(couplings_.size()));
+    couplings_.push_back(Coupling{i, j, amplitude, rate, phase, offset});
+    holonomic_.push_back(true);
   }
   void add_motor(int index, int joint, int reaction) { motors_.push_back(Motor{index, joint, reaction}); }
   // The rows used and the independent velocity indices (a selection of v).
@@ -137,6 +201,7 @@ class Evaluator {
     independent_ = independent;
     dependent_ = dependent;
     operational_ = false;
+    selected_ = true;
   }
   // Operational velocities: nu = J_o v with J_o the selected components of a frame's twist (local or world axes).
   void set_operational(const std::vector<int>& rows, int frame, const std::vector<int>& select, bool local) {
@@ -145,6 +210,7 @@ class Evaluator {
     op_select_ = select;
     op_local_ = local;
     operational_ = true;
+    selected_ = true;
   }
 
   int nv() const { return nv_; }
@@ -165,6 +231,7 @@ class Evaluator {
   // ------------------------------------------------------------------------------------------ evaluation
   // Configuration level: kinematics, the constraint rows A, residuals, the motors' B and the projection S.
   void configure(const Eigen::Ref<const VectorXd>& q) {
+    if (!selected_) throw Fallback("no projection chosen yet");
     if (q.size() != nv_) throw std::invalid_argument("q has the wrong length");
     q_ = q;
     pin::computeJointJacobians(model_, data_, q_);
@@ -178,10 +245,10 @@ class Evaluator {
       Jf_[f].setZero(6, nv_);
       pin::getFrameJacobian(model_, data_, frames_[f], pin::LOCAL_WORLD_ALIGNED, Jf_[f]);
     }
-    int row = 0;
     Aw_.resize(wheels_.size());
-    for (const auto& [kind, i] : order_) row = kind == 0 ? wheel_rows(i, row) : closure_rows(i, row);
-    // motors (configuration only)
+    int row = 0;
+    for (const auto& [kind, i] : order_)
+      row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
     B_.setZero(nv_, motors_.size());
     for (size_t j = 0; j < motors_.size(); ++j) {
       const Motor& mo = motors_[j];
@@ -189,11 +256,12 @@ class Evaluator {
         B_(mo.index, j) = 1.0;
         continue;
       }
-      Matrix6x Jc = Matrix6x::Zero(6, nv_);
-      pin::getJointJacobian(model_, data_, mo.joint, pin::LOCAL_WORLD_ALIGNED, Jc);
-      Vector3d ang = Jc.block<3, 1>(3, mo.index);
-      Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(Jc.block<3, 1>(0, mo.index));
-      B_.col(j) = (Jc.bottomRows<3>() - Jf_[mo.reaction].bottomRows<3>()).transpose() * axis;
+      Jc_.setZero(6, nv_);
+      pin::getJointJacobian(model_, data_, mo.joint, pin::LOCAL_WORLD_ALIGNED, Jc_);
+      Vector3d ang = Jc_.block<3, 1>(3, mo.index);
+      Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(Jc_.block<3, 1>(0, mo.index));
+      B_.col(j).noalias() = Jc_.bottomRows<3>().transpose() * axis;
+      B_.col(j).noalias() -= Jf_[mo.reaction].bottomRows<3>().transpose() * axis;
     }
     project();
   }
@@ -201,31 +269,32 @@ class Evaluator {
   // State level: v = S nu, the drift, w and the dynamics.
   void dynamics(const Eigen::Ref<const VectorXd>& nu) {
     if (nu.size() != S_.cols()) throw std::invalid_argument("nu has the wrong length");
-    v_ = S_ * nu;
-    VectorXd zero = VectorXd::Zero(nv_);
-    pin::forwardKinematics(model_, data_, q_, v_, zero);
+    v_.noalias() = S_ * nu;
+    pin::forwardKinematics(model_, data_, q_, v_, zero_);
     drift_.setZero(nrows());
     int row = 0;
-    for (const auto& [kind, i] : order_) row = kind == 0 ? wheel_drift(i, row) : closure_drift(i, row);
+    for (const auto& [kind, i] : order_)
+      row = kind == 0 ? wheel_drift(i, row) : kind == 1 ? closure_drift(i, row) : coupling_drift(i, row);
     w_.setZero(nv_);
+    const int nr = static_cast<int>(rows_.size());
     if (operational_) {
-      VectorXd rhs(nv_);
-      for (size_t r = 0; r < rows_.size(); ++r) rhs[r] = drift_[rows_[r]];
-      rhs.tail(op_select_.size()) = operational_drift();
-      w_ = -(Kinv_ * rhs);
-    } else if (!rows_.empty()) {
-      VectorXd d(rows_.size());
-      for (size_t r = 0; r < rows_.size(); ++r) d[r] = drift_[rows_[r]];
-      VectorXd wd = -(Adinv_ * d);
-      for (size_t r = 0; r < dependent_.size(); ++r) w_[dependent_[r]] = wd[r];
+      rhs_.resize(nv_);
+      for (int r = 0; r < nr; ++r) rhs_[r] = drift_[rows_[r]];
+      operational_drift(rhs_);
+      w_.noalias() = -Kinv_ * rhs_;
+    } else if (nr) {
+      rhs_.resize(nr);
+      for (int r = 0; r < nr; ++r) rhs_[r] = drift_[rows_[r]];
+      wd_.noalias() = -Adinv_ * rhs_;
+      for (int r = 0; r < nr; ++r) w_[dependent_[r]] = wd_[r];
     }
-    M_ = pin::crba(model_, data_, q_);
-    M_.triangularView<Eigen::StrictlyLower>() = M_.transpose().triangularView<Eigen::StrictlyLower>();
-    Mr_.noalias() = S_.transpose() * M_ * S_;
-    g_ = pin::computeGeneralizedGravity(model_, data_, q_);
-    gr_.noalias() = S_.transpose() * g_;
-    const VectorXd& tau = pin::rnea(model_, data_, q_, v_, w_);
-    hr_.noalias() = S_.transpose() * tau;
+    pin::crba(model_, data_, q_);
+    SM_.noalias() = data_.M.selfadjointView<Eigen::Upper>() * S_;
+    Mr_.noalias() = S_.transpose() * SM_;
+    pin::computeGeneralizedGravity(model_, data_, q_);
+    gr_.noalias() = S_.transpose() * data_.g;
+    pin::rnea(model_, data_, q_, v_, w_);
+    hr_.noalias() = S_.transpose() * data_.tau;
     Br_.noalias() = S_.transpose() * B_;
   }
 
@@ -235,11 +304,19 @@ class Evaluator {
     return py::make_tuple(Mr_, hr_, gr_, Br_, S_, w_, v_, A_, residual_, cond_, Adinv_);
   }
 
-  // The same without returning anything: the results are read through the views M, h, g, B, S, w, v (valid
-  // until the next call).
-  void compute(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
+  // The same without copies: the results stay in buffers read through the views M, h, g, B, S, w, v. Returns a
+  // counter that changes whenever a buffer moved (then views taken before are stale).
+  long compute(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
     configure(q);
     dynamics(nu);
+    const double* now[7] = {Mr_.data(), hr_.data(), gr_.data(), Br_.data(), S_.data(), w_.data(), v_.data()};
+    for (int i = 0; i < 7; ++i)
+      if (now[i] != buffers_[i]) {
+        std::copy(now, now + 7, buffers_);
+        ++generation_;
+        break;
+      }
+    return generation_;
   }
   const MatrixXd& Mr() const { return Mr_; }
   const VectorXd& hr() const { return hr_; }
@@ -255,18 +332,22 @@ class Evaluator {
     configure(q);
     dynamics(nu);
     const int k = static_cast<int>(S_.cols());
+    if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
     VectorXd out(nv_ + k);
     out.head(nv_) = v_;
     if (alpha != 0.0) pull_back(alpha, out);
-    out.tail(k) = Mr_.llt().solve(Br_ * tau - hr_);
+    force_ = Br_ * tau - hr_;
+    llt_.compute(Mr_);
+    out.tail(k) = llt_.solve(force_);
     return out;
   }
 
-  // Many states: stacked M_r (N, k, k), h (N, k), g (N, k), S (N, n, k), w (N, n).
+  // Many states: stacked M_r (N, k, k), h (N, k), g (N, k), S (N, n, k), w (N, n), B_r (N, k, motors).
   py::tuple evaluate_many(const Eigen::Ref<const RowMat>& Q, const Eigen::Ref<const RowMat>& NU) {
     const int N = static_cast<int>(Q.rows());
     const int k = mobility();
-    RowMat Mr(N, k * k), hr(N, k), gr(N, k), S(N, nv_ * k), w(N, nv_), B(N, k * motors_.size());
+    const int nm = static_cast<int>(motors_.size());
+    RowMat Mr(N, k * k), hr(N, k), gr(N, k), S(N, nv_ * k), w(N, nv_), B(N, k * nm);
     std::vector<int> failed;
     for (int i = 0; i < N; ++i) {
       try {
@@ -281,62 +362,114 @@ class Evaluator {
       gr.row(i) = gr_.transpose();
       Eigen::Map<RowMat>(S.row(i).data(), nv_, k) = S_;
       w.row(i) = w_.transpose();
-      Eigen::Map<RowMat>(B.row(i).data(), k, motors_.size()) = Br_;
+      Eigen::Map<RowMat>(B.row(i).data(), k, nm) = Br_;
     }
     return py::make_tuple(Mr, hr, gr, S, w, B, failed);
   }
 
  private:
+  // Contact point and frame of wheel i (RollingWheel._geometry), its rows D E^T A_w and residuals.
   int wheel_rows(size_t i, int row) {
     const Wheel& wh = wheels_[i];
     const pin::SE3& oMf = data_.oMf[frames_[wh.frame]];
     Geometry& g = geo_[i];
     g.R = wh.radius;
-    g.a = oMf.rotation() * wh.axis;
-    g.na = g.a.dot(n0_);
-    Vector3d wv = n0_ - g.na * g.a;
-    g.nw = wv.norm();
-    if (g.nw < 1e-9) throw Fallback("wheel lying flat");
-    g.u = wv / g.nw;
-    Vector3d p = oMf.translation() - g.R * g.u;
-    double phi = (p.dot(height_row_) - h_) / slope_norm_;
-    Vector3d c1 = g.a.cross(n0_);
+    if (wh.radius_index >= 0) {
+      g.R += q_[wh.radius_index];
+      if (g.R <= 0) throw Fallback("radius not positive");
+    }
+    g.a.noalias() = oMf.rotation() * wh.axis;
+    const Vector3d c = oMf.translation();
+    const bool flat = terrain_.flat();
+    Vector3d n = terrain_.normal(c[0], c[1]), p;
+    int it = 0;
+    for (; it < 100; ++it) {
+      g.na = n.dot(g.a);
+      Vector3d wv = n - g.na * g.a;
+      g.nw = wv.norm();
+      if (g.nw < 1e-9) throw Fallback("wheel lying flat");
+      g.u = wv / g.nw;
+      p = c - g.R * g.u;
+      if (flat) break;
+      const Vector3d m = terrain_.normal(p[0], p[1]);
+      const double d2 = (m - n).squaredNorm();
+      n = m;
+      if (d2 < 1e-30) {
+        g.na = n.dot(g.a);
+        wv = n - g.na * g.a;
+        g.nw = wv.norm();
+        g.u = wv / g.nw;
+        p = c - g.R * g.u;
+        break;
+      }
+    }
+    if (it == 100) throw Fallback("contact point did not converge");
+    g.n = n;
+    double f;
+    Eigen::Vector2d grad;
+    Eigen::Matrix2d H;
+    terrain_.eval(p[0], p[1], f, grad, H);
+    const double norm = std::sqrt(1.0 + grad.squaredNorm());
+    const double phi = (p[2] - f) / norm;
+    if (!flat) {  // Terrain.normal_derivative
+      Matrix3d dm = Matrix3d::Zero();
+      dm.block<2, 2>(0, 0) = -H;
+      g.N = (Matrix3d::Identity() - n * n.transpose()) * dm / norm;
+    }
+    const Vector3d c1 = g.a.cross(n);
     g.nc1 = c1.norm();
     g.t1 = c1 / g.nc1;
-    g.t2 = n0_.cross(g.t1);
+    g.t2 = n.cross(g.t1);
     const Matrix6x& J = Jf_[wh.frame];
-    Vector3d r = -g.R * g.u;
-    Aw_[i] = J.topRows<3>() - skew(r) * J.bottomRows<3>();
+    const Vector3d r = -g.R * g.u;
+    MatrixXd& Aw = Aw_[i];
+    Aw = J.topRows<3>();
+    Aw.noalias() -= skew(r) * J.bottomRows<3>();
+    if (wh.radius_index >= 0) Aw.col(wh.radius_index) -= g.u;
     Matrix3d ET;
     ET.row(0) = g.t1.transpose();
     ET.row(1) = g.t2.transpose();
-    ET.row(2) = n0_.transpose();
+    ET.row(2) = n.transpose();
     const int nd = static_cast<int>(wh.D.rows());
-    A_.middleRows(row, nd) = (wh.D * ET) * Aw_[i];
+    const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3> W = wh.D * ET;
+    A_.middleRows(row, nd).noalias() = W * Aw;
     for (int r2 = 0; r2 < nd; ++r2) residual_[row + r2] = wh.D(r2, 2) != 0.0 ? phi : 0.0;
     return row + nd;
   }
 
+  // Drift D (Edot^T s + E^T acc) of wheel i (RollingWheel.drift, WheelGroup._drift).
   int wheel_drift(size_t i, int row) {
     const Wheel& wh = wheels_[i];
     const Geometry& g = geo_[i];
     const int fid = frames_[wh.frame];
     const pin::Motion vf = pin::getFrameVelocity(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
     const pin::Motion af = pin::getFrameClassicalAcceleration(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
-    const Vector3d omega = vf.angular();
+    const Vector3d omega = vf.angular(), cdot = vf.linear();
+    const double Rdot = wh.radius_index >= 0 ? v_[wh.radius_index] : 0.0;
+    const Vector3d& n = g.n;
     const Vector3d adot = omega.cross(g.a);
-    const double nad = adot.dot(n0_);
-    const Vector3d qv = -nad * g.a - g.na * adot;
-    const Vector3d udot = (qv - g.u * g.u.dot(qv)) / g.nw;
-    const Vector3d r = -g.R * g.u, rdot = -g.R * udot;
-    const Vector3d k = adot.cross(n0_);
-    const Vector3d t1dot = (k - g.t1 * g.t1.dot(k)) / g.nc1;
-    const Vector3d t2dot = n0_.cross(t1dot);
-    const Vector3d acc = af.linear() + af.angular().cross(r) + omega.cross(rdot);
+    const Vector3d rhs_const = -(n.dot(adot)) * g.a - g.na * adot;
+    Vector3d udot, ndot = Vector3d::Zero();
+    if (terrain_.flat()) {
+      udot = (rhs_const - g.u * g.u.dot(rhs_const)) / g.nw;
+    } else {
+      const Matrix3d P = (Matrix3d::Identity() - g.u * g.u.transpose()) / g.nw;
+      const Matrix3d QaN = (Matrix3d::Identity() - g.a * g.a.transpose()) * g.N;
+      const Matrix3d K = Matrix3d::Identity() + g.R * (P * QaN);
+      const Vector3d rhs = P * (QaN * (cdot - Rdot * g.u) + rhs_const);
+      udot = K.partialPivLu().solve(rhs);
+      ndot = g.N * (cdot - g.R * udot - Rdot * g.u);
+    }
+    const Vector3d r = -g.R * g.u, rdot = -g.R * udot - Rdot * g.u;
+    const Vector3d c1dot = adot.cross(n) + g.a.cross(ndot);
+    const Vector3d t1dot = (c1dot - g.t1 * g.t1.dot(c1dot)) / g.nc1;
+    const Vector3d t2dot = ndot.cross(g.t1) + n.cross(t1dot);
+    Vector3d acc = af.linear() + af.angular().cross(r) + omega.cross(rdot);
+    if (wh.radius_index >= 0) acc -= udot * Rdot;
     const Vector3d s = Aw_[i] * v_;
-    Vector3d d(t1dot.dot(s) + g.t1.dot(acc), t2dot.dot(s) + g.t2.dot(acc), n0_.dot(acc));
+    const Vector3d d(t1dot.dot(s) + g.t1.dot(acc), t2dot.dot(s) + g.t2.dot(acc), ndot.dot(s) + n.dot(acc));
     const int nd = static_cast<int>(wh.D.rows());
-    drift_.segment(row, nd) = wh.D * d;
+    drift_.segment(row, nd).noalias() = wh.D * d;
     return row + nd;
   }
 
@@ -344,25 +477,27 @@ class Evaluator {
     const Closure& c = closures_[i];
     const pin::SE3& M1 = data_.oMf[frames_[c.f1]];
     const pin::SE3& M2 = data_.oMf[frames_[c.f2]];
-    const Matrix3d& R1 = M1.rotation();
+    const Matrix3d R1T = M1.rotation().transpose();
     const Matrix6x& J1 = Jf_[c.f1];
     const Matrix6x& J2 = Jf_[c.f2];
-    Vector3d dp = M2.translation() - M1.translation();
-    // relative velocity in frame 1's axes: translation d/dt(R1^T dp), rotation R1^T (w2 - w1)
-    Eigen::Matrix<double, 6, Eigen::Dynamic> Jrel(6, nv_);
-    Jrel.topRows<3>() = R1.transpose() * (J2.topRows<3>() - J1.topRows<3>() + skew(dp) * J1.bottomRows<3>());
-    Jrel.bottomRows<3>() = R1.transpose() * (J2.bottomRows<3>() - J1.bottomRows<3>());
-    Vector3d e_pos = R1.transpose() * dp;
-    Vector3d e_rot = pin::log3(Matrix3d(R1.transpose() * M2.rotation()));
+    const Vector3d dp = M2.translation() - M1.translation();
+    Jrel_.resize(6, nv_);  // relative velocity in frame 1's axes (LoopClosure.jacobian)
+    K3_ = J2.topRows<3>() - J1.topRows<3>();
+    K3_.noalias() += skew(dp) * J1.bottomRows<3>();
+    Jrel_.topRows<3>().noalias() = R1T * K3_;
+    K3_ = J2.bottomRows<3>() - J1.bottomRows<3>();
+    Jrel_.bottomRows<3>().noalias() = R1T * K3_;
+    const Vector3d e_pos = R1T * dp;
+    const Vector3d e_rot = pin::log3(Matrix3d(R1T * M2.rotation()));
     for (size_t r = 0; r < c.select.size(); ++r) {
       const int s = c.select[r];
-      A_.row(row + r) = Jrel.row(s);
+      A_.row(row + r) = Jrel_.row(s);
       residual_[row + r] = s < 3 ? e_pos[s] : e_rot[s - 3];
     }
     return row + static_cast<int>(c.select.size());
   }
 
-  int closure_drift(size_t i, int row) {
+  int closure_drift(size_t i, int row) {  // LoopClosure.drift
     const Closure& c = closures_[i];
     const int f1 = frames_[c.f1], f2 = frames_[c.f2];
     const pin::Motion V1 = pin::getFrameVelocity(model_, data_, f1, pin::LOCAL_WORLD_ALIGNED);
@@ -385,36 +520,48 @@ class Evaluator {
     return row + static_cast<int>(c.select.size());
   }
 
-  VectorXd operational_drift() {
-    const int fid = frames_[op_frame_];
-    Vector3d lin, ang;
-    if (op_local_) {  // d/dt of the body-axes twist: the spatial acceleration at zero joint acceleration
-      const pin::Motion a = pin::getFrameAcceleration(model_, data_, fid, pin::LOCAL);
-      lin = a.linear();
-      ang = a.angular();
-    } else {
-      const pin::Motion a = pin::getFrameClassicalAcceleration(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
-      lin = a.linear();
-      ang = a.angular();
-    }
-    VectorXd out(op_select_.size());
-    for (size_t r = 0; r < op_select_.size(); ++r) out[r] = op_select_[r] < 3 ? lin[op_select_[r]] : ang[op_select_[r] - 3];
-    return out;
+  int coupling_rows(size_t i, int row) {  // JointCoupling.jacobian with a CosineLaw
+    const Coupling& c = couplings_[i];
+    const double arg = c.rate * q_[c.j] + c.phase;
+    A_(row, c.i) = 1.0;
+    A_(row, c.j) -= -c.amplitude * c.rate * std::sin(arg);
+    residual_[row] = q_[c.i] - (c.amplitude * std::cos(arg) + c.offset);
+    return row + 1;
   }
 
-  void project() {
+  int coupling_drift(size_t i, int row) {  // JointCoupling.drift: -f''(q_r) v_r^2
+    const Coupling& c = couplings_[i];
+    const double arg = c.rate * q_[c.j] + c.phase;
+    const double vr = v_[c.j];
+    drift_[row] = -(-c.amplitude * c.rate * c.rate * std::cos(arg)) * vr * vr;
+    return row + 1;
+  }
+
+  void operational_drift(VectorXd& out) {  // the last k entries: d/dt J_o at zero joint acceleration, times v
+    const int fid = frames_[op_frame_];
+    const pin::Motion a = op_local_ ? pin::getFrameAcceleration(model_, data_, fid, pin::LOCAL)
+                                    : pin::getFrameClassicalAcceleration(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
+    const int base = static_cast<int>(rows_.size());
+    for (size_t r = 0; r < op_select_.size(); ++r) {
+      const int s = op_select_[r];
+      out[base + r] = s < 3 ? a.linear()[s] : a.angular()[s - 3];
+    }
+  }
+
+  void project() {  // projection.py _build / operational_space.py project_operational, with the given rows
     const double scale = std::max(1.0, A_.size() ? A_.cwiseAbs().maxCoeff() : 0.0);
     if (operational_) {
       const int k = static_cast<int>(op_select_.size());
-      if (static_cast<int>(rows_.size()) + k != nv_) throw Fallback("operational rows do not match");
-      MatrixXd K(nv_, nv_);
-      for (size_t r = 0; r < rows_.size(); ++r) K.row(r) = A_.row(rows_[r]);
-      Matrix6x Jo = Matrix6x::Zero(6, nv_);
-      pin::getFrameJacobian(model_, data_, frames_[op_frame_], op_local_ ? pin::LOCAL : pin::LOCAL_WORLD_ALIGNED, Jo);
-      for (int r = 0; r < k; ++r) K.row(rows_.size() + r) = Jo.row(op_select_[r]);
-      Eigen::PartialPivLU<MatrixXd> lu(K);
-      Kinv_ = lu.inverse();
-      cond_ = K.cwiseAbs().colwise().sum().maxCoeff() * Kinv_.cwiseAbs().colwise().sum().maxCoeff();
+      const int nr = static_cast<int>(rows_.size());
+      if (nr + k != nv_) throw Fallback("operational rows do not match");
+      K_.resize(nv_, nv_);
+      for (int r = 0; r < nr; ++r) K_.row(r) = A_.row(rows_[r]);
+      Jc_.setZero(6, nv_);
+      pin::getFrameJacobian(model_, data_, frames_[op_frame_], op_local_ ? pin::LOCAL : pin::LOCAL_WORLD_ALIGNED, Jc_);
+      for (int r = 0; r < k; ++r) K_.row(nr + r) = Jc_.row(op_select_[r]);
+      lu_.compute(K_);
+      Kinv_ = lu_.inverse();
+      cond_ = K_.cwiseAbs().colwise().sum().maxCoeff() * Kinv_.cwiseAbs().colwise().sum().maxCoeff();
       if (!std::isfinite(cond_) || cond_ > 1e10) throw Fallback("singular");
       S_ = Kinv_.rightCols(k);
       Adinv_ = Kinv_;
@@ -428,19 +575,23 @@ class Evaluator {
         Adinv_.resize(0, 0);
         return;
       }
-      MatrixXd Ad(nd, nd), Ai(nd, k);
+      Ad_.resize(nd, nd);
+      Ai_.resize(nd, k);
       for (int r = 0; r < nd; ++r) {
-        for (int c = 0; c < nd; ++c) Ad(r, c) = A_(rows_[r], dependent_[c]);
-        for (int c = 0; c < k; ++c) Ai(r, c) = A_(rows_[r], independent_[c]);
+        for (int c = 0; c < nd; ++c) Ad_(r, c) = A_(rows_[r], dependent_[c]);
+        for (int c = 0; c < k; ++c) Ai_(r, c) = A_(rows_[r], independent_[c]);
       }
-      Eigen::PartialPivLU<MatrixXd> lu(Ad);
-      Adinv_ = lu.inverse();
-      cond_ = Ad.cwiseAbs().colwise().sum().maxCoeff() * Adinv_.cwiseAbs().colwise().sum().maxCoeff();
+      lu_.compute(Ad_);
+      Adinv_ = lu_.inverse();
+      cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * Adinv_.cwiseAbs().colwise().sum().maxCoeff();
       if (!std::isfinite(cond_) || cond_ > 1e10) throw Fallback("singular");
-      MatrixXd Sd = -(Adinv_ * Ai);
-      for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = Sd.row(r);
+      Sd_.noalias() = -Adinv_ * Ai_;
+      for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = Sd_.row(r);
     }
-    if (A_.size() && (A_ * S_).cwiseAbs().maxCoeff() > 1e-10 * scale) throw Fallback("row choice no longer spans");
+    if (A_.size()) {
+      AS_.noalias() = A_ * S_;
+      if (AS_.cwiseAbs().maxCoeff() > 1e-10 * scale) throw Fallback("row choice no longer spans");
+    }
   }
 
   void pull_back(double alpha, VectorXd& out) {
@@ -469,21 +620,27 @@ class Evaluator {
   std::vector<int> frames_;
   std::vector<Wheel> wheels_;
   std::vector<Closure> closures_;
-  std::vector<std::pair<int, int>> order_;  // (0: wheel, 1: closure; index), in row order
+  std::vector<Coupling> couplings_;
+  std::vector<std::pair<int, int>> order_;  // (0: wheel, 1: closure, 2: coupling; index), in row order
   std::vector<Motor> motors_;
   std::vector<bool> holonomic_;
-  Vector3d n0_{0.0, 0.0, 1.0}, height_row_{0.0, 0.0, 1.0};
-  double h_ = 0.0, slope_norm_ = 1.0;
+  Terrain terrain_;
   std::vector<int> rows_, independent_, dependent_, op_select_;
   int op_frame_ = -1;
-  bool op_local_ = true, operational_ = false;
-  // state
-  VectorXd q_, v_, w_, residual_, drift_, g_, gr_, hr_;
-  MatrixXd A_, S_, B_, Br_, M_, Mr_, Adinv_, Kinv_;
+  bool op_local_ = true, operational_ = false, selected_ = false;
+  // state and work buffers (sized on first use, then reused)
+  VectorXd q_, v_, w_, zero_, residual_, drift_, gr_, hr_, rhs_, wd_, force_;
+  MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
+  Matrix6x Jc_;
+  Eigen::PartialPivLU<MatrixXd> lu_;
+  Eigen::LLT<MatrixXd> llt_;
   double cond_ = 1.0;
   std::vector<Geometry> geo_;
   std::vector<Matrix6x> Jf_;
   std::vector<MatrixXd> Aw_;
+  const double* buffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  long generation_ = 0;
 };
 
 }  // namespace
@@ -495,7 +652,8 @@ PYBIND11_MODULE(_compiled, m) {
       .def(py::init<const std::vector<std::string>&, const std::vector<int>&, const std::vector<MatrixXd>&,
                     const std::vector<Vector3d>&, const std::vector<VectorXd>&, const Vector3d&>())
       .def("add_frame", &Evaluator::add_frame)
-      .def("set_plane", &Evaluator::set_plane)
+      .def("set_terrain", &Evaluator::set_terrain)
+      .def("add_coupling", &Evaluator::add_coupling)
       .def("add_wheel", &Evaluator::add_wheel)
       .def("add_closure", &Evaluator::add_closure)
       .def("add_motor", &Evaluator::add_motor)

@@ -2,7 +2,8 @@
 
 :func:`evaluate` returns stacked arrays, ``M`` (N, k, k), ``h`` (N, k), ``g`` (N, k), ``B`` (N, k, m) and ``S``
 (N, n, k), for N states, optionally spread over worker processes (one robot copy per process, inherited by
-fork). A state where the constraints are singular raises :class:`~robotdyn.errors.SingularConstraintError`
+fork): by the robot's compiled model (:mod:`robotdyn.compiled`) where it serves the robot, else vectorised in
+numpy (wheels on a plane and loop closures) or one by one. A state where the constraints are singular raises :class:`~robotdyn.errors.SingularConstraintError`
 naming its index.
 """
 
@@ -17,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from .actuation import input_matrix
+from .compiled import compiled_model
 from .constraint import LWA, KinematicState
 from .errors import RobotDynError, SingularConstraintError
 from .projection import MAX_CONDITION, project
@@ -182,7 +184,22 @@ def _reduced_named(robot, q: np.ndarray, nu: np.ndarray, index: int):
         raise SingularConstraintError(f"state {index}: {exc}", exc.condition) from None
 
 
+def _evaluate_compiled(robot, fast, Q: np.ndarray, NU: np.ndarray, offset: int) -> tuple[np.ndarray, ...]:
+    """All states in one call of the robot's compiled model (:mod:`robotdyn.compiled`); states where its row
+    choice does not apply are evaluated one by one by :meth:`Robot.reduced`."""
+    if not fast.ready:  # the Python path chooses the projection's rows at the first state
+        _reduced_named(robot, Q[0], NU[0], offset)
+    M, h, g, S, _, B, failed = fast.evaluate_many(Q, NU)
+    for i in failed:
+        red = _reduced_named(robot, Q[i], NU[i], offset + i)
+        M[i], h[i], g[i], B[i], S[i] = red.M, red.h, red.g, red.B, red.S
+    return M, h, g, B, S
+
+
 def _evaluate_chunk(robot, Q: np.ndarray, NU: np.ndarray, offset: int) -> tuple[np.ndarray, ...]:
+    fast = compiled_model(robot)
+    if len(Q) and fast is not None:
+        return _evaluate_compiled(robot, fast, Q, NU, offset)
     if len(Q) and _vectorisable(robot):
         return _evaluate_vectorised(robot, Q, NU, offset)
     return _evaluate_loop(robot, Q, NU, offset)

@@ -7,8 +7,9 @@
 the robot's Pinocchio model rebuilt joint by joint and checked against it when built (M, g and RNEA at a random
 state). Pinocchio's own C++ algorithms do the rigid-body work; only the Python call overhead is saved.
 
-It serves robots whose constraints are rolling wheels (standard, omni, support) on a plane without radius joints
-and loop closures, with independent velocities that are a selection of v or a frame twist
+It serves robots whose constraints are rolling wheels (standard, omni, support; with or without a radius joint) on
+a plane, a sine or a bump terrain of :mod:`robotdyn.terrain`, loop closures and joint couplings with a
+:class:`~robotdyn.joint_coupling.CosineLaw`, with independent velocities that are a selection of v or a frame twist
 (:class:`~robotdyn.operational_space.OperationalVelocities`); :func:`why_not` names what keeps another robot on
 the Python path. The row choice of the projection is the Python path's (its last projection); where that choice
 stops working (a singular block, rows that no longer span, a wheel lying flat) the evaluation falls back to the
@@ -25,11 +26,12 @@ from contextlib import contextmanager
 import numpy as np
 
 from .constraint import ConstraintRows, KinematicState
+from .joint_coupling import CosineLaw, JointCoupling
 from .loop_closure import LoopClosure
 from .loop_closure import groupable as groupable_loop
 from .projection import Projection
 from .rolling_contact import RollingWheel
-from .terrain import RampTerrain
+from .terrain import BumpTerrain, RampTerrain, SineTerrain
 from .wheel_group import groupable as groupable_wheel
 
 try:
@@ -69,6 +71,18 @@ def use_compiled(flag: bool):
         _ENABLED = old
 
 
+def _terrain_code(terrain) -> tuple[int, list[float]] | None:
+    """The C++ code of a terrain of :mod:`robotdyn.terrain` (``None``: not compiled, e.g. a user function)."""
+    if isinstance(terrain, RampTerrain):
+        grad = terrain.gradient(0.0, 0.0)
+        return 0, [terrain.h, float(grad[0]), float(grad[1])]
+    if type(terrain) is SineTerrain:
+        return 1, [terrain.a, terrain.kx, terrain.ky, terrain.phase]
+    if type(terrain) is BumpTerrain:
+        return 2, [terrain.h, terrain.x0, terrain.w, float("nan") if terrain.length is None else terrain.length]
+    return None
+
+
 def why_not(robot) -> str | None:
     """Why ``robot`` cannot use the compiled path (``None``: it can)."""
     if _compiled is None:
@@ -77,17 +91,18 @@ def why_not(robot) -> str | None:
         kind = robot.model.joints[i].shortname().replace("JointModel", "")
         if kind not in _KINDS:
             return f"joint {robot.model.names[i]!r} of type {kind} is not compiled"
-    planes = set()
+    terrains = set()
     for c in robot.constraints:
         if isinstance(c, RollingWheel) and groupable_wheel(c):
-            if c.radius_index is not None:
-                return f"wheel {c.name!r} has a radius joint"
-            if not (isinstance(c.terrain, RampTerrain) and c.terrain.is_flat):
-                return f"wheel {c.name!r} rolls on {c.terrain!r}, not a plane"
-            planes.add(id(c.terrain))
+            if _terrain_code(c.terrain) is None:
+                return f"wheel {c.name!r} rolls on {c.terrain!r}, whose formulas are not compiled"
+            terrains.add(id(c.terrain))
+        elif isinstance(c, JointCoupling) and type(c).rows is JointCoupling.rows:
+            if not (isinstance(c.law, CosineLaw) and c.dlaw == c.law.d and c.ddlaw == c.law.dd):
+                return f"coupling {c.name!r} has a law other than a CosineLaw"
         elif not (isinstance(c, LoopClosure) and groupable_loop(c)):
             return f"constraint {c!r} is not compiled"
-    if len(planes) > 1:
+    if len(terrains) > 1:
         return "the wheels roll on different terrains"
     op = getattr(robot, "operational", None)
     if op is not None and not hasattr(op, "twist"):
@@ -133,17 +148,16 @@ class CompiledModel:
                 frames[fid] = ev.add_frame(int(f.parentJoint), _placement(f.placement))
             return frames[fid]
 
-        terrain = None
         for c in self.constraints:
             if isinstance(c, RollingWheel):
-                terrain = c.terrain
-                ev.add_wheel(frame(c.fid), np.asarray(c.axis, float), float(c.radius), np.asarray(c._directions, float))
+                ev.set_terrain(*_terrain_code(c.terrain))
+                ev.add_wheel(frame(c.fid), np.asarray(c.axis, float), float(c.radius),
+                             -1 if c.radius_index is None else int(c.radius_index), np.asarray(c._directions, float))
+            elif isinstance(c, JointCoupling):
+                law = c.law
+                ev.add_coupling(int(c.i), int(c.j), law.amplitude, law.rate, law.phase, law.offset)
             else:
                 ev.add_closure(frame(c.f1), frame(c.f2), [int(s) for s in c._sel])
-        if terrain is not None:
-            grad = terrain.gradient(0.0, 0.0)
-            ev.set_plane(terrain.normal(0.0, 0.0), np.array([-grad[0], -grad[1], 1.0]), float(terrain.h),
-                         float(np.sqrt(1.0 + grad @ grad)))
         for m in robot.motors:
             ev.add_motor(int(m.index), int(m.jid), -1 if m.rid is None else frame(m.rid))
         self.operational = getattr(robot, "operational", None)
@@ -155,6 +169,7 @@ class CompiledModel:
         self.labels, self.holonomic = rows.labels, rows.holonomic
         self._check_model()
         self._hint = None
+        self._compute, self._generation, self._views = ev.compute, -1, None
 
     def __repr__(self) -> str:
         return f"CompiledModel({self.robot.spec.name!r}, nv={self.ev.nv}, rows={self.ev.nrows})"
@@ -201,6 +216,20 @@ class CompiledModel:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
         """
         return self.ev.evaluate(q, nu)
+
+    def compute(self, q: np.ndarray, nu: np.ndarray) -> tuple:
+        """``(M_r, h, g_r, B_r, S, w, v)`` at (q, nu) without copies: read-only views of the evaluator's buffers,
+        overwritten by the next call (copy what must be kept). The cheapest evaluation, e.g. inside an integrator.
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        generation = self._compute(q, nu)
+        if generation != self._generation:
+            ev = self.ev
+            self._views = (ev.M, ev.h, ev.g, ev.B, ev.S, ev.w, ev.v)
+            self._generation = generation
+        return self._views
 
     def reduced(self, q: np.ndarray, nu: np.ndarray, independent: np.ndarray | None = None):
         """The :class:`~robotdyn.reduced_dynamics.ReducedDynamics` at (q, nu), or ``None`` where the Python path

@@ -14,7 +14,9 @@ The law and its first two derivatives are supplied by the caller (they are not d
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -24,6 +26,33 @@ from .errors import DescriptionError
 Law = Callable[[float], float]
 
 
+@dataclass(frozen=True)
+class CosineLaw:
+    """The law :math:`f(q) = a\\cos(b q + c) + d` with its exact derivatives (a law given as data, which the compiled
+    path of :mod:`robotdyn.compiled` evaluates too; any other callable keeps a robot on the Python path).
+
+    Attributes:
+        amplitude: a [unit of the driven joint]; rate: b [1/unit of the driver]; phase: c [rad];
+        offset: d [unit of the driven joint].
+    """
+
+    amplitude: float
+    rate: float
+    phase: float = 0.0
+    offset: float = 0.0
+
+    def __call__(self, q: float) -> float:
+        return self.amplitude * math.cos(self.rate * q + self.phase) + self.offset
+
+    def d(self, q: float) -> float:
+        """:math:`f'(q) = -ab\\sin(bq + c)`."""
+        return -self.amplitude * self.rate * math.sin(self.rate * q + self.phase)
+
+    def dd(self, q: float) -> float:
+        """:math:`f''(q) = -ab^2\\cos(bq + c)`."""
+        return -self.amplitude * self.rate * self.rate * math.cos(self.rate * q + self.phase)
+
+
 class JointCoupling(Constraint):
     """The holonomic constraint :math:`q_{\\text{driven}} = f(q_{\\text{driver}})` (one row).
 
@@ -31,13 +60,18 @@ class JointCoupling(Constraint):
         description: The robot's :class:`~robotdyn.description.Description`.
         driven: Joint whose coordinate is set by the law (:math:`q_d`).
         driver: Joint whose coordinate is the law's argument (:math:`q_r`).
-        law: :math:`f`; ``dlaw``: :math:`f'`; ``ddlaw``: :math:`f''` (callables of a float).
+        law: :math:`f`; ``dlaw``: :math:`f'`; ``ddlaw``: :math:`f''` (callables of a float; for a
+            :class:`CosineLaw` the derivatives default to its own).
         name: Name used in the row label (default ``"driven=f(driver)"``).
     """
 
     def __init__(
-        self, description, driven: str, driver: str, law: Law, dlaw: Law, ddlaw: Law, name: str | None = None
+        self, description, driven: str, driver: str, law: Law, dlaw: Law | None = None, ddlaw: Law | None = None,
+        name: str | None = None,
     ) -> None:
+        if isinstance(law, CosineLaw):
+            dlaw = law.d if dlaw is None else dlaw
+            ddlaw = law.dd if ddlaw is None else ddlaw
         if driven == driver:
             raise DescriptionError(f"joint coupling: driven and driver are both {driven!r}; expected two joints")
         for f, what in ((law, "law"), (dlaw, "dlaw"), (ddlaw, "ddlaw")):

@@ -99,6 +99,20 @@ def test_coupling_enforces_eq1(robot):
     np.testing.assert_allclose(c.solve_driven(q)[i], 0.3 * np.cos(0.5) * np.cos(np.pi / 6), atol=1e-15)
 
 
+def test_coupling_law_is_eq1_and_eq33(robot):
+    """The coupling's law (a CosineLaw, so the compiled path can evaluate it) is eq 1 and its derivatives eq 33
+    (and the second derivative) as transcribed in radius_law*, and f' and f'' agree with finite differences."""
+    w = robot.params["w"]
+    c = next(c for c in robot.constraints if c.name == "eq1_fr")
+    for q in np.linspace(0.0, np.pi, 7):
+        assert c.law(q) == pytest.approx(aw.radius_law(q, w), abs=1e-15)
+        assert c.dlaw(q) == pytest.approx(aw.radius_law_d(q, w), abs=1e-15)
+        assert c.ddlaw(q) == pytest.approx(aw.radius_law_dd(q, w), abs=1e-15)
+        h = 1e-5
+        assert c.dlaw(q) == pytest.approx((c.law(q + h) - c.law(q - h)) / (2 * h), abs=1e-9)
+        assert c.ddlaw(q) == pytest.approx((c.dlaw(q + h) - c.dlaw(q - h)) / (2 * h), abs=1e-9)
+
+
 def _fd_drift(robot, q, v, h=1e-5):
     """d/dt [A(q + t v) v] at t = 0 by central differences (a = 0, q' = v)."""
     def Av(s):

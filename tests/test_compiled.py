@@ -751,3 +751,29 @@ def test_simulate_energy_conserved_operational():
     assert spy.served == spy.calls > 0
     assert np.abs(traj.energy - traj.energy[0]).max() / abs(traj.energy[0]) < 1e-8
     assert np.ptp(traj.q[:, 0]) > 0.1
+
+
+def test_simulate_linkage_equals_python(linkage, monkeypatch):
+    """The linkage's straight_line scenario (motors tracking a speed profile, loop closures, stabilised residuals)
+    over 0.5 s: the compiled right-hand side gives the Python path's trajectory."""
+    from robotdyn.robots.linkage_suspension import SCENARIOS
+
+    scenario = SCENARIOS["straight_line"]
+    calls = []
+    inner = compiled.CompiledModel.rhs
+
+    def rhs(self, *args):  # the scenario may set its terrain, so a new compiled model serves the run
+        out = inner(self, *args)
+        calls.append(self)
+        return out
+
+    monkeypatch.setattr(compiled.CompiledModel, "rhs", rhs)
+    got = scenario.run(linkage, t_end=0.5, progress=False)
+    assert len(calls) >= 0.9 * got.stats["nfev"] > 50  # all but the first evaluations (which choose the rows)
+    monkeypatch.undo()
+    with use_compiled(False):
+        ref = scenario.run(linkage, t_end=0.5, progress=False)
+    assert np.ptp(ref.q[:, 0]) > 1e-3  # it drives
+    assert np.abs(got.q - ref.q).max() <= 1e-8
+    assert np.abs(got.nu - ref.nu).max() <= 1e-8
+    assert 0.5 * ref.stats["nfev"] <= got.stats["nfev"] <= 2.0 * ref.stats["nfev"]

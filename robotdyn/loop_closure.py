@@ -15,7 +15,6 @@ All rows are holonomic.
 
 from __future__ import annotations
 
-import copy
 
 import numpy as np
 import pinocchio as pin
@@ -142,18 +141,6 @@ class LoopGroup:
     def current(self) -> bool:
         """Whether the closures still select the components this group was built with."""
         return all(c._sel is sel for c, sel in zip(self.closures, self._built))
-
-    def tile(self, count: int) -> LoopGroup:
-        """The group repeated ``count`` times (the same closures at ``count`` states, stacked state by state)."""
-        m = len(self.closures)
-        out = copy.copy(self)
-        out.closures = self.closures * count
-        out.f1, out.f2 = self.f1 * count, self.f2 * count
-        out.keep = (self.keep[None, :] + 6 * m * np.arange(count)[:, None]).reshape(-1)
-        out.labels = self.labels * count
-        out.holonomic = np.ones(out.keep.size, bool)
-        out.rotational = [i + m * j for j in range(count) for i in self.rotational]
-        return out
 
     def _frames(self, kin: KinematicState) -> tuple:
         m, nv = len(self.closures), kin.model.nv

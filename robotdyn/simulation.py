@@ -4,7 +4,8 @@ State: natural coordinates q (n) and independent velocities nu (k). The ODE is
 
 .. math:: \\dot q = S(q)\\nu - \\alpha\\, A_h^+ \\phi(q),\\qquad M_r \\dot\\nu = B_r \\tau(t, q, \\nu) - C_r\\nu - g_r,
 
-integrated with scipy's ``solve_ivp``. Velocity constraints hold exactly (v = S nu by construction); the
+integrated with scipy's ``solve_ivp``; the right-hand side is one call of the robot's compiled model
+(:mod:`robotdyn.compiled`) where it serves the robot, else the Python path. Velocity constraints hold exactly (v = S nu by construction); the
 position residuals :math:`\\phi` of holonomic rows (loop closures, contacts on a sloped or curved terrain) are
 pulled back with the stabilisation gain :math:`\\alpha` [1/s] (0 disables it) and reported.
 """
@@ -116,7 +117,7 @@ def simulate(
     q0 = robot.check_q(q0)
     nu0 = robot.check_nu(nu0)
     robot.check_constraints(q0)
-    n, k = robot.nq, robot.mobility
+    n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
     report = _Progress(t_end, progress)
 

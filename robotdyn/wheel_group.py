@@ -9,7 +9,6 @@ constraint set (:class:`robotdyn.reduced_dynamics.ConstraintSet`) and the batch 
 
 from __future__ import annotations
 
-import copy
 import math
 
 import numpy as np
@@ -46,9 +45,9 @@ class WheelGroup:
     for the whole group instead of ~80 per wheel. On a plane (``terrain.is_flat``, a
     :class:`~robotdyn.terrain.RampTerrain`) without radius joints the 3-vector geometry and drift of one state are
     computed wheel by wheel in Python floats (cheaper than numpy calls on 3-vectors) and only the (3, nv) rows
-    in numpy; with radius joints, and for many states at once (:meth:`tile`, the batch API), the same formulas
-    run vectorised over wheels; on other terrains the contact point of each wheel is found by
-    :meth:`RollingWheel._geometry` (an iteration on the terrain) and the rest is vectorised.
+    in numpy; with radius joints the same formulas run vectorised over wheels; on other terrains the contact
+    point of each wheel is found by :meth:`RollingWheel._geometry` (an iteration on the terrain) and the rest is
+    vectorised.
 
     Args:
         wheels: The wheels (instances for which :func:`groupable` holds).
@@ -109,25 +108,6 @@ class WheelGroup:
             w.terrain is t and w.radius == r and w.axis is ax and w._directions is D
             for w, (t, r, ax, D) in zip(self.wheels, self._built)
         )
-
-    def tile(self, count: int) -> WheelGroup:
-        """The group repeated ``count`` times (the same wheels at ``count`` states, stacked state by state), for
-        evaluations vectorised over states; only for a plane group without radius joints."""
-        if not self.plane or self.radial.size:
-            raise ValueError("only wheel groups on a plane without radius joints can be tiled")
-        m = len(self.wheels)
-        out = copy.copy(self)
-        out.wheels = self.wheels * count
-        out.fids = self.fids * count
-        out.axis = np.tile(self.axis, (count, 1))
-        out.R0 = np.tile(self.R0, (count, 1))
-        out.n = np.tile(self.n0, (count * m, 1))
-        out.Dpad = np.tile(self.Dpad, (count, 1, 1))
-        out.keep = (self.keep[None, :] + 3 * m * np.arange(count)[:, None]).reshape(-1)
-        out.row_wheel = out.keep // 3
-        out.holonomic = np.tile(self.holonomic, count)
-        out.labels = self.labels * count
-        return out
 
     def _geometry(self, kin: KinematicState) -> dict:
         """Configuration-level geometry of all wheels (cached in ``kin.geometry``)."""

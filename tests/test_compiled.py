@@ -608,7 +608,7 @@ def test_fallback_bad_row_choice(robot):
         if bad is not None:
             break
     if bad is None:
-        pytest.skip(f"every row choice is regular at this state of {robot.spec.name}")
+        pytest.skip(f"no singular row choice of this size at this state of {robot.spec.name} (e.g. every row is used)")
     if operational:
         from robotdyn.operational_space import OperationalProjection
 

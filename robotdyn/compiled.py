@@ -196,6 +196,15 @@ class CompiledModel:
         """Whether a projection was chosen (by the Python path's first evaluation), so :meth:`rhs` can run."""
         return self._hint is not None
 
+    def _choose(self, q: np.ndarray, nu: np.ndarray) -> None:
+        """Let the Python path choose the projection's rows at (q, nu) (it raises its usual errors there)."""
+        from .reduced_dynamics import reduce
+
+        with use_compiled(False):
+            out = reduce(self.robot, np.asarray(q, float), np.asarray(nu, float)) if self.operational is None else \
+                self.operational.reduce(self.robot, q, nu)
+        self.select(out.projection)
+
     def select(self, proj) -> None:
         """Use the row choice (and independent velocities) of a Python projection from now on."""
         if proj is self._hint:
@@ -215,6 +224,8 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
         """
+        if self._hint is None:
+            self._choose(q, nu)
         return self.ev.evaluate(q, nu)
 
     def compute(self, q: np.ndarray, nu: np.ndarray) -> tuple:
@@ -224,6 +235,8 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        if self._hint is None:
+            self._choose(q, nu)
         generation = self._compute(q, nu)
         if generation != self._generation:
             ev = self.ev
@@ -263,6 +276,8 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        if self._hint is None:
+            self._choose(q, nu)
         return self.ev.rhs(q, nu, tau, stabilisation)
 
     def evaluate_many(self, Q: np.ndarray, NU: np.ndarray) -> tuple:

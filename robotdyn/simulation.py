@@ -126,7 +126,7 @@ def simulate(
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         q, nu = y[:n], y[n:]
         tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
-        if fast is not None and fast.ready:
+        if fast is not None:
             try:  # the whole right-hand side in one compiled call (robotdyn.compiled)
                 out = fast.rhs(q, nu, tau, stabilisation)
                 report(t)

@@ -8,7 +8,9 @@
 //   projection                  robotdyn/projection.py (_build: S = P [I; -Ad^-1 Ai], w = -Ad^-1 drift)
 //   operational velocities      robotdyn/operational_space.py (K = [A_r; J_o], K S = [0; I])
 //   motors                      robotdyn/actuation.py
-//   dynamics                    robotdyn/reduced_dynamics.py (M_r = S^T M S, h = S^T RNEA(q, S nu, w))
+//   dynamics                    robotdyn/reduced_dynamics.py (M_r = S^T M S, h = S^T RNEA(q, S nu, w), here
+//                               S^T (C v + g + M w): two Pinocchio passes per state, CRBA (M, g from its
+//                               composite inertias) and RNEA without gravity (C v, and the drift's accelerations))
 // The rigid-body algorithms are Pinocchio's (header-only use of the installed Pinocchio 4), on a copy of the
 // robot's Pinocchio model rebuilt joint by joint; tests/test_compiled.py checks every output against the Python
 // path on every robot.
@@ -157,7 +159,8 @@ class Evaluator {
       I << in[4], in[5], in[6], in[5], in[7], in[8], in[6], in[8], in[9];
       model_.appendBodyToJoint(id, pin::Inertia(in[0], Vector3d(in[1], in[2], in[3]), I), pin::SE3::Identity());
     }
-    model_.gravity.linear(gravity);
+    gravity_ = pin::Motion(gravity, Vector3d::Zero());
+    model_.gravity.setZero();  // gravity enters through g_ (see configure), so RNEA gives C v alone
     nv_ = model_.nv;
     data_ = pin::Data(model_);
     zero_.setZero(nv_);
@@ -221,10 +224,12 @@ class Evaluator {
 
   // The full-coordinate model at q (for the self-check against the Python model): M, g and RNEA(q, v, a).
   py::tuple full(const VectorXd& q, const VectorXd& v, const VectorXd& a) {
+    model_.gravity = gravity_;
     MatrixXd M = pin::crba(model_, data_, q);
     M.triangularView<Eigen::StrictlyLower>() = M.transpose().triangularView<Eigen::StrictlyLower>();
     VectorXd g = pin::computeGeneralizedGravity(model_, data_, q);
     VectorXd tau = pin::rnea(model_, data_, q, v, a);
+    model_.gravity.setZero();
     return py::make_tuple(M, g, tau);
   }
 
@@ -234,7 +239,15 @@ class Evaluator {
     if (!selected_) throw Fallback("no projection chosen yet");
     if (q.size() != nv_) throw std::invalid_argument("q has the wrong length");
     q_ = q;
-    pin::computeJointJacobians(model_, data_, q_);
+    // one pass: placements, world joint Jacobians, M (upper triangle) and the subtrees' composite inertias, from
+    // which g_k = -J_k^T (Y_subtree(k) * gravity): the torque that holds the subtree's weight
+    pin::crba(model_, data_, q_, pin::Convention::WORLD);
+    g_.resize(nv_);
+    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) {
+      const int col = model_.joints[i].idx_v();
+      const pin::Force weight = data_.oYcrb[i] * gravity_;
+      g_[col] = -(data_.J.col(col).head<3>().dot(weight.linear()) + data_.J.col(col).tail<3>().dot(weight.angular()));
+    }
     pin::updateFramePlacements(model_, data_);
     const int m = nrows();
     A_.setZero(m, nv_);
@@ -270,7 +283,10 @@ class Evaluator {
   void dynamics(const Eigen::Ref<const VectorXd>& nu) {
     if (nu.size() != S_.cols()) throw std::invalid_argument("nu has the wrong length");
     v_.noalias() = S_ * nu;
-    pin::forwardKinematics(model_, data_, q_, v_, zero_);
+    // one pass: RNEA(q, v, 0) without gravity = C v, whose forward sweep leaves the joint velocities and their
+    // accelerations at zero joint acceleration (for the drift terms); RNEA(q, v, w) = C v + g + M w
+    pin::rnea(model_, data_, q_, v_, zero_);
+    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) data_.a[i] = data_.a_gf[i];
     drift_.setZero(nrows());
     int row = 0;
     for (const auto& [kind, i] : order_)
@@ -288,13 +304,12 @@ class Evaluator {
       wd_.noalias() = -Adinv_ * rhs_;
       for (int r = 0; r < nr; ++r) w_[dependent_[r]] = wd_[r];
     }
-    pin::crba(model_, data_, q_);
     SM_.noalias() = data_.M.selfadjointView<Eigen::Upper>() * S_;
     Mr_.noalias() = S_.transpose() * SM_;
-    pin::computeGeneralizedGravity(model_, data_, q_);
-    gr_.noalias() = S_.transpose() * data_.g;
-    pin::rnea(model_, data_, q_, v_, w_);
+    gr_.noalias() = S_.transpose() * g_;
+    data_.tau += g_;
     hr_.noalias() = S_.transpose() * data_.tau;
+    hr_.noalias() += SM_.transpose() * w_;
     Br_.noalias() = S_.transpose() * B_;
   }
 
@@ -625,11 +640,12 @@ class Evaluator {
   std::vector<Motor> motors_;
   std::vector<bool> holonomic_;
   Terrain terrain_;
+  pin::Motion gravity_;  // the model's gravity (the Pinocchio model itself has none, see the constructor)
   std::vector<int> rows_, independent_, dependent_, op_select_;
   int op_frame_ = -1;
   bool op_local_ = true, operational_ = false, selected_ = false;
   // state and work buffers (sized on first use, then reused)
-  VectorXd q_, v_, w_, zero_, residual_, drift_, gr_, hr_, rhs_, wd_, force_;
+  VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_;
   MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
   Matrix6x Jc_;

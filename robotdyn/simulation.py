@@ -153,13 +153,26 @@ def simulate(
     energy = np.empty(len(sol.t))
     residual = np.zeros(len(sol.t))
     for i in range(len(sol.t)):
-        v, rows = velocity(robot, q[i], nu[i])  # the reduced model's v and rows, without its dynamics
+        v, res, holonomic = _velocity(robot, fast, q[i], nu[i])
         energy[i] = robot.energy(q[i], v)
-        if rows.holonomic.any():
-            residual[i] = np.max(np.abs(rows.residual[rows.holonomic]))
+        if holonomic.any():
+            residual[i] = np.max(np.abs(res[holonomic]))
     stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol}
     return Trajectory(sol.t, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
                       robot.units)
+
+
+def _velocity(robot, fast, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """v = S nu, the constraint residuals and which rows are holonomic: from the compiled model when it serves
+    the robot, else from the Python path's kinematics (without dynamics)."""
+    if fast is not None:
+        try:
+            out = fast.evaluate(q, nu)
+            return out[6], out[8], fast.holonomic
+        except Fallback:
+            pass
+    v, rows = velocity(robot, q, nu)
+    return v, rows.residual, rows.holonomic
 
 
 def power(robot, traj: Trajectory, torque: TorqueFunction | None) -> np.ndarray:

@@ -27,6 +27,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -301,22 +302,25 @@ class Evaluator {
     } else if (nr) {
       rhs_.resize(nr);
       for (int r = 0; r < nr; ++r) rhs_[r] = drift_[rows_[r]];
-      wd_.noalias() = -Adinv_ * rhs_;
+      wd_ = lu_.solve(rhs_);
+      wd_ = -wd_;
       for (int r = 0; r < nr; ++r) w_[dependent_[r]] = wd_[r];
     }
-    SM_.noalias() = data_.M.selfadjointView<Eigen::Upper>() * S_;
-    Mr_.noalias() = S_.transpose() * SM_;
+    data_.M.triangularView<Eigen::StrictlyLower>() = data_.M.transpose().triangularView<Eigen::StrictlyLower>();
+    SM_.noalias() = data_.M.lazyProduct(S_);
+    Mr_.noalias() = S_.transpose().lazyProduct(SM_);
     gr_.noalias() = S_.transpose() * g_;
     data_.tau += g_;
     hr_.noalias() = S_.transpose() * data_.tau;
     hr_.noalias() += SM_.transpose() * w_;
-    Br_.noalias() = S_.transpose() * B_;
+    Br_.noalias() = S_.transpose().lazyProduct(B_);
   }
 
   py::tuple evaluate(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
     configure(q);
     dynamics(nu);
-    return py::make_tuple(Mr_, hr_, gr_, Br_, S_, w_, v_, A_, residual_, cond_, Adinv_);
+    if (operational_) return py::make_tuple(Mr_, hr_, gr_, Br_, S_, w_, v_, A_, residual_, cond_, Kinv_);
+    return py::make_tuple(Mr_, hr_, gr_, Br_, S_, w_, v_, A_, residual_, py::none(), py::none());
   }
 
   // The same without copies: the results stay in buffers read through the views M, h, g, B, S, w, v. Returns a
@@ -577,7 +581,7 @@ class Evaluator {
       lu_.compute(K_);
       Kinv_ = lu_.inverse();
       cond_ = K_.cwiseAbs().colwise().sum().maxCoeff() * Kinv_.cwiseAbs().colwise().sum().maxCoeff();
-      if (!std::isfinite(cond_) || cond_ > 1e10) throw Fallback("singular");
+      if (!(std::isfinite(cond_) && cond_ <= 1e10) || !Kinv_.allFinite()) throw Fallback("singular");
       S_ = Kinv_.rightCols(k);
       Adinv_ = Kinv_;
     } else {
@@ -597,15 +601,24 @@ class Evaluator {
         for (int c = 0; c < k; ++c) Ai_(r, c) = A_(rows_[r], independent_[c]);
       }
       lu_.compute(Ad_);
-      Adinv_ = lu_.inverse();
-      cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * Adinv_.cwiseAbs().colwise().sum().maxCoeff();
-      if (!std::isfinite(cond_) || cond_ > 1e10) throw Fallback("singular");
-      Sd_.noalias() = -Adinv_ * Ai_;
-      for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = Sd_.row(r);
+      // The Python path refuses a block whose 1-norm condition number exceeds 1e10 (projection.MAX_CONDITION).
+      // LAPACK's estimate (rcond, O(n^2)) decides far from that bound; from an estimate of 1e8 on, the exact
+      // number (an O(n^3) inverse) decides, as in Python. The exact number is reported by the Python side
+      // (robotdyn.compiled.LazyProjection), from A.
+      const double rc = lu_.rcond();
+      cond_ = rc > 0.0 ? 1.0 / rc : std::numeric_limits<double>::infinity();
+      if (!(cond_ < 1e8)) {
+        Adinv_ = lu_.inverse();
+        cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * Adinv_.cwiseAbs().colwise().sum().maxCoeff();
+        if (!(std::isfinite(cond_) && cond_ <= 1e10)) throw Fallback("singular");
+      }
+      Sd_ = lu_.solve(Ai_);
+      if (!Sd_.allFinite()) throw Fallback("singular");  // an exactly singular block (a zero pivot)
+      for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -Sd_.row(r);
     }
     if (A_.size()) {
-      AS_.noalias() = A_ * S_;
-      if (AS_.cwiseAbs().maxCoeff() > 1e-10 * scale) throw Fallback("row choice no longer spans");
+      AS_.noalias() = A_.lazyProduct(S_);
+      if (!(AS_.cwiseAbs().maxCoeff() <= 1e-10 * scale)) throw Fallback("row choice no longer spans");  // NaN too
     }
   }
 

@@ -29,7 +29,7 @@ from .constraint import ConstraintRows, KinematicState
 from .joint_coupling import CosineLaw, JointCoupling
 from .loop_closure import LoopClosure
 from .loop_closure import groupable as groupable_loop
-from .projection import Projection
+from .projection import Projection, solve
 from .rolling_contact import RollingWheel
 from .terrain import BumpTerrain, RampTerrain, SineTerrain
 from .wheel_group import groupable as groupable_wheel
@@ -108,6 +108,44 @@ def why_not(robot) -> str | None:
     if op is not None and not hasattr(op, "twist"):
         return f"operational velocities {op!r} are not compiled"
     return None
+
+
+class LazyProjection(Projection):
+    """The :class:`~robotdyn.projection.Projection` of a compiled evaluation: the same S, independent, dependent
+    velocities and rows, with :math:`A_d^{-1}` and the exact 1-norm condition number computed from A on first
+    access (by the formulas of :func:`robotdyn.projection.project`). The compiled path itself needs neither: it
+    solves with the LU factors and decides singularity by LAPACK's condition estimate, switching to the exact
+    number from an estimate of 1e8 on (``robotdyn/_compiled.cpp``).
+
+    Args:
+        S: (n, k) with v = S nu.
+        hint: The Python projection whose choice of rows and velocities was used.
+        A: The stacked constraint rows at this configuration (m, n).
+    """
+
+    def __init__(self, S: np.ndarray, hint: Projection, A: np.ndarray) -> None:  # noqa: D107 (no dataclass init)
+        self.S, self.independent, self.dependent, self.rows = S, hint.independent, hint.dependent, hint.rows
+        self._layout, self._A, self._exact = hint._layout, A, None
+
+    def _inverse(self) -> tuple[np.ndarray | None, float]:
+        if self._exact is None:
+            if not self.rows.size:
+                self._exact = (None, 1.0)
+            else:
+                Ad = self._A[self._layout[1]]
+                inv = solve(Ad, np.eye(len(Ad)))
+                self._exact = (inv, float(abs(Ad).sum(axis=0).max() * abs(inv).sum(axis=0).max()))
+        return self._exact
+
+    @property
+    def Ad_inv(self) -> np.ndarray | None:
+        """:math:`A_d^{-1}` (rows used x dependent), ``None`` without constraints."""
+        return self._inverse()[0]
+
+    @property
+    def condition(self) -> float:
+        """1-norm condition number of the dependent block :math:`A_d` (1 without constraints)."""
+        return self._inverse()[1]
 
 
 def _placement(M) -> np.ndarray:
@@ -219,7 +257,8 @@ class CompiledModel:
 
     def evaluate(self, q: np.ndarray, nu: np.ndarray) -> tuple:
         """The raw outputs at (q, nu): ``(M_r, h, g_r, B_r, S, w, v, A, residual, condition, inverse)``, with
-        ``inverse`` :math:`A_d^{-1}` (or :math:`K^{-1}` for operational velocities).
+        ``condition`` and ``inverse`` :math:`K^{-1}` for operational velocities, ``None`` otherwise (the exact
+        condition number and :math:`A_d^{-1}` then come from :class:`LazyProjection`, on request).
 
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
@@ -263,8 +302,7 @@ class CompiledModel:
 
             proj = OperationalProjection(S, hint.rows, cond, inv)
         else:
-            proj = Projection(S, hint.independent, hint.dependent, hint.rows, cond,
-                              inv if hint.rows.size else None, hint._layout)
+            proj = LazyProjection(S, hint, A)
         rows0 = ConstraintRows(A, None, residual, self.holonomic, self.labels)
         robot = self.robot
         full_rows = lambda: robot.constraint_rows(KinematicState(robot.model, robot.data, q, v))  # noqa: E731
@@ -306,4 +344,4 @@ def compiled_model(robot) -> CompiledModel | None:
     return fast
 
 
-__all__ = ["Fallback", "CompiledModel", "compiled_model", "why_not", "available", "enabled", "use_compiled"]
+__all__ = ["Fallback", "CompiledModel", "LazyProjection", "compiled_model", "why_not", "available", "enabled", "use_compiled"]

@@ -213,12 +213,12 @@ def cmd_view(args) -> int:
         viewer.close()
         _emit(args, out, f"wrote {args.html}" + ("" if traj is None else f" ({out['duration_s']:g} s animation)"))
         return 0
-    _emit(args, out, f"meshcat viewer of {args.robot} at {viewer.url}  (Ctrl-C to stop)")
-    if args.open:
-        import webbrowser
+    try:  # from the first line printed on, Ctrl-C stops the server cleanly
+        _emit(args, out, f"meshcat viewer of {args.robot} at {viewer.url}  (Ctrl-C to stop)")
+        if args.open:
+            import webbrowser
 
-        webbrowser.open(viewer.url)
-    try:
+            webbrowser.open(viewer.url)
         import time
 
         while True:

@@ -5,7 +5,11 @@
 (:mod:`robotdyn.rolling_contact` on a plane, :mod:`robotdyn.loop_closure`, :mod:`robotdyn.projection`,
 :mod:`robotdyn.operational_space`, :mod:`robotdyn.actuation`) in C++ (``robotdyn/_compiled.cpp``), on a copy of
 the robot's Pinocchio model rebuilt joint by joint and checked against it when built (M, g and RNEA at a random
-state). Pinocchio's own C++ algorithms do the rigid-body work; only the Python call overhead is saved.
+state). Pinocchio's own C++ algorithms do the rigid-body work, two passes per state: CRBA in the world convention
+(M, the joint Jacobians and, from its composite inertias, :math:`g_k = -J_k^T (Y_k a_g)`) and RNEA without gravity
+(:math:`C v`, and the zero-acceleration accelerations the drift terms need), so that
+:math:`\\mathrm{RNEA}(q, v, w) = Cv + g + Mw`. The projection solves with the LU factors of :math:`A_d`; its exact
+condition number and inverse (:class:`LazyProjection`) are computed on request.
 
 It serves robots whose constraints are rolling wheels (standard, omni, support; with or without a radius joint) on
 a plane, a sine or a bump terrain of :mod:`robotdyn.terrain`, loop closures and joint couplings with a

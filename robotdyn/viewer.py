@@ -121,7 +121,14 @@ class _SceneRecorder:
         return _static_page(self.commands())
 
     def close(self) -> None:
-        if self.live is not None and getattr(self.live, "server_proc", None) is not None:
+        """Close the socket to the live server (dropping unsent messages, so that nothing waits for them at
+        exit) and stop the server."""
+        if self.live is None:
+            return
+        sock = getattr(self.live, "zmq_socket", None)
+        if sock is not None and not sock.closed:
+            sock.close(linger=0)
+        if getattr(self.live, "server_proc", None) is not None:
             proc = self.live.server_proc
             proc.kill()
             proc.wait()

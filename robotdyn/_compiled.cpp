@@ -443,7 +443,7 @@ class Evaluator {
     const Vector3d r = -g.R * g.u;
     MatrixXd& Aw = Aw_[i];
     Aw = J.topRows<3>();
-    Aw.noalias() -= skew(r) * J.bottomRows<3>();
+    Aw.noalias() -= skew(r).lazyProduct(J.bottomRows<3>());
     if (wh.radius_index >= 0) Aw.col(wh.radius_index) -= g.u;
     Matrix3d ET;
     ET.row(0) = g.t1.transpose();
@@ -451,7 +451,7 @@ class Evaluator {
     ET.row(2) = n.transpose();
     const int nd = static_cast<int>(wh.D.rows());
     const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3> W = wh.D * ET;
-    A_.middleRows(row, nd).noalias() = W * Aw;
+    A_.middleRows(row, nd).noalias() = W.lazyProduct(Aw);
     for (int r2 = 0; r2 < nd; ++r2) residual_[row + r2] = wh.D(r2, 2) != 0.0 ? phi : 0.0;
     return row + nd;
   }
@@ -502,10 +502,10 @@ class Evaluator {
     const Vector3d dp = M2.translation() - M1.translation();
     Jrel_.resize(6, nv_);  // relative velocity in frame 1's axes (LoopClosure.jacobian)
     K3_ = J2.topRows<3>() - J1.topRows<3>();
-    K3_.noalias() += skew(dp) * J1.bottomRows<3>();
-    Jrel_.topRows<3>().noalias() = R1T * K3_;
+    K3_.noalias() += skew(dp).lazyProduct(J1.bottomRows<3>());
+    Jrel_.topRows<3>().noalias() = R1T.lazyProduct(K3_);
     K3_ = J2.bottomRows<3>() - J1.bottomRows<3>();
-    Jrel_.bottomRows<3>().noalias() = R1T * K3_;
+    Jrel_.bottomRows<3>().noalias() = R1T.lazyProduct(K3_);
     const Vector3d e_pos = R1T * dp;
     const Vector3d e_rot = pin::log3(Matrix3d(R1T * M2.rotation()));
     for (size_t r = 0; r < c.select.size(); ++r) {

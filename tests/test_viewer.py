@@ -4,6 +4,7 @@ the trajectory's own times). Every registered robot is covered (parametrised ove
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 from dataclasses import dataclass
@@ -311,8 +312,9 @@ def test_cli_view_live_serves_until_interrupted():
     """Without --html, `robotdyn view` prints the live URL, serves the page, and stops cleanly on Ctrl-C."""
     import signal
 
+    env = {**os.environ, "PYTHONFAULTHANDLER": "1"}  # on SIGABRT the child prints where each thread is
     proc = subprocess.Popen([sys.executable, "-m", "robotdyn", "view", "quasimoro", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         lines = []
         while not (lines and lines[-1].startswith("}")):
@@ -327,7 +329,12 @@ def test_cli_view_live_serves_until_interrupted():
         assert servers, "the meshcat server should be a child process of robotdyn view"
     finally:
         proc.send_signal(signal.SIGINT)
-        code = proc.wait(timeout=20)
+        try:
+            code = proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:  # say where it hangs, then fail
+            proc.send_signal(signal.SIGABRT)
+            _, err = proc.communicate(timeout=20)
+            pytest.fail(f"robotdyn view did not stop within 20 s of Ctrl-C; its threads:\n{err[-6000:]}")
     err = proc.stderr.read()
     assert code == 0 and "Traceback" not in err, err
     alive = [pid for pid in servers if running(pid)]

@@ -313,8 +313,11 @@ def test_cli_view_live_serves_until_interrupted():
     import signal
 
     env = {**os.environ, "PYTHONFAULTHANDLER": "1"}  # on SIGABRT the child prints where each thread is
+    # Ctrl-C as in a terminal: a test run started in the background (`make test &` from a script) ignores SIGINT,
+    # and a child would inherit that, so the child gets the default disposition back
     proc = subprocess.Popen([sys.executable, "-m", "robotdyn", "view", "quasimoro", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         lines = []
         while not (lines and lines[-1].startswith("}")):

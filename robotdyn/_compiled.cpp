@@ -302,8 +302,8 @@ class Evaluator {
     } else if (nr) {
       rhs_.resize(nr);
       for (int r = 0; r < nr; ++r) rhs_[r] = drift_[rows_[r]];
-      wd_ = lu_.solve(rhs_);
-      wd_ = -wd_;
+      lu_solve(rhs_);
+      wd_ = -rhs_;
       for (int r = 0; r < nr; ++r) w_[dependent_[r]] = wd_[r];
     }
     data_.M.triangularView<Eigen::StrictlyLower>() = data_.M.transpose().triangularView<Eigen::StrictlyLower>();
@@ -387,6 +387,61 @@ class Evaluator {
   }
 
  private:
+  // A_d^-1 x in place, with the LU factors (P A_d = L U): vector triangular solves, no temporaries
+  void lu_solve(Eigen::Ref<VectorXd> x) {
+    x = lu_.permutationP() * x;
+    lu_.matrixLU().triangularView<Eigen::UnitLower>().solveInPlace(x);
+    lu_.matrixLU().triangularView<Eigen::Upper>().solveInPlace(x);
+  }
+  // A_d^-T x in place
+  void lu_solve_transposed(Eigen::Ref<VectorXd> x) {
+    lu_.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(x);
+    lu_.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(x);
+    x = lu_.permutationP().transpose() * x;
+  }
+  // LAPACK's estimate of ||A_d^-1||_1 (Hager and Higham, as Eigen's rcond estimate) with the solves above
+  double inverse_norm_estimate() {
+    const Eigen::Index n = lu_.rows();
+    est_v_.setConstant(n, 1.0 / static_cast<double>(n));
+    lu_solve(est_v_);
+    double lower = est_v_.lpNorm<1>();
+    if (n == 1) return lower;
+    auto signs = [](const VectorXd& v, VectorXd& out) {
+      out.resize(v.size());
+      for (Eigen::Index i = 0; i < v.size(); ++i) out[i] = v[i] >= 0.0 ? 1.0 : -1.0;
+    };
+    signs(est_v_, est_old_);
+    est_v_ = est_old_;
+    lu_solve_transposed(est_v_);
+    Eigen::Index index, old_index;
+    est_v_.cwiseAbs().maxCoeff(&index);
+    double old_lower = lower;
+    for (int k = 0; k < 4; ++k) {
+      est_v_.setZero(n);
+      est_v_[index] = 1.0;
+      lu_solve(est_v_);
+      lower = est_v_.lpNorm<1>();
+      if (lower <= old_lower) break;
+      signs(est_v_, est_s_);
+      if (est_s_ == est_old_) break;
+      est_v_ = est_s_;
+      lu_solve_transposed(est_v_);
+      old_index = index;
+      est_v_.cwiseAbs().maxCoeff(&index);
+      if (index == old_index) break;
+      old_lower = lower;
+      est_old_ = est_s_;
+    }
+    double alternate = 1.0;
+    est_v_.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      est_v_[i] = alternate * (1.0 + static_cast<double>(i) / static_cast<double>(n - 1));
+      alternate = -alternate;
+    }
+    lu_solve(est_v_);
+    return std::max(lower, 2.0 * est_v_.lpNorm<1>() / (3.0 * static_cast<double>(n)));
+  }
+
   // Contact point and frame of wheel i (RollingWheel._geometry), its rows D E^T A_w and residuals.
   int wheel_rows(size_t i, int row) {
     const Wheel& wh = wheels_[i];
@@ -602,17 +657,18 @@ class Evaluator {
       }
       lu_.compute(Ad_);
       // The Python path refuses a block whose 1-norm condition number exceeds 1e10 (projection.MAX_CONDITION).
-      // LAPACK's estimate (rcond, O(n^2)) decides far from that bound; from an estimate of 1e8 on, the exact
+      // LAPACK's estimate (O(n^2), inverse_norm_estimate) decides far from that bound; from an estimate of 1e8 on, the exact
       // number (an O(n^3) inverse) decides, as in Python. The exact number is reported by the Python side
       // (robotdyn.compiled.LazyProjection), from A.
-      const double rc = lu_.rcond();
-      cond_ = rc > 0.0 ? 1.0 / rc : std::numeric_limits<double>::infinity();
+      cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm_estimate();
+      if (std::isnan(cond_)) cond_ = std::numeric_limits<double>::infinity();
       if (!(cond_ < 1e8)) {
         Adinv_ = lu_.inverse();
         cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * Adinv_.cwiseAbs().colwise().sum().maxCoeff();
         if (!(std::isfinite(cond_) && cond_ <= 1e10)) throw Fallback("singular");
       }
-      Sd_ = lu_.solve(Ai_);
+      Sd_ = Ai_;
+      for (int c = 0; c < k; ++c) lu_solve(Sd_.col(c));
       if (!Sd_.allFinite()) throw Fallback("singular");  // an exactly singular block (a zero pivot)
       for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -Sd_.row(r);
     }
@@ -658,7 +714,7 @@ class Evaluator {
   int op_frame_ = -1;
   bool op_local_ = true, operational_ = false, selected_ = false;
   // state and work buffers (sized on first use, then reused)
-  VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_;
+  VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_, est_v_, est_s_, est_old_;
   MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
   Matrix6x Jc_;

@@ -218,6 +218,7 @@ class Evaluator {
   }
 
   int nv() const { return nv_; }
+  double condition() const { return cond_; }
   int nrows() const { return static_cast<int>(holonomic_.size()); }
   int mobility() const {
     return operational_ ? static_cast<int>(op_select_.size()) : static_cast<int>(independent_.size());
@@ -756,6 +757,9 @@ PYBIND11_MODULE(_compiled, m) {
       .def_property_readonly("v", &Evaluator::v, py::return_value_policy::reference_internal)
       .def("rhs", &Evaluator::rhs)
       .def("evaluate_many", &Evaluator::evaluate_many)
+      .def_property_readonly("condition", &Evaluator::condition,
+                             "1-norm condition number of the last projection's block: LAPACK's estimate below 1e8, "
+                             "exact above (operational velocities: exact)")
       .def_property_readonly("nv", &Evaluator::nv)
       .def_property_readonly("nrows", &Evaluator::nrows);
 }

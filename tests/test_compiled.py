@@ -15,7 +15,7 @@ import pytest
 
 import robotdyn
 from robotdyn import compiled
-from robotdyn.compiled import Fallback, compiled_model, use_compiled, why_not
+from robotdyn.compiled import Fallback, LazyProjection, compiled_model, use_compiled, why_not
 from robotdyn.errors import SingularConstraintError
 from robotdyn.robots import names
 
@@ -779,3 +779,26 @@ def test_simulate_linkage_equals_python(linkage, monkeypatch):
     assert np.abs(got.q - ref.q).max() <= 1e-8
     assert np.abs(got.nu - ref.nu).max() <= 1e-8
     assert 0.5 * ref.stats["nfev"] <= got.stats["nfev"] <= 2.0 * ref.stats["nfev"]
+
+
+def test_condition_estimate_bounds_the_exact_number(robot):
+    """The compiled path decides singularity by LAPACK's estimate of the 1-norm condition number below 1e8: a
+    lower bound of the exact number (robot.reduced's projection.condition), and here within a factor 3 of it."""
+    if robot.operational is not None:
+        pytest.skip("operational velocities: the compiled path computes the exact number")
+    rng = np.random.default_rng(5)
+    fast = compiled_model(robot)
+    checked = 0
+    for _ in range(30):
+        q, nu = random_state(robot, rng)
+        try:
+            red = robot.reduced(q, nu)
+        except SingularConstraintError:
+            continue
+        if not isinstance(red.projection, LazyProjection) or not red.projection.rows.size:
+            continue
+        exact, estimate = red.projection.condition, fast.ev.condition
+        assert estimate <= exact * (1 + 1e-9)
+        assert estimate >= exact / 3
+        checked += 1
+    assert checked >= 10

@@ -231,7 +231,9 @@ class CompiledModel:
         for name, x, ref in (("M", M, ref_M), ("g", g, ref_g), ("RNEA", tau, ref_tau)):
             err = float(np.max(np.abs(x - ref))) / max(1.0, float(np.max(np.abs(ref))))
             if not err <= SELF_CHECK_TOL:
-                raise RuntimeError(f"compiled model of {self.robot.spec.name}: {name} differs from Pinocchio's by {err:.3g}")
+                raise RuntimeError(
+                    f"compiled model of {self.robot.spec.name}: {name} differs from Pinocchio's by {err:.3g}"
+                )
 
     @property
     def ready(self) -> bool:
@@ -327,7 +329,8 @@ class CompiledModel:
         B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path."""
         N, n = Q.shape
         k = NU.shape[1]
-        M, h, g, S, w, B, failed = self.ev.evaluate_many(np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float))
+        Q, NU = np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float)
+        M, h, g, S, w, B, failed = self.ev.evaluate_many(Q, NU)
         return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
 
 
@@ -339,7 +342,8 @@ def compiled_model(robot) -> CompiledModel | None:
     cached = getattr(robot, "_compiled_model", None)
     gravity = robot.model.gravity.linear
     if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
-        getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r for c, (t, r) in zip(robot.constraints, cached[2])
+        getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r
+        for c, (t, r) in zip(robot.constraints, cached[2])
     ):
         return cached[3]
     fast = CompiledModel(robot) if why_not(robot) is None else None
@@ -348,4 +352,5 @@ def compiled_model(robot) -> CompiledModel | None:
     return fast
 
 
-__all__ = ["Fallback", "CompiledModel", "LazyProjection", "compiled_model", "why_not", "available", "enabled", "use_compiled"]
+__all__ = ["Fallback", "CompiledModel", "LazyProjection", "compiled_model", "why_not", "available", "enabled",
+           "use_compiled"]

@@ -28,10 +28,10 @@ import numpy as np
 import pinocchio as pin
 
 from .actuation import input_matrix
+from .compiled import compiled_model
 from .constraint import KinematicState
 from .errors import DescriptionError, InputError, SingularConstraintError
 from .projection import MAX_CONDITION, independent_rows
-from .compiled import compiled_model
 from .reduced_dynamics import ReducedDynamics, assemble, constraint_set
 
 COMPONENTS = ("vx", "vy", "vz", "wx", "wy", "wz")

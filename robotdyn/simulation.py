@@ -5,9 +5,10 @@ State: natural coordinates q (n) and independent velocities nu (k). The ODE is
 .. math:: \\dot q = S(q)\\nu - \\alpha\\, A_h^+ \\phi(q),\\qquad M_r \\dot\\nu = B_r \\tau(t, q, \\nu) - C_r\\nu - g_r,
 
 integrated with scipy's ``solve_ivp``; the right-hand side is one call of the robot's compiled model
-(:mod:`robotdyn.compiled`) where it serves the robot, else the Python path. Velocity constraints hold exactly (v = S nu by construction); the
-position residuals :math:`\\phi` of holonomic rows (loop closures, contacts on a sloped or curved terrain) are
-pulled back with the stabilisation gain :math:`\\alpha` [1/s] (0 disables it) and reported.
+(:mod:`robotdyn.compiled`) where it serves the robot, else the Python path. Velocity constraints hold exactly
+(v = S nu by construction); the position residuals :math:`\\phi` of holonomic rows (loop closures, contacts on a
+sloped or curved terrain) are pulled back with the stabilisation gain :math:`\\alpha` [1/s] (0 disables it) and
+reported.
 """
 
 from __future__ import annotations

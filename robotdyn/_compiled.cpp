@@ -639,7 +639,6 @@ class Evaluator {
       cond_ = K_.cwiseAbs().colwise().sum().maxCoeff() * Kinv_.cwiseAbs().colwise().sum().maxCoeff();
       if (!(std::isfinite(cond_) && cond_ <= 1e10) || !Kinv_.allFinite()) throw Fallback("singular");
       S_ = Kinv_.rightCols(k);
-      Adinv_ = Kinv_;
     } else {
       const int nd = static_cast<int>(dependent_.size());
       const int k = static_cast<int>(independent_.size());
@@ -647,7 +646,6 @@ class Evaluator {
       for (int j = 0; j < k; ++j) S_(independent_[j], j) = 1.0;
       if (nd == 0) {
         cond_ = 1.0;
-        Adinv_.resize(0, 0);
         return;
       }
       Ad_.resize(nd, nd);

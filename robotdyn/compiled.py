@@ -33,7 +33,7 @@ from .constraint import ConstraintRows, KinematicState
 from .joint_coupling import CosineLaw, JointCoupling
 from .loop_closure import LoopClosure
 from .loop_closure import groupable as groupable_loop
-from .projection import Projection, solve
+from .projection import Projection, inverse_and_condition
 from .rolling_contact import RollingWheel
 from .terrain import BumpTerrain, RampTerrain, SineTerrain
 from .wheel_group import groupable as groupable_wheel
@@ -133,12 +133,7 @@ class LazyProjection(Projection):
 
     def _inverse(self) -> tuple[np.ndarray | None, float]:
         if self._exact is None:
-            if not self.rows.size:
-                self._exact = (None, 1.0)
-            else:
-                Ad = self._A[self._layout[1]]
-                inv = solve(Ad, np.eye(len(Ad)))
-                self._exact = (inv, float(abs(Ad).sum(axis=0).max() * abs(inv).sum(axis=0).max()))
+            self._exact = inverse_and_condition(self._A[self._layout[1]]) if self.rows.size else (None, 1.0)
         return self._exact
 
     @property
@@ -242,11 +237,8 @@ class CompiledModel:
 
     def _choose(self, q: np.ndarray, nu: np.ndarray) -> None:
         """Let the Python path choose the projection's rows at (q, nu) (it raises its usual errors there)."""
-        from .reduced_dynamics import reduce
-
         with use_compiled(False):
-            out = reduce(self.robot, np.asarray(q, float), np.asarray(nu, float)) if self.operational is None else \
-                self.operational.reduce(self.robot, q, nu)
+            out = self.robot.reduced(q, nu)
         self.select(out.projection)
 
     def select(self, proj) -> None:

@@ -31,7 +31,7 @@ from .actuation import input_matrix
 from .compiled import compiled_model
 from .constraint import KinematicState
 from .errors import DescriptionError, InputError, SingularConstraintError
-from .projection import MAX_CONDITION, independent_rows
+from .projection import MAX_CONDITION, independent_rows, inverse_and_condition
 from .reduced_dynamics import ReducedDynamics, assemble, constraint_set
 
 COMPONENTS = ("vx", "vy", "vz", "wx", "wy", "wz")
@@ -132,12 +132,7 @@ def project_operational(A: np.ndarray, J: np.ndarray, names: list[str] | None = 
             f"{k} operational velocities ({', '.join(names)}) but the constraints leave {n - rows.size} "
             f"(n = {n}, rank A = {rows.size}); expected exactly the mobility"
         )
-    K = np.vstack([A[rows], J])
-    try:
-        Kinv = np.linalg.inv(K)
-        cond = float(np.abs(K).sum(axis=0).max() * np.abs(Kinv).sum(axis=0).max())  # 1-norm condition number
-    except np.linalg.LinAlgError:
-        cond = float("inf")
+    Kinv, cond = inverse_and_condition(np.vstack([A[rows], J]))
     if not np.isfinite(cond) or cond > MAX_CONDITION:
         raise SingularConstraintError(
             f"the operational velocities ({', '.join(names)}) do not determine the motion here: [A; J] singular "

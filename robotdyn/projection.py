@@ -60,6 +60,16 @@ def solve(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return X
 
 
+def inverse_and_condition(A: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """:math:`A^{-1}` (``None`` if A is exactly singular) and the 1-norm condition number
+    :math:`\\|A\\|_1 \\|A^{-1}\\|_1` (``inf`` if singular) of a small square matrix."""
+    try:
+        inv = solve(A, np.eye(len(A)))
+    except np.linalg.LinAlgError:
+        return None, float("inf")
+    return inv, float(abs(A).sum(axis=0).max() * abs(inv).sum(axis=0).max())
+
+
 def independent_rows(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
     """Indices of a maximal set of linearly independent rows of ``A`` (rank-revealing QR with pivoting)."""
     if A.shape[0] == 0:
@@ -139,12 +149,7 @@ def _build(A, independent, dependent, rows, names, layout: tuple | None = None) 
     S = S0.copy()
     if rows.size == 0:
         return Projection(S, independent, dependent, rows, 1.0, None, layout)
-    Ad = A[ix_dep]
-    try:
-        Ad_inv = solve(Ad, np.eye(len(Ad)))
-        cond = float(abs(Ad).sum(axis=0).max() * abs(Ad_inv).sum(axis=0).max())
-    except np.linalg.LinAlgError:
-        cond = float("inf")
+    Ad_inv, cond = inverse_and_condition(A[ix_dep])
     if not np.isfinite(cond) or cond > MAX_CONDITION:
         raise SingularConstraintError(
             f"the dependent velocities ({', '.join(names[i] for i in dependent)}) cannot be solved from the "

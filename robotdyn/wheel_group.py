@@ -3,7 +3,7 @@
 :class:`WheelGroup` gives exactly the rows of each wheel's :meth:`~robotdyn.rolling_contact.RollingWheel.jacobian`
 and :meth:`~robotdyn.rolling_contact.RollingWheel.drift` (same formulas; the module docstring of
 :mod:`robotdyn.rolling_contact` states them), stacked, with far fewer Python-level operations; the robot's
-constraint set (:class:`robotdyn.reduced_dynamics.ConstraintSet`) and the batch API use it.
+constraint set (:class:`robotdyn.reduced_dynamics.ConstraintSet`) uses it on the Python path.
 ``tests/test_fast_paths.py`` checks it against the per-wheel rows on every robot.
 """
 

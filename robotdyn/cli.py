@@ -17,6 +17,7 @@ import numpy as np
 
 from .errors import RobotDynError
 from .inputs import as_vector, parse_assignments
+from .rolling_contact import RollingWheel
 
 
 def _load(args):
@@ -142,6 +143,12 @@ def cmd_dump(args) -> int:
         nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
         out["a"] = nudot
         text.append(_vector_text("a (independent accelerations)", names, nudot))
+    if args.forces:
+        if args.a is None and args.tau is None:
+            raise RobotDynError("--forces needs --tau (forward dynamics) or --a (inverse dynamics)")
+        forces = robot.contact_forces(q, nu, tau=tau, nudot=nudot)
+        out["forces"] = forces.as_dict()
+        text.append(forces.table())
     _emit(args, out, "\n".join(text))
     return 0
 
@@ -155,8 +162,17 @@ def cmd_simulate(args) -> int:
         )
     sc = scenarios[args.scenario]
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet)
+    tr = None
+    if any(isinstance(c, RollingWheel) for c in robot.constraints):
+        from .traction import plot_traction, traction
+
+        tr = traction(robot, traj, sc.torque, args.mu)
+        if args.traction_plot:
+            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction")
+    elif args.mu is not None or args.traction_plot:
+        raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
     if args.csv:
-        traj.to_csv(args.csv)
+        traj.to_csv(args.csv, tr.columns() if tr is not None else None)
     if args.plot:
         from .plotting import plot_trajectory
 
@@ -167,14 +183,23 @@ def cmd_simulate(args) -> int:
     out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,
            "energy_start": float(traj.energy[0]), "energy_end": float(traj.energy[-1]),
            "max_holonomic_residual": drift, "wall_time_s": traj.stats["wall"], "csv": args.csv, "plot": args.plot}
+    if tr is not None:
+        out["traction"] = {"summary": tr.summary(), "wheels": tr.wheels, "undetermined": list(tr.undetermined),
+                           "events": [vars(e) for e in tr.events],
+                           "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)},
+                           "min_normal_load": {w: float(np.min(tr.normal[:, j])) for j, w in enumerate(tr.wheels)}}
     text = [f"{args.robot} / {sc.name}: {sc.description}",
             f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations)",
             "final state:", *(f"  {k:<14} {v: .8g}" for k, v in final.items()),
             f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
+    if tr is not None:
+        text.append(tr.summary())
     if args.csv:
         text.append(f"wrote {args.csv}")
     if args.plot:
         text.append(f"wrote {args.plot}")
+    if args.traction_plot:
+        text.append(f"wrote {args.traction_plot}")
     _emit(args, out, "\n".join(text))
     return 0
 
@@ -260,6 +285,8 @@ def build_parser() -> argparse.ArgumentParser:
     group.add_argument("--a", nargs="+", help="accelerations -> torques (inverse dynamics)")
     group.add_argument("--tau", nargs="+", help="motor torques -> accelerations (forward dynamics)")
     p.add_argument("--full", action="store_true", help="the unconstrained tree's M, C, g instead")
+    p.add_argument("--forces", action="store_true",
+                   help="also the wheel-ground contact forces and loop-closure forces (needs --tau or --a)")
     p.set_defaults(func=cmd_dump)
     p = sub.add_parser("simulate", parents=[common, robot_args], help="run a scenario")
     p.add_argument("--scenario", required=True, help="scenario name (robotdyn info ROBOT lists them)")
@@ -267,6 +294,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file")
     p.add_argument("--plot", help="save the paper's figures reproduced to this image file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--mu", type=float, default=None,
+                   help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
+    p.add_argument("--traction-plot", metavar="FILE",
+                   help="save the wheel loads and required friction against time to this image file")
     p.set_defaults(func=cmd_simulate)
     p = sub.add_parser("compare", parents=[common, robot_args], help="the paper comparison table")
     p.set_defaults(func=cmd_compare)

@@ -37,3 +37,7 @@ class SingularConstraintError(ConstraintError):
     def __init__(self, message: str, condition: float = float("inf")) -> None:
         super().__init__(message)
         self.condition = condition
+
+
+class NonFiniteError(RobotDynError):
+    """A computed result that is not finite (NaN or infinite): never returned as a number."""

@@ -66,6 +66,7 @@ class Wheel:
     roller_angle: float | str = 0.0
     radius_joint: str | None = None
     name: str | None = None
+    mu: float | None = None  # friction coefficient (traction checks); None: not given
 
 
 @dataclass
@@ -331,6 +332,14 @@ class Robot:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)
         return Q, tau, float(np.linalg.norm(red.B @ tau - Q))
+
+    def contact_forces(self, q, nu, tau=None, nudot=None):
+        """Wheel-ground contact forces and loop-closure forces at (q, nu) for motor torques ``tau`` (forward
+        dynamics) or independent accelerations ``nudot`` (inverse dynamics); see
+        :func:`robotdyn.contact_forces.constraint_forces`."""
+        from .contact_forces import constraint_forces
+
+        return constraint_forces(self, q, nu, tau=tau, nudot=nudot)
 
     def velocity(self, q, nu) -> np.ndarray:
         """Full velocity v = S(q) nu."""

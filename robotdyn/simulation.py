@@ -65,10 +65,13 @@ class Trajectory:
             return self.nu[:, self.velocity_names.index(name)]
         raise RobotDynError(f"no column {name!r}; expected one of {', '.join(self.coordinates + self.velocity_names)}")
 
-    def to_csv(self, path) -> None:
-        """Write ``t``, the q columns, then the nu columns."""
-        header = ",".join(["t", *self.coordinates, *self.velocity_names])
-        np.savetxt(path, np.column_stack([self.t, self.q, self.nu]), delimiter=",", header=header, comments="")
+    def to_csv(self, path, extra: dict[str, np.ndarray] | None = None) -> None:
+        """Write ``t``, the q columns, the nu columns, then any ``extra`` columns by name (e.g. the wheel loads of
+        :meth:`robotdyn.traction.Traction.columns`)."""
+        extra = extra or {}
+        header = ",".join(["t", *self.coordinates, *self.velocity_names, *extra])
+        data = np.column_stack([self.t, self.q, self.nu, *extra.values()])
+        np.savetxt(path, data, delimiter=",", header=header, comments="")
 
 
 class _Progress:

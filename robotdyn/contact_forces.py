@@ -1,0 +1,287 @@
+"""Constraint forces at a state: wheel-ground contact loads and loop-closure forces.
+
+With the constraint rows :math:`A(q)v = 0` (m rows, rank r) the full equations of motion read
+
+.. math:: M a + h = B\\tau + A^T\\lambda,\\qquad a = S\\dot\\nu + w,
+
+so once :math:`\\dot\\nu` is known (forward dynamics from motor torques) or given (inverse dynamics), the residual
+:math:`e = M a + h - B\\tau = \\mathrm{RNEA}(q, v, a) - B\\tau` lies in the range of :math:`A^T` and
+:math:`A^T\\lambda = e` gives the constraint forces (``shared/notes/contact-forces-and-friction.md``).
+
+Units and frames. Each row's multiplier is the force along that row:
+
+- a rolling wheel's rows are the velocity of its material point at the contact along (t1, t2, n) of the contact
+  frame (t1 = rolling direction, t2 = n x t1, n = terrain normal, upward), so its multipliers are the force
+  *the ground exerts on the wheel* at the contact point, in N, split into longitudinal (t1), lateral (t2) and
+  normal (n) components; a positive normal component presses the wheel up (a load);
+- an omni wheel has a driving row (along its rollers' constrained direction) and a normal row; a support wheel
+  only the normal row;
+- a loop closure's rows are the relative motion of its frame 2 with respect to frame 1 in frame 1's axes, so its
+  multipliers are the force [N] (x, y, z) and moment [N m] (rx, ry, rz) that the closure exerts on the body of
+  frame 2, at frame 2's origin, in frame 1's axes (the body of frame 1 receives the opposite).
+
+Redundant rows (r < m). :math:`\\lambda` is then determined only up to the null space N of :math:`A^T`: a rigid
+four-wheel chassis on flat ground is statically indeterminate, and under a planar root the wheels' normal rows do
+not act on any coordinate at all (the model has no vertical motion), so the normal loads are not determined by that
+model. The result reports, per row and per wheel component, whether rigid-body dynamics determine it, and the
+undetermined combinations (the columns of N); the values shown for undetermined rows are the minimum-norm choice,
+one arbitrary member of the family :math:`\\lambda + N z`, and are flagged as such, never presented as the answer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from .actuation import input_matrix
+from .constraint import KinematicState
+from .errors import InputError, NonFiniteError
+from .loop_closure import LoopClosure
+from .rolling_contact import RollingWheel
+
+DETERMINED_TOL = 1e-8
+"""A row (or force component) is determined when its weight in every null-space direction is below this."""
+
+
+@dataclass
+class WheelForce:
+    """The ground's force on one wheel at its contact point.
+
+    Attributes:
+        name: The wheel's name.
+        kind: ``standard``, ``omni`` or ``support``.
+        force: (3,) components along (t1 longitudinal, t2 lateral, n normal) of the contact frame [N].
+        determined: (3,) whether rigid-body dynamics determine each component.
+        world: (3,) the same force in world axes [N].
+        point: (3,) the contact point in world coordinates [m].
+    """
+
+    name: str
+    kind: str
+    force: np.ndarray
+    determined: np.ndarray
+    world: np.ndarray
+    point: np.ndarray
+
+    @property
+    def normal(self) -> float:
+        """Normal load f_n [N] (positive: the ground pushes the wheel up)."""
+        return float(self.force[2])
+
+    @property
+    def tangential(self) -> float:
+        """Magnitude of the tangential (friction) force :math:`\\|(f_{t1}, f_{t2})\\|` [N]."""
+        return float(np.hypot(self.force[0], self.force[1]))
+
+    @property
+    def required_mu(self) -> float:
+        """Friction coefficient the motion requires, :math:`|f_t| / f_n` (``inf`` if the wheel is not pressed
+        on the ground, :math:`f_n \\le 0`)."""
+        return self.tangential / self.normal if self.normal > 0 else float("inf")
+
+    @property
+    def load_determined(self) -> bool:
+        """Whether the normal load and the friction force are all determined."""
+        return bool(self.determined.all())
+
+    def __repr__(self) -> str:
+        flag = "" if self.load_determined else ", NOT all determined"
+        return (f"WheelForce({self.name!r}, long={self.force[0]:.6g} N, lat={self.force[1]:.6g} N, "
+                f"normal={self.force[2]:.6g} N{flag})")
+
+
+@dataclass
+class ConstraintForces:
+    """Constraint forces of a robot at one state.
+
+    Attributes:
+        labels: Row names (constraint name and component), in row order.
+        lam: (m,) multipliers :math:`\\lambda` [N or N m] (minimum-norm where not determined).
+        determined: (m,) whether rigid-body dynamics determine each row's multiplier.
+        null_space: (m, m - r) orthonormal basis of the undetermined combinations (zero columns: none).
+        rank: Rank r of the constraint Jacobian.
+        residual: :math:`\\|A^T\\lambda - e\\|` relative to :math:`\\|e\\|` (0 for a consistent motion; large when
+            the given accelerations are not reachable with the motors).
+        nudot: (k,) independent accelerations used.
+        tau: Motor torques used [N m or N].
+        wheels: One :class:`WheelForce` per rolling, omni or support wheel.
+        closures: Loop-closure forces/moments by closure name, then component (x, y, z [N]; rx, ry, rz [N m]).
+        undetermined_reason: Why rows are undetermined (empty when all are determined).
+    """
+
+    labels: list[str]
+    lam: np.ndarray
+    determined: np.ndarray
+    null_space: np.ndarray
+    rank: int
+    residual: float
+    nudot: np.ndarray
+    tau: np.ndarray
+    wheels: list[WheelForce] = field(default_factory=list)
+    closures: dict[str, dict[str, float]] = field(default_factory=dict)
+    undetermined_reason: list[str] = field(default_factory=list)
+
+    @property
+    def all_determined(self) -> bool:
+        """Whether every multiplier is determined by rigid-body dynamics."""
+        return bool(self.determined.all())
+
+    def wheel(self, name: str) -> WheelForce:
+        """The force on the wheel called ``name``."""
+        for w in self.wheels:
+            if w.name == name:
+                return w
+        raise InputError(f"unknown wheel {name!r}; expected one of {', '.join(w.name for w in self.wheels)}")
+
+    def as_dict(self) -> dict:
+        """Plain data (for JSON): rows, wheels, closures and what is undetermined."""
+        return {
+            "rows": {lab: float(x) for lab, x in zip(self.labels, self.lam)},
+            "determined": {lab: bool(d) for lab, d in zip(self.labels, self.determined)},
+            "wheels": {
+                w.name: {"longitudinal": float(w.force[0]), "lateral": float(w.force[1]), "normal": w.normal,
+                         "determined": {"longitudinal": bool(w.determined[0]), "lateral": bool(w.determined[1]),
+                                        "normal": bool(w.determined[2])},
+                         "required_mu": w.required_mu if w.load_determined and w.normal > 0 else None,
+                         "world": w.world.tolist(), "contact_point": w.point.tolist()}
+                for w in self.wheels
+            },
+            "closures": self.closures,
+            "rank": self.rank,
+            "rows_count": len(self.labels),
+            "undetermined_combinations": [
+                {lab: float(c) for lab, c in zip(self.labels, col) if abs(c) > DETERMINED_TOL}
+                for col in self.null_space.T
+            ],
+            "undetermined_reason": self.undetermined_reason,
+            "residual": self.residual,
+        }
+
+    def table(self) -> str:
+        """A readable text table of the wheel and closure forces."""
+        lines = []
+        if self.wheels:
+            lines.append("contact forces (ground on wheel, contact frame) [N]:")
+            lines.append(f"{'wheel':>16} {'longitudinal':>14} {'lateral':>14} {'normal':>14} {'required mu':>12}")
+            for w in self.wheels:
+                cells = [f"{x:>14.6g}" if d else f"{'undetermined':>14}" for x, d in zip(w.force, w.determined)]
+                mu = w.required_mu if w.load_determined else None
+                mu_text = "-" if mu is None else ("lift-off" if w.normal <= 0 else f"{mu:.4g}")
+                lines.append(f"{w.name:>16} " + " ".join(cells) + f" {mu_text:>12}")
+        for name, comps in self.closures.items():
+            det = {c: d for c, d in zip(self.labels, self.determined)}
+            parts = [f"{c}={v:.6g}" if det[f"{name}.{c}"] else f"{c}=undetermined" for c, v in comps.items()]
+            lines.append(f"closure {name} (on frame 2's body, frame 1's axes; N, N m): " + ", ".join(parts))
+        for reason in self.undetermined_reason:
+            lines.append(f"not determined by rigid-body dynamics: {reason}")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        und = int((~self.determined).sum())
+        return (f"ConstraintForces(rows={len(self.labels)}, rank={self.rank}, undetermined={und}, "
+                f"wheels={[w.name for w in self.wheels]}, closures={list(self.closures)})")
+
+
+def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
+    """Constraint forces at (q, nu) for given motor torques (forward dynamics) or accelerations (inverse dynamics).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad].
+        nu: Independent velocities (k,).
+        tau: Motor torques [N m or N]; with ``nudot`` None the accelerations follow from forward dynamics
+            (default: zero torques).
+        nudot: Independent accelerations (k,); the motor torques then follow by least squares (``tau`` given
+            too: those torques are used as given, and ``residual`` says whether they produce ``nudot``).
+
+    Returns:
+        The :class:`ConstraintForces`.
+    """
+    q = robot.check_q(q)
+    nu = robot.check_nu(nu, "v")
+    red = robot.reduced(q, nu)
+    if nudot is None:
+        tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
+        nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
+    else:
+        nudot = robot.check_nu(nudot, "a")
+        if tau is None:
+            tau = robot.inverse_dynamics(q, nu, nudot)[1]
+        else:
+            tau = robot.check_tau(tau)
+    model, data = robot.model, robot.data
+    a = red.S @ nudot + red.w
+    kin = KinematicState(model, data, q, red.v)
+    B = input_matrix(robot.motors, kin)
+    e = pin.rnea(model, data, q, red.v, a) - B @ tau
+    rows = red.jacobian_rows
+    A = rows.A
+    lam, N, rank, residual = _solve_transpose(A, e)
+    determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
+    out = ConstraintForces(list(rows.labels), lam, determined, N, rank, residual, nudot, tau)
+    index = {lab: i for i, lab in enumerate(rows.labels)}
+    for c in robot.constraints:
+        if isinstance(c, RollingWheel):
+            out.wheels.append(_wheel_force(c, kin, index, lam, N))
+        elif isinstance(c, LoopClosure):
+            out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
+                                    if f"{c.name}.{comp}" in index}
+    out.undetermined_reason = _reasons(A, rows.labels, N)
+    if not (np.all(np.isfinite(lam)) and np.isfinite(residual)):
+        raise NonFiniteError(f"constraint forces at this state are not finite (max |e| = {np.max(np.abs(e)):.3g})")
+    return out
+
+
+def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float]:
+    """Minimum-norm :math:`\\lambda` of :math:`A^T\\lambda = e`, the null space of :math:`A^T` (orthonormal
+    columns), the rank and the relative residual, by SVD (rank tolerance as numpy's ``matrix_rank``)."""
+    m = A.shape[0]
+    if m == 0:
+        return np.zeros(0), np.zeros((0, 0)), 0, float(np.linalg.norm(e) / max(1.0, np.linalg.norm(e)))
+    U, s, Vt = np.linalg.svd(A.T, full_matrices=True)  # A^T = U diag(s) Vt, n x m
+    tol = s.max(initial=0.0) * max(A.shape) * np.finfo(float).eps
+    rank = int(np.sum(s > tol))
+    lam = Vt[:rank].T @ ((U[:, :rank].T @ e) / s[:rank])
+    N = Vt[rank:].T
+    scale = max(np.linalg.norm(e), 1.0)
+    return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale)
+
+
+def _wheel_force(wheel: RollingWheel, kin: KinematicState, index: dict, lam: np.ndarray,
+                 N: np.ndarray) -> WheelForce:
+    """A wheel's force in its contact frame, from its rows' multipliers (row i acts along D[i] of (t1, t2, n))."""
+    geo = wheel._geometry(kin)
+    E, p = geo[9], geo[5]
+    labels = wheel._labels()
+    idx = [index[lab] for lab in labels]
+    D = wheel._directions
+    force = D.T @ lam[idx]
+    if N.shape[1]:
+        determined = np.linalg.norm(D.T @ N[idx], axis=1) <= DETERMINED_TOL
+        # a direction with no row at all (e.g. the lateral direction of an omni wheel) carries no force: determined
+    else:
+        determined = np.ones(3, bool)
+    kind = "support" if D.shape[0] == 1 else ("omni" if D.shape[0] == 2 else "standard")
+    return WheelForce(wheel.name, kind, force, determined, E @ force, np.array(p, float))
+
+
+def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
+    """Plain-language reasons why rows are undetermined: rows that act on no coordinate of the model (e.g. a
+    wheel's normal row under a planar root), and combinations of rows that the motion cannot tell apart."""
+    if N.shape[1] == 0:
+        return []
+    out = []
+    scale = max(np.abs(A).max(initial=0.0), 1.0)
+    zero = [lab for lab, row in zip(labels, A) if np.abs(row).max(initial=0.0) <= 1e-12 * scale]
+    if zero:
+        out.append(f"rows {', '.join(zero)} act on no coordinate of this model at this configuration (the tree "
+                   "already enforces them; a wheel's normal row does so under a planar root, which has no vertical, "
+                   "roll or pitch motion: a floating root determines normal loads)")
+    others = N.shape[1] - len(zero)
+    if others > 0:
+        mixed = sorted({lab for col in N.T for lab, c in zip(labels, col) if abs(c) > DETERMINED_TOL} - set(zero))
+        out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: the rows are "
+                   "redundant, e.g. more wheels than a rigid body needs; a compliance model would split them)")
+    return out

@@ -1,0 +1,162 @@
+"""Constraint forces (robotdyn.contact_forces) against independent references: Pinocchio's own KKT solve of the
+constrained dynamics, the static force and moment balance of the whole robot, and the closed form of a disc
+rolling down an incline."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.linalg import qr
+from scipy.optimize import brentq
+
+import robotdyn
+from robotdyn.errors import InputError
+from robotdyn.robot import Robot, RobotSpec, Wheel
+from robotdyn.terrain import RampTerrain
+
+ROBOTS = ["quasimoro", "omni_caster", "linkage_suspension", "adaptable_wheel", "mmr12_eod"]
+DISC = Path(__file__).parent / "data" / "disc.urdf"
+
+
+@pytest.fixture(scope="module")
+def robots():
+    return {name: robotdyn.load(name) for name in ROBOTS}
+
+
+def _pinocchio_kkt(robot, q, v, tau_full):
+    """Pinocchio's forwardDynamics with the independent constraint rows: accelerations and A^T lambda."""
+    rows = robot.constraint_rows(robotdyn.constraint.KinematicState(robot.model, robot.data, q, v))
+    A, gamma = rows.A, rows.Adot @ v
+    r = np.linalg.matrix_rank(A)
+    sel = np.sort(qr(A.T, pivoting=True)[2][:r])  # a maximal independent subset of the rows
+    data = robot.model.createData()
+    a = pin.forwardDynamics(robot.model, data, q, v, tau_full, A[sel], gamma[sel], 0.0).copy()
+    lam_sel = data.lambda_c.copy()
+    if not np.all(np.isfinite(a)):
+        # massless links make M singular (Pinocchio's solve factors M): the same KKT system, solved densely
+        M = pin.crba(robot.model, data, q)
+        h = pin.rnea(robot.model, data, q, v, np.zeros_like(v))
+        J = A[sel]
+        K = np.block([[M, -J.T], [J, np.zeros((len(sel), len(sel)))]])
+        sol = np.linalg.solve(K, np.concatenate([tau_full - h, -gamma[sel]]))
+        a, lam_sel = sol[: len(v)], sol[len(v):]
+    return a, A, sel, lam_sel
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_forces_match_pinocchio_kkt(robots, name):
+    """A^T lambda and every determined multiplier equal Pinocchio's KKT solution to 1e-9 (random velocities and
+    motor torques at the robot's neutral configuration)."""
+    robot = robots[name]
+    rng = np.random.default_rng(7)
+    q = robot.neutral()
+    for _ in range(3):
+        nu = rng.normal(scale=0.5, size=robot.mobility)
+        tau = rng.normal(size=len(robot.motors))
+        f = robot.contact_forces(q, nu, tau=tau)
+        red = robot.reduced(q, nu)
+        kin = robotdyn.constraint.KinematicState(robot.model, robot.data, q, red.v)
+        B = robotdyn.actuation.input_matrix(robot.motors, kin)
+        a_pin, A, sel, lam_pin = _pinocchio_kkt(robot, q, red.v, B @ tau)
+        scale = 1.0 + np.abs(A.T @ f.lam).max()
+        np.testing.assert_allclose(red.S @ f.nudot + red.w, a_pin, atol=1e-9 * (1 + np.abs(a_pin).max()))
+        # Pinocchio's convention: M a + h = tau + J^T lambda_c, the same sign as robotdyn's
+        np.testing.assert_allclose(A.T @ f.lam, A[sel].T @ lam_pin, atol=1e-9 * scale)
+        full = np.zeros(len(f.lam))
+        full[sel] = lam_pin
+        np.testing.assert_allclose(f.lam[f.determined], full[f.determined], atol=1e-9 * scale)
+        assert f.residual < 1e-10
+
+
+def _holding(robot, q):
+    """Motor torques that hold the robot at rest at q (inverse dynamics with zero accelerations)."""
+    return robot.inverse_dynamics(q, np.zeros(robot.mobility), np.zeros(robot.mobility))[1]
+
+
+@pytest.mark.parametrize("name", ["adaptable_wheel", "linkage_suspension"])
+def test_static_balance_at_rest(robots, name):
+    """At rest with holding torques, the ground's forces balance the weight: their sum is (0, 0, m g) and their
+    moment about the centre of mass is zero (Newton-Euler of the whole robot, independent of the projection)."""
+    robot = robots[name]
+    q = robot.neutral()
+    zero = np.zeros(robot.mobility)
+    f = robot.contact_forces(q, zero, nudot=zero, tau=_holding(robot, q))
+    assert all(w.determined[2] for w in f.wheels)  # every normal load (the linkage's two middle lateral forces
+    # are statically indeterminate; any member of lambda + N z has the same resultant, so the balance still holds)
+    mass = sum(robot.model.inertias[i].mass for i in range(robot.model.njoints))
+    g = -robot.model.gravity.linear[2]
+    com = pin.centerOfMass(robot.model, robot.data, q)
+    total = sum(w.world for w in f.wheels)
+    moment = sum(np.cross(w.point - com, w.world) for w in f.wheels)
+    np.testing.assert_allclose(total, [0.0, 0.0, mass * g], atol=1e-8 * mass * g)
+    np.testing.assert_allclose(moment, 0.0, atol=1e-8 * mass * g)
+    assert all(w.normal > 0 for w in f.wheels)
+
+
+def _disc_on_ramp(slope: float) -> tuple[Robot, np.ndarray]:
+    spec = RobotSpec(name="disc", title="rolling disc", xacro=DISC, root="planar", wheels=[Wheel("disc", 0.3)],
+                     independent=["psi", "lean", "spin"])
+    robot = Robot(spec, terrain=RampTerrain(slope))
+    q = np.zeros(robot.nq)
+    iz = robot.coordinate_index("z")
+
+    def gap(z):
+        qq = q.copy()
+        qq[iz] = z
+        return robot.constraint_residual(qq)[0]
+
+    q[iz] = brentq(gap, -2.0, 2.0, xtol=1e-15)
+    return robot, q
+
+
+@pytest.mark.parametrize("slope", [0.1, 0.5, 1.2])
+def test_disc_rolling_down_incline_closed_form(slope):
+    """A disc of inertia ratio k = I/(m R^2) rolling down an incline of angle alpha: normal load m g cos(alpha),
+    friction m g sin(alpha) k/(1+k) up the slope, required mu = tan(alpha) k/(1+k) (tan(alpha)/3 for a solid disc)."""
+    robot, q = _disc_on_ramp(slope)
+    m, inertia, radius, g = 2.0, 0.04, 0.3, 9.81
+    k = inertia / (m * radius**2)
+    alpha = np.arctan(slope)
+    f = robot.contact_forces(q, np.zeros(robot.mobility))
+    w = f.wheels[0]
+    assert f.all_determined
+    assert w.normal == pytest.approx(m * g * np.cos(alpha), rel=1e-12)
+    assert w.tangential == pytest.approx(m * g * np.sin(alpha) * k / (1 + k), rel=1e-12)
+    assert w.force[1] == pytest.approx(0.0, abs=1e-12)
+    assert w.required_mu == pytest.approx(np.tan(alpha) * k / (1 + k), rel=1e-12)
+    # the friction points up the slope (the ground holds the disc back): negative x in world axes
+    assert w.world[0] < 0
+
+
+def test_planar_root_reports_normal_loads_as_undetermined(robots):
+    """Under a planar root the normal rows act on no coordinate: the loads are reported undetermined, with why."""
+    f = robots["omni_caster"].contact_forces(robots["omni_caster"].neutral(), np.zeros(3))
+    assert not any(w.determined[2] for w in f.wheels)
+    assert any("act on no coordinate" in r for r in f.undetermined_reason)
+    assert "undetermined" in f.table()
+    assert f.as_dict()["wheels"]["wheel_1"]["required_mu"] is None
+
+
+def test_redundant_rows_give_the_null_space(robots):
+    """Quasimoro's two lateral rows on one axle: only their sum is determined; the null space says which
+    combination is free, and A^T N = 0."""
+    robot = robots["quasimoro"]
+    q = robot.neutral()
+    f = robot.contact_forces(q, [0.3, -0.2, 0.1], tau=[0.2, -0.1])
+    A = robot.rows_at(q).A
+    np.testing.assert_allclose(A.T @ f.null_space, 0.0, atol=1e-12)
+    i, j = f.labels.index("wheel_A.lateral"), f.labels.index("wheel_B.lateral")
+    assert not f.determined[i] and not f.determined[j]
+    # the sum of the two lateral forces is determined: it is orthogonal to every null direction
+    np.testing.assert_allclose(f.null_space[i] + f.null_space[j], 0.0, atol=1e-12)
+
+
+def test_bad_input_is_one_line(robots):
+    robot = robots["quasimoro"]
+    with pytest.raises(InputError, match="tau"):
+        robot.contact_forces(robot.neutral(), np.zeros(3), tau=[1.0])
+    with pytest.raises(InputError, match="unknown wheel"):
+        robot.contact_forces(robot.neutral(), np.zeros(3)).wheel("nope")

@@ -37,6 +37,9 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     axis = [0, 0, 1]                    # axle in the wheel frame (default: the spin joint's axis)
     kind = "standard"                   # standard | omni (with roller_angle) | caster (a standard wheel on a
                                         # steering joint of the URDF: nothing special)
+    mu = 0.8                            # friction coefficient (traction checks; the coulomb law's mu)
+    friction = "rolling"                # rolling (no slip, default) | coulomb (regularised: slip_velocity [m/s],
+                                        # default 1e-3) | linear (stiffness [s/m], saturated at mu if given)
     [[closures]]
     frame1 = "a"; frame2 = "b"; components = "x y z"   # subset of x y z rx ry rz in frame1's axes
 
@@ -52,6 +55,7 @@ from __future__ import annotations
 import difflib
 import fnmatch
 import inspect
+import math
 import os
 import re
 import sysconfig
@@ -63,7 +67,8 @@ from pathlib import Path
 import numpy as np
 
 from .description import _ROOT_CHAINS, ROOT_KINDS, expand_xacro
-from .errors import RobotDynError
+from .errors import InputError, RobotDynError
+from .friction import LAWS, make_law
 from .robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
 from .scenario import Scenario
 from .terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
@@ -78,7 +83,8 @@ TOP_KEYS = (
     "locked", "terrain", "parameters", "wheels", "closures", "motors", "scenarios", "paper",
 )
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro")
-WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint")
+WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
+              "slip_velocity", "stiffness")
 WHEEL_KINDS = ("standard", "omni", "caster")
 CLOSURE_KEYS = ("name", "frame1", "frame2", "components")
 MOTOR_KEYS = ("name", "joint", "reaction")
@@ -431,8 +437,24 @@ def read(
                 r.fail(where, "roller_angle is only meaningful for kind = 'omni'")
             if not (isinstance(roller, str) and roller in pvalues):
                 roller = r.number(where, roller, "roller_angle")
-        wheels.append(Wheel(fname, radius, tuple(float(a) for a in axis), "omni" if kind == "omni" else "standard",
-                            roller, w.get("radius_joint"), w.get("name", fname)))
+        friction = w.get("friction", "rolling")
+        if not isinstance(friction, str):
+            r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
+        numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness") if key in w}
+        wheel = Wheel(fname, radius, tuple(float(a) for a in axis), "omni" if kind == "omni" else "standard",
+                      roller, w.get("radius_joint"), w.get("name", fname), friction=friction, **numbers)
+        try:  # the friction keys' physics (mu >= 0, a known law with its parameters) in one line
+            if friction != "rolling":
+                if wheel.kind != "standard":
+                    raise InputError(f"friction law {friction!r} on an omni wheel; expected a standard wheel")
+                make_law(friction, wheel.mu, wheel.slip_velocity, wheel.stiffness, wheel.name)
+            elif wheel.mu is not None and not (math.isfinite(wheel.mu) and wheel.mu >= 0):
+                raise InputError(f"mu = {wheel.mu}; expected a friction coefficient >= 0")
+            elif wheel.slip_velocity is not None or wheel.stiffness is not None:
+                raise InputError("slip_velocity/stiffness need friction = 'coulomb' or 'linear'")
+        except InputError as exc:
+            r.fail(where, str(exc))
+        wheels.append(wheel)
 
     # ----------------------------------------------------------------------------------------- closures
     closures: list[Closure] = []

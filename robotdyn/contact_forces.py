@@ -40,6 +40,8 @@ from .constraint import KinematicState
 from .errors import InputError, NonFiniteError
 from .loop_closure import LoopClosure
 from .rolling_contact import RollingWheel
+from .sliding import forward as forward_sliding
+from .sliding import slipping_wheels
 
 DETERMINED_TOL = 1e-8
 """A row (or force component) is determined when its weight in every null-space direction is below this."""
@@ -202,7 +204,17 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
     q = robot.check_q(q)
     nu = robot.check_nu(nu, "v")
     red = robot.reduced(q, nu)
-    if nudot is None:
+    friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
+    if slipping_wheels(robot):
+        if nudot is not None:
+            raise InputError("with slipping wheels the forces follow from motor torques: give tau, not nudot")
+        tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
+        st = forward_sliding(robot, q, nu, tau)
+        nudot = st.nudot
+        kin_v = KinematicState(robot.model, robot.data, q, red.v)
+        for i, wheel in enumerate(slipping_wheels(robot)):
+            friction[wheel.name] = (wheel.slip(kin_v)[0], st.force[i])
+    elif nudot is None:
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
     else:
@@ -216,6 +228,8 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
     kin = KinematicState(model, data, q, red.v)
     B = input_matrix(robot.motors, kin)
     e = pin.rnea(model, data, q, red.v, a) - B @ tau
+    for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
+        e -= Jt.T @ force
     rows = red.jacobian_rows
     A = rows.A
     lam, N, rank, residual = _solve_transpose(A, e)
@@ -224,7 +238,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
     index = {lab: i for i, lab in enumerate(rows.labels)}
     for c in robot.constraints:
         if isinstance(c, RollingWheel):
-            out.wheels.append(_wheel_force(c, kin, index, lam, N))
+            out.wheels.append(_wheel_force(c, kin, index, lam, N, friction.get(c.name, (None, None))[1]))
         elif isinstance(c, LoopClosure):
             out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
                                     if f"{c.name}.{comp}" in index}
@@ -250,8 +264,9 @@ def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def _wheel_force(wheel: RollingWheel, kin: KinematicState, index: dict, lam: np.ndarray,
-                 N: np.ndarray) -> WheelForce:
-    """A wheel's force in its contact frame, from its rows' multipliers (row i acts along D[i] of (t1, t2, n))."""
+                 N: np.ndarray, friction: np.ndarray | None = None) -> WheelForce:
+    """A wheel's force in its contact frame, from its rows' multipliers (row i acts along D[i] of (t1, t2, n));
+    a slipping wheel's tangential part is its friction force (t1, t2)."""
     geo = wheel._geometry(kin)
     E, p = geo[9], geo[5]
     labels = wheel._labels()
@@ -264,6 +279,9 @@ def _wheel_force(wheel: RollingWheel, kin: KinematicState, index: dict, lam: np.
     else:
         determined = np.ones(3, bool)
     kind = "support" if D.shape[0] == 1 else ("omni" if D.shape[0] == 2 else "standard")
+    if friction is not None:
+        force[:2] = friction
+        kind = "slipping"
     return WheelForce(wheel.name, kind, force, determined, E @ force, np.array(p, float))
 
 

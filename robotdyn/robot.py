@@ -21,11 +21,14 @@ from .constraint import ConstraintRows, KinematicState
 from .description import URDF_DIR, Description, build_description, expand_xacro
 from .dynamics import energy
 from .errors import ConstraintError, InputError
+from .friction import make_law
 from .inputs import as_vector
 from .loop_closure import LoopClosure
 from .projection import auto_independent
 from .reduced_dynamics import ReducedDynamics, reduce
 from .rolling_contact import OmniWheel, RollingWheel, SupportWheel
+from .sliding import SlippingWheel, slipping_wheels
+from .sliding import forward as forward_sliding
 from .terrain import FlatTerrain, Terrain
 
 
@@ -66,7 +69,10 @@ class Wheel:
     roller_angle: float | str = 0.0
     radius_joint: str | None = None
     name: str | None = None
-    mu: float | None = None  # friction coefficient (traction checks); None: not given
+    mu: float | None = None  # friction coefficient (traction checks, friction laws); None: not given
+    friction: str = "rolling"  # rolling (no slip) | coulomb | linear (robotdyn.friction)
+    slip_velocity: float | None = None  # coulomb law's regularisation scale [m/s]
+    stiffness: float | None = None  # linear law's slip stiffness [s/m]
 
 
 @dataclass
@@ -209,6 +215,18 @@ class Robot:
     def _wheel(self, w: Wheel):
         kw = dict(axis=w.axis, terrain=None, radius_joint=w.radius_joint, name=w.name)
         kw["terrain"] = self.terrain
+        name = w.name or w.frame
+        if w.mu is not None and not (np.isfinite(float(w.mu)) and float(w.mu) >= 0):
+            raise InputError(f"wheel {name!r}: mu = {w.mu}; expected a friction coefficient >= 0")
+        if w.friction not in ("rolling", None):
+            if w.kind != "standard":
+                raise InputError(f"wheel {name!r}: friction law {w.friction!r} on a {w.kind} wheel; expected a "
+                                 "standard wheel (support wheels are frictionless, omni wheels roll on rollers)")
+            law = make_law(w.friction, w.mu, w.slip_velocity, w.stiffness, wheel=name)
+            return SlippingWheel(self.description, w.frame, self._value(w.radius), law, **kw)
+        if w.slip_velocity is not None or w.stiffness is not None:
+            raise InputError(f"wheel {name!r}: slip_velocity/stiffness given but friction = 'rolling'; expected "
+                             "friction = 'coulomb' or 'linear'")
         if w.kind == "omni":
             return OmniWheel(self.description, w.frame, self._value(w.radius), self._value(w.roller_angle), **kw)
         if w.kind == "support":
@@ -314,7 +332,10 @@ class Robot:
         return M, C, g
 
     def forward_dynamics(self, q, nu, tau) -> np.ndarray:
-        """Independent accelerations :math:`\\dot\\nu = M_r^{-1}(B_r\\tau - C_r\\nu - g_r)`."""
+        """Independent accelerations :math:`\\dot\\nu = M_r^{-1}(B_r\\tau - C_r\\nu - g_r)` (with slipping
+        wheels, together with their normal loads and friction: :func:`robotdyn.sliding.forward`)."""
+        if slipping_wheels(self):
+            return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
         red = self.reduced(q, nu)
         return np.linalg.solve(red.M, red.B @ np.asarray(tau, float) - red.h)
 

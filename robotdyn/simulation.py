@@ -25,6 +25,8 @@ from .compiled import Fallback, compiled_model
 from .errors import RobotDynError
 from .projection import solve
 from .reduced_dynamics import velocity
+from .sliding import forward as forward_sliding
+from .sliding import slipping_wheels
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
@@ -42,6 +44,8 @@ class Trajectory:
         coordinates, velocity_names: Column names.
         stats: Integrator statistics (nfev, wall time).
         units: Unit of each column by name (m, rad, m/s, rad/s).
+        friction_work: Work done by the slipping wheels' friction forces since t = 0 (N,) [J] (<= 0; ``None``
+            without slipping wheels): energy balance E(t) - E(0) = motor work + friction_work.
     """
 
     t: np.ndarray
@@ -53,6 +57,7 @@ class Trajectory:
     velocity_names: list[str]
     stats: dict = field(default_factory=dict)
     units: dict[str, str] = field(default_factory=dict)
+    friction_work: np.ndarray | None = None
 
     def __repr__(self) -> str:
         return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"
@@ -125,11 +130,17 @@ def simulate(
     zero_tau = np.zeros(len(robot.motors))
     report = _Progress(t_end, progress)
 
-    fast = compiled_model(robot)
+    slipping = slipping_wheels(robot)
+    fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path
+    k = robot.mobility
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
-        q, nu = y[:n], y[n:]
+        q, nu = y[:n], y[n:n + k]
         tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
+        if slipping:  # normal loads and friction solved with the accelerations; y[-1] is the friction work
+            st = forward_sliding(robot, q, nu, tau)
+            report(t)
+            return np.concatenate([_qdot(st.reduced, stabilisation), st.nudot, [st.power]])
         if fast is not None:
             try:  # the whole right-hand side in one compiled call (robotdyn.compiled)
                 out = fast.rhs(q, nu, tau, stabilisation)
@@ -139,21 +150,35 @@ def simulate(
                 pass
         red = robot.reduced(q, nu)
         nudot = solve(red.M, red.B @ tau - red.h)  # numpy.linalg.solve's LAPACK call, without its overhead
-        qdot = red.v
-        rows = red.jacobian_rows
-        hol = rows.holonomic
-        if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
-            qdot = qdot - stabilisation * np.linalg.lstsq(rows.A[hol], rows.residual[hol], rcond=None)[0]
         report(t)
-        return np.concatenate([qdot, nudot])
+        return np.concatenate([_qdot(red, stabilisation), nudot])
 
+    events = None
+    if slipping:
+        def lift_off(t: float, y: np.ndarray) -> float:  # the smallest normal load of a slipping wheel [N]
+            q, nu = y[:n], y[n:n + k]
+            tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
+            return float(np.min(forward_sliding(robot, q, nu, tau).normal))
+
+        lift_off.terminal, lift_off.direction = True, -1.0
+        events = [lift_off]
     t_eval = np.linspace(0.0, t_end, n_out)
     start = time.perf_counter()
-    sol = solve_ivp(rhs, (0.0, t_end), np.concatenate([q0, nu0]), method=method, t_eval=t_eval, rtol=rtol, atol=atol)
+    y0 = np.concatenate([q0, nu0, [0.0] if slipping else []])
+    sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
     wall = time.perf_counter() - start
     if not sol.success:
         raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}")
-    q, nu = sol.y[:n].T, sol.y[n:].T
+    stats_event = None
+    if slipping and sol.status == 1:  # a slipping wheel's load reached zero: the contact model ends there
+        t_ev, y_ev = sol.t_events[0][0], sol.y_events[0][0]
+        st = forward_sliding(robot, y_ev[:n], y_ev[n:n + k], zero_tau if torque is None else
+                             np.asarray(torque(t_ev, y_ev[:n], y_ev[n:n + k]), float))
+        wheel = slipping[int(np.argmin(st.normal))].name
+        stats_event = (f"lift-off of wheel {wheel} at t = {t_ev:.6g} s (normal load {np.min(st.normal):.3g} N): "
+                       "the run stops there (a wheel in flight is not modelled)")
+        print(f"simulate: {stats_event}", file=sys.stderr, flush=True)
+    q, nu = sol.y[:n].T, sol.y[n:n + k].T
     energy = np.empty(len(sol.t))
     residual = np.zeros(len(sol.t))
     for i in range(len(sol.t)):
@@ -162,8 +187,20 @@ def simulate(
         if holonomic.any():
             residual[i] = np.max(np.abs(res[holonomic]))
     stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol}
+    if stats_event:
+        stats["event"] = stats_event
     return Trajectory(sol.t, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
-                      robot.units)
+                      robot.units, sol.y[n + k] if slipping else None)
+
+
+def _qdot(red, stabilisation: float) -> np.ndarray:
+    """:math:`\\dot q = v - \\alpha A_h^+\\phi`: the velocity with the holonomic residuals pulled back."""
+    qdot = red.v
+    rows = red.jacobian_rows
+    hol = rows.holonomic
+    if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
+        qdot = qdot - stabilisation * np.linalg.lstsq(rows.A[hol], rows.residual[hol], rcond=None)[0]
+    return qdot
 
 
 def _velocity(robot, fast, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

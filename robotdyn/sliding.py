@@ -1,0 +1,124 @@
+"""Wheels that slip: a normal contact kept as a constraint, the tangential force from a friction law.
+
+A :class:`SlippingWheel` contributes only its holonomic normal row (it stays on the terrain); the no-slip rows
+are replaced by the force of its :class:`~robotdyn.friction.FrictionLaw`, applied at the contact point:
+:math:`J_t^T F_t` with :math:`J_t` the tangential rows of the rolling Jacobian (the slip velocity is
+:math:`s = J_t v`) and :math:`F_t = -f_n c(s)`. The normal load :math:`f_n` is a constraint force, so it depends on
+the accelerations; with the friction direction fixed by the current slip, the system in
+:math:`(\\dot\\nu, \\lambda)` stays linear and is solved exactly at each evaluation (no lagged load,
+``shared/notes/contact-forces-and-friction.md``):
+
+.. math:: M S\\dot\\nu - \\Big(A_R^T - \\sum_i J_{t,i}^T c_i e_{n_i}^T\\Big)\\lambda = B\\tau - \\mathrm{RNEA}(q, v, w),
+
+with :math:`A_R` the independent constraint rows the projection uses and :math:`e_{n_i}` selecting wheel i's
+normal multiplier. A singular system is the Painlevé paradox of Coulomb friction (no or many solutions): it is
+reported, never regularised silently.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from .actuation import input_matrix
+from .constraint import KinematicState
+from .errors import ConstraintError, SingularConstraintError
+from .friction import FrictionLaw
+from .rolling_contact import SupportWheel
+
+PAINLEVE_CONDITION = 1e12
+"""Condition number of the coupled system above which it counts as singular."""
+
+
+class SlippingWheel(SupportWheel):
+    """A wheel that keeps contact (its normal row) and slips under a friction law.
+
+    Args:
+        law: The :class:`~robotdyn.friction.FrictionLaw` of its tangential force.
+        Other arguments as :class:`~robotdyn.rolling_contact.RollingWheel`.
+    """
+
+    def __init__(self, description, frame: str, radius: float, law: FrictionLaw, **kwargs) -> None:
+        super().__init__(description, frame, radius, **kwargs)
+        self.law = law
+
+    def __repr__(self) -> str:
+        return f"SlippingWheel(frame={self.frame!r}, radius={self.radius}, law={self.law!r}, terrain={self.terrain!r})"
+
+    def slip(self, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
+        """The tangential rows :math:`J_t` (2, nv) (t1 longitudinal, t2 lateral of the contact frame) and the slip
+        velocity :math:`s = J_t v` (2,) [m/s] at the state of ``kin``."""
+        Aw, geo = self._world_jacobian(kin)
+        Jt = geo[9][:, :2].T @ Aw
+        return Jt, Jt @ kin.v
+
+
+def slipping_wheels(robot) -> list[SlippingWheel]:
+    """The robot's slipping wheels (empty: every wheel rolls without slipping)."""
+    return [c for c in robot.constraints if isinstance(c, SlippingWheel)]
+
+
+@dataclass
+class SlidingState:
+    """Forward dynamics with slipping wheels at one state.
+
+    Attributes:
+        nudot: Independent accelerations (k,).
+        reduced: The :class:`~robotdyn.reduced_dynamics.ReducedDynamics` at the state (S, w, v, rows).
+        normal: Normal load of each slipping wheel (W,) [N].
+        slip: Slip velocity of each slipping wheel (W, 2) [m/s] (t1, t2).
+        force: Friction force on each slipping wheel (W, 2) [N] (t1, t2).
+        power: Power of the friction forces :math:`\\sum F_t\\cdot s` [W] (<= 0 while loads are positive).
+    """
+
+    nudot: np.ndarray
+    reduced: object
+    normal: np.ndarray
+    slip: np.ndarray
+    force: np.ndarray
+    power: float
+
+
+def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingState:
+    """Accelerations and normal loads with the slipping wheels' friction, solved together (see the module).
+
+    Raises:
+        ConstraintError: a slipping wheel's normal row is redundant (its load is not determined).
+        SingularConstraintError: the coupled system is singular (Painlevé).
+    """
+    wheels = slipping_wheels(robot)
+    red = robot.reduced(q, nu)
+    model, data = robot.model, robot.data
+    kin = KinematicState(model, data, q, red.v)
+    rows = red.jacobian_rows
+    kept = np.asarray(red.projection.rows, int)
+    G = rows.A[kept].T.copy()
+    slip = np.zeros((len(wheels), 2))
+    coef = np.zeros((len(wheels), 2))
+    position = np.zeros(len(wheels), int)
+    for i, wheel in enumerate(wheels):
+        row = rows.labels.index(f"{wheel.name}.normal")
+        hit = np.flatnonzero(kept == row)
+        if not hit.size:
+            raise ConstraintError(f"slipping wheel {wheel.name!r}: its normal row is redundant here, so its load "
+                                  "(and its friction) is not determined by rigid-body dynamics")
+        Jt, slip[i] = wheel.slip(kin)
+        coef[i] = wheel.law.coefficient(slip[i])
+        position[i] = hit[0]
+        G[:, hit[0]] -= Jt.T @ coef[i]
+    M = pin.crba(model, data, q)
+    K = np.hstack([M @ red.S, -G])
+    rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
+    cond = np.linalg.cond(K)
+    if not np.isfinite(cond) or cond > PAINLEVE_CONDITION:
+        raise SingularConstraintError(
+            f"the friction of slipping wheels {', '.join(w.name for w in wheels)} makes the contact problem "
+            f"singular (condition {cond:.3g}; Painleve paradox: the accelerations and loads have no or many "
+            "solutions); expected a smaller mu or another friction law", cond)
+    sol = np.linalg.solve(K, rhs)
+    k = red.S.shape[1]
+    normal = sol[k + position]
+    force = -normal[:, None] * coef
+    return SlidingState(sol[:k], red, normal, slip, force, float(np.sum(force * slip)))

@@ -163,7 +163,12 @@ def cmd_simulate(args) -> int:
     sc = scenarios[args.scenario]
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet)
     tr = None
-    if any(isinstance(c, RollingWheel) for c in robot.constraints):
+    switches = traj.stats.get("switches")
+    if switches is not None:  # exact stick-slip: the phases' switches stand for the traction summary
+        if args.mu is not None or args.traction_plot:
+            raise RobotDynError("--mu/--traction-plot: this robot's wheels switch between sticking and sliding "
+                                "(friction = 'stick_slip'); their phases are reported instead")
+    elif any(isinstance(c, RollingWheel) for c in robot.constraints):
         from .traction import plot_traction, traction
 
         tr = traction(robot, traj, sc.torque, args.mu)
@@ -194,6 +199,14 @@ def cmd_simulate(args) -> int:
             f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
     if tr is not None:
         text.append(tr.summary())
+    if switches is not None:
+        out["switches"] = switches
+        text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
+            f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
+            + ("; ..." if len(switches) > 10 else ""))
+    if "event" in traj.stats:
+        out["stopped"] = traj.stats["event"]
+        text.append(f"stopped early: {traj.stats['event']}")
     if args.csv:
         text.append(f"wrote {args.csv}")
     if args.plot:

@@ -41,7 +41,7 @@ from .errors import InputError, NonFiniteError
 from .loop_closure import LoopClosure
 from .rolling_contact import RollingWheel
 from .sliding import forward as forward_sliding
-from .sliding import slipping_wheels
+from .sliding import sliding_now, tangential
 
 DETERMINED_TOL = 1e-8
 """A row (or force component) is determined when its weight in every null-space direction is below this."""
@@ -205,15 +205,15 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
     nu = robot.check_nu(nu, "v")
     red = robot.reduced(q, nu)
     friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
-    if slipping_wheels(robot):
+    if sliding_now(robot):
         if nudot is not None:
             raise InputError("with slipping wheels the forces follow from motor torques: give tau, not nudot")
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         st = forward_sliding(robot, q, nu, tau)
         nudot = st.nudot
         kin_v = KinematicState(robot.model, robot.data, q, red.v)
-        for i, wheel in enumerate(slipping_wheels(robot)):
-            friction[wheel.name] = (wheel.slip(kin_v)[0], st.force[i])
+        for i, wheel in enumerate(sliding_now(robot)):
+            friction[wheel.name] = (tangential(wheel, kin_v)[0], st.force[i])
     elif nudot is None:
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         nudot = np.linalg.solve(red.M, red.B @ tau - red.h)

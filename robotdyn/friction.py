@@ -91,6 +91,30 @@ class LinearTyre(FrictionLaw):
         return f"LinearTyre(stiffness={self.stiffness} s/m, mu={self.mu})"
 
 
+class ExactCoulomb(FrictionLaw):
+    """Coulomb friction without regularisation, for wheels that stick and slide with exact switching
+    (:mod:`robotdyn.stick_slip`): sticking inside the cone :math:`\\|f_t\\| \\le \\mu f_n`, sliding with
+    :math:`c = \\mu\\hat s`.
+
+    Args:
+        mu: Friction coefficient (>= 0).
+    """
+
+    name = "stick_slip"
+
+    def __init__(self, mu: float) -> None:
+        self.mu = _coefficient(mu, "mu")
+
+    def coefficient(self, s: np.ndarray) -> np.ndarray:
+        speed = math.sqrt(float(s @ s))
+        if speed == 0.0:
+            raise InputError("exact Coulomb friction has no direction at zero slip; expected a sliding wheel")
+        return self.mu * s / speed
+
+    def __repr__(self) -> str:
+        return f"ExactCoulomb(mu={self.mu})"
+
+
 LAWS = {"coulomb": RegularisedCoulomb, "linear": LinearTyre}
 """The friction laws by the name used in TOML files and the API (``rolling``: no slip, the default)."""
 
@@ -100,11 +124,18 @@ def make_law(name: str, mu: float | None = None, slip_velocity: float | None = N
     """A friction law from its name and parameters, with one-line errors naming the wheel.
 
     Args:
-        name: ``coulomb`` (needs ``mu``; ``slip_velocity`` default 1e-3 m/s) or ``linear`` (needs ``stiffness``;
-            ``mu`` saturates it, default none).
+        name: ``coulomb`` (needs ``mu``; ``slip_velocity`` default 1e-3 m/s), ``linear`` (needs ``stiffness``;
+            ``mu`` saturates it, default none) or ``stick_slip`` (needs ``mu``: exact switching,
+            :mod:`robotdyn.stick_slip`).
         wheel: The wheel's name, for messages.
     """
     try:
+        if name == "stick_slip":
+            if mu is None:
+                raise InputError("the stick_slip law needs mu")
+            if slip_velocity is not None or stiffness is not None:
+                raise InputError("stick_slip is exact Coulomb friction: no slip_velocity or stiffness")
+            return ExactCoulomb(mu)
         if name == "coulomb":
             if mu is None:
                 raise InputError("the coulomb law needs mu")
@@ -117,7 +148,8 @@ def make_law(name: str, mu: float | None = None, slip_velocity: float | None = N
             return LinearTyre(stiffness, math.inf if mu is None else mu)
     except InputError as exc:
         raise InputError(f"wheel {wheel!r}: {exc}") from None
-    raise InputError(f"wheel {wheel!r}: unknown friction law {name!r}; expected one of rolling, {', '.join(LAWS)}")
+    raise InputError(f"wheel {wheel!r}: unknown friction law {name!r}; expected one of rolling, {', '.join(LAWS)}, "
+                     "stick_slip")
 
 
 def _coefficient(value, what: str) -> float:

@@ -27,7 +27,7 @@ from .loop_closure import LoopClosure
 from .projection import auto_independent
 from .reduced_dynamics import ReducedDynamics, reduce
 from .rolling_contact import OmniWheel, RollingWheel, SupportWheel
-from .sliding import SlippingWheel, slipping_wheels
+from .sliding import SlippingWheel, sliding_now
 from .sliding import forward as forward_sliding
 from .terrain import FlatTerrain, Terrain
 
@@ -223,6 +223,10 @@ class Robot:
                 raise InputError(f"wheel {name!r}: friction law {w.friction!r} on a {w.kind} wheel; expected a "
                                  "standard wheel (support wheels are frictionless, omni wheels roll on rollers)")
             law = make_law(w.friction, w.mu, w.slip_velocity, w.stiffness, wheel=name)
+            if w.friction == "stick_slip":
+                from .stick_slip import StickSlipWheel
+
+                return StickSlipWheel(self.description, w.frame, self._value(w.radius), law.mu, **kw)
             return SlippingWheel(self.description, w.frame, self._value(w.radius), law, **kw)
         if w.slip_velocity is not None or w.stiffness is not None:
             raise InputError(f"wheel {name!r}: slip_velocity/stiffness given but friction = 'rolling'; expected "
@@ -334,7 +338,7 @@ class Robot:
     def forward_dynamics(self, q, nu, tau) -> np.ndarray:
         """Independent accelerations :math:`\\dot\\nu = M_r^{-1}(B_r\\tau - C_r\\nu - g_r)` (with slipping
         wheels, together with their normal loads and friction: :func:`robotdyn.sliding.forward`)."""
-        if slipping_wheels(self):
+        if sliding_now(self):
             return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
         red = self.reduced(q, nu)
         return np.linalg.solve(red.M, red.B @ np.asarray(tau, float) - red.h)

@@ -126,6 +126,11 @@ def simulate(
     q0 = robot.check_q(q0)
     nu0 = robot.check_nu(nu0)
     robot.check_constraints(q0)
+    if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):  # exact switching: segment by segment
+        from .stick_slip import simulate as simulate_stick_slip
+
+        return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol, method,
+                                   stabilisation, progress)
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
     report = _Progress(t_end, progress)

@@ -40,19 +40,37 @@ class SlippingWheel(SupportWheel):
         Other arguments as :class:`~robotdyn.rolling_contact.RollingWheel`.
     """
 
+    sliding = True  # its friction force comes from a law (robotdyn.sliding.forward)
+
     def __init__(self, description, frame: str, radius: float, law: FrictionLaw, **kwargs) -> None:
         super().__init__(description, frame, radius, **kwargs)
         self.law = law
+
+    def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
+        """:math:`c(s)` of its law: the friction force is :math:`-f_n c(s)` (t1, t2)."""
+        return self.law.coefficient(s)
 
     def __repr__(self) -> str:
         return f"SlippingWheel(frame={self.frame!r}, radius={self.radius}, law={self.law!r}, terrain={self.terrain!r})"
 
     def slip(self, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
-        """The tangential rows :math:`J_t` (2, nv) (t1 longitudinal, t2 lateral of the contact frame) and the slip
-        velocity :math:`s = J_t v` (2,) [m/s] at the state of ``kin``."""
-        Aw, geo = self._world_jacobian(kin)
-        Jt = geo[9][:, :2].T @ Aw
-        return Jt, Jt @ kin.v
+        """The tangential rows :math:`J_t` (2, nv) and the slip velocity (2,) [m/s]: :func:`tangential`."""
+        return tangential(self, kin)
+
+
+def tangential(wheel, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
+    """A wheel's tangential rows :math:`J_t` (2, nv) (t1 longitudinal, t2 lateral of the contact frame) and its slip
+    velocity :math:`s = J_t v` (2,) [m/s] at the state of ``kin`` (the velocity of its material point at the
+    contact, in the tangent plane)."""
+    Aw, geo = wheel._world_jacobian(kin)
+    Jt = geo[9][:, :2].T @ Aw
+    return Jt, Jt @ kin.v
+
+
+def sliding_now(robot) -> list:
+    """The robot's wheels whose tangential force currently comes from friction (slipping wheels, and stick-slip
+    wheels in their sliding phase)."""
+    return [c for c in robot.constraints if getattr(c, "sliding", False)]
 
 
 def slipping_wheels(robot) -> list[SlippingWheel]:
@@ -88,7 +106,7 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
         ConstraintError: a slipping wheel's normal row is redundant (its load is not determined).
         SingularConstraintError: the coupled system is singular (Painlevé).
     """
-    wheels = slipping_wheels(robot)
+    wheels = sliding_now(robot)
     red = robot.reduced(q, nu)
     model, data = robot.model, robot.data
     kin = KinematicState(model, data, q, red.v)
@@ -104,8 +122,8 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
         if not hit.size:
             raise ConstraintError(f"slipping wheel {wheel.name!r}: its normal row is redundant here, so its load "
                                   "(and its friction) is not determined by rigid-body dynamics")
-        Jt, slip[i] = wheel.slip(kin)
-        coef[i] = wheel.law.coefficient(slip[i])
+        Jt, slip[i] = tangential(wheel, kin)
+        coef[i] = wheel.friction_coefficient(slip[i])
         position[i] = hit[0]
         G[:, hit[0]] -= Jt.T @ coef[i]
     M = pin.crba(model, data, q)

@@ -20,9 +20,9 @@ M, I, R, G = 2.0, 0.04, 0.3, 9.81  # tests/data/disc.urdf: mass, axle inertia; w
 K = I / (M * R**2)  # inertia ratio (1/2 for a solid disc)
 
 
-def disc(slope: float = 0.0, **friction) -> tuple[Robot, np.ndarray]:
+def disc(slope: float = 0.0, independent=("x", "y", "psi", "lean", "spin"), **friction) -> tuple[Robot, np.ndarray]:
     spec = RobotSpec(name="disc", title="sliding disc", xacro=DISC, root="planar",
-                     wheels=[Wheel("disc", R, **friction)], independent=["x", "y", "psi", "lean", "spin"])
+                     wheels=[Wheel("disc", R, **friction)], independent=None if independent is None else list(independent))
     robot = Robot(spec, terrain=RampTerrain(slope))
     q = np.zeros(robot.nq)
     iz = robot.coordinate_index("z")

@@ -111,6 +111,8 @@ class ConstraintForces:
         wheels: One :class:`WheelForce` per rolling, omni or support wheel.
         closures: Loop-closure forces/moments by closure name, then component (x, y, z [N]; rx, ry, rz [N m]).
         undetermined_reason: Why rows are undetermined (empty when all are determined).
+        notes: How the forces were obtained where that is not the model itself (e.g. a planar model's loads from
+            its floating twin).
     """
 
     labels: list[str]
@@ -124,11 +126,44 @@ class ConstraintForces:
     wheels: list[WheelForce] = field(default_factory=list)
     closures: dict[str, dict[str, float]] = field(default_factory=dict)
     undetermined_reason: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    _tangential: list = field(default_factory=list, repr=False)  # per wheel: (row indices, D, friction or None)
 
     @property
     def all_determined(self) -> bool:
         """Whether every multiplier is determined by rigid-body dynamics."""
         return bool(self.determined.all())
+
+    def minimum_mu(self) -> float | None:
+        """The smallest friction coefficient with which some force distribution that rigid-body dynamics allow
+        (:math:`\\lambda + N z`) lies inside every wheel's friction cone:
+        :math:`\\min_z \\max_i \\|f_{t,i}(z)\\| / f_{n,i}` (a convex problem, solved by SLSQP in epigraph form).
+
+        Equal to the largest per-wheel required mu when every friction force is determined; ``None`` when a
+        normal load is undetermined; ``inf`` when a wheel is not pressed on the ground."""
+        if not self.wheels or not all(w.determined[2] for w in self.wheels):
+            return None
+        fn = np.array([w.normal for w in self.wheels])
+        if np.any(fn <= 0):
+            return float("inf")
+        maps = []  # f_t,i(z) = base_i + T_i z
+        for (idx, D, friction), w in zip(self._tangential, self.wheels):
+            if friction is not None:
+                maps.append((np.asarray(friction, float), np.zeros((2, self.null_space.shape[1]))))
+            else:
+                maps.append((D.T[:2] @ self.lam[idx], D.T[:2] @ self.null_space[idx]))
+        ratio = lambda z: max(float(np.linalg.norm(b + T @ z)) / f for (b, T), f in zip(maps, fn))  # noqa: E731
+        d = self.null_space.shape[1]
+        if d == 0 or all(not np.any(T) for _, T in maps):
+            return ratio(np.zeros(d))
+        from scipy.optimize import minimize
+
+        cons = [{"type": "ineq", "fun": (lambda x, b=b, T=T, f=f: (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2))}
+                for (b, T), f in zip(maps, fn)]
+        x0 = np.append(np.zeros(d), ratio(np.zeros(d)))
+        res = minimize(lambda x: x[-1], x0, constraints=cons, bounds=[(None, None)] * d + [(0, None)],
+                       method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
+        return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
 
     def wheel(self, name: str) -> WheelForce:
         """The force on the wheel called ``name``."""
@@ -158,6 +193,8 @@ class ConstraintForces:
                 for col in self.null_space.T
             ],
             "undetermined_reason": self.undetermined_reason,
+            "notes": self.notes,
+            "minimum_mu": self.minimum_mu(),
             "residual": self.residual,
         }
 
@@ -178,6 +215,13 @@ class ConstraintForces:
             lines.append(f"closure {name} (on frame 2's body, frame 1's axes; N, N m): " + ", ".join(parts))
         for reason in self.undetermined_reason:
             lines.append(f"not determined by rigid-body dynamics: {reason}")
+        if self.wheels and not all(w.load_determined for w in self.wheels):
+            mu = self.minimum_mu()
+            if mu is not None:
+                lines.append(f"smallest mu with which some admissible split of the undetermined forces lies in every "
+                             f"friction cone: {mu:.6g}")
+        for note in self.notes:
+            lines.append(f"note: {note}")
         return "\n".join(lines)
 
     def __repr__(self) -> str:
@@ -186,7 +230,7 @@ class ConstraintForces:
                 f"wheels={[w.name for w in self.wheels]}, closures={list(self.closures)})")
 
 
-def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
+def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> ConstraintForces:
     """Constraint forces at (q, nu) for given motor torques (forward dynamics) or accelerations (inverse dynamics).
 
     Args:
@@ -197,6 +241,8 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
             (default: zero torques).
         nudot: Independent accelerations (k,); the motor torques then follow by least squares (``tau`` given
             too: those torques are used as given, and ``residual`` says whether they produce ``nudot``).
+        twin: For a planar-root robot whose normal loads the planar model leaves undetermined, take them from its
+            floating twin (:func:`_from_floating_twin`); False keeps the planar model's own answer.
 
     Returns:
         The :class:`ConstraintForces`.
@@ -223,14 +269,22 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
             tau = robot.inverse_dynamics(q, nu, nudot)[1]
         else:
             tau = robot.check_tau(tau)
-    model, data = robot.model, robot.data
     a = red.S @ nudot + red.w
-    kin = KinematicState(model, data, q, red.v)
+    out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
+    if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
+        out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
+    return out
+
+
+def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
+    """:math:`A^T\\lambda = \\mathrm{RNEA}(q, v, a) - B\\tau - \\sum J_t^T F_t` and the per-wheel and per-closure
+    forces, at a state whose accelerations are known."""
+    model, data = robot.model, robot.data
+    kin = KinematicState(model, data, q, v)
     B = input_matrix(robot.motors, kin)
-    e = pin.rnea(model, data, q, red.v, a) - B @ tau
+    e = pin.rnea(model, data, q, v, a) - B @ tau
     for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
         e -= Jt.T @ force
-    rows = red.jacobian_rows
     A = rows.A
     lam, N, rank, residual = _solve_transpose(A, e)
     determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
@@ -238,13 +292,59 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None) -> ConstraintForces:
     index = {lab: i for i, lab in enumerate(rows.labels)}
     for c in robot.constraints:
         if isinstance(c, RollingWheel):
-            out.wheels.append(_wheel_force(c, kin, index, lam, N, friction.get(c.name, (None, None))[1]))
+            fr = friction.get(c.name, (None, None))[1]
+            out.wheels.append(_wheel_force(c, kin, index, lam, N, fr))
+            out._tangential.append(([index[lab] for lab in c._labels()], c._directions, fr))
         elif isinstance(c, LoopClosure):
             out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
                                     if f"{c.name}.{comp}" in index}
     out.undetermined_reason = _reasons(A, rows.labels, N)
     if not (np.all(np.isfinite(lam)) and np.isfinite(residual)):
         raise NonFiniteError(f"constraint forces at this state are not finite (max |e| = {np.max(np.abs(e)):.3g})")
+    return out
+
+
+TWIN_RESIDUAL = 1e-8
+"""Relative residual above which the wheels cannot hold a planar model's out-of-plane equilibrium."""
+
+
+def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) -> ConstraintForces:
+    """The loads of a planar-root model from its floating twin.
+
+    A planar root holds the robot at z = 0, pitch = roll = 0 without saying by what; physically the ground does,
+    through the wheels' normal rows. The same description on a floating root (x, y, z, yaw, pitch, roll), at the
+    same state with zero z, pitch and roll rates and accelerations, has those rows active, and the out-of-plane
+    equations of motion (vertical force, roll and pitch moments of the whole robot) then determine the normal
+    loads. If the wheels cannot hold that equilibrium (e.g. a robot on two wheels with no other support) the
+    residual says so and the planar result is kept, with the reason."""
+    from dataclasses import replace
+
+    twin = getattr(robot, "_floating_twin", None)
+    if twin is None:
+        from .robot import Robot
+
+        spec = replace(robot.spec, root="floating", independent=None, operational=None)
+        twin = Robot(spec, robot.params, robot.terrain)
+        robot._floating_twin = twin
+    names = twin.description.joint_names
+    index = [names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]
+
+    def lift(x):
+        out = np.zeros(twin.nq)
+        out[index] = x
+        return out
+
+    qt, vt, at = lift(q), lift(v), lift(a)
+    rows = twin.constraint_rows(KinematicState(twin.model, twin.data, qt, vt))
+    out = _forces(twin, qt, vt, at, tau, rows, {}, nudot)
+    if out.residual > TWIN_RESIDUAL:
+        planar.undetermined_reason.append(
+            f"the wheels cannot hold this planar model's out-of-plane equilibrium (relative residual "
+            f"{out.residual:.3g} on its floating twin): the description lacks a support, so its normal loads stay "
+            "undetermined")
+        return planar
+    out.notes.append("normal loads from the out-of-plane equilibrium (vertical force, roll and pitch moments) of the "
+                     "same description on a floating root: the planar root's z, roll and pitch are held by the ground")
     return out
 
 

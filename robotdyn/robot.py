@@ -358,13 +358,13 @@ class Robot:
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)
         return Q, tau, float(np.linalg.norm(red.B @ tau - Q))
 
-    def contact_forces(self, q, nu, tau=None, nudot=None):
+    def contact_forces(self, q, nu, tau=None, nudot=None, twin: bool = True):
         """Wheel-ground contact forces and loop-closure forces at (q, nu) for motor torques ``tau`` (forward
         dynamics) or independent accelerations ``nudot`` (inverse dynamics); see
         :func:`robotdyn.contact_forces.constraint_forces`."""
         from .contact_forces import constraint_forces
 
-        return constraint_forces(self, q, nu, tau=tau, nudot=nudot)
+        return constraint_forces(self, q, nu, tau=tau, nudot=nudot, twin=twin)
 
     def velocity(self, q, nu) -> np.ndarray:
         """Full velocity v = S(q) nu."""

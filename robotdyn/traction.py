@@ -59,6 +59,9 @@ class Traction:
         required_mu: (N, W) :math:`\\|f_t\\|/f_n` (``inf`` where :math:`f_n \\le 0`; only meaningful where
             ``friction_determined``).
         friction_determined: (W,) whether each wheel's friction force (so its required mu) is determined.
+        minimum_mu: (N,) the smallest mu with which some admissible split of undetermined forces lies in every
+            cone (:meth:`robotdyn.contact_forces.ConstraintForces.minimum_mu`); ``None`` when every friction force
+            is determined (then it is the largest per-wheel required mu) or a normal load is not.
         mu: (W,) the wheels' friction coefficients (``nan``: not given, no slip check).
         undetermined: Wheels whose loads rigid-body dynamics do not determine, with the reason.
         events: The first lift-off and slip of each wheel, in time order.
@@ -72,6 +75,7 @@ class Traction:
     mu: np.ndarray
     friction_determined: np.ndarray
     undetermined: dict[str, str] = field(default_factory=dict)
+    minimum_mu: np.ndarray | None = None
     events: list[TractionEvent] = field(default_factory=list)
 
     def broken(self) -> np.ndarray:
@@ -88,6 +92,8 @@ class Traction:
             out[f"{name}.normal"] = self.normal[:, j]
             if self.friction_determined[j]:
                 out[f"{name}.mu_required"] = self.required_mu[:, j]
+        if self.minimum_mu is not None:
+            out["mu_required_min"] = self.minimum_mu
         return out
 
     def summary(self) -> str:
@@ -97,7 +103,10 @@ class Traction:
             mus = self.required_mu[:, self.friction_determined]
             finite = mus[np.isfinite(mus)]
             peak = finite.max() if finite.size else float("inf")
-            parts.append(f"loads {self.normal.min():.4g}..{self.normal.max():.4g} N, required mu up to {peak:.3g}")
+            parts.append(f"loads {self.normal.min():.4g}..{self.normal.max():.4g} N"
+                         + (f", required mu up to {peak:.3g}" if self.friction_determined.any() else ""))
+            if self.minimum_mu is not None:
+                parts.append(f"with the best split of undetermined forces mu >= {np.max(self.minimum_mu):.3g} suffices")
         if self.events:
             parts.append("first: " + str(self.events[0]))
         elif self.wheels:
@@ -130,10 +139,13 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
         The :class:`Traction`.
     """
     zero = np.zeros(len(robot.motors))
-    samples = []
+    samples, minimum = [], []
     for i, t in enumerate(traj.t):
         tau = zero if torque is None else np.asarray(torque(t, traj.q[i], traj.nu[i]), float)
-        samples.append(constraint_forces(robot, traj.q[i], traj.nu[i], tau=tau).wheels)
+        forces = constraint_forces(robot, traj.q[i], traj.nu[i], tau=tau)
+        samples.append(forces.wheels)
+        if not all(w.load_determined for w in forces.wheels):
+            minimum.append(forces.minimum_mu())
     names = [w.name for w in samples[0]] if samples else []
     undetermined = {}
     for j, name in enumerate(names):
@@ -148,6 +160,8 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
     wheels = [names[j] for j in keep]
     out = Traction(np.asarray(traj.t, float), wheels, normal, tangential, required,
                    _friction_coefficients(robot, wheels, mu), friction_known, undetermined)
+    if minimum and len(minimum) == len(samples) and all(m is not None for m in minimum):
+        out.minimum_mu = np.array(minimum, float)
     out.events = _events(out)
     return out
 

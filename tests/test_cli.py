@@ -60,7 +60,10 @@ def test_simulate_writes_csv_and_plot(tmp_path):
     assert res.returncode == 0, res.stderr
     header = csv.read_text().splitlines()[0].split(",")
     robot = robotdyn.load("quasimoro")
-    assert header == ["t", *robot.coordinates, "theta1_dot", "theta2_dot", "theta3_dot"]
+    # then the traction columns: normal loads (from the floating twin) and the smallest mu that admits a split of
+    # the two wheels' lateral forces in both cones (robotdyn.traction)
+    assert header == ["t", *robot.coordinates, "theta1_dot", "theta2_dot", "theta3_dot", "wheel_A.normal",
+                      "wheel_B.normal", "mu_required_min"]
     data = np.loadtxt(csv, delimiter=",", skiprows=1)
     assert data[-1, 0] == pytest.approx(2.0) and png.stat().st_size > 10_000
 

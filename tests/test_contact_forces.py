@@ -56,7 +56,7 @@ def test_forces_match_pinocchio_kkt(robots, name):
     for _ in range(3):
         nu = rng.normal(scale=0.5, size=robot.mobility)
         tau = rng.normal(size=len(robot.motors))
-        f = robot.contact_forces(q, nu, tau=tau)
+        f = robot.contact_forces(q, nu, tau=tau, twin=False)  # the model's own multipliers
         red = robot.reduced(q, nu)
         kin = robotdyn.constraint.KinematicState(robot.model, robot.data, q, red.v)
         B = robotdyn.actuation.input_matrix(robot.motors, kin)
@@ -131,9 +131,46 @@ def test_disc_rolling_down_incline_closed_form(slope):
     assert w.world[0] < 0
 
 
+def test_planar_loads_from_the_floating_twin_match_pinocchio(robots):
+    """A planar model's normal loads come from its floating twin: Pinocchio's KKT solve of the floating model at
+    the lifted state gives zero out-of-plane accelerations (the planar motion is a motion of the floating model)
+    and the same multipliers, to 1e-9 (omni caster: three casters, loads determinate)."""
+    robot = robots["omni_caster"]
+    q = robot.neutral()
+    rng = np.random.default_rng(3)
+    nu, tau = rng.normal(scale=0.5, size=3), rng.normal(size=len(robot.motors))
+    f = robot.contact_forces(q, nu, tau=tau)
+    assert all(w.load_determined for w in f.wheels) and f.notes
+    twin = robot._floating_twin
+    red = robot.reduced(q, nu)
+    idx = [twin.description.joint_names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]
+    qt, vt = np.zeros(twin.nq), np.zeros(twin.nq)
+    qt[idx], vt[idx] = q, red.v
+    kin = robotdyn.constraint.KinematicState(twin.model, twin.data, qt, vt)
+    B = robotdyn.actuation.input_matrix(twin.motors, kin)
+    a_pin, A, sel, lam_pin = _pinocchio_kkt(twin, qt, vt, B @ tau)
+    out_of_plane = [twin.coordinate_index(c) for c in ("z", "pitch", "roll")]
+    np.testing.assert_allclose(a_pin[out_of_plane], 0.0, atol=1e-9)
+    np.testing.assert_allclose(a_pin[idx], red.S @ f.nudot + red.w, atol=1e-9)
+    full = np.zeros(len(f.lam))
+    full[sel] = lam_pin
+    np.testing.assert_allclose(f.lam[f.determined], full[f.determined], atol=1e-9 * (1 + np.abs(full).max()))
+    weight = -sum(twin.model.inertias[i].mass for i in range(twin.model.njoints)) * twin.model.gravity.linear[2]
+    assert sum(w.normal for w in f.wheels) == pytest.approx(weight, rel=1e-12)  # no vertical acceleration
+
+
+def test_two_wheels_alone_cannot_hold_a_planar_model(robots):
+    """MMR12-EOD's description stands on two wheels: its floating twin cannot be held by them, so the loads stay
+    undetermined and the reason says so."""
+    robot = robots["mmr12_eod"]
+    f = robot.contact_forces(robot.neutral(), np.zeros(robot.mobility))
+    assert any("cannot hold" in r for r in f.undetermined_reason)
+    assert not f.wheels[0].determined[2]
+
+
 def test_planar_root_reports_normal_loads_as_undetermined(robots):
-    """Under a planar root the normal rows act on no coordinate: the loads are reported undetermined, with why."""
-    f = robots["omni_caster"].contact_forces(robots["omni_caster"].neutral(), np.zeros(3))
+    """Under a planar root the normal rows act on no coordinate: the model's own loads are undetermined, with why."""
+    f = robots["omni_caster"].contact_forces(robots["omni_caster"].neutral(), np.zeros(3), twin=False)
     assert not any(w.determined[2] for w in f.wheels)
     assert any("act on no coordinate" in r for r in f.undetermined_reason)
     assert "undetermined" in f.table()
@@ -160,3 +197,27 @@ def test_bad_input_is_one_line(robots):
         robot.contact_forces(robot.neutral(), np.zeros(3), tau=[1.0])
     with pytest.raises(InputError, match="unknown wheel"):
         robot.contact_forces(robot.neutral(), np.zeros(3)).wheel("nope")
+
+
+def test_minimum_mu_over_undetermined_splits(robots):
+    """Quasimoro's two lateral forces on one axle: only their sum L is determined. The smallest mu that admits a
+    split inside both cones, min over y of max_i sqrt(l_i^2 + y_i^2)/n_i with y_A + y_B = L, against a brute-force
+    search over the split (independent of the SLSQP solve)."""
+    robot = robots["quasimoro"]
+    q = robot.neutral()
+    q[robot.coordinate_index("theta3")] = 0.3
+    f = robot.contact_forces(q, [1.0, 0.5, 0.2], tau=[0.1, 0.1])
+    wa, wb = f.wheel("wheel_A"), f.wheel("wheel_B")
+    total = wa.force[1] + wb.force[1]  # determined: the min-norm split has the right sum
+    def ratio(y):
+        return np.maximum(np.hypot(wa.force[0], y) / wa.normal, np.hypot(wb.force[0], total - y) / wb.normal)
+
+    y = np.linspace(-5 * abs(total) - 1, 5 * abs(total) + 1, 400001)
+    for _ in range(3):  # zoom in around the best grid point
+        best, step = y[np.argmin(ratio(y))], y[1] - y[0]
+        y = np.linspace(best - 2 * step, best + 2 * step, 100001)
+    assert f.minimum_mu() == pytest.approx(ratio(y).min(), rel=1e-9)
+    # determined everywhere (the disc): the minimum is the wheel's own required mu
+    robot_d, qd = _disc_on_ramp(0.5)
+    fd = robot_d.contact_forces(qd, np.zeros(robot_d.mobility))
+    assert fd.minimum_mu() == pytest.approx(fd.wheels[0].required_mu, rel=1e-12)

@@ -79,18 +79,20 @@ def test_cli_simulate_reports_traction(tmp_path, capsys):
 
 
 def test_cli_dump_forces(capsys):
-    """dump --forces: the table and JSON; the planar Quasimoro's normal loads are reported undetermined."""
+    """dump --forces: the table and JSON; the planar Quasimoro's normal loads come from its floating twin, the split
+    of its lateral force between the two wheels of one rigid axle is undetermined."""
     q = ["0", "0", "0", "0", "0", "0.3"]
     assert main(["dump", "quasimoro", "--q", *q, "--v", "1", "0.5", "0.2", "--tau", "0.1", "0.1", "--forces"]) == 0
     out = capsys.readouterr().out
     assert "contact forces (ground on wheel, contact frame)" in out and "undetermined" in out
-    assert "act on no coordinate" in out
-    assert main(["dump", "quasimoro", "--q", *q, "--v", "1", "0.5", "0.2", "--a", "0", "0", "0", "--forces",
+    assert "note: normal loads from the out-of-plane equilibrium" in out
+    assert main(["dump", "quasimoro", "--q", *q, "--v", "1", "0.5", "0.2", "--tau", "0", "0.2", "--forces",
                  "--json"]) == 0
     import json
 
     data = json.loads(capsys.readouterr().out)
-    assert data["forces"]["wheels"]["wheel_A"]["determined"]["normal"] is False
+    assert data["forces"]["wheels"]["wheel_A"]["determined"]["normal"] is True
+    assert data["forces"]["wheels"]["wheel_A"]["determined"]["lateral"] is False
     assert data["forces"]["wheels"]["wheel_A"]["required_mu"] is None
     assert main(["dump", "quasimoro", "--q", *q, "--v", "1", "0.5", "0.2", "--forces"]) == 2
     assert "--forces needs --tau" in capsys.readouterr().err

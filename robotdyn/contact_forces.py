@@ -43,6 +43,9 @@ from .rolling_contact import RollingWheel
 from .sliding import forward as forward_sliding
 from .sliding import sliding_now, tangential
 
+ILL_DETERMINED = 1e3
+"""Condition number of the rows above which the forces are flagged as ill-determined (a note, not an error)."""
+
 DETERMINED_TOL = 1e-8
 """A row (or force component) is determined when its weight in every null-space direction is below this."""
 
@@ -110,6 +113,7 @@ class ConstraintForces:
         tau: Motor torques used [N m or N].
         wheels: One :class:`WheelForce` per rolling, omni or support wheel.
         closures: Loop-closure forces/moments by closure name, then component (x, y, z [N]; rx, ry, rz [N m]).
+        condition: Condition number of the rows' rank-r part (large: nearly redundant rows, ill-determined forces).
         undetermined_reason: Why rows are undetermined (empty when all are determined).
         notes: How the forces were obtained where that is not the model itself (e.g. a planar model's loads from
             its floating twin).
@@ -127,6 +131,7 @@ class ConstraintForces:
     closures: dict[str, dict[str, float]] = field(default_factory=dict)
     undetermined_reason: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    condition: float = 1.0
     _tangential: list = field(default_factory=list, repr=False)  # per wheel: (row indices, D, friction or None)
 
     @property
@@ -187,6 +192,7 @@ class ConstraintForces:
             },
             "closures": self.closures,
             "rank": self.rank,
+            "condition": self.condition,
             "rows_count": len(self.labels),
             "undetermined_combinations": [
                 {lab: float(c) for lab, c in zip(self.labels, col) if abs(c) > DETERMINED_TOL}
@@ -286,9 +292,14 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
         e -= Jt.T @ force
     A = rows.A
-    lam, N, rank, residual = _solve_transpose(A, e)
+    lam, N, rank, residual, condition = _solve_transpose(A, e)
     determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
     out = ConstraintForces(list(rows.labels), lam, determined, N, rank, residual, nudot, tau)
+    out.condition = condition
+    if condition > ILL_DETERMINED:
+        out.notes.append(f"the rows' condition number is {condition:.3g}: nearly redundant rows, so the determined "
+                         "forces (e.g. an internal squeeze between two wheels) hinge on small geometric differences "
+                         "and a little compliance would redistribute them")
     index = {lab: i for i, lab in enumerate(rows.labels)}
     for c in robot.constraints:
         if isinstance(c, RollingWheel):
@@ -348,19 +359,21 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
     return out
 
 
-def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float]:
+def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float, float]:
     """Minimum-norm :math:`\\lambda` of :math:`A^T\\lambda = e`, the null space of :math:`A^T` (orthonormal
-    columns), the rank and the relative residual, by SVD (rank tolerance as numpy's ``matrix_rank``)."""
+    columns), the rank, the relative residual and the condition number of the rank-r part (largest over smallest
+    nonzero singular value), by SVD (rank tolerance as numpy's ``matrix_rank``)."""
     m = A.shape[0]
     if m == 0:
-        return np.zeros(0), np.zeros((0, 0)), 0, float(np.linalg.norm(e) / max(1.0, np.linalg.norm(e)))
+        return np.zeros(0), np.zeros((0, 0)), 0, float(np.linalg.norm(e) / max(1.0, np.linalg.norm(e))), 1.0
     U, s, Vt = np.linalg.svd(A.T, full_matrices=True)  # A^T = U diag(s) Vt, n x m
     tol = s.max(initial=0.0) * max(A.shape) * np.finfo(float).eps
     rank = int(np.sum(s > tol))
     lam = Vt[:rank].T @ ((U[:, :rank].T @ e) / s[:rank])
     N = Vt[rank:].T
     scale = max(np.linalg.norm(e), 1.0)
-    return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale)
+    condition = float(s[0] / s[rank - 1]) if rank else 1.0
+    return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale), condition
 
 
 def _wheel_force(wheel: RollingWheel, kin: KinematicState, index: dict, lam: np.ndarray,

@@ -137,6 +137,41 @@ def main() -> None:
                 print(f"{'  ' + label:<36} {t_end:>8.1f} {wall:>9.2f} {t_end / wall:>9.1f} {other.stats['nfev']:>7d} "
                       f"{drift_fn(robot, other):>9.1e}  (max |q - q(default)| = {dev:.1e})")
 
+    forces_bench()
+
+
+def forces_bench() -> None:
+    """Contact forces against a compiled evaluation, and a slipping against a rolling simulation (issue 13)."""
+    from dataclasses import replace
+
+    from robotdyn.constraint_file import read
+    from robotdyn.robot import Robot
+
+    print(f"\n{'robot':<20} {'compiled [us]':>14} {'forces [us]':>12} {'forces / compiled':>18}")
+    for name in ("quasimoro", "omni_caster", "adaptable_wheel", "linkage_suspension"):
+        robot = robotdyn.load(name)
+        q, nu = robot.neutral(), np.full(robot.mobility, 0.3)
+        tau = np.full(len(robot.motors), 0.1)
+        fast = compiled_model(robot)
+        t_fast = timeit(lambda: fast.compute(q, nu)) if fast is not None else float("nan")
+        t_forces = timeit(lambda: robot.contact_forces(q, nu, tau=tau), number=20)
+        print(f"{name:<20} {t_fast * 1e6:>14.2f} {t_forces * 1e6:>12.1f} {t_forces / t_fast:>18.1f}")
+    # the skid-steer rover: four slipping wheels (linear law) against the same rover with rolling wheels
+    example = Path(__file__).resolve().parents[1] / "examples" / "skid_steer.toml"
+    mod = read(example)
+    slipping = mod.robot()
+    sc = mod.SCENARIOS["straight"]
+    start = time.perf_counter()
+    traj = sc.run(slipping, t_end=2.0, progress=False)
+    t_slip = time.perf_counter() - start
+    rolling = Robot(replace(mod.SPEC, wheels=[replace(w, friction="rolling", stiffness=None)
+                                              for w in mod.SPEC.wheels], independent=None))
+    start = time.perf_counter()
+    other = sc.run(rolling, t_end=2.0, progress=False)
+    t_roll = time.perf_counter() - start
+    print(f"skid-steer 'straight', 2 s: slipping wheels {t_slip:.2f} s wall ({traj.stats['nfev']} evaluations), "
+          f"rolling wheels {t_roll:.2f} s ({other.stats['nfev']}): ratio {t_slip / t_roll:.1f}")
+
 
 if __name__ == "__main__":
     main()

@@ -327,11 +327,16 @@ class CompiledModel:
 
 
 def compiled_model(robot) -> CompiledModel | None:
-    """The robot's :class:`CompiledModel` (built once; rebuilt when its constraints, their terrain or radius, or
-    the model's gravity change), or ``None`` when the fast path is off or :func:`why_not` gives a reason."""
+    """The robot's :class:`CompiledModel` for the calling thread (built once per thread; rebuilt when its
+    constraints, their terrain or radius, or the model's gravity change), or ``None`` when the fast path is off or
+    :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated from several
+    threads at once."""
     if not enabled():
         return None
-    cached = getattr(robot, "_compiled_model", None)
+    # one compiled model per thread: compute() returns views of its buffers, which another thread's call would
+    # overwrite (the robot's Pinocchio data is per thread as well, see Robot.data)
+    local = getattr(robot, "_local", None)
+    cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
     gravity = robot.model.gravity.linear
     if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
         getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r
@@ -340,7 +345,11 @@ def compiled_model(robot) -> CompiledModel | None:
         return cached[3]
     fast = CompiledModel(robot) if why_not(robot) is None else None
     state = [(getattr(c, "terrain", None), getattr(c, "radius", None)) for c in robot.constraints]
-    robot._compiled_model = (list(robot.constraints), gravity.copy(), state, fast)
+    entry = (list(robot.constraints), gravity.copy(), state, fast)
+    if local is not None:
+        local.compiled = entry
+    else:
+        robot._compiled_model = entry
     return fast
 
 

@@ -9,6 +9,7 @@ forward/inverse dynamics and energies. Configurations are natural coordinates na
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -181,7 +182,7 @@ class Robot:
             expand_xacro(path, xacro_args), spec.root, [str(d) for d in spec.package_dirs], spec.locked, spec.massless
         )
         self.model = self.description.model
-        self.data = self.model.createData()
+        self._local = threading.local()  # per-thread Pinocchio data and compiled model (see ``data``)
         self.model.gravity.linear = np.array([0.0, 0.0, -float(values.get("g", 9.81))])
         self.coordinates = [spec.labels.get(j, j) for j in self.description.joint_names]
         self.velocity_labels = [f"{c}_dot" for c in self.coordinates]
@@ -201,6 +202,15 @@ class Robot:
         self.operational = spec.operational.build(self.description) if spec.operational is not None else None
         if self.operational is not None:
             self.velocity_names = list(self.operational.names)
+
+    @property
+    def data(self) -> pin.Data:
+        """Pinocchio's data for the calling thread (each thread gets its own, so that one Robot may be used from
+        several threads: Pinocchio's algorithms write their results into it)."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self.model.createData()
+        return data
 
     def __repr__(self) -> str:
         return (

@@ -154,6 +154,14 @@ def cmd_dump(args) -> int:
 
 
 def cmd_simulate(args) -> int:
+    from .output import IMAGE_FORMATS, check_target
+
+    # output paths checked before the run, so that a typo does not cost a simulation
+    if args.csv:
+        check_target(args.csv, "CSV file")
+    for path in (args.plot, args.traction_plot):
+        if path:
+            check_target(path, "plot", IMAGE_FORMATS)
     mod, robot = _load(args)
     scenarios = getattr(mod, "SCENARIOS", {})
     if args.scenario not in scenarios:
@@ -269,12 +277,20 @@ def cmd_view(args) -> int:
 
 
 # ------------------------------------------------------------------------------------------------ parser
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors as robotdyn's one line (``robotdyn: error: ...``, exit status 2), no usage block."""
+
+    def error(self, message: str):
+        raise RobotDynError(f"{message} (see robotdyn {self.prog.split(' ', 1)[-1] + ' ' if ' ' in self.prog else ''}"
+                            "--help)")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="robotdyn", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="robotdyn", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    common = argparse.ArgumentParser(add_help=False)
+    common = _Parser(add_help=False)
     common.add_argument("--json", action="store_true", help="machine-readable output")
-    robot_args = argparse.ArgumentParser(add_help=False)
+    robot_args = _Parser(add_help=False)
     robot_args.add_argument("robot", metavar="ROBOT", nargs="?", default=None,
                             help="robot name (robotdyn list); or describe your own with --urdf/--constraints")
     robot_args.add_argument("--urdf", metavar="FILE",
@@ -343,7 +359,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
-        return int(args.func(args) or 0)
+        with np.errstate(all="ignore"):  # non-finite results are refused explicitly (NonFiniteError), in one line
+            return int(args.func(args) or 0)
     except RobotDynError as exc:
         print(f"robotdyn: error: {exc}", file=sys.stderr)
         return 2

@@ -41,3 +41,7 @@ class SingularConstraintError(ConstraintError):
 
 class NonFiniteError(RobotDynError):
     """A computed result that is not finite (NaN or infinite): never returned as a number."""
+
+
+class OutputError(RobotDynError):
+    """An output file that cannot be written (missing directory, a directory, no permission, full disk, format)."""

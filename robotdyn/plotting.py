@@ -61,6 +61,10 @@ def plot_trajectory(
         fig.suptitle(title)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        from .output import save_figure
+
+        try:
+            save_figure(fig, path)
+        finally:
+            plt.close(fig)
     return fig

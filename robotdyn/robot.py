@@ -21,7 +21,7 @@ from .actuation import Motor
 from .constraint import ConstraintRows, KinematicState
 from .description import URDF_DIR, Description, build_description, expand_xacro
 from .dynamics import energy
-from .errors import ConstraintError, InputError
+from .errors import ConstraintError, InputError, NonFiniteError
 from .friction import make_law
 from .inputs import as_vector
 from .loop_closure import LoopClosure
@@ -334,8 +334,14 @@ class Robot:
     def reduced(self, q, nu, coriolis: bool = False) -> ReducedDynamics:
         """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduced_dynamics`."""
         if self.operational is not None:
-            return self.operational.reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
-        return reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
+            out = self.operational.reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
+        else:
+            out = reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
+        if not (np.isfinite(out.M).all() and np.isfinite(out.h).all() and np.isfinite(out.w).all()):
+            raise NonFiniteError(f"the reduced model at this state is not finite (|q| up to "
+                                 f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g}): the "
+                                 "state is beyond what double precision holds")
+        return out
 
     def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Full-coordinate M(q), C(q, v), g(q) of the unconstrained tree (Pinocchio)."""
@@ -351,7 +357,11 @@ class Robot:
         if sliding_now(self):
             return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
         red = self.reduced(q, nu)
-        return np.linalg.solve(red.M, red.B @ np.asarray(tau, float) - red.h)
+        out = np.linalg.solve(red.M, red.B @ np.asarray(tau, float) - red.h)
+        if not np.isfinite(out).all():
+            raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
+                                 "what double precision holds)")
+        return out
 
     def inverse_dynamics(self, q, nu, nudot) -> tuple[np.ndarray, np.ndarray, float]:
         """Generalised forces and motor torques for given independent accelerations.

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .errors import RobotDynError
 from .simulation import Trajectory, simulate
 
 
@@ -47,9 +48,16 @@ class Scenario:
             nu0[robot.velocity_names.index(label)] = value
         return q0, nu0
 
+    def span(self, t_end: float | None = None, n_out: int | None = None) -> tuple[float, int]:
+        """The duration [s] (default the scenario's; checked finite and positive) and the number of output samples
+        (default: the scenario's sampling rate over that duration)."""
+        t_end = self.t_end if t_end is None else float(t_end)
+        if not np.isfinite(t_end) or t_end <= 0:
+            raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
+        return t_end, n_out or max(2, int(round(self.n_out * t_end / self.t_end)))
+
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs) -> Trajectory:
         """Simulate the scenario on ``robot`` (keyword arguments go to :func:`~robotdyn.simulation.simulate`)."""
+        t_end, n_out = self.span(t_end, n_out)
         q0, nu0 = self.initial_state(robot)
-        t_end = self.t_end if t_end is None else t_end
-        n_out = n_out or max(2, int(round(self.n_out * t_end / self.t_end)))
         return simulate(robot, t_end, q0, nu0, self.torque, n_out=n_out, **kwargs)

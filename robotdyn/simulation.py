@@ -30,6 +30,9 @@ from .sliding import slipping_wheels
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
+MAX_SAMPLES = 5_000_000
+"""Largest number of output samples of one simulation (memory: 8 bytes x (2n + 3) columns each)."""
+
 
 @dataclass
 class Trajectory:
@@ -73,10 +76,13 @@ class Trajectory:
     def to_csv(self, path, extra: dict[str, np.ndarray] | None = None) -> None:
         """Write ``t``, the q columns, the nu columns, then any ``extra`` columns by name (e.g. the wheel loads of
         :meth:`robotdyn.traction.Traction.columns`)."""
+        from .output import atomic_output
+
         extra = extra or {}
         header = ",".join(["t", *self.coordinates, *self.velocity_names, *extra])
         data = np.column_stack([self.t, self.q, self.nu, *extra.values()])
-        np.savetxt(path, data, delimiter=",", header=header, comments="")
+        with atomic_output(path, "CSV file") as tmp:
+            np.savetxt(tmp, data, delimiter=",", header=header, comments="")
 
 
 class _Progress:
@@ -123,6 +129,10 @@ def simulate(
     """
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
+    if not 2 <= n_out <= MAX_SAMPLES:
+        width = 2 * robot.nq + 3
+        raise RobotDynError(f"{n_out:.3g} output samples for t_end = {t_end:g} s ({8 * width * n_out / 1e9:.3g} GB); "
+                            f"expected 2 to {MAX_SAMPLES:,} samples: give a shorter duration or fewer samples")
     q0 = robot.check_q(q0)
     nu0 = robot.check_nu(nu0)
     robot.check_constraints(q0)

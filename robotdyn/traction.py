@@ -245,6 +245,10 @@ def plot_traction(tr: Traction, path=None, title: str = ""):
         fig.suptitle(title)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        from .output import save_figure
+
+        try:
+            save_figure(fig, path)
+        finally:
+            plt.close(fig)
     return fig

@@ -40,6 +40,7 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import InputError, RobotDynError
+from .output import atomic_output
 
 _ROOT = "robotdyn"
 LAYERS = ("robot", "terrain", "contacts", "frames")
@@ -497,7 +498,8 @@ class Viewer:
         """Write :meth:`static_html` to ``path`` and return the path."""
         path = Path(path)
         try:
-            path.write_text(self.static_html(), encoding="utf-8")
+            with atomic_output(path, "HTML page") as tmp:
+                tmp.write_text(self.static_html(), encoding="utf-8")
         except OSError as exc:
             raise InputError(f"cannot write {path}: {exc.strerror}") from None
         return path

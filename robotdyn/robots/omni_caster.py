@@ -446,9 +446,8 @@ class PathScenario(Scenario):
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
         from ..simulation import simulate
 
+        t_end, n_out = self.span(t_end, n_out)
         q0, nu0 = self.initial_state(robot)
-        t_end = self.t_end if t_end is None else t_end
-        n_out = n_out or max(2, int(round(self.n_out * t_end / self.t_end)))
         kwargs.setdefault("method", "LSODA")
         kwargs.setdefault("rtol", 1e-9)
         kwargs.setdefault("atol", 1e-9)

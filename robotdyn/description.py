@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .errors import DescriptionError
+from .errors import DescriptionError, InputError
 
 URDF_DIR = Path(__file__).resolve().parent.parent / "urdf"
 """Directory of the Xacro descriptions shipped with robotdyn."""
@@ -44,6 +45,38 @@ _ROOT_CHAINS = {
 }
 
 
+_PLAIN_WORD = re.compile(r"[A-Za-z0-9_./:+-]*")
+
+
+def xacro_value(name: str, value) -> str:
+    """A value for a ``xacro:arg`` as data, never as code.
+
+    xacro substitutes ``$(arg name)`` textually, also inside ``${...}`` expressions, which it evaluates: a value is
+    therefore handed over only as a number (finite, in Python's canonical form) or a plain word (letters, digits
+    and ``_ . / : + -``, no ``__``: a choice, a frame name, a ``package://`` path). Anything else raises
+    :class:`~robotdyn.errors.InputError` before xacro sees it. (A Xacro *file* is code by design: only expand
+    descriptions you trust.)
+    """
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        x = float(value)
+        if not np.isfinite(x):
+            raise InputError(f"xacro argument {name} = {value!r}; expected a finite number")
+        return repr(int(x)) if isinstance(value, (int, np.integer)) else repr(x)
+    text = str(value)
+    try:
+        x = float(text)
+    except ValueError:
+        if _PLAIN_WORD.fullmatch(text) and "__" not in text:
+            return text
+        raise InputError(f"xacro argument {name} = {text!r}; expected a number or a plain word (letters, digits and "
+                         "_ . / : + -): robotdyn hands xacro data, never expressions") from None
+    if not np.isfinite(x):
+        raise InputError(f"xacro argument {name} = {text!r}; expected a finite number")
+    return text if _PLAIN_WORD.fullmatch(text) else repr(x)
+
+
 def expand_xacro(path: str | Path, args: dict[str, object] | None = None) -> str:
     """Expand a Xacro file into a URDF string.
 
@@ -62,7 +95,7 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None) -> str
     path = Path(path)
     if not path.is_file():
         raise DescriptionError(f"description file not found: {path}")
-    mappings = {str(k): str(v) for k, v in (args or {}).items()}
+    mappings = {str(k): xacro_value(str(k), v) for k, v in (args or {}).items()}
     try:
         doc = xacro.process_file(str(path), mappings=mappings)
     except Exception as exc:  # xacro raises a variety of exception types

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .errors import DescriptionError, InputError
+from .errors import DescriptionError, InputError, RobotDynError
 
 URDF_DIR = Path(__file__).resolve().parent.parent / "urdf"
 """Directory of the Xacro descriptions shipped with robotdyn."""
@@ -104,12 +104,52 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None) -> str
     return doc.toxml()
 
 
+_CHECKS = 1
+"""Revision of robotdyn's own checks in :func:`_validate_with_yourdfpy` (raise it when they change, so that the
+cache of validated texts does not skip a new check)."""
+
+
+def _validated_cache() -> Path:
+    """The file listing the URDF texts (by SHA-256, with yourdfpy's version) that passed :func:`validate_urdf`:
+    ``$ROBOTDYN_CACHE`` or ``~/.cache/robotdyn``."""
+    import os
+
+    root = os.environ.get("ROBOTDYN_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "robotdyn")
+    return Path(root) / "validated-urdf.txt"
+
+
 def validate_urdf(urdf: str) -> None:
     """Check a URDF string with yourdfpy (parses, one tree, known joint types, physical inertias).
+
+    A text that passed once (same SHA-256, same yourdfpy version) is not checked again: the cache file of
+    :func:`_validated_cache` remembers it (importing yourdfpy alone costs about 0.15 s of every command).
 
     Raises:
         DescriptionError: naming the first problem found.
     """
+    import hashlib
+    from importlib.metadata import version
+
+    key = f"{hashlib.sha256(urdf.encode()).hexdigest()} yourdfpy-{version('yourdfpy')} checks-{_CHECKS}"
+    cache = _validated_cache()
+    try:
+        if key in cache.read_text().split("\n"):
+            return
+    except OSError:
+        pass
+    _validate_with_yourdfpy(urdf)
+    try:  # remember it (atomically; a cache that cannot be written only costs time)
+        from .output import atomic_output
+
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        lines = cache.read_text().split("\n") if cache.is_file() else []
+        with atomic_output(cache, "cache") as tmp:
+            tmp.write_text("\n".join([line for line in lines[-999:] if line] + [key]) + "\n")
+    except (OSError, RobotDynError):
+        pass
+
+
+def _validate_with_yourdfpy(urdf: str) -> None:
     import yourdfpy
 
     try:

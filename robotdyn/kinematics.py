@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import least_squares
 
 from .errors import InputError, RobotDynError
 
@@ -157,6 +156,8 @@ def position_ik(
         if extra is not None:
             parts.append(np.atleast_1d(extra(q)))
         return np.concatenate(parts)
+
+    from scipy.optimize import least_squares
 
     sol = least_squares(residual, x0, bounds=(lo, hi), xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=2000)
     nfev = int(sol.nfev)

@@ -21,7 +21,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from .errors import ConstraintError, InputError, RobotDynError
 from .terrain import Terrain
@@ -127,6 +126,8 @@ def solve_posture(
             break
         it += 1
         J = A[:, free]
+        import scipy.linalg
+
         step, *_ = scipy.linalg.lstsq(J, -res, cond=1e-12, lapack_driver="gelsd")
         alpha, accepted = 1.0, False
         while alpha > 1e-6:

@@ -15,10 +15,20 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
-import scipy.linalg.lapack
 
 from .errors import SingularConstraintError
+
+_LAPACK = None
+
+
+def _lapack():
+    """scipy.linalg.lapack, imported on first use (keeps ``robotdyn info`` free of scipy's import cost)."""
+    global _LAPACK
+    if _LAPACK is None:
+        import scipy.linalg.lapack
+
+        _LAPACK = scipy.linalg.lapack
+    return _LAPACK
 
 RANK_TOL = 1e-9
 """Relative tolerance on QR diagonal entries below which rows are counted as redundant."""
@@ -35,13 +45,15 @@ def _pivoted_qr(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     The LAPACK call ``scipy.linalg.qr(a, pivoting=True)`` makes (``?geqp3`` with the optimal workspace, queried
     once per shape here), without its wrapper's overhead: the same numbers."""
     if a.size == 0 or not np.all(np.isfinite(a)):  # scipy's own checks and messages
+        import scipy.linalg
+
         _, R, piv = scipy.linalg.qr(a, mode="economic", pivoting=True)
         return np.diag(R), piv
     a = np.asarray(a, dtype=float)
     lwork = _LWORK.get(a.shape)
     if lwork is None:
-        lwork = _LWORK[a.shape] = int(scipy.linalg.lapack.dgeqp3(a, lwork=-1)[-2][0].real)
-    qr, jpvt, _, _, info = scipy.linalg.lapack.dgeqp3(a, lwork=lwork)
+        lwork = _LWORK[a.shape] = int(_lapack().dgeqp3(a, lwork=-1)[-2][0].real)
+    qr, jpvt, _, _, info = _lapack().dgeqp3(a, lwork=lwork)
     if info < 0:
         raise ValueError(f"illegal value in {-info}th argument of internal geqp3")
     return np.diag(qr).copy(), jpvt - 1
@@ -54,7 +66,7 @@ def solve(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     Raises:
         numpy.linalg.LinAlgError: A is exactly singular.
     """
-    _, _, X, info = scipy.linalg.lapack.dgesv(A, B)
+    _, _, X, info = (_LAPACK or _lapack()).dgesv(A, B)
     if info != 0:
         raise np.linalg.LinAlgError("Singular matrix" if info > 0 else f"illegal value in argument {-info} of dgesv")
     return X

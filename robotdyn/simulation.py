@@ -19,7 +19,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .compiled import Fallback, compiled_model
 from .errors import RobotDynError
@@ -144,6 +143,8 @@ def simulate(
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
     report = _Progress(t_end, progress)
+
+    from scipy.integrate import solve_ivp
 
     slipping = slipping_wheels(robot)
     fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path

@@ -18,7 +18,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
 
 from .constraint import skew
 from .errors import ConstraintError, InputError
@@ -118,6 +117,8 @@ def solve_contact_forces(
             {"type": "ineq", "fun": lambda x: np.einsum("ij,ij->i", x.reshape(k, 3), N)},
             {"type": "ineq", "fun": lambda x: (mu * split(x)[1]) ** 2 - split(x)[2] ** 2},
         ]
+        from scipy.optimize import minimize
+
         res = minimize(lambda x: 0.5 * x @ H @ x, x, jac=lambda x: H @ x, constraints=cons, method="SLSQP",
                        options={"ftol": 1e-14, "maxiter": 500})
         x = res.x

@@ -25,7 +25,6 @@ import sys
 import time
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .contact_forces import constraint_forces
 from .errors import RobotDynError
@@ -117,6 +116,8 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         ``<coordinate>_dot``), with ``friction_work`` and ``stats["switches"]`` (time, wheel, phase) and, where the
         run stopped early, ``stats["event"]``.
     """
+    from scipy.integrate import solve_ivp
+
     from .simulation import Trajectory, _qdot
 
     if not np.isfinite(t_end) or t_end <= 0:

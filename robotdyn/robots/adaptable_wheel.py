@@ -27,7 +27,6 @@ from functools import partial
 
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import root
 
 from ..actuation import input_matrix
 from ..comparison import Comparison
@@ -233,6 +232,8 @@ def _needed_radius(R_cg, d_cg, p, terrain, tag, beta0: float) -> float:
     off = offsets(p)[tag]
     RT0 = float(d_cg[2] - terrain.height(*(d_cg + R_cg @ off)[:2]))
     fun = partial(_wheel_rt, R_cg=R_cg, d_cg=d_cg, offset=off, tag=tag, terrain=terrain)
+    from scipy.optimize import root
+
     sol = root(fun, [beta0, RT0], method="hybr", options={"xtol": 1e-14})
     if np.linalg.norm(fun(sol.x)) > 1e-8:
         raise ConstraintError(f"wheel {tag}: cannot touch the surface with any radius at these commands")
@@ -264,6 +265,8 @@ def solve_ik(cmd: Commands, p: dict, terrain: Terrain, guess: np.ndarray | None 
     R_cg, d_cg = body_pose(cmd, terrain)
     x0 = np.array([0.0, 0.0, 0.0, _Q0, _Q0, _Q0]) if guess is None else np.array(guess, float)
     f = partial(ik_residual, R_cg=R_cg, d_cg=d_cg, p=p, terrain=terrain)
+    from scipy.optimize import root
+
     sol = root(f, x0, method="hybr", options={"xtol": 1e-15})
     x = sol.x.copy()
     x[3:] = np.abs(x[3:])  # eq 1 is even in q: -q and q give the same radius

@@ -138,6 +138,21 @@ def main() -> None:
                       f"{drift_fn(robot, other):>9.1e}  (max |q - q(default)| = {dev:.1e})")
 
     forces_bench()
+    startup_bench()
+
+
+def startup_bench() -> None:
+    """Wall time of `robotdyn info quasimoro` and `robotdyn dump quasimoro` in fresh processes (median of 5)."""
+    import subprocess
+
+    for argv in (["info", "quasimoro"], ["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "1", "0.5",
+                                         "0.2"]):
+        walls = []
+        for _ in range(5):
+            start = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "robotdyn", *argv], check=True, capture_output=True)
+            walls.append(time.perf_counter() - start)
+        print(f"CLI start-up: robotdyn {argv[0]} quasimoro: {statistics.median(walls):.3f} s wall (median of 5)")
 
 
 def forces_bench() -> None:

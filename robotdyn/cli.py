@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 
 import numpy as np
@@ -58,7 +59,7 @@ def _jsonable(x):
 
 
 def _matrix_text(name: str, rows: list[str], cols: list[str], A: np.ndarray) -> str:
-    w = max(12, *(len(c) + 1 for c in cols))
+    w = max(14, *(len(c) + 2 for c in cols))  # a '-1.23457e-05' (12 characters) keeps a space on its left
     lines = [f"{name}:", " " * 14 + "".join(f"{c:>{w}}" for c in cols)]
     for r, row in zip(rows, np.atleast_2d(A)):
         lines.append(f"{r:>14}" + "".join(f"{x:>{w}.6g}" for x in row))
@@ -87,6 +88,10 @@ def cmd_info(args) -> int:
         *([f"paper: shared/papers/{info['paper']}"] if info["paper"] else []),
         f"coordinates q ({len(info['coordinates'])}): {', '.join(info['coordinates'])}   [m, rad]",
         f"independent velocities ({info['mobility']}): {', '.join(info['independent_velocities'])}",
+        f"mobility at the neutral configuration: {info['mobility_at_neutral']} (n - rank A)"
+        + ("" if info["mobility_at_neutral"] == info["mobility"] else
+           f"; the independent velocities listed are {info['mobility']}: expected as many as the mobility"),
+        *(f"note: {n}" for n in info["mobility_notes"]),
         "parameters:",
         *(f"  {k:<14} = {v['value']!s:<10} {v['unit']:<8} {v['description']}" for k, v in info["parameters"].items()),
         "actuators:",
@@ -278,7 +283,12 @@ def cmd_view(args) -> int:
 
 # ------------------------------------------------------------------------------------------------ parser
 class _Parser(argparse.ArgumentParser):
-    """argparse with its errors as robotdyn's one line (``robotdyn: error: ...``, exit status 2), no usage block."""
+    """argparse with its errors as robotdyn's one line (``robotdyn: error: ...``, exit status 2), no usage block,
+    and negative numbers in scientific notation (``--v 1e-5 -2e-5``) read as values, not options."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$|^-(inf|nan)$", re.I)
 
     def error(self, message: str):
         raise RobotDynError(f"{message} (see robotdyn {self.prog.split(' ', 1)[-1] + ' ' if ' ' in self.prog else ''}"

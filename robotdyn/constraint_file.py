@@ -36,7 +36,8 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     radius = 0.0985                     # a number > 0 or a parameter name
     axis = [0, 0, 1]                    # axle in the wheel frame (default: the spin joint's axis)
     kind = "standard"                   # standard | omni (with roller_angle) | caster (a standard wheel on a
-                                        # steering joint of the URDF: nothing special)
+                                        # steering joint of the URDF: nothing special) | support (touches the
+                                        # ground only: normal row, frictionless, e.g. a free castor or a skid)
     mu = 0.8                            # friction coefficient (traction checks; the coulomb law's mu)
     friction = "rolling"                # rolling (no slip, default) | coulomb (regularised: slip_velocity [m/s],
                                         # default 1e-3) | linear (stiffness [s/m], saturated at mu if given)
@@ -85,7 +86,7 @@ TOP_KEYS = (
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro")
 WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
               "slip_velocity", "stiffness")
-WHEEL_KINDS = ("standard", "omni", "caster")
+WHEEL_KINDS = ("standard", "omni", "caster", "support")
 CLOSURE_KEYS = ("name", "frame1", "frame2", "components")
 MOTOR_KEYS = ("name", "joint", "reaction")
 SCENARIO_KEYS = ("name", "description", "t_end", "torque", "q0", "nu0")
@@ -441,12 +442,13 @@ def read(
         if not isinstance(friction, str):
             r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
         numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness") if key in w}
-        wheel = Wheel(fname, radius, tuple(float(a) for a in axis), "omni" if kind == "omni" else "standard",
+        wheel = Wheel(fname, radius, tuple(float(a) for a in axis), kind if kind in ("omni", "support") else "standard",
                       roller, w.get("radius_joint"), w.get("name", fname), friction=friction, **numbers)
         try:  # the friction keys' physics (mu >= 0, a known law with its parameters) in one line
             if friction != "rolling":
                 if wheel.kind != "standard":
-                    raise InputError(f"friction law {friction!r} on an omni wheel; expected a standard wheel")
+                    raise InputError(f"friction law {friction!r} on a {wheel.kind} wheel; expected a standard wheel "
+                                     "(support wheels are frictionless, omni wheels roll on their rollers)")
                 make_law(friction, wheel.mu, wheel.slip_velocity, wheel.stiffness, wheel.name)
             elif wheel.mu is not None and not (math.isfinite(wheel.mu) and wheel.mu >= 0):
                 raise InputError(f"mu = {wheel.mu}; expected a friction coefficient >= 0")

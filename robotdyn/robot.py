@@ -395,9 +395,33 @@ class Robot:
         kinetic, potential = energy(self.model, self.data, np.asarray(q, float), np.asarray(v, float))
         return kinetic + potential
 
+    def mobility_check(self) -> tuple[int, list[str]]:
+        """The mobility n - rank A at the neutral configuration, and plain-language notes where the wheels lock
+        the base (no admissible motion turns it, or moves it at all), e.g. a skid-steer base whose non-steering
+        wheels roll without slipping."""
+        A = self.rows_at(self.neutral()).A
+        rank = int(np.linalg.matrix_rank(A)) if A.size else 0
+        notes = []
+        if self.spec.root in ("planar", "floating") and A.size:
+            _, sv, Vt = np.linalg.svd(A)
+            null = Vt[rank:]  # admissible velocities at the neutral configuration
+            names = self.description.joint_names
+            yaw = names.index("psi" if "psi" in names else "yaw")
+            xy = [names.index("x"), names.index("y")]
+            if not np.any(np.abs(null[:, yaw]) > 1e-9):
+                notes.append("the base cannot turn: in every motion its wheels allow (rolling without slipping) the "
+                             "yaw rate is zero, so turning requires slip; give the wheels a friction law "
+                             "(friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and friction')")
+            if not np.any(np.abs(null[:, xy]) > 1e-9):
+                notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+        return self.nq - rank, notes
+
     def info(self) -> dict:
         """Coordinates, independent velocities, parameters (value, unit) and actuators, as plain data."""
+        mobility, notes = self.mobility_check()
         return {
+            "mobility_at_neutral": mobility,
+            "mobility_notes": notes,
             "robot": self.spec.name,
             "title": self.spec.title,
             "paper": self.spec.paper,

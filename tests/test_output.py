@@ -92,3 +92,16 @@ def test_huge_states_are_refused_not_returned(capsys):
 def test_check_target_accepts_a_plain_file_name(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert check_target("out.png", suffixes=("png",)).name == "out.png"
+
+
+def test_negative_numbers_in_scientific_notation_are_values(capsys):
+    assert main(["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "1e-5", "-2e-5", "-.5E+1"]) == 0
+    out = capsys.readouterr().out
+    assert "theta1_dot" in out
+    # every number of a table keeps a space on its left (no '-1.23457e-05-1.23457e-05' runs): rows of M, C and B
+    # split into a label and exactly as many numbers as there are columns
+    rows = [line.split() for line in out.splitlines() if line.startswith("    theta")]
+    assert rows and all(len(r) in (2, 3, 4) and all(float(x) == float(x) for x in r[1:]) for r in rows)
+    assert main(["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "-1e-5", "-2e-5", "-3e-5"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines() if line.startswith("    theta")]
+    assert all(len(r) in (2, 3, 4) for r in rows)

@@ -78,3 +78,37 @@ def test_without_slip_the_rover_cannot_turn(rover):
     A_rows = rolling.rows_at(rolling.neutral()).A
     assert rolling.nq - np.linalg.matrix_rank(A_rows) == 1
     assert rolling.mobility == 1
+
+
+def test_info_explains_a_locked_base(tmp_path, capsys):
+    """robotdyn info on the rover with wheels that roll without slipping: mobility 1 (n - rank A), and the note
+    that turning requires slip; with its slipping wheels, mobility 7 and no such note."""
+    from robotdyn.cli import main
+
+    text = EXAMPLE.read_text().replace('friction = "linear"', 'friction = "rolling"').replace("stiffness = 5.0", "")
+    text = text.replace("mu = 0.8", "").replace('urdf = "skid_steer.urdf.xacro"',
+                                                 f'urdf = "{EXAMPLE.parent / "skid_steer.urdf.xacro"}"')
+    text = "\n".join(line for line in text.splitlines() if not line.startswith("independent ="))
+    rolling = tmp_path / "rolling.toml"
+    rolling.write_text(text)
+    assert main(["info", "--constraints", str(rolling)]) == 0
+    out = capsys.readouterr().out
+    assert "mobility at the neutral configuration: 1 (n - rank A)" in out and "turning requires slip" in out
+    assert main(["info", "--constraints", str(EXAMPLE)]) == 0
+    out = capsys.readouterr().out
+    assert "mobility at the neutral configuration: 7" in out and "turning requires slip" not in out
+
+
+def test_support_wheels_from_toml(tmp_path):
+    """kind = "support" in a constraint file: the normal row only (mobility of the rover grows by the two
+    tangential rows of each wheel made a support)."""
+    text = EXAMPLE.read_text().replace('urdf = "skid_steer.urdf.xacro"',
+                                       f'urdf = "{EXAMPLE.parent / "skid_steer.urdf.xacro"}"')
+    text = "\n".join(line for line in text.splitlines() if not line.startswith("independent ="))
+    text = "\n".join('kind = "support"' if line.startswith("friction =") else line for line in text.splitlines()
+                     if not line.startswith(("stiffness =", "mu =")))
+    path = tmp_path / "support.toml"
+    path.write_text(text)
+    robot = read(path).robot()
+    assert [type(c).__name__ for c in robot.constraints] == ["SupportWheel"] * 4
+    assert [lab.split(".")[1] for lab in robot.rows_at(robot.neutral()).labels] == ["normal"] * 4

@@ -174,7 +174,13 @@ def cmd_simulate(args) -> int:
             f"unknown scenario {args.scenario!r} for {args.robot}; expected one of {', '.join(scenarios) or '(none)'}"
         )
     sc = scenarios[args.scenario]
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():  # SIGTERM stops the run like Ctrl-C: results kept
+        signal.signal(signal.SIGTERM, _interrupt)
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet)
+    partial = traj.stats.get("partial")
     tr = None
     switches = traj.stats.get("switches")
     if switches is not None:  # exact stick-slip: the phases' switches stand for the traction summary
@@ -184,8 +190,12 @@ def cmd_simulate(args) -> int:
     elif any(isinstance(c, RollingWheel) for c in robot.constraints):
         from .traction import plot_traction, traction
 
-        tr = traction(robot, traj, sc.torque, args.mu)
-        if args.traction_plot:
+        try:
+            tr = traction(robot, traj, sc.torque, args.mu)
+        except KeyboardInterrupt:  # the trajectory is kept; only its traction columns are lost
+            partial = traj.stats["partial"] = (partial + "; " if partial else "") + "traction not computed (interrupted)"
+            tr = None
+        if tr is not None and args.traction_plot:
             plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction")
     elif args.mu is not None or args.traction_plot:
         raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
@@ -226,8 +236,19 @@ def cmd_simulate(args) -> int:
         text.append(f"wrote {args.plot}")
     if args.traction_plot:
         text.append(f"wrote {args.traction_plot}")
+    if partial:
+        out["partial"] = partial
+        text.append(f"partial: {partial}")
     _emit(args, out, "\n".join(text))
+    if partial:
+        written = ", ".join(p for p in (args.csv, args.plot, args.traction_plot) if p) or "nothing"
+        print(f"robotdyn: {partial}; wrote the partial results: {written}", file=sys.stderr)
+        return 130
     return 0
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
 
 
 def cmd_compare(args) -> int:

@@ -161,6 +161,13 @@ class ConstraintForces:
         d = self.null_space.shape[1]
         if d == 0 or all(not np.any(T) for _, T in maps):
             return ratio(np.zeros(d))
+        if d == 1:  # one undetermined combination (two wheels on one axle, ...): a bounded scalar search
+            from scipy.optimize import minimize_scalar
+
+            scale = 10.0 * (1.0 + max(float(np.linalg.norm(b)) for b, _ in maps))
+            res = minimize_scalar(lambda z: ratio(np.array([z])), bounds=(-scale, scale), method="bounded",
+                                  options={"xatol": 1e-12 * scale})
+            return min(float(res.fun), ratio(np.zeros(1)))
         from scipy.optimize import minimize
 
         cons = [{"type": "ineq", "fun": (lambda x, b=b, T=T, f=f: (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2))}

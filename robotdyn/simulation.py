@@ -80,8 +80,10 @@ class Trajectory:
         extra = extra or {}
         header = ",".join(["t", *self.coordinates, *self.velocity_names, *extra])
         data = np.column_stack([self.t, self.q, self.nu, *extra.values()])
+        partial = self.stats.get("partial")
         with atomic_output(path, "CSV file") as tmp:
-            np.savetxt(tmp, data, delimiter=",", header=header, comments="")
+            np.savetxt(tmp, data, delimiter=",", header=header, comments="",
+                       footer=f"# partial: {partial}" if partial else "")  # a comment line: loadtxt skips it
 
 
 class _Progress:
@@ -181,7 +183,11 @@ def simulate(
     t_eval = np.linspace(0.0, t_end, n_out)
     start = time.perf_counter()
     y0 = np.concatenate([q0, nu0, [0.0] if slipping else []])
-    sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
+    interrupted = None
+    if events is None:
+        sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol)
+    else:
+        sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
     wall = time.perf_counter() - start
     if not sol.success:
         raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}")
@@ -197,16 +203,61 @@ def simulate(
     q, nu = sol.y[:n].T, sol.y[n:n + k].T
     energy = np.empty(len(sol.t))
     residual = np.zeros(len(sol.t))
-    for i in range(len(sol.t)):
-        v, res, holonomic = _velocity(robot, fast, q[i], nu[i])
-        energy[i] = robot.energy(q[i], v)
-        if holonomic.any():
-            residual[i] = np.max(np.abs(res[holonomic]))
+    times = sol.t
+    try:
+        for i in range(len(sol.t)):
+            v, res, holonomic = _velocity(robot, fast, q[i], nu[i])
+            energy[i] = robot.energy(q[i], v)
+            if holonomic.any():
+                residual[i] = np.max(np.abs(res[holonomic]))
+    except KeyboardInterrupt:  # keep the samples whose energy and residual are known
+        times, q, nu, energy, residual = sol.t[:i], q[:i], nu[:i], energy[:i], residual[:i]
+        interrupted = (f"interrupted after the integration, while computing energies: samples up to t = "
+                       f"{times[-1] if i else 0.0:.6g} s of {t_end:g} s")
     stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol}
+    if interrupted is not None:
+        stats["partial"] = interrupted
     if stats_event:
         stats["event"] = stats_event
-    return Trajectory(sol.t, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
-                      robot.units, sol.y[n + k] if slipping else None)
+    return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
+                      robot.units, sol.y[n + k][: len(times)] if slipping else None)
+
+
+def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarray, rtol: float, atol: float):
+    """scipy's ``solve_ivp`` loop (the same solver, steps and dense output at ``t_eval``, so the same numbers),
+    written out so that an interruption (Ctrl-C, SIGTERM) keeps what was computed: returns the solution object
+    and, if interrupted, a message saying up to which time the samples reach."""
+    from types import SimpleNamespace
+
+    from scipy.integrate._ivp.ivp import METHODS
+
+    solver = METHODS[method](rhs, 0.0, y0, t_end, rtol=rtol, atol=atol)
+    ts, ys, i, status, message, interrupted = [], [], 0, None, "", None
+    try:
+        while status is None:
+            message = solver.step()
+            if solver.status == "finished":
+                status = 0
+            elif solver.status == "failed":
+                status = -1
+                break
+            j = np.searchsorted(t_eval, solver.t, side="right")
+            if j > i:
+                dense = solver.dense_output()
+                ts.append(t_eval[i:j])
+                ys.append(np.atleast_2d(dense(t_eval[i:j])).reshape(len(y0), j - i))
+                i = j
+    except KeyboardInterrupt:
+        status = 0
+        del ts[len(ys):], ys[len(ts):]  # the signal may fall between the two appends
+        reached = float(ts[-1][-1]) if ts else 0.0
+        interrupted = f"interrupted at t = {solver.t:.6g} s: samples up to t = {reached:.6g} s of {t_end:g} s"
+    t = np.concatenate(ts) if ts else np.zeros(0)
+    y = np.hstack(ys) if ys else np.zeros((len(y0), 0))
+    if status == -1:
+        t, y = np.append(t, solver.t), np.column_stack([y, solver.y]) if y.size else solver.y[:, None]
+    return SimpleNamespace(t=t, y=y, success=status >= 0, message=message or "", nfev=solver.nfev,
+                           status=status), interrupted
 
 
 def _qdot(red, stabilisation: float) -> np.ndarray:

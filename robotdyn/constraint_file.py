@@ -86,6 +86,10 @@ TOP_KEYS = (
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro")
 WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
               "slip_velocity", "stiffness")
+MAX_RADIUS = 1e4
+"""Largest wheel radius accepted [m] (larger values only overflow the dynamics)."""
+MAX_FILE_BYTES = 1_000_000
+"""Largest constraint file read (a robot's description is a few kB; larger files are refused, not parsed)."""
 WHEEL_KINDS = ("standard", "omni", "caster", "support")
 CLOSURE_KEYS = ("name", "frame1", "frame2", "components")
 MOTOR_KEYS = ("name", "joint", "reaction")
@@ -263,10 +267,30 @@ def read(
     r = _Reader(path)
     if not path.is_file():
         raise ConstraintFileError(f"constraint file not found: {path}")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise ConstraintFileError(f"{path}: {path.stat().st_size:,} bytes; expected a constraint file of at most "
+                                  f"{MAX_FILE_BYTES:,} bytes")
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise ConstraintFileError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError:
+        raise ConstraintFileError(f"{path}: not UTF-8 text; expected a TOML constraint file") from None
+    except OSError as exc:
+        raise ConstraintFileError(f"{path}: cannot read: {exc.strerror}") from None
+    try:
+        return _read(path, r, data, urdf, xacro_args, package_dirs)
+    except (TypeError, AttributeError, KeyError, IndexError, ValueError, RecursionError) as exc:
+        if isinstance(exc, RobotDynError):
+            raise
+        # the last line of defence: a value of a shape the reader did not expect is an error of the file
+        raise ConstraintFileError(f"{path}: malformed constraint file ({type(exc).__name__}: "
+                                  f"{' '.join(str(exc).split())}); see the format in robotdyn/constraint_file.py"
+                                  ) from None
+
+
+def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) -> ConstraintFile:
+    """The body of :func:`read`, on the parsed TOML data."""
     r.keys("", data, TOP_KEYS)
     base = path.resolve().parent
 
@@ -429,6 +453,8 @@ def read(
             joint(where, w["radius_joint"], "radius_joint")
         elif not isinstance(rv, (int, float)) or not rv > 0:
             r.fail(where, f"radius {rv!r} is not > 0; expected a positive radius in m")
+        elif rv > MAX_RADIUS:
+            r.fail(where, f"radius {rv!r} m is above {MAX_RADIUS:g} m; expected a wheel radius in m")
         kind = w.get("kind", "standard")
         if kind not in WHEEL_KINDS:
             r.fail(where, f"kind {kind!r}{_suggest(kind, WHEEL_KINDS)}; expected one of {', '.join(WHEEL_KINDS)}")
@@ -490,6 +516,9 @@ def read(
     independent = data.get("independent")
     if independent is not None:
         independent = [coordinate("independent", x) for x in r.strings("independent", independent, "independent")]
+        if not independent:
+            r.fail("independent", "empty; expected the names of the independent coordinates (or no 'independent' "
+                                  "key: chosen automatically)")
     neutral_table = data.get("neutral", {})
     r.keys("neutral", neutral_table, list(neutral_table))
     neutral = {coordinate(f"neutral.{k}", k): r.number(f"neutral.{k}", v, "value") for k, v in neutral_table.items()}
@@ -497,6 +526,8 @@ def read(
     if "terrain" in data:
         t = dict(data["terrain"]) if isinstance(data["terrain"], dict) else r.fail("terrain", "expected a table")
         kind = t.pop("kind", "flat")
+        if not isinstance(kind, str):
+            r.fail("terrain", f"kind = {kind!r}; expected one of {', '.join(TERRAINS)}")
         if kind not in TERRAINS:
             r.fail("terrain", f"kind {kind!r}{_suggest(kind, TERRAINS)}; expected one of {', '.join(TERRAINS)}")
         cls = TERRAINS[kind]
@@ -533,7 +564,12 @@ def read(
         where = f"scenarios[{i}]"
         r.keys(where, s, SCENARIO_KEYS)
         name = r.string(where, s.get("name"), "name")
+        if name in scenarios:
+            r.fail(where, f"a second scenario named {name!r}; expected unique scenario names")
         where = f"scenarios[{i}] ({name})"
+        for key in ("q0", "nu0"):
+            if not isinstance(s.get(key, {}), dict):
+                r.fail(where, f"{key} = {s[key]!r}; expected a table of values by coordinate name")
         t_end = r.number(where, s.get("t_end"), "t_end")
         if t_end <= 0:
             r.fail(where, f"t_end = {t_end}; expected a positive duration in s")

@@ -299,7 +299,8 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
         e -= Jt.T @ force
     A = rows.A
-    lam, N, rank, residual, condition = _solve_transpose(A, e)
+    with np.errstate(all="ignore"):  # an overflow is refused below as a NonFiniteError, in one line
+        lam, N, rank, residual, condition = _solve_transpose(A, e)
     determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
     out = ConstraintForces(list(rows.labels), lam, determined, N, rank, residual, nudot, tau)
     out.condition = condition

@@ -18,6 +18,7 @@ import numpy as np
 
 from .errors import RobotDynError
 from .inputs import as_vector, parse_assignments
+from .robot import solve_mass
 from .rolling_contact import RollingWheel
 
 
@@ -145,7 +146,7 @@ def cmd_dump(args) -> int:
                  _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
     elif args.tau is not None:
         tau = robot.check_tau(args.tau)
-        nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
+        nudot = solve_mass(red.M, red.B @ tau - red.h)
         out["a"] = nudot
         text.append(_vector_text("a (independent accelerations)", names, nudot))
     if args.forces:
@@ -394,6 +395,10 @@ def main(argv: list[str] | None = None) -> int:
             return int(args.func(args) or 0)
     except RobotDynError as exc:
         print(f"robotdyn: error: {exc}", file=sys.stderr)
+        return 2
+    except np.linalg.LinAlgError as exc:  # a solve the checks above did not foresee: still one line
+        print(f"robotdyn: error: a linear solve failed ({exc}): the model is singular at this state (massless "
+              "bodies, or redundant constraints)", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("robotdyn: interrupted", file=sys.stderr)

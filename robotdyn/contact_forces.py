@@ -275,7 +275,9 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
             friction[wheel.name] = (tangential(wheel, kin_v)[0], st.force[i])
     elif nudot is None:
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
-        nudot = np.linalg.solve(red.M, red.B @ tau - red.h)
+        from .robot import solve_mass
+
+        nudot = solve_mass(red.M, red.B @ tau - red.h)
     else:
         nudot = robot.check_nu(nudot, "a")
         if tau is None:

@@ -33,6 +33,19 @@ from .sliding import forward as forward_sliding
 from .terrain import FlatTerrain, Terrain
 
 
+def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:math:`M^{-1} b` for a reduced mass matrix, which must be positive definite (Cholesky); else a one-line
+    :class:`~robotdyn.errors.InputError` naming the likely cause."""
+    try:
+        L = np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        eig = np.linalg.eigvalsh(M) if np.all(np.isfinite(M)) else np.array([np.nan])
+        raise InputError(f"the reduced mass matrix is not positive definite (smallest eigenvalue {eig.min():.3g}): "
+                         "massless or zero-inertia bodies move freely; expected positive masses and inertias"
+                         ) from None
+    return np.linalg.solve(L.T, np.linalg.solve(L, b))
+
+
 @dataclass
 class Parameter:
     """A physical parameter: name, default, unit, meaning; ``xacro=False`` if it is not a xacro argument."""
@@ -43,6 +56,7 @@ class Parameter:
     description: str = ""
     choices: tuple[str, ...] | None = None
     xacro: bool = True
+    minimum: float | None = None  # smallest physical value (default: 0 for masses and inertias, by their unit)
 
     def convert(self, value) -> float | str:
         """Validate and convert a user value."""
@@ -56,6 +70,10 @@ class Parameter:
             raise InputError(f"parameter {self.name} = {value!r} is not a number [{self.unit}]") from None
         if not np.isfinite(out):
             raise InputError(f"parameter {self.name} = {value!r} is not finite; expected a number [{self.unit}]")
+        low = self.minimum if self.minimum is not None else (0.0 if self.unit in ("kg", "kg m^2") else None)
+        if low is not None and out < low:
+            raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a value >= {low:g} "
+                             f"({self.description or self.name})")
         return out
 
 
@@ -357,7 +375,7 @@ class Robot:
         if sliding_now(self):
             return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
         red = self.reduced(q, nu)
-        out = np.linalg.solve(red.M, red.B @ np.asarray(tau, float) - red.h)
+        out = solve_mass(red.M, red.B @ np.asarray(tau, float) - red.h)
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
                                  "what double precision holds)")

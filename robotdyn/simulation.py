@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .compiled import Fallback, compiled_model
-from .errors import RobotDynError
+from .errors import NonFiniteError, RobotDynError
 from .projection import solve
 from .reduced_dynamics import velocity
 from .sliding import forward as forward_sliding
@@ -152,7 +152,13 @@ def simulate(
     fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path
     k = robot.mobility
 
+    # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.robot.solve_mass)
+    robot.forward_dynamics(q0, nu0, zero_tau if torque is None else np.asarray(torque(0.0, q0, nu0), float))
+
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        if not np.isfinite(y).all():
+            raise NonFiniteError(f"the state became non-finite at t = {t:.6g} s (the dynamics blew up: massless "
+                                 "bodies, a singular state, or torques beyond what double precision holds)")
         q, nu = y[:n], y[n:n + k]
         tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
         if slipping:  # normal loads and friction solved with the accelerations; y[-1] is the friction work

@@ -105,3 +105,22 @@ def test_negative_numbers_in_scientific_notation_are_values(capsys):
     assert main(["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "-1e-5", "-2e-5", "-3e-5"]) == 0
     rows = [line.split() for line in capsys.readouterr().out.splitlines() if line.startswith("    theta")]
     assert all(len(r) in (2, 3, 4) for r in rows)
+
+
+@pytest.mark.parametrize("params, message", [
+    (["M=0", "m=0", "J1=0", "J2=0"], "not positive definite"),
+    (["m=-1"], "parameter m = -1 kg; expected a value >= 0"),
+    (["J2=-0.4"], "parameter J2 = -0.4 kg m^2; expected a value >= 0"),
+    (["r=0"], "radius 0.0 is not > 0"),
+])
+def test_physically_impossible_parameters_are_one_line(capsys, params, message):
+    argv = ["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "1", "0.5", "0.2", "--tau", "0.1", "0.1"]
+    for p in params:
+        argv += ["--param", p]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err and "Traceback" not in err
+    assert main(["simulate", "quasimoro", "--scenario", "rectilinear", "--t-end", "0.5", "--quiet",
+                 *[x for p in params for x in ("--param", p)]]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err

@@ -57,6 +57,12 @@ def plot_trajectory(
                 ax.set_title("whole run" if j == 0 else f"first {zoom:g} s")
             if (references or {}).get(name) and j == ncol - 1:
                 ax.legend(fontsize=7, loc="upper right")
+    return finish(fig, path, title)
+
+
+def finish(fig, path=None, title: str = ""):
+    """Title and lay out a figure, then save it atomically (:func:`robotdyn.output.save_figure`) and close it when
+    ``path`` is given; returns the figure."""
     if title:
         fig.suptitle(title)
     fig.tight_layout()

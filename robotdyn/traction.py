@@ -214,7 +214,7 @@ def _crossing(t: np.ndarray, y: np.ndarray, k: int, level: float) -> float:
 def plot_traction(tr: Traction, path=None, title: str = ""):
     """Normal loads and required friction per wheel against time, shaded where the no-slip assumption is broken
     (load <= 0, or required friction above the wheel's mu, drawn dashed)."""
-    from .plotting import plt
+    from .plotting import finish, plt
 
     fig, (ax_n, ax_mu) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
     broken = tr.broken().any(axis=1) if tr.wheels else np.zeros(len(tr.t), bool)
@@ -241,14 +241,4 @@ def plot_traction(tr: Traction, path=None, title: str = ""):
         ax_mu.legend(fontsize=7, loc="upper right")
     if tr.undetermined:
         ax_n.set_title(f"loads of {', '.join(tr.undetermined)} not determined", fontsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    if path is not None:
-        from .output import save_figure
-
-        try:
-            save_figure(fig, path)
-        finally:
-            plt.close(fig)
-    return fig
+    return finish(fig, path, title)

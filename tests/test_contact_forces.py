@@ -4,21 +4,17 @@ rolling down an incline."""
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
 from scipy.linalg import qr
-from scipy.optimize import brentq
 
 import robotdyn
 from robotdyn.errors import InputError
-from robotdyn.robot import Robot, RobotSpec, Wheel
-from robotdyn.terrain import RampTerrain
+from robotdyn.robot import Robot
 
 ROBOTS = ["quasimoro", "omni_caster", "linkage_suspension", "adaptable_wheel", "mmr12_eod"]
-DISC = Path(__file__).parent / "data" / "disc.urdf"
 
 
 @pytest.fixture(scope="module")
@@ -97,19 +93,10 @@ def test_static_balance_at_rest(robots, name):
 
 
 def _disc_on_ramp(slope: float) -> tuple[Robot, np.ndarray]:
-    spec = RobotSpec(name="disc", title="rolling disc", xacro=DISC, root="planar", wheels=[Wheel("disc", 0.3)],
-                     independent=["psi", "lean", "spin"])
-    robot = Robot(spec, terrain=RampTerrain(slope))
-    q = np.zeros(robot.nq)
-    iz = robot.coordinate_index("z")
+    """The test disc rolling (no slip) on a ramp, its height solved onto the terrain."""
+    from test_sliding import disc
 
-    def gap(z):
-        qq = q.copy()
-        qq[iz] = z
-        return robot.constraint_residual(qq)[0]
-
-    q[iz] = brentq(gap, -2.0, 2.0, xtol=1e-15)
-    return robot, q
+    return disc(slope, independent=("psi", "lean", "spin"))
 
 
 @pytest.mark.parametrize("slope", [0.1, 0.5, 1.2])

@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 
 from robotdyn.constraint_file import read
-from robotdyn.errors import ConstraintError
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skid_steer.toml"
 A, B, R, K, TAU, G = 0.25, 0.22, 0.1, 5.0, 0.3, 9.81

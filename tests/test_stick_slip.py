@@ -8,7 +8,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robotdyn.cli import main
 from robotdyn.simulation import simulate
 
 from test_sliding import G, K, M, disc
@@ -56,8 +55,8 @@ def test_disc_on_incline_rolls_iff_cone_allows(slope):
         assert switches == ([] if expect == "roll" else [{"t": 0.0, "wheel": "disc", "phase": "slide"}])
 
 
-def test_stick_slip_keys_through_the_constraint_file(tmp_path, capsys):
-    """friction = "stick_slip" is accepted with mu and refused without it, in one line."""
+def test_stick_slip_needs_mu_and_no_regularisation():
+    """friction = "stick_slip" is accepted with mu and refused without it, or with a regularisation, in one line."""
     from robotdyn.errors import InputError
 
     with pytest.raises(InputError, match="stick_slip law needs mu"):

@@ -110,7 +110,16 @@ def cmd_info(args) -> int:
 
 def cmd_dump(args) -> int:
     _, robot = _load(args)
-    q = robot.check_q(args.q)
+    q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates)
+    for name, value in parse_assignments(args.set, "--set").items():
+        try:
+            x = float(value)
+        except ValueError:
+            raise RobotDynError(f"--set {name}={value!r}: not a number; expected a value in m or rad") from None
+        if not np.isfinite(x):
+            raise RobotDynError(f"--set {name}={value!r}: not finite; expected a value in m or rad")
+        q[robot.coordinate_index(name)] = x
+    q = robot.check_q(q)
     if args.full:
         v = as_vector(args.v, robot.nq, "v", robot.velocity_labels)
         M, C, g = robot.full(q, v)
@@ -340,7 +349,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_info)
     p = sub.add_parser("dump", parents=[common, robot_args],
                        help="minimal-coordinate M, C, g and torques (or accelerations) at a state")
-    p.add_argument("--q", nargs="+", required=True, help="natural coordinates, in the order info lists them")
+    p.add_argument("--q", nargs="+", help="natural coordinates, in the order info lists them (default: the neutral "
+                                          "configuration)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="set one coordinate by name, e.g. --set theta3=0.3 (repeatable; applied after --q)")
     p.add_argument("--v", nargs="+", required=True, help="independent velocities (with --full: all velocities)")
     group = p.add_mutually_exclusive_group()
     group.add_argument("--a", nargs="+", help="accelerations -> torques (inverse dynamics)")

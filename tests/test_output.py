@@ -124,3 +124,18 @@ def test_physically_impossible_parameters_are_one_line(capsys, params, message):
                  *[x for p in params for x in ("--param", p)]]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_dump_values_by_name(capsys):
+    """--set NAME=VALUE sets coordinates by name (from the neutral configuration or --q), with one-line errors."""
+    assert main(["dump", "quasimoro", "--set", "theta3=0.3", "--v", "1", "0.5", "0.2", "--json"]) == 0
+    import json
+
+    by_name = json.loads(capsys.readouterr().out)
+    assert main(["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "1", "0.5", "0.2", "--json"]) == 0
+    by_position = json.loads(capsys.readouterr().out)
+    assert by_name["M"] == by_position["M"] and by_name["q"] == by_position["q"]
+    assert main(["dump", "quasimoro", "--set", "theta9=0.3", "--v", "1", "0.5", "0.2"]) == 2
+    assert "unknown coordinate 'theta9'" in capsys.readouterr().err
+    assert main(["dump", "quasimoro", "--set", "theta3=abc", "--v", "1", "0.5", "0.2"]) == 2
+    assert "not a number" in capsys.readouterr().err

@@ -221,6 +221,17 @@ class Robot:
         if self.operational is not None:
             self.velocity_names = list(self.operational.names)
 
+    def __getstate__(self) -> dict:
+        """Pickle without the per-thread caches (Pinocchio data and compiled models are rebuilt on use)."""
+        state = self.__dict__.copy()
+        for key in ("_local", "_constraint_set", "_compiled_model", "_floating_twin"):
+            state.pop(key, None)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._local = threading.local()
+
     @property
     def data(self) -> pin.Data:
         """Pinocchio's data for the calling thread (each thread gets its own, so that one Robot may be used from

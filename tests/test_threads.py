@@ -49,3 +49,16 @@ def test_concurrent_evaluations_equal_sequential(name):
     finally:
         sys.setswitchinterval(interval)
     assert errors == []
+
+
+def test_robot_pickles_without_its_thread_caches():
+    """A robot (e.g. sent to a worker process) pickles after use; the copy rebuilds its caches and gives the same
+    numbers."""
+    import pickle
+
+    robot = robotdyn.load("quasimoro")
+    q, nu = robot.neutral(), np.array([0.3, -0.2, 0.1])
+    h = robot.reduced(q, nu).h.copy()
+    compiled_model(robot)
+    copy = pickle.loads(pickle.dumps(robot))
+    np.testing.assert_array_equal(copy.reduced(q, nu).h, h)

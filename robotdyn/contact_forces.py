@@ -341,7 +341,7 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
     from dataclasses import replace
 
     twin = getattr(robot, "_floating_twin", None)
-    if twin is None:
+    if twin is None or twin.terrain is not robot.terrain:  # (re)built for the robot's current terrain
         from .robot import Robot
 
         spec = replace(robot.spec, root="floating", independent=None, operational=None)

@@ -155,13 +155,16 @@ def simulate(
     # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.robot.solve_mass)
     robot.forward_dynamics(q0, nu0, zero_tau if torque is None else np.asarray(torque(0.0, q0, nu0), float))
 
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+    def finite(t: float, y: np.ndarray) -> None:  # on the Python paths only: the compiled one stays lean
         if not np.isfinite(y).all():
             raise NonFiniteError(f"the state became non-finite at t = {t:.6g} s (the dynamics blew up: massless "
                                  "bodies, a singular state, or torques beyond what double precision holds)")
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
         q, nu = y[:n], y[n:n + k]
         tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
         if slipping:  # normal loads and friction solved with the accelerations; y[-1] is the friction work
+            finite(t, y)
             st = forward_sliding(robot, q, nu, tau)
             report(t)
             return np.concatenate([_qdot(st.reduced, stabilisation), st.nudot, [st.power]])
@@ -172,6 +175,7 @@ def simulate(
                 return out
             except Fallback:
                 pass
+        finite(t, y)
         red = robot.reduced(q, nu)
         nudot = solve(red.M, red.B @ tau - red.h)  # numpy.linalg.solve's LAPACK call, without its overhead
         report(t)

@@ -35,7 +35,7 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     # frame = "wheel_right_link"        # ... or the wheel centre frame directly
     radius = 0.0985                     # a number > 0 or a parameter name
     axis = [0, 0, 1]                    # axle in the wheel frame (default: the spin joint's axis)
-    kind = "standard"                   # standard | omni (with roller_angle) | caster (a standard wheel on a
+    kind = "standard"                   # standard | omni (with roller_angle: rad, or "45 deg") | caster (a wheel on a
                                         # steering joint of the URDF: nothing special) | support (touches the
                                         # ground only: normal row, frictionless, e.g. a free castor or a skid)
     mu = 0.8                            # friction coefficient (traction checks; the coulomb law's mu)
@@ -198,6 +198,21 @@ class _Reader:
         if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
             self.fail(where, f"{what} = {x!r}; expected a finite number")
         return float(x)
+
+    def angle(self, where: str, x, what: str) -> float:
+        """An angle in rad: a number in [-pi, pi], or a string with its unit ("45 deg", "0.785 rad"); a bare
+        number beyond pi is refused (it is almost always degrees written without their unit)."""
+        if isinstance(x, str):
+            match = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(deg|rad)\s*", x)
+            if not match:
+                self.fail(where, f"{what} = {x!r}; expected a number in rad or a string like '45 deg' or '0.79 rad'")
+            value = self.number(where, float(match.group(1)), what)
+            return float(np.radians(value)) if match.group(2) == "deg" else value
+        value = self.number(where, x, what)
+        if abs(value) > np.pi:
+            self.fail(where, f"{what} = {value:g}; a bare number is in rad and expected in [-pi, pi]: write "
+                             f"'{value:g} deg' for degrees")
+        return value
 
     def string(self, where: str, x, what: str) -> str:
         if not isinstance(x, str) or not x:
@@ -463,7 +478,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) ->
             if kind != "omni":
                 r.fail(where, "roller_angle is only meaningful for kind = 'omni'")
             if not (isinstance(roller, str) and roller in pvalues):
-                roller = r.number(where, roller, "roller_angle")
+                roller = r.angle(where, roller, "roller_angle")
         friction = w.get("friction", "rolling")
         if not isinstance(friction, str):
             r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")

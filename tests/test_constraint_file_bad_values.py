@@ -69,3 +69,31 @@ ACCEPTABLE = {"description", "title", "t_end", "mu", "stiffness", "default", "un
               "name"}
 """Keys where some of the 'wrong' values are legitimate (a huge t_end or mu, a negative torque or height, a name
 that is any text): accepting those is right."""
+
+
+def _omni(tmp_path, angle):
+    data = tomllib.loads(EXAMPLE.read_text())
+    data["urdf"] = str(EXAMPLE.parent / "skid_steer.urdf.xacro")
+    data.pop("independent")
+    for w in data["wheels"]:
+        for key in ("friction", "stiffness", "mu"):
+            w.pop(key, None)
+        w["kind"], w["roller_angle"] = "omni", angle
+    path = tmp_path / "omni.toml"
+    path.write_text(tomli_w.dumps(data))
+    return path
+
+
+def test_angles_with_units(tmp_path, capsys):
+    """roller_angle = "45 deg" is pi/4 rad; a bare 45 (degrees without their unit) is refused, not taken as rad."""
+    from robotdyn.constraint_file import read
+
+    rows = {}
+    for label, angle in (("deg", "45 deg"), ("rad", 0.7853981633974483), ("rad-string", "0.7853981633974483 rad")):
+        robot = read(_omni(tmp_path, angle)).robot()
+        rows[label] = robot.rows_at(robot.neutral()).A
+    assert abs(rows["deg"] - rows["rad"]).max() < 1e-15 and abs(rows["rad-string"] - rows["rad"]).max() == 0
+    for bad, message in ((45, "write '45 deg' for degrees"), ("45 grad", "expected a number in rad or a string")):
+        assert main(["info", "--constraints", str(_omni(tmp_path, bad))]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and message in err

@@ -158,25 +158,34 @@ def _validate_with_yourdfpy(urdf: str) -> None:
         raise DescriptionError(f"invalid URDF: {' '.join(str(exc).split())}") from None
     if not robot.validate():
         raise DescriptionError("invalid URDF: yourdfpy validation failed (check links, joints and inertials)")
-    for link in robot.robot.links:
-        inertial = link.inertial
-        if inertial is None or inertial.mass is None:
-            continue
-        if inertial.mass < 0 or not math.isfinite(inertial.mass):
-            raise DescriptionError(f"link {link.name!r} has mass {inertial.mass}; expected a finite value >= 0")
-        inertia = np.asarray(inertial.inertia, dtype=float)
-        eig = np.linalg.eigvalsh(inertia)
-        if inertial.mass > 0 and (eig.min() < -1e-12 or not np.all(np.isfinite(eig))):
-            raise DescriptionError(
-                f"link {link.name!r} has a non-positive inertia tensor (eigenvalues {np.round(eig, 6).tolist()}); "
-                "expected a positive semi-definite central inertia"
-            )
-        a, b, c = np.sort(eig)
-        if inertial.mass > 0 and c > a + b + 1e-9 * max(c, 1.0):
-            raise DescriptionError(
-                f"link {link.name!r} violates the triangle inequality of principal inertias "
-                f"({a:.6g}, {b:.6g}, {c:.6g}); no rigid body has that inertia"
-            )
+    problems = [p for p in map(_inertial_problem, robot.robot.links) if p]
+    if len(problems) == 1:
+        raise DescriptionError(problems[0])
+    if problems:
+        names = [p.split("'")[1] for p in problems]
+        raise DescriptionError(
+            f"{len(problems)} links have non-physical inertials: {'; '.join(problems)}. If they are placeholders, "
+            f"declare them massless (massless = {names} in a constraint file)".replace("'", '"'))
+
+
+def _inertial_problem(link) -> str | None:
+    """What is physically impossible about a link's inertial (negative or non-finite mass, an inertia tensor that
+    is not positive semi-definite or violates the triangle inequality), or None."""
+    inertial = link.inertial
+    if inertial is None or inertial.mass is None:
+        return None
+    if inertial.mass < 0 or not math.isfinite(inertial.mass):
+        return f"link {link.name!r} has mass {inertial.mass}; expected a finite value >= 0"
+    inertia = np.asarray(inertial.inertia, dtype=float)
+    eig = np.linalg.eigvalsh(inertia)
+    if inertial.mass > 0 and (eig.min() < -1e-12 or not np.all(np.isfinite(eig))):
+        return (f"link {link.name!r} has a non-positive inertia tensor (eigenvalues {np.round(eig, 6).tolist()}); "
+                "expected a positive semi-definite central inertia")
+    a, b, c = np.sort(eig)
+    if inertial.mass > 0 and c > a + b + 1e-9 * max(c, 1.0):
+        return (f"link {link.name!r} violates the triangle inequality of principal inertias "
+                f"({a:.6g}, {b:.6g}, {c:.6g}); no rigid body has that inertia")
+    return None
 
 
 def _naturalise(urdf: str, root: str) -> tuple[str, list[str]]:

@@ -76,3 +76,20 @@ def test_units_follow_joint_types():
     assert units["x"] == "m" and units["psi"] == "rad" and units["theta1_dot"] == "rad/s"
     units = robotdyn.load("mmr12_eod").units
     assert units["lambda2"] == "m" and units["lambda2_dot"] == "m/s" and units["theta1"] == "rad"
+
+
+def test_every_placeholder_inertia_is_named_at_once(tmp_path):
+    """Two links with impossible inertials: both are named in one line, with the hint to declare them massless."""
+    from robotdyn.description import validate_urdf
+    from robotdyn.errors import DescriptionError
+
+    bad = ('<inertial><mass value="1e-6"/><inertia ixx="-1e-8" iyy="1e-9" izz="1e-9" ixy="0" ixz="0" iyz="0"/>'
+           '</inertial>')
+    urdf = (f'<robot name="r"><link name="base"/><link name="antenna_l">{bad}</link><link name="antenna_r">{bad}'
+            '</link><joint name="a" type="fixed"><parent link="base"/><child link="antenna_l"/></joint>'
+            '<joint name="b" type="fixed"><parent link="base"/><child link="antenna_r"/></joint></robot>')
+    with pytest.raises(DescriptionError) as exc:
+        validate_urdf(urdf)
+    msg = str(exc.value)
+    assert "\n" not in msg and "2 links" in msg and "antenna_l" in msg and "antenna_r" in msg
+    assert 'massless = ["antenna_l", "antenna_r"]' in msg

@@ -63,3 +63,4 @@ def test_cli_and_constraint_file_values_are_checked(tmp_path, capsys):
     assert main(["info", "--constraints", str(toml)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "xacro argument b" in err and "Traceback" not in err
+

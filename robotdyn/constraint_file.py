@@ -41,6 +41,8 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     mu = 0.8                            # friction coefficient (traction checks; the coulomb law's mu)
     friction = "rolling"                # rolling (no slip, default) | coulomb (regularised: slip_velocity [m/s],
                                         # default 1e-3) | linear (stiffness [s/m], saturated at mu if given)
+    slip = "both"                       # with a friction law: both | lateral (rolls along its rolling direction
+                                        # and slides sideways: only the lateral force follows the law)
     [[closures]]
     frame1 = "a"; frame2 = "b"; components = "x y z"   # subset of x y z rx ry rz in frame1's axes
 
@@ -72,6 +74,7 @@ from .errors import InputError, RobotDynError
 from .friction import LAWS, make_law
 from .robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
 from .scenario import Scenario
+from .sliding import SLIP_DIRECTIONS
 from .terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
 
 
@@ -85,7 +88,7 @@ TOP_KEYS = (
 )
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro")
 WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
-              "slip_velocity", "stiffness")
+              "slip_velocity", "stiffness", "slip")
 MAX_RADIUS = 1e4
 """Largest wheel radius accepted [m] (larger values only overflow the dynamics)."""
 MAX_FILE_BYTES = 1_000_000
@@ -483,14 +486,22 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) ->
         if not isinstance(friction, str):
             r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
         numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness") if key in w}
+        slip = w.get("slip", "both")
+        if slip not in SLIP_DIRECTIONS:
+            r.fail(where, f"slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")
         wheel = Wheel(fname, radius, tuple(float(a) for a in axis), kind if kind in ("omni", "support") else "standard",
-                      roller, w.get("radius_joint"), w.get("name", fname), friction=friction, **numbers)
+                      roller, w.get("radius_joint"), w.get("name", fname), friction=friction, slip=slip, **numbers)
         try:  # the friction keys' physics (mu >= 0, a known law with its parameters) in one line
             if friction != "rolling":
                 if wheel.kind != "standard":
                     raise InputError(f"friction law {friction!r} on a {wheel.kind} wheel; expected a standard wheel "
                                      "(support wheels are frictionless, omni wheels roll on their rollers)")
                 make_law(friction, wheel.mu, wheel.slip_velocity, wheel.stiffness, wheel.name)
+                if friction == "stick_slip" and slip != "both":
+                    raise InputError("slip = 'lateral' with friction = 'stick_slip'; exact stick-slip switches the "
+                                     "whole tangential force (expected slip = 'both')")
+            elif slip != "both":
+                raise InputError("slip = 'lateral' needs friction = 'coulomb' or 'linear'")
             elif wheel.mu is not None and not (math.isfinite(wheel.mu) and wheel.mu >= 0):
                 raise InputError(f"mu = {wheel.mu}; expected a friction coefficient >= 0")
             elif wheel.slip_velocity is not None or wheel.stiffness is not None:

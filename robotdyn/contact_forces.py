@@ -402,8 +402,8 @@ def _wheel_force(wheel: RollingWheel, kin: KinematicState, index: dict, lam: np.
     else:
         determined = np.ones(3, bool)
     kind = "support" if D.shape[0] == 1 else ("omni" if D.shape[0] == 2 else "standard")
-    if friction is not None:
-        force[:2] = friction
+    if friction is not None:  # the law's force along its free directions (zero along a rolling one)
+        force[:2] += friction
         kind = "slipping"
     return WheelForce(wheel.name, kind, force, determined, E @ force, np.array(p, float))
 

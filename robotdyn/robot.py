@@ -92,6 +92,7 @@ class Wheel:
     friction: str = "rolling"  # rolling (no slip) | coulomb | linear (robotdyn.friction)
     slip_velocity: float | None = None  # coulomb law's regularisation scale [m/s]
     stiffness: float | None = None  # linear law's slip stiffness [s/m]
+    slip: str = "both"  # with a friction law: both tangential directions slip, or only the lateral one
 
 
 @dataclass
@@ -265,10 +266,13 @@ class Robot:
             if w.friction == "stick_slip":
                 from .stick_slip import StickSlipWheel
 
+                if w.slip != "both":
+                    raise InputError(f"wheel {name!r}: slip = {w.slip!r} with friction = 'stick_slip'; exact "
+                                     "stick-slip switches the whole tangential force (expected slip = 'both')")
                 return StickSlipWheel(self.description, w.frame, self._value(w.radius), law.mu, **kw)
-            return SlippingWheel(self.description, w.frame, self._value(w.radius), law, **kw)
-        if w.slip_velocity is not None or w.stiffness is not None:
-            raise InputError(f"wheel {name!r}: slip_velocity/stiffness given but friction = 'rolling'; expected "
+            return SlippingWheel(self.description, w.frame, self._value(w.radius), law, slip=w.slip, **kw)
+        if w.slip_velocity is not None or w.stiffness is not None or w.slip != "both":
+            raise InputError(f"wheel {name!r}: slip_velocity/stiffness/slip given but friction = 'rolling'; expected "
                              "friction = 'coulomb' or 'linear'")
         if w.kind == "omni":
             return OmniWheel(self.description, w.frame, self._value(w.radius), self._value(w.roller_angle), **kw)

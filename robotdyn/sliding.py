@@ -24,7 +24,7 @@ import pinocchio as pin
 
 from .actuation import input_matrix
 from .constraint import KinematicState
-from .errors import ConstraintError, SingularConstraintError
+from .errors import ConstraintError, InputError, SingularConstraintError
 from .friction import FrictionLaw
 from .rolling_contact import SupportWheel
 
@@ -32,26 +32,50 @@ PAINLEVE_CONDITION = 1e12
 """Condition number of the coupled system above which it counts as singular."""
 
 
+SLIP_DIRECTIONS = ("both", "lateral")
+"""Which tangential directions of a slipping wheel follow its law: ``both`` (the wheel slides freely in its
+tangent plane) or ``lateral`` (it rolls without slipping along t1 and slides sideways along t2: the tyre model
+of vehicle dynamics that neglects longitudinal slip)."""
+
+
 class SlippingWheel(SupportWheel):
     """A wheel that keeps contact (its normal row) and slips under a friction law.
 
+    With ``slip="lateral"`` it also keeps its longitudinal no-slip row (t1; the rolling constraint force is the
+    traction) and only its lateral force (t2) follows the law, from the lateral slip velocity. The law then sees a
+    purely lateral slip, so the lateral force alone is bounded by :math:`\\mu f_n`; the combined force
+    :math:`\\|(f_{t1}, f_{t2})\\|/f_n` is reported by :mod:`robotdyn.contact_forces` (``required_mu``), and exceeding
+    :math:`\\mu` there means the longitudinal no-slip assumption breaks too.
+
     Args:
         law: The :class:`~robotdyn.friction.FrictionLaw` of its tangential force.
+        slip: ``both`` (default) or ``lateral`` (:data:`SLIP_DIRECTIONS`).
         Other arguments as :class:`~robotdyn.rolling_contact.RollingWheel`.
     """
 
     sliding = True  # its friction force comes from a law (robotdyn.sliding.forward)
 
-    def __init__(self, description, frame: str, radius: float, law: FrictionLaw, **kwargs) -> None:
+    def __init__(self, description, frame: str, radius: float, law: FrictionLaw, slip: str = "both",
+                 **kwargs) -> None:
         super().__init__(description, frame, radius, **kwargs)
+        if slip not in SLIP_DIRECTIONS:
+            raise InputError(f"wheel {self.name!r}: slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")
         self.law = law
+        self.slip_directions = slip
+        self._free = np.array([1.0, 1.0]) if slip == "both" else np.array([0.0, 1.0])
+        if slip == "lateral":  # the longitudinal no-slip row stays a constraint
+            self._directions = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+            self._row_names = ("longitudinal", "normal")
 
     def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
-        """:math:`c(s)` of its law: the friction force is :math:`-f_n c(s)` (t1, t2)."""
-        return self.law.coefficient(s)
+        """:math:`c(s)` of its law on the free directions: the friction force is :math:`-f_n c(s)` (t1, t2), zero
+        along a direction that rolls without slipping."""
+        return self.law.coefficient(s * self._free) * self._free
 
     def __repr__(self) -> str:
-        return f"SlippingWheel(frame={self.frame!r}, radius={self.radius}, law={self.law!r}, terrain={self.terrain!r})"
+        slip = "" if self.slip_directions == "both" else ", slip='lateral'"
+        return (f"SlippingWheel(frame={self.frame!r}, radius={self.radius}, law={self.law!r}{slip}, "
+                f"terrain={self.terrain!r})")
 
     def slip(self, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
         """The tangential rows :math:`J_t` (2, nv) and the slip velocity (2,) [m/s]: :func:`tangential`."""
@@ -140,3 +164,69 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     normal = sol[k + position]
     force = -normal[:, None] * coef
     return SlidingState(sol[:k], red, normal, slip, force, float(np.sum(force * slip)))
+
+
+@dataclass
+class SlidingInverse:
+    """Inverse dynamics with slipping wheels at one state (:func:`inverse`).
+
+    Attributes:
+        tau: Motor torques (n_motors,) [N m or N].
+        multipliers: The constraint rows' forces by label (rows of :meth:`Robot.constraint_rows`) [N, N m].
+        normal: Normal load of each sliding wheel (W,) [N].
+        slip: Slip velocity of each sliding wheel (W, 2) [m/s] (t1, t2).
+        force: Friction force of each sliding wheel from its law (W, 2) [N] (t1, t2).
+        residual: :math:`\\|K x - b\\|` of the least-squares solve [N, N m] (0: the motion is exactly realisable by
+            these motors and contacts).
+        rank: Rank of K; below its column count the torques and forces are not all determined.
+    """
+
+    tau: np.ndarray
+    multipliers: dict[str, float]
+    normal: np.ndarray
+    slip: np.ndarray
+    force: np.ndarray
+    residual: float
+    rank: int
+
+
+def inverse(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> SlidingInverse:
+    """Motor torques and contact forces that produce the full accelerations ``a`` at (q, v), with the sliding
+    wheels' friction from their laws.
+
+    The friction forces are linear in the (unknown) normal loads, so torques and constraint forces solve one linear
+    system, by least squares with its residual and rank reported:
+
+    .. math:: \\Big[B \\;\\; A^T - \\sum_i J_{t,i}^T c_i e_{n_i}^T\\Big] \\begin{bmatrix}\\tau\\\\ \\lambda\\end{bmatrix}
+        = \\mathrm{RNEA}(q, v, a).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` (its sliding wheels as :func:`sliding_now` lists them).
+        q, v, a: Natural coordinates, full velocities (consistent with the constraints) and full accelerations.
+    """
+    q, v, a = (np.asarray(x, float) for x in (q, v, a))
+    wheels = sliding_now(robot)
+    model, data = robot.model, robot.data
+    kin = KinematicState(model, data, q, v)
+    from .reduced_dynamics import constraint_set
+
+    rows = constraint_set(robot).jacobian(kin)
+    G = rows.A.T.copy()
+    slip = np.zeros((len(wheels), 2))
+    coef = np.zeros((len(wheels), 2))
+    normal_row = np.zeros(len(wheels), int)
+    for i, wheel in enumerate(wheels):
+        normal_row[i] = rows.labels.index(f"{wheel.name}.normal")
+        Jt, slip[i] = tangential(wheel, kin)
+        coef[i] = wheel.friction_coefficient(slip[i])
+        G[:, normal_row[i]] -= Jt.T @ coef[i]
+    B = input_matrix(robot.motors, kin)
+    K = np.hstack([B, G])
+    b = pin.rnea(model, data, q, v, a)
+    x, _, rank, _ = np.linalg.lstsq(K, b, rcond=None)
+    n_tau = B.shape[1]
+    lam = x[n_tau:]
+    normal = lam[normal_row]
+    return SlidingInverse(x[:n_tau], dict(zip(rows.labels, lam.tolist())), normal, slip, -normal[:, None] * coef,
+                          float(np.linalg.norm(K @ x - b)), int(rank))
+

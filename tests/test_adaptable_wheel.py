@@ -411,3 +411,36 @@ def test_generic_modules_reject_bad_input(robot):
         solve_contact_forces(np.zeros((3, 3)), np.tile([0, 0, 1.0], (3, 1)), [0, 0, 1], [0, 0, 0], [0, 0, 0], 0.0)
     with pytest.raises(RobotDynError, match="expected two"):
         solve_contact_forces(np.zeros((3, 2)), np.zeros((3, 3)), [0, 0, 1], [0, 0, 0], [0, 0, 0], 1.0)
+
+
+# -------------------------------------------------------------------- mission 1 with a lateral friction law
+@pytest.fixture(scope="module")
+def friction_run():
+    from dataclasses import replace
+
+    return aw.mission_friction(aw.run_mission(replace(aw.MISSIONS["mission1"], t_end=1.0)))
+
+
+def test_mission1_lateral_friction_energy_balance(friction_run):
+    """Wheels rolling along t1 and sliding sideways under Coulomb friction (mu = 1, Table 1): the torques and loads
+    of robotdyn.sliding.inverse close the energy balance dE/dt = motor power + friction power (finite differences of
+    Pinocchio's energy, O(dt^2) = 1e-4 of the ~100 W powers), and the friction only dissipates."""
+    fr = friction_run
+    assert np.all(fr.rank == 15) and fr.residual.max() < 1e-9
+    dE = np.gradient(fr.energy, fr.t)
+    np.testing.assert_allclose(dE[2:-2], fr.power.sum(axis=1)[2:-2], atol=1e-3)
+    assert np.all(fr.normal > 0) and np.all(fr.power[:, 1] < 0)
+    np.testing.assert_allclose(np.abs(fr.lateral), fr.normal, rtol=1e-5)  # Coulomb: |f_lat| = mu f_n at 0.6 m/s
+    assert np.all(np.abs(fr.slip) > 0.5)
+
+
+def test_mission1_impossible_with_lateral_friction(friction_run):
+    """The finding of the errata: with a real lateral law the commanded motion needs friction far beyond mu = 1
+    (the rigid model balances the lateral forces only through the terrain's tilt, with traction of ~1 kN), and on
+    flat ground no torques and contact forces realise it at all (rank 14 of 15: lateral sliding friction sums to
+    mu (f_fr + f_fl - f_r), which the pitch balance forces to zero, while the path needs m v^2 / rho = 10 N)."""
+    from dataclasses import replace
+
+    assert friction_run.required_mu.min() > 10
+    flat = aw.mission_friction(aw.run_mission(replace(aw.MISSIONS["mission1"], terrain="flat", t_end=0.2)))
+    assert np.all(flat.rank == 14) and flat.residual.min() > 1.0

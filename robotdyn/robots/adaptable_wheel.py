@@ -32,10 +32,12 @@ from ..actuation import input_matrix
 from ..comparison import Comparison
 from ..constraint import KinematicState
 from ..errors import ConstraintError, InputError, RobotDynError
+from ..friction import LinearTyre, RegularisedCoulomb
 from ..joint_coupling import CosineLaw, JointCoupling
 from ..robot import MotorSpec, Parameter, Robot, RobotSpec
 from ..rolling_contact import OmniWheel, RollingWheel
 from ..scenario import Scenario
+from ..sliding import SlippingWheel
 from ..statics import solve_contact_forces
 from ..terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
 
@@ -43,6 +45,11 @@ WHEELS = ("fr", "fl", "r")
 """Wheel tags: front right, front left, rear (eq 8)."""
 COS30 = float(np.cos(np.pi / 6))
 IK_TOL = 1e-10
+LATERAL_SLIP_VELOCITY = 1e-3
+"""Slip-velocity scale [m/s] of the regularised Coulomb law of ``lateral=coulomb`` (mission 1 slides at ~0.6 m/s, so
+the law is Coulomb's to a relative 1e-6 there)."""
+LATERAL_STIFFNESS = 10.0
+"""Slip stiffness [s/m] of the brush law of ``lateral=linear`` (saturated at mu; not in the paper)."""
 """Convergence criterion ||C|| of the inverse kinematics (the paper used 1e-5, Table 1)."""
 
 
@@ -72,7 +79,12 @@ def _terrain(p: dict) -> Terrain:
 
 def _wheel_factory(tag: str) -> Callable[[Robot], RollingWheel]:
     def make(robot: Robot) -> RollingWheel:
-        kind = RollingWheel if robot.params["lateral"] == "rolling" else partial(OmniWheel, roller_angle=0.0)
+        lateral = robot.params["lateral"]
+        kind = {"rolling": RollingWheel, "slip": partial(OmniWheel, roller_angle=0.0)}.get(lateral)
+        if kind is None:  # rolling along t1, sliding sideways under a friction law of coefficient mu
+            law = RegularisedCoulomb(robot.params["mu"], LATERAL_SLIP_VELOCITY) if lateral == "coulomb" else \
+                LinearTyre(LATERAL_STIFFNESS, robot.params["mu"])
+            kind = partial(SlippingWheel, law=law, slip="lateral")
         return kind(robot.description, f"wheel_{tag}", robot.params["R_ru"], axis=(0.0, 1.0, 0.0),
                     terrain=robot.terrain, radius_joint=f"radius_{tag}_joint", name=tag)
 
@@ -117,8 +129,9 @@ SPEC = RobotSpec(
                   choices=("rough", "ramp", "flat"), xacro=False),
         Parameter("ramp_slope", 0.2, "-", "slope of the ramp terrain (mission 2)", xacro=False),
         Parameter("ramp_heading", -np.pi / 2, "rad", "direction in which the ramp rises (mission 2)", xacro=False),
-        Parameter("lateral", "rolling", "", "rolling: wheels roll without slipping; slip: lateral row dropped",
-                  choices=("rolling", "slip"), xacro=False),
+        Parameter("lateral", "rolling", "", "rolling: wheels roll without slipping; slip: lateral row dropped "
+                  "(frictionless); coulomb, linear: sideways sliding under that friction law with mu",
+                  choices=("rolling", "slip", "coulomb", "linear"), xacro=False),
     ],
     constraints=[_wheel_factory(t) for t in WHEELS] + [_coupling_factory(t) for t in WHEELS],
     motors=[MotorSpec(f"spin_{t}", f"wheel_{t}_joint") for t in WHEELS]
@@ -729,6 +742,77 @@ def mission_dynamics(run: IKRun, params: dict | None = None, every: int = 1) -> 
         out.qdot_fd[row] = _derivatives(lambda s: mm.ik_at(s, r["x"])[1][3:], t)[0]
     return out
 
+
+
+@dataclass
+class FrictionRun:
+    """Mission kinematics with a real lateral friction law (:func:`mission_friction`).
+
+    The wheels roll along their rolling direction and slide sideways under the law of ``lateral`` (Coulomb with the
+    robot's mu, Table 1: 1.0), so each lateral force is :math:`-\\mu f_n` times the slip direction: known once the
+    normal loads are. Torques, normal loads and traction then follow from one square linear system per state
+    (:func:`robotdyn.sliding.inverse`).
+
+    Attributes:
+        t: (N,) times [s].
+        tau: (N, 6) motor torques (spin fr, fl, r, adjust fr, fl, r) [N m].
+        normal: (N, 3) normal loads [N].
+        longitudinal: (N, 3) traction (the rolling rows' forces) [N].
+        lateral: (N, 3) lateral friction forces from the law [N].
+        slip: (N, 3) lateral slip velocities [m/s].
+        required_mu: (N, 3) :math:`\\|(f_{t1}, f_{t2})\\| / f_n` (inf where :math:`f_n \\le 0`).
+        residual: (N,) least-squares residual [N, N m] (> 0: no torques and contact forces realise the motion).
+        rank: (N,) rank of the system (15 when regular).
+        power: (N, 2) motor power and friction power [W] (their sum is dE/dt).
+        energy: (N,) the robot's total energy [J].
+    """
+
+    t: np.ndarray
+    tau: np.ndarray
+    normal: np.ndarray
+    longitudinal: np.ndarray
+    lateral: np.ndarray
+    slip: np.ndarray
+    required_mu: np.ndarray
+    residual: np.ndarray
+    rank: np.ndarray
+    power: np.ndarray
+    energy: np.ndarray
+
+
+def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None = None, every: int = 1) -> FrictionRun:
+    """Torques and contact forces along a kinematic mission with wheels that slide sideways under a friction law.
+
+    Args:
+        run: An :class:`IKRun` (its mission fixes the terrain).
+        lateral: ``coulomb`` or ``linear`` (the ``lateral`` parameter of :data:`SPEC`).
+        params: Parameter overrides (e.g. ``mu``).
+        every: Use every n-th step of the run.
+    """
+    from ..sliding import inverse
+
+    if lateral not in ("coulomb", "linear"):
+        raise InputError(f"lateral = {lateral!r}; expected a friction law: coulomb or linear")
+    mm = MissionModel(run, params)
+    robot = Robot(SPEC, {**(params or {}), "terrain": run.mission.terrain, "lateral": lateral})
+    idx = np.arange(0, len(run.t), every)
+    n = len(idx)
+    out = FrictionRun(run.t[idx], *(np.zeros((n, k)) for k in (6, 3, 3, 3, 3, 3)), np.zeros(n), np.zeros(n, int),
+                      np.zeros((n, 2)), np.zeros(n))
+    for row, i in enumerate(idx):
+        _, _, q, v, a = mm.state(run.t[i])
+        inv = inverse(robot, q, v, a)
+        kin = KinematicState(robot.model, robot.data, q, v)
+        out.tau[row] = inv.tau[mm.order]
+        out.normal[row], out.lateral[row], out.slip[row] = inv.normal, inv.force[:, 1], inv.slip[:, 1]
+        out.longitudinal[row] = [inv.multipliers[f"{t}.longitudinal"] for t in WHEELS]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out.required_mu[row] = np.where(inv.normal > 0, np.hypot(out.longitudinal[row], out.lateral[row])
+                                            / inv.normal, np.inf)
+        out.residual[row], out.rank[row] = inv.residual, inv.rank
+        out.power[row] = inv.tau @ (input_matrix(robot.motors, kin).T @ v), float(np.sum(inv.force * inv.slip))
+        out.energy[row] = robot.energy(q, v)
+    return out
 
 # ------------------------------------------------------------------------------------------------ scenarios
 class HoldScenario(Scenario):

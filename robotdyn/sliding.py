@@ -35,9 +35,10 @@ PAINLEVE_CONDITION = 1e12
 class SlippingWheel(SupportWheel):
     """A wheel that keeps contact (its normal row) and slips under a friction law.
 
+    Takes the arguments of :class:`~robotdyn.rolling_contact.RollingWheel` and:
+
     Args:
         law: The :class:`~robotdyn.friction.FrictionLaw` of its tangential force.
-        Other arguments as :class:`~robotdyn.rolling_contact.RollingWheel`.
     """
 
     sliding = True  # its friction force comes from a law (robotdyn.sliding.forward)

@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench venv clean chromium
+.PHONY: demo test bench venv clean chromium docs
 
 $(STAMP): pyproject.toml setup.py robotdyn/_compiled.cpp
 	$(PYTHON) -m venv $(VENV)
@@ -35,9 +35,25 @@ test: $(STAMP) chromium
 	$(PY) -m pytest -q tests
 	$(PY) -m pytest -q --nbmake notebooks
 
+## make docs: the documentation site into docs/_build/html (Sphinx + MyST-NB: the notebooks executed, the API
+## reference from the docstrings, the errata, the viewer pages), warnings as errors. Installs the `docs` group of
+## pyproject.toml without reinstalling robotdyn (no recompilation). SPHINXOPTS="-D nb_execution_mode=cache" reuses
+## notebook outputs whose source did not change.
+DOCS_STAMP := $(VENV)/.docs-installed
+SPHINXOPTS ?=
+$(DOCS_STAMP): $(STAMP) pyproject.toml
+	$(PY) -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['docs']))" > $(VENV)/docs-requirements.txt
+	$(PY) -m pip install --quiet -r $(VENV)/docs-requirements.txt
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	rm -rf docs/api
+	$(PY) -m sphinx -b html -W --keep-going -c docs $(SPHINXOPTS) . docs/_build/html
+	@echo "docs: open docs/_build/html/index.html"
+
 ## make bench: speed of the reduced model against raw Pinocchio, side by side in one run
 bench: $(STAMP)
 	$(PY) bench/bench.py
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out .pytest_cache docs/_build docs/api

@@ -188,7 +188,7 @@ class LinearisingController:
 
 def tracking_errors(controller: LinearisingController, traj: Trajectory, task: int = 0,
                     after: float = 0.0) -> dict[str, float]:
-    """Position error norms |y_d - y| of one task along a trajectory: mean, RMS and max [same unit as y]."""
+    """Position error norms :math:`\\|y_d - y\\|` of one task along a trajectory: mean, RMS and max [same unit as y]."""
     errs = []
     for t, q, nu in zip(traj.t, traj.q, traj.nu):
         if t < after:

@@ -65,7 +65,7 @@ def _check(M, n, e: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def effective_mass(M, n) -> float:
-    """:math:`1/(n^T M^{-1} n)` for the unit direction n/|n| [kg for a force direction]."""
+    """:math:`1/(n^T M^{-1} n)` for the unit direction :math:`n/\\|n\\|` [kg for a force direction]."""
     M, n = _check(M, n, 0.0)
     return float(1.0 / (n @ np.linalg.solve(M, n)))
 
@@ -101,7 +101,7 @@ def impulse_curve(M, e: float, speed: float = 1.0, plane: tuple[int, int] = (0, 
     """Impulse against a wall hit head-on at ``speed`` in every direction of a plane of velocity components.
 
     For each angle a, the motion is ``speed * d`` with d = cos(a) e_i + sin(a) e_j (i, j = ``plane``) and the
-    wall normal is n = -d. The curve a -> |F(a)| d is what Chung, Yi, Kim, Han call the impulse ellipse
+    wall normal is n = -d. The curve :math:`a \\mapsto |F(a)|\\,d` is what Chung, Yi, Kim, Han call the impulse ellipse
     (Figs. 16-19); it is a circle when the plane block of M^{-1} is isotropic.
 
     Returns:

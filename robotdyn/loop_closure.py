@@ -10,6 +10,7 @@ With :math:`d = p_2 - p_1` (world), rotation :math:`R_1` of F1 and LOCAL_WORLD_A
 - translation rows: :math:`e = R_1^T d`, :math:`\\dot e = R_1^T (J_{2,v} - J_{1,v} + [d]_\\times J_{1,\\omega}) v`;
 - rotation rows: :math:`R_1^T (J_{2,\\omega} - J_{1,\\omega}) v`, residual :math:`\\log(R_1^T R_2)`;
 - both time derivatives use :math:`\\frac{d}{dt} R_1^T x = R_1^T(\\dot x - \\omega_1 \\times x)`.
+
 All rows are holonomic.
 """
 

@@ -1,12 +1,15 @@
-"""Plots of trajectories and comparisons (matplotlib, Agg backend: files, no window)."""
+"""Plots of trajectories and comparisons (matplotlib: the Agg backend, files and no window, unless ``MPLBACKEND``
+names one, as a Jupyter kernel does for its inline figures)."""
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 
 import matplotlib
 
-matplotlib.use("Agg")
+if not os.environ.get("MPLBACKEND"):  # keep a backend chosen by the user or a notebook kernel (inline figures)
+    matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 def _unit(traj, name: str) -> str:

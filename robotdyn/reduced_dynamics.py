@@ -44,7 +44,8 @@ class ReducedDynamics:
         Sdot: :math:`\\dot S` (n, k), only with C.
         projection: The :class:`~robotdyn.projection.Projection` used.
         jacobian_rows: The stacked constraint rows without their time derivative (A, residual, labels).
-        rows: The stacked constraint rows at this state, ``Adot`` included (computed on first access).
+
+    The property :attr:`rows` gives the stacked constraint rows with ``Adot`` (computed on first access).
     """
 
     M: np.ndarray

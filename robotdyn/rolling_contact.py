@@ -222,10 +222,11 @@ class RollingWheel(Constraint):
 class OmniWheel(RollingWheel):
     """An omni/Swedish wheel: rolls without slipping along its rollers' axis only, and touches the ground.
 
+    Takes the arguments of :class:`RollingWheel` and:
+
     Args:
         roller_angle: Angle [rad] of the constrained direction from the rolling direction t1 towards t2
             (0: a 90-degree omni wheel, lateral motion free; pi/4: a 45-degree mecanum wheel).
-        Other arguments as :class:`RollingWheel`.
     """
 
     _row_names = ("driving", "normal")

@@ -43,9 +43,10 @@ SLIP_ZERO = 1e-12
 class StickSlipWheel(RollingWheel):
     """A standard wheel with Coulomb friction coefficient ``mu`` that sticks (rolls) or slides (see the module).
 
+    Takes the arguments of :class:`~robotdyn.rolling_contact.RollingWheel` and:
+
     Args:
         mu: Friction coefficient (>= 0), the same for sticking and sliding.
-        Other arguments as :class:`~robotdyn.rolling_contact.RollingWheel`.
     """
 
     def __init__(self, description, frame: str, radius: float, mu: float, **kwargs) -> None:

@@ -471,7 +471,7 @@ RESTITUTION = 0.8
 
 
 def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, samples: int = 361) -> dict:
-    """The impulse curves of Figs. 16-19: |F(a)| for unit-speed head-on impacts of the platform centre.
+    """The impulse curves of Figs. 16-19: :math:`|F(a)|` for unit-speed head-on impacts of the platform centre.
 
     Returns:
         {figure: (angles [rad], magnitudes [N s])} for :data:`IMPULSE_CONFIGS`.
@@ -543,7 +543,7 @@ def fit_printed_matrix(p: dict, free: tuple[str, ...] = (), starts: int = 60, se
 
     Returns:
         dict with ``phi`` [rad], ``params`` (the fitted free ones), ``residual`` (entries, printed - fit) and
-        ``max_abs`` (largest |residual|).
+        ``max_abs`` (the largest absolute residual).
     """
     from scipy.optimize import least_squares
 

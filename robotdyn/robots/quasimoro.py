@@ -133,7 +133,7 @@ def paper_rectilinear_torque(p: dict, theta3: float, theta1_ddot: float, theta3_
 
 
 def paper_rotation_inertia(p: dict) -> float:
-    """Eq 31: m1 = |m2| = [m r^2 (3/2 + rho^2) + 2 rho^2 J1] th1'' (pure rotation, theta3 = 0)."""
+    """Eq 31: :math:`m_1 = |m_2|` = [m r^2 (3/2 + rho^2) + 2 rho^2 J1] th1'' (pure rotation, theta3 = 0)."""
     return p["m"] * p["r"] ** 2 * (1.5 + p["rho"] ** 2) + 2 * p["rho"] ** 2 * p["J1"]
 
 

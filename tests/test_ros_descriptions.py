@@ -1,6 +1,6 @@
 """A robot straight from its ROS repository (issue 14): packages, meshes, the root's height, rows dropped as
 redundant, body twists and torques by motor name, on fixtures laid out as a ROS workspace
-(``tests/data/ros_ws/src``: two packages, one in a directory named differently from the package, ``$(find)``
+(``examples/ros_ws/src``: two packages, one in a directory named differently from the package, ``$(find)``
 includes, ``package://`` meshes, a Gazebo-only path), written for these tests.
 
 Dynamics are checked against closed forms derived independently with sympy (``tests/oracles/
@@ -32,8 +32,8 @@ from robotdyn.ros_packages import MissingPackagesError, PackageIndex, required_p
 from robotdyn.scene_page import pack_scene, page_commands, unpack_scene
 from robotdyn.viewer import Viewer
 
-DATA = Path(__file__).resolve().parent / "data"
-SRC = DATA / "ros_ws" / "src"
+WS = Path(__file__).resolve().parent.parent / "examples" / "ros_ws"
+SRC = WS / "src"
 PKG = SRC / "demo_description"
 TOML = PKG / "robotdyn"
 G = 9.81
@@ -142,7 +142,7 @@ def test_meshes_missing_or_outside_are_reported_with_stand_ins():
     assert "bumper.stl (file not found" in messages[0] and "antenna.dae" in messages[0]
     assert "Packages not found: demo_mast_description" in messages[0]
     assert "outside the description's packages not read" in messages[1] and "package_dirs" in messages[1]
-    assert {Path(p) for _, p, _ in report.refused} == {(DATA / "outside" / "elsewhere.stl").resolve()}
+    assert {Path(p) for _, p, _ in report.refused} == {(WS / "outside" / "elsewhere.stl").resolve()}
     shapes = {g.name.rsplit("_", 1)[0]: g for g in robot.description.visual.geometryObjects}
     assert set(shapes) >= {"base_link", "left_wheel_link", "right_wheel_link", "lidar_link", "caster_link",
                            "bumper", "antenna", "mast", "cover", "plate"}
@@ -154,13 +154,13 @@ def test_meshes_missing_or_outside_are_reported_with_stand_ins():
     page = Viewer(robot).static_html()
     objects = [c for c in page_commands(page) if b"set_object" in c and b"robotdyn/robot/visuals" in c]
     assert len(objects) == len(shapes)
-    secret = (DATA / "outside" / "elsewhere.stl").read_bytes()
+    secret = (WS / "outside" / "elsewhere.stl").read_bytes()
     assert not any(secret[:200] in c for c in page_commands(page))
 
 
 def test_meshes_outside_allowed_by_declaring_their_directory():
     robot, messages = quiet(load_robot, TOML / "diff_drive.toml", urdf=str(PKG / "urdf" / "meshes_broken.urdf.xacro"),
-                            package_dirs=[DATA / "outside"])
+                            package_dirs=[WS / "outside"])
     assert not robot.description.visual_report.refused
     assert robot.description.visual_report.standins.get("cover") is None
     assert len(messages) == 1 and "outside" not in messages[0]

@@ -140,13 +140,7 @@ def cmd_info(args) -> int:
 def cmd_dump(args) -> int:
     _, robot = _load(args)
     q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates)
-    for name, value in parse_assignments(args.set, "--set").items():
-        try:
-            x = float(value)
-        except ValueError:
-            raise RobotDynError(f"--set {name}={value!r}: not a number; expected a value in m or rad") from None
-        if not np.isfinite(x):
-            raise RobotDynError(f"--set {name}={value!r}: not finite; expected a value in m or rad")
+    for name, x in _numbers(args.set, "--set", "a value in m or rad").items():
         q[robot.coordinate_index(name)] = x
     q = robot.check_q(q)
     if args.full:
@@ -211,16 +205,24 @@ def _torques(robot, tau, assignments) -> np.ndarray:
     """Motor torques from ``--tau`` (all, in motor order; default zeros) and ``--tau-set MOTOR=VALUE`` by name."""
     motors = [m.name for m in robot.motors]
     out = robot.check_tau(tau) if tau is not None else np.zeros(len(motors))
-    for name, value in parse_assignments(assignments, "--tau-set").items():
+    for name, x in _numbers(assignments, "--tau-set", "a torque in N m (or N)").items():
         if name not in motors:
             raise RobotDynError(f"--tau-set {name}: no motor named {name!r}; motors are {', '.join(motors) or '(none)'}")
+        out[motors.index(name)] = x
+    return out
+
+
+def _numbers(items, option: str, expected: str) -> dict[str, float]:
+    """``NAME=VALUE`` options as finite numbers by name (one line naming the option otherwise)."""
+    out = {}
+    for name, value in parse_assignments(items, option).items():
         try:
             x = float(value)
         except ValueError:
-            raise RobotDynError(f"--tau-set {name}={value!r}: not a number; expected a torque in N m (or N)") from None
+            raise RobotDynError(f"{option} {name}={value!r}: not a number; expected {expected}") from None
         if not np.isfinite(x):
-            raise RobotDynError(f"--tau-set {name}={value!r}: not finite; expected a torque in N m (or N)")
-        out[motors.index(name)] = x
+            raise RobotDynError(f"{option} {name}={value!r}: not finite; expected {expected}")
+        out[name] = x
     return out
 
 

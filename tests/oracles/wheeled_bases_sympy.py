@@ -120,18 +120,25 @@ def mecanum_ik(wheels) -> sp.Matrix:
     return sp.Matrix(rows)
 
 
-@functools.lru_cache(maxsize=None)
-def _mecanum(bodies: tuple, wheels: tuple):
+def _planar_base(bodies, wheels, names: str, base, wheel_rows):
+    """(M_r(psi, nu), h_r(psi, nu)) lambdified, for a base whose admissible velocities are
+    (x', y', psi') = base(psi) nu and wheel spin rates wheel_rows nu (constant rows)."""
     c = Coordinates(["x", "y", "psi"] + [f"phi{i}" for i in range(len(wheels))])
     psi = c.q[2]
-    nu = sp.symbols("vx vy wz", real=True)
-    nudot = sp.symbols("vxd vyd wzd", real=True)
+    nu = sp.symbols(names, real=True)
+    nudot = sp.symbols(" ".join(f"{n}_dot" for n in names.split()), real=True)
+    S = sp.Matrix([*base(psi), *wheel_rows])
+    M, h = reduced_lagrange(_planar_T(c, bodies, wheels, range(3, 3 + len(wheels))), c, S, nu, nudot)
+    return sp.lambdify((psi, nu), M), sp.lambdify((psi, nu), h)
+
+
+@functools.lru_cache(maxsize=None)
+def _mecanum(bodies: tuple, wheels: tuple):
     J = mecanum_ik(wheels)
-    cs, sn = sp.cos(psi), sp.sin(psi)
-    S = sp.Matrix([[cs, -sn, 0], [sn, cs, 0], [0, 0, 1], *J.tolist()])
-    T = _planar_T(c, bodies, wheels, range(3, 3 + len(wheels)))
-    M, h = reduced_lagrange(T, c, S, nu, nudot)
-    return sp.lambdify((psi, nu), M), sp.lambdify((psi, nu), h), J
+    fM, fh = _planar_base(bodies, wheels, "vx vy wz",
+                          lambda psi: [[sp.cos(psi), -sp.sin(psi), 0], [sp.sin(psi), sp.cos(psi), 0], [0, 0, 1]],
+                          J.tolist())
+    return fM, fh, J
 
 
 def mecanum(bodies, wheels, psi: float, nu) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -143,15 +150,9 @@ def mecanum(bodies, wheels, psi: float, nu) -> tuple[np.ndarray, np.ndarray, np.
 
 @functools.lru_cache(maxsize=None)
 def _unicycle(bodies: tuple, wheels: tuple):
-    c = Coordinates(["x", "y", "psi"] + [f"phi{i}" for i in range(len(wheels))])
-    psi = c.q[2]
-    nu = sp.symbols("v w", real=True)
-    nudot = sp.symbols("vd wd", real=True)
     # standard wheels on the axle (x = 0): the centre moves at v - w y forward, so r phi' = v - w y
-    S = sp.Matrix([[sp.cos(psi), 0], [sp.sin(psi), 0], [0, 1], *[[1 / w.r, -w.y / w.r] for w in wheels]])
-    T = _planar_T(c, bodies, wheels, range(3, 3 + len(wheels)))
-    M, h = reduced_lagrange(T, c, S, nu, nudot)
-    return sp.lambdify((psi, nu), M), sp.lambdify((psi, nu), h)
+    return _planar_base(bodies, wheels, "v w", lambda psi: [[sp.cos(psi), 0], [sp.sin(psi), 0], [0, 1]],
+                        [[1 / w.r, -w.y / w.r] for w in wheels])
 
 
 def unicycle(bodies, wheels, psi: float, nu) -> tuple[np.ndarray, np.ndarray]:

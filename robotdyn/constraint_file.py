@@ -335,6 +335,10 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
     # ------------------------------------------------------------------------------------- description
     pdirs = [str((base / d).resolve()) for d in r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")]
     pdirs += [str(Path(d).resolve()) for d in package_dirs]
+    for d in pdirs:
+        if not Path(d).is_dir():
+            r.fail("package_dirs", f"{d}: no such directory; expected directories holding ROS packages (or --package "
+                                   "DIR)")
     pkg_table = data.get("packages", {})
     r.keys("packages", pkg_table, list(pkg_table))
     named = {k: str((base / r.string(f"packages.{k}", v, "directory")).resolve()) for k, v in pkg_table.items()}

@@ -122,6 +122,8 @@ def test_packages_from_the_cli_and_the_constraint_file(tmp_path, capsys):
     assert main(["info", "--constraints", str(toml), "--package", f"demo_description={PKG}",
                  "--package", f"demo_sensors={SRC / 'sensors'}"]) == 0
     assert main(["info", "--constraints", str(toml), "--package", str(SRC)]) == 0
+    assert main(["info", "--constraints", str(toml), "--package", str(tmp_path / "absent")]) == 2
+    assert "package_dirs: " in capsys.readouterr().err
     capsys.readouterr()
     table = f'[packages]\ndemo_description = "{PKG}"\ndemo_sensors = "{SRC / "sensors"}"\n\n[[wheels]]'
     toml.write_text(body.replace("[[wheels]]", table, 1))
@@ -156,6 +158,17 @@ def test_meshes_missing_or_outside_are_reported_with_stand_ins():
     assert len(objects) == len(shapes)
     secret = (WS / "outside" / "elsewhere.stl").read_bytes()
     assert not any(secret[:200] in c for c in page_commands(page))
+
+
+def test_a_mesh_that_cannot_be_loaded_is_replaced(tmp_path):
+    shutil.copytree(SRC, tmp_path / "src")
+    (tmp_path / "src/demo_description/meshes/wheel.stl").write_bytes(b"not a mesh\x00\x01")
+    robot, messages = quiet(load_robot, tmp_path / "src/demo_description/robotdyn/diff_drive.toml")
+    assert robot.description.visual_report.standins == {"left_wheel_link": "collision",
+                                                        "right_wheel_link": "collision"}
+    assert len(messages) == 1 and messages[0].count("cannot be loaded") == 2
+    kinds = {g.name: type(g.geometry).__name__ for g in robot.description.visual.geometryObjects}
+    assert kinds["left_wheel_link_0"] == kinds["right_wheel_link_0"] == "Cylinder"  # the collision cylinders
 
 
 def test_meshes_outside_allowed_by_declaring_their_directory():

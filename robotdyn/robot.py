@@ -575,6 +575,12 @@ class Robot:
         """Coordinates, independent velocities, parameters (value, unit) and actuators, as plain data."""
         mobility, notes = self.mobility_check()
         report = self.description.visual_report
+        heights = self.wheel_heights() if self.spec.root != "fixed" else {}
+        if heights and max(map(abs, heights.values())) > 1e-6:
+            listed = ", ".join(f"{k} {v:+.4g} m" for k, v in heights.items())
+            notes.append(f"at the neutral configuration the wheels do not all touch the ground (contact heights above "
+                         f"it: {listed}); a {self.spec.root} root cannot fix that with one height: check the radii, "
+                         "the joint values (neutral) or the terrain")
         return {
             "mobility_at_neutral": mobility,
             "mobility_notes": notes,

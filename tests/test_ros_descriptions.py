@@ -196,19 +196,33 @@ def test_compact_page_stores_a_shared_mesh_once(diff_drive):
 
 @pytest.mark.skipif(shutil.which("node") is None, reason="node not installed (the browser tests check the page)")
 def test_page_unpacker_script_gives_the_same_commands(diff_drive, tmp_path):
-    """The page's own JavaScript unpacker, run by node, returns byte for byte the commands Python packed."""
+    """The page's own JavaScript (inflate and unpack), run by node: byte for byte the commands Python packed, and
+    zlib's output inflated exactly for stored, fixed-Huffman and dynamic-Huffman blocks."""
+    import base64
     import hashlib
+    import json
+    import zlib
 
     from robotdyn.scene_page import _UNPACK_JS
 
     page = Viewer(diff_drive).static_html()
     scene = re.search(r'var robotdyn_scene = "[^"]*";', page).group(0)
+    rng = np.random.default_rng(0)
+    samples = [b"", b"a", b"abcabcabc" * 50, rng.bytes(70000), bytes(rng.choice([97, 98], 100000).astype(np.uint8)),
+               (PKG / "meshes" / "wheel.stl").read_bytes(), bytes(300000)]
+    cases = [[base64.b64encode(zlib.compress(b, level)).decode(), hashlib.sha256(b).hexdigest()]
+             for b in samples for level in (0, 1, 9)]
     script = tmp_path / "unpack.js"
-    script.write_text(scene + "\n" + _UNPACK_JS + "\nconst crypto = require('crypto');\nrobotdyn_unpack(robotdyn_scene)"
-                      ".then(cs => console.log(cs.map(c => crypto.createHash('sha256').update(c).digest('hex'))"
-                      ".join(' ')));\n")
+    script.write_text(scene + "\n" + _UNPACK_JS + f"\nconst cases = {json.dumps(cases)};\n" + """
+const crypto = require('crypto');
+const sha = (b) => crypto.createHash('sha256').update(b).digest('hex');
+console.log(robotdyn_unpack(robotdyn_scene).map(sha).join(' '));
+console.log(cases.every(([z, h]) => sha(robotdyn_inflate(new Uint8Array(Buffer.from(z, 'base64')))) === h));
+""")
     out = subprocess.run(["node", str(script)], capture_output=True, text=True, timeout=60)
-    assert out.stdout.split() == [hashlib.sha256(c).hexdigest() for c in page_commands(page)], out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0].split() == [hashlib.sha256(c).hexdigest() for c in page_commands(page)], out.stderr
+    assert lines[1] == "true", out.stderr
 
 
 def test_view_cli_writes_a_page_with_the_robot(tmp_path, capsys):

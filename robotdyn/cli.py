@@ -34,14 +34,38 @@ def _load(args):
             raise RobotDynError("--urdf needs --constraints FILE (the wheels, closures and motors of the robot)")
         from .constraint_file import read
 
-        mod = read(constraints, urdf, parse_assignments(args.xacro_arg, "--xacro-arg"))
+        named, dirs = _packages(getattr(args, "package", []))
+        mod = read(constraints, urdf, parse_assignments(args.xacro_arg, "--xacro-arg"), dirs, named,
+                   getattr(args, "twist", None))
         robot = mod.robot(parse_assignments(args.param))
         args.robot = robot.spec.name
         return mod, robot
     if args.robot is None:
         raise RobotDynError("no robot given: expected ROBOT (robotdyn list) or --urdf FILE --constraints FILE")
+    if getattr(args, "package", []):
+        raise RobotDynError("--package is for your own robot (--constraints FILE); the built-in robots need none")
     mod = module(args.robot)
-    return mod, Robot(mod.SPEC, parse_assignments(args.param))
+    spec = mod.SPEC
+    if getattr(args, "twist", None):
+        from dataclasses import replace
+
+        from .operational_space import OperationalVelocities
+
+        frame, _, comps = args.twist.partition(":")
+        comps = tuple(comps.replace(",", " ").split()) or ("vx", "vy", "wz")
+        spec = replace(spec, independent=None, operational=OperationalVelocities(frame, comps, "local", list(comps)))
+    return mod, Robot(spec, parse_assignments(args.param))
+
+
+def _packages(items) -> tuple[dict[str, str], list[str]]:
+    """``--package NAME=DIR`` (a package by name) and ``--package DIR`` (a directory searched for packages)."""
+    named, dirs = {}, []
+    for item in items or []:
+        if "=" in item:
+            named.update(parse_assignments([item], "--package"))
+        else:
+            dirs.append(item)
+    return named, dirs
 
 
 def _emit(args, data: dict, text: str) -> None:
@@ -61,14 +85,16 @@ def _jsonable(x):
 
 def _matrix_text(name: str, rows: list[str], cols: list[str], A: np.ndarray) -> str:
     w = max(14, *(len(c) + 2 for c in cols))  # a '-1.23457e-05' (12 characters) keeps a space on its left
-    lines = [f"{name}:", " " * 14 + "".join(f"{c:>{w}}" for c in cols)]
+    left = max(14, *(len(r) for r in rows)) if rows else 14  # long row names keep the columns aligned
+    lines = [f"{name}:", " " * left + "".join(f"{c:>{w}}" for c in cols)]
     for r, row in zip(rows, np.atleast_2d(A)):
-        lines.append(f"{r:>14}" + "".join(f"{x:>{w}.6g}" for x in row))
+        lines.append(f"{r:>{left}}" + "".join(f"{x:>{w}.6g}" for x in row))
     return "\n".join(lines)
 
 
 def _vector_text(name: str, rows: list[str], x: np.ndarray) -> str:
-    return f"{name}:\n" + "\n".join(f"{r:>14}  {v:.10g}" for r, v in zip(rows, x))
+    left = max(14, *(len(r) for r in rows)) if rows else 14
+    return f"{name}:\n" + "\n".join(f"{r:>{left}}  {v:.10g}" for r, v in zip(rows, x))
 
 
 # --------------------------------------------------------------------------------------------- commands
@@ -93,6 +119,9 @@ def cmd_info(args) -> int:
         + ("" if info["mobility_at_neutral"] == info["mobility"] else
            f"; the independent velocities listed are {info['mobility']}: expected as many as the mobility"),
         *(f"note: {n}" for n in info["mobility_notes"]),
+        *([f"root: {info['root']}, its link at {info['root_height']:.6g} m above the ground "
+           f"({info['root_height_source']}; root_height in the constraint file)"]
+          if info["root"] == "planar" and info["root_height"] else []),
         "parameters:",
         *(f"  {k:<14} = {v['value']!s:<10} {v['unit']:<8} {v['description']}" for k, v in info["parameters"].items()),
         "actuators:",
@@ -111,13 +140,7 @@ def cmd_info(args) -> int:
 def cmd_dump(args) -> int:
     _, robot = _load(args)
     q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates)
-    for name, value in parse_assignments(args.set, "--set").items():
-        try:
-            x = float(value)
-        except ValueError:
-            raise RobotDynError(f"--set {name}={value!r}: not a number; expected a value in m or rad") from None
-        if not np.isfinite(x):
-            raise RobotDynError(f"--set {name}={value!r}: not finite; expected a value in m or rad")
+    for name, x in _numbers(args.set, "--set", "a value in m or rad").items():
         q[robot.coordinate_index(name)] = x
     q = robot.check_q(q)
     if args.full:
@@ -153,19 +176,54 @@ def cmd_dump(args) -> int:
         out.update(tau=Q, motor_torques=dict(zip(motors, tau)), motor_residual=resid)
         text += [_vector_text("tau (generalised forces M a + C v + g)", names, Q),
                  _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
-    elif args.tau is not None:
-        tau = robot.check_tau(args.tau)
+    elif args.tau is not None or args.tau_set:
+        tau = _torques(robot, args.tau, args.tau_set)
         nudot = solve_mass(red.M, red.B @ tau - red.h)
         out["a"] = nudot
         text.append(_vector_text("a (independent accelerations)", names, nudot))
+    from .redundancy import message, violations
+
+    found = violations(red, nudot if (args.a is not None or args.tau is not None or args.tau_set) else None)
+    out["dropped_row_violations"] = [vars(f) for f in found]
+    if found and args.a is None:  # (inverse dynamics warns by itself)
+        import warnings
+
+        from .errors import RobotDynWarning
+
+        warnings.warn(message(found), RobotDynWarning, stacklevel=1)
     if args.forces:
-        if args.a is None and args.tau is None:
+        if args.a is None and args.tau is None and not args.tau_set:
             raise RobotDynError("--forces needs --tau (forward dynamics) or --a (inverse dynamics)")
         forces = robot.contact_forces(q, nu, tau=tau, nudot=nudot)
         out["forces"] = forces.as_dict()
         text.append(forces.table())
     _emit(args, out, "\n".join(text))
     return 0
+
+
+def _torques(robot, tau, assignments) -> np.ndarray:
+    """Motor torques from ``--tau`` (all, in motor order; default zeros) and ``--tau-set MOTOR=VALUE`` by name."""
+    motors = [m.name for m in robot.motors]
+    out = robot.check_tau(tau) if tau is not None else np.zeros(len(motors))
+    for name, x in _numbers(assignments, "--tau-set", "a torque in N m (or N)").items():
+        if name not in motors:
+            raise RobotDynError(f"--tau-set {name}: no motor named {name!r}; motors are {', '.join(motors) or '(none)'}")
+        out[motors.index(name)] = x
+    return out
+
+
+def _numbers(items, option: str, expected: str) -> dict[str, float]:
+    """``NAME=VALUE`` options as finite numbers by name (one line naming the option otherwise)."""
+    out = {}
+    for name, value in parse_assignments(items, option).items():
+        try:
+            x = float(value)
+        except ValueError:
+            raise RobotDynError(f"{option} {name}={value!r}: not a number; expected {expected}") from None
+        if not np.isfinite(x):
+            raise RobotDynError(f"{option} {name}={value!r}: not finite; expected {expected}")
+        out[name] = x
+    return out
 
 
 def cmd_simulate(args) -> int:
@@ -342,6 +400,12 @@ def build_parser() -> argparse.ArgumentParser:
                             help="TOML constraint file: root, wheels, closures, motors (see examples/*.toml)")
     robot_args.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                             help="override a parameter (repeatable; robotdyn info ROBOT lists them)")
+    robot_args.add_argument("--package", action="append", default=[], metavar="NAME=DIR|DIR",
+                            help="a ROS package for $(find NAME) and package://NAME (NAME=DIR), or a directory "
+                                 "searched for packages (DIR) (repeatable; ROS_PACKAGE_PATH is searched too)")
+    robot_args.add_argument("--twist", metavar="FRAME[:vx,vy,wz]",
+                            help="independent velocities that are FRAME's twist in its own axes (default components "
+                                 "vx vy wz: a base's body twist) instead of joint velocities")
 
     p = sub.add_parser("list", parents=[common], help="list the robots")
     p.set_defaults(func=cmd_list)
@@ -357,6 +421,8 @@ def build_parser() -> argparse.ArgumentParser:
     group = p.add_mutually_exclusive_group()
     group.add_argument("--a", nargs="+", help="accelerations -> torques (inverse dynamics)")
     group.add_argument("--tau", nargs="+", help="motor torques -> accelerations (forward dynamics)")
+    p.add_argument("--tau-set", action="append", default=[], metavar="MOTOR=VALUE",
+                   help="one motor torque by name, e.g. --tau-set tau_R=0.5 (repeatable; the others from --tau or 0)")
     p.add_argument("--full", action="store_true", help="the unconstrained tree's M, C, g instead")
     p.add_argument("--forces", action="store_true",
                    help="also the wheel-ground contact forces and loop-closure forces (needs --tau or --a)")
@@ -398,8 +464,28 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line_warnings() -> None:
+    """robotdyn's warnings (:class:`~robotdyn.errors.RobotDynWarning`) as ``robotdyn: warning: ...`` on stderr, each
+    message once per run."""
+    import warnings
+
+    from .errors import RobotDynWarning
+
+    default = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, RobotDynWarning):
+            print(f"robotdyn: warning: {message}", file=sys.stderr)
+        else:
+            default(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    warnings.simplefilter("default", RobotDynWarning)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``robotdyn`` console script."""
+    _one_line_warnings()
     try:
         parser = build_parser()
         args = parser.parse_args(argv)

@@ -14,13 +14,24 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     urdf = "robot.urdf.xacro"           # relative to this file, absolute, or package://PKG/path (optional when
                                         # the description is given separately, e.g. robotdyn ... --urdf FILE)
     root = "planar"                     # fixed | planar (x, y, psi) | floating (x, y, z, yaw, pitch, roll)
-    package_dirs = ["meshes_root"]      # where package:// URIs resolve (relative to this file)
+    package_dirs = ["meshes_root"]      # directories searched for ROS packages ($(find PKG), package://PKG; relative
+                                        # to this file; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are searched too), and
+                                        # from which meshes may be read (robotdyn/ros_packages.py, visual_geometry.py)
+    root_height = "auto"                # planar root: height [m] of the root link above the ground (default "auto":
+                                        # found from the wheels at the neutral configuration; 0 keeps it on it)
     massless = ["some_link"]            # links whose URDF inertial is ignored
     independent = ["theta_R", "theta_L"]  # coordinate labels or joint names (default: automatic)
     xacro_args = { wheel_radius = "0.1" }
     labels = { wheel_right_joint = "theta_R" }      # display names of coordinates
     neutral = { torso_lift_joint = 0.1 }            # a valid configuration (default all zero)
     locked = { "arm_*" = 0.0 }                      # joints held fixed (glob patterns allowed)
+
+    [packages]                          # ROS packages by name (directories relative to this file)
+    my_robot_description = "../my_robot_description"
+
+    [twist]                             # independent velocities that are a frame's twist instead of `independent`
+    frame = "base_link"; components = ["vx", "vy", "wz"]   # default; axes = "body" (default) or "world"
+    # names = ["vx", "vy", "wz"]        # display names (default: the components)
 
     [terrain]                           # default flat z = 0
     kind = "ramp"                       # flat (height) | ramp (slope, heading) | bump (height, x0, width, length)
@@ -51,6 +62,8 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
 
     [[scenarios]]                       # constant-torque manoeuvres for robotdyn simulate
     name = "spin"; t_end = 2.0; torque = [0.5, -0.5]; q0 = { psi = 0.0 }; nu0 = { theta_R = 1.0 }
+    # torque = { tau_R = 0.5, tau_L = -0.5 }   # ... or by motor name (motors not named: 0)
+    # nu0 = { vx = 0.3 }                       # with [twist]: by twist component name
 """
 
 from __future__ import annotations
@@ -73,6 +86,7 @@ from .description import _ROOT_CHAINS, ROOT_KINDS, expand_xacro
 from .errors import InputError, RobotDynError
 from .friction import LAWS, make_law
 from .robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from .ros_packages import HINT, PackageIndex
 from .scenario import Scenario
 from .sliding import SLIP_DIRECTIONS
 from .terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
@@ -84,8 +98,10 @@ class ConstraintFileError(RobotDynError):
 
 TOP_KEYS = (
     "name", "title", "urdf", "root", "package_dirs", "massless", "independent", "xacro_args", "labels", "neutral",
-    "locked", "terrain", "parameters", "wheels", "closures", "motors", "scenarios", "paper",
+    "locked", "terrain", "parameters", "wheels", "closures", "motors", "scenarios", "paper", "packages",
+    "root_height", "twist",
 )
+TWIST_KEYS = ("frame", "components", "axes", "names")
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro")
 WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
               "slip_velocity", "stiffness", "slip")
@@ -110,7 +126,8 @@ def _suggest(name: str, candidates) -> str:
 
 def package_search_dirs(extra=()) -> list[Path]:
     """Directories where ``package://NAME/...`` is looked up: ``extra``, ``ROS_PACKAGE_PATH``, and the
-    ``cmeel.prefix/share`` directory of pip-installed robot data (e.g. example-robot-data), if present."""
+    ``cmeel.prefix/share`` directory of pip-installed robot data (e.g. example-robot-data), if present.
+    (:class:`robotdyn.ros_packages.PackageIndex` is the lookup itself.)"""
     dirs = [Path(d) for d in extra]
     dirs += [Path(d) for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
     share = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
@@ -119,18 +136,18 @@ def package_search_dirs(extra=()) -> list[Path]:
     return dirs
 
 
-def resolve_path(text: str, base: Path, package_dirs=()) -> Path:
-    """Resolve a description path: ``package://PKG/rest`` against :func:`package_search_dirs`, a relative path
-    against ``base``. Raises :class:`ConstraintFileError` if the file does not exist."""
+def resolve_path(text: str, base: Path, package_dirs=(), packages: PackageIndex | None = None) -> Path:
+    """Resolve a description path: ``package://PKG/rest`` with a :class:`~robotdyn.ros_packages.PackageIndex`
+    (default: one of ``package_dirs`` and the environment), a relative path against ``base``. Raises
+    :class:`ConstraintFileError` if the file does not exist."""
     if text.startswith("package://"):
-        rest = text[len("package://"):]
-        dirs = package_search_dirs(package_dirs)
-        for d in dirs:
-            if (d / rest).is_file():
-                return (d / rest).resolve()
-        raise ConstraintFileError(
-            f"cannot resolve {text}: not found under {', '.join(map(str, dirs)) or '(no package directories)'}"
-        )
+        index = packages if packages is not None else PackageIndex.create(dirs=package_dirs)
+        path, missing = index.resolve_uri(text)
+        if missing is not None:
+            raise ConstraintFileError(f"cannot resolve {text}: packages not found: {missing}; {HINT}")
+        if not path.is_file():
+            raise ConstraintFileError(f"cannot resolve {text}: no file {path}")
+        return path
     path = Path(os.path.expanduser(text))
     if not path.is_absolute():
         path = base / path
@@ -257,8 +274,9 @@ class ConstraintFile:
             for name in sc.nu0:
                 if name not in robot.velocity_names:
                     raise ConstraintFileError(
-                        f"{self.path}: scenarios[{i}] ({sc.name}): nu0 {name[:-4]!r} is not an independent velocity; "
-                        f"expected one of {', '.join(v[:-4] for v in robot.velocity_names)}"
+                        f"{self.path}: scenarios[{i}] ({sc.name}): nu0 {name.removesuffix('_dot')!r} is not an "
+                        "independent velocity; expected one of "
+                        f"{', '.join(v.removesuffix('_dot') for v in robot.velocity_names)}"
                     )
         return robot
 
@@ -268,15 +286,20 @@ def read(
     urdf: str | Path | None = None,
     xacro_args: dict[str, str] | None = None,
     package_dirs=(),
+    packages: dict[str, str] | None = None,
+    twist: str | None = None,
 ) -> ConstraintFile:
     """Read and validate a constraint file.
 
     Args:
         path: The TOML file.
         urdf: The URDF/Xacro description (overrides the file's ``urdf``); a relative path is relative to the
-            current directory; ``package://PKG/...`` is resolved with :func:`package_search_dirs`.
+            current directory; ``package://PKG/...`` is resolved with the packages (:mod:`robotdyn.ros_packages`).
         xacro_args: Xacro arguments (override the file's ``xacro_args``).
-        package_dirs: Extra directories for ``package://`` URIs.
+        package_dirs: Extra directories searched for ROS packages (``$(find)``, ``package://``).
+        packages: Extra ROS packages by name (name -> directory; override the file's ``[packages]``).
+        twist: Independent velocities that are a body twist instead (overrides the file's ``independent`` and
+            ``twist``): ``FRAME`` (components vx vy wz) or ``FRAME:vx,vy,wz``.
 
     Raises:
         ConstraintFileError: one line naming the file, the entry and what was expected.
@@ -297,7 +320,7 @@ def read(
     except OSError as exc:
         raise ConstraintFileError(f"{path}: cannot read: {exc.strerror}") from None
     try:
-        return _read(path, r, data, urdf, xacro_args, package_dirs)
+        return _read(path, r, data, urdf, xacro_args, package_dirs, packages or {}, twist)
     except (TypeError, AttributeError, KeyError, IndexError, ValueError, RecursionError) as exc:
         if isinstance(exc, RobotDynError):
             raise
@@ -307,19 +330,31 @@ def read(
                                   ) from None
 
 
-def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) -> ConstraintFile:
+def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, packages, twist) -> ConstraintFile:
     """The body of :func:`read`, on the parsed TOML data."""
     r.keys("", data, TOP_KEYS)
     base = path.resolve().parent
 
     # ------------------------------------------------------------------------------------- description
-    pdirs = [str(base / d) for d in r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")]
+    pdirs = [str((base / d).resolve()) for d in r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")]
     pdirs += [str(Path(d).resolve()) for d in package_dirs]
+    for d in pdirs:
+        if not Path(d).is_dir():
+            r.fail("package_dirs", f"{d}: no such directory; expected directories holding ROS packages (or --package "
+                                   "DIR)")
+    pkg_table = data.get("packages", {})
+    r.keys("packages", pkg_table, list(pkg_table))
+    named = {k: str((base / r.string(f"packages.{k}", v, "directory")).resolve()) for k, v in pkg_table.items()}
+    named.update({k: str(Path(v).resolve()) for k, v in packages.items()})
+    try:
+        index = PackageIndex.create(named, pdirs)
+    except RobotDynError as exc:
+        r.fail("packages", str(exc))
     if urdf is not None:
-        desc = resolve_path(str(urdf), Path.cwd(), pdirs)
+        desc = resolve_path(str(urdf), Path.cwd(), pdirs, index)
     elif "urdf" in data:
         try:
-            desc = resolve_path(r.string("urdf", data["urdf"], "urdf"), base, pdirs)
+            desc = resolve_path(r.string("urdf", data["urdf"], "urdf"), base, pdirs, index)
         except ConstraintFileError as exc:
             r.fail("urdf", str(exc))
     else:
@@ -361,7 +396,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) ->
         if any(p.name == name and p.xacro for p in params):
             r.fail("xacro_args", f"{name!r} is a parameter of this file; set it with --param {name}=VALUE")
     try:
-        text = expand_xacro(desc, {**xargs, **{p.name: p.default for p in params if p.xacro}})
+        text = expand_xacro(desc, {**xargs, **{p.name: p.default for p in params if p.xacro}}, index)
         tree = _Tree.parse(text, declared)
     except RobotDynError as exc:
         raise ConstraintFileError(f"{path}: {exc}") from None
@@ -564,6 +599,40 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) ->
         except TypeError as exc:
             r.fail(f"terrain ({kind})", f"{exc}; arguments are {', '.join(allowed)}")
 
+    # ------------------------------------------------------------------------- root height, body twist
+    root_height = data.get("root_height", "auto")
+    if root_height == "auto":
+        root_height = None
+    else:
+        root_height = r.number("root_height", root_height, "root_height")
+        if root == "fixed":
+            r.fail("root_height", "a fixed root has no height; expected root = 'planar' or 'floating'")
+        if abs(root_height) > MAX_RADIUS:
+            r.fail("root_height", f"{root_height:g} m; expected the root link's height above the ground in m")
+    operational = None
+    twist_table = data.get("twist")
+    if twist is not None:
+        frame_name, _, comps = str(twist).partition(":")
+        twist_table = {"frame": frame_name, **({"components": comps.replace(",", " ")} if comps else {})}
+        independent = None
+    if twist_table is not None:
+        from .operational_space import COMPONENTS, OperationalVelocities
+
+        r.keys("twist", twist_table, TWIST_KEYS)
+        if independent is not None:
+            r.fail("twist", "give either 'independent' (coordinates) or 'twist' (a body twist), not both")
+        tframe = frame("twist", twist_table.get("frame"), "frame")
+        comps = r.strings("twist", twist_table.get("components", ["vx", "vy", "wz"]), "components")
+        if not comps or len(set(comps)) != len(comps) or any(c not in COMPONENTS for c in comps):
+            r.fail("twist", f"components {comps}; expected distinct entries of {' '.join(COMPONENTS)}")
+        axes = twist_table.get("axes", "body")
+        if axes not in ("body", "local", "world"):
+            r.fail("twist", f"axes = {axes!r}; expected 'body' (the frame's own axes) or 'world'")
+        tnames = r.strings("twist", twist_table.get("names", comps), "names")
+        if len(tnames) != len(comps) or len(set(tnames)) != len(tnames):
+            r.fail("twist", f"names {tnames}; expected {len(comps)} distinct names, one per component")
+        operational = OperationalVelocities(tframe, tuple(comps), "world" if axes == "world" else "local", tnames)
+
     spec = RobotSpec(
         name=r.string("name", data.get("name", path.stem), "name"),
         title=str(data.get("title", f"{path.stem} (from {path.name} and {desc.name})")),
@@ -579,9 +648,12 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) ->
         paper=str(data.get("paper", "")),
         neutral=neutral,
         xacro_args=xargs,
-        package_dirs=[str(d) for d in package_search_dirs(pdirs)],
+        package_dirs=pdirs,
         locked=locked,
         massless=massless,
+        packages=named,
+        root_height=root_height,
+        operational=operational,
     )
 
     # ---------------------------------------------------------------------------------------- scenarios
@@ -600,12 +672,22 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) ->
         if t_end <= 0:
             r.fail(where, f"t_end = {t_end}; expected a positive duration in s")
         tau = s.get("torque", [0.0] * len(motors))
+        motor_names = [m.name for m in motors]
+        if isinstance(tau, dict):  # by motor name, the others zero
+            r.keys(f"{where}: torque", tau, motor_names)
+            tau = [tau.get(name, 0.0) for name in motor_names]
         if not isinstance(tau, list) or len(tau) != len(motors):
-            r.fail(where, f"torque = {tau!r}; expected {len(motors)} numbers ({', '.join(m.name for m in motors)})")
+            r.fail(where, f"torque = {tau!r}; expected {len(motors)} numbers ({', '.join(motor_names)}) or a table "
+                          "by motor name")
         tau = np.array([r.number(where, x, "torque") for x in tau])
         q0 = {coordinate(where, k): r.number(where, v, k) for k, v in s.get("q0", {}).items()}
         nu0 = {}
         for k, v in s.get("nu0", {}).items():
+            if operational is not None:
+                if k not in operational.names:
+                    r.fail(where, f"nu0 {k!r} is not a twist component; expected one of {', '.join(operational.names)}")
+                nu0[k] = r.number(where, v, k)
+                continue
             label = coordinate(where, k)
             nu0[f"{labels.get(label, label)}_dot"] = r.number(where, v, k)
         scenarios[name] = Scenario(name, str(s.get("description", f"constant torques {tau.tolist()}")), t_end,

@@ -77,30 +77,42 @@ def xacro_value(name: str, value) -> str:
     return text if _PLAIN_WORD.fullmatch(text) else repr(x)
 
 
-def expand_xacro(path: str | Path, args: dict[str, object] | None = None) -> str:
+def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packages=None) -> str:
     """Expand a Xacro file into a URDF string.
 
     Args:
         path: The ``.xacro`` (or plain ``.urdf``) file. Includes are resolved relative to it.
         args: Values of the file's ``xacro:arg`` s, converted with ``str``.
+        packages: A :class:`~robotdyn.ros_packages.PackageIndex` answering ``$(find PKG)`` (default: one from
+            ``ROS_PACKAGE_PATH``/``AMENT_PREFIX_PATH``); no ROS installation is needed.
 
     Returns:
         The URDF XML text.
 
     Raises:
+        MissingPackagesError: Packages the description includes were not found (all of them, at once).
         DescriptionError: The file is missing or xacro cannot expand it.
     """
     import xacro
+
+    from .ros_packages import MISSING_ROOT, MissingPackagesError, PackageIndex, required_packages, xacro_find
 
     path = Path(path)
     if not path.is_file():
         raise DescriptionError(f"description file not found: {path}")
     mappings = {str(k): xacro_value(str(k), v) for k, v in (args or {}).items()}
-    try:
-        doc = xacro.process_file(str(path), mappings=mappings)
-    except Exception as exc:  # xacro raises a variety of exception types
-        msg = " ".join(str(exc).split()) or type(exc).__name__
-        raise DescriptionError(f"cannot expand xacro {path.name}: {msg}") from None
+    index = packages if packages is not None else PackageIndex.create()
+    with xacro_find(index) as missing:
+        try:
+            doc = xacro.process_file(str(path), mappings=mappings)
+        except Exception as exc:  # xacro raises a variety of exception types
+            msg = " ".join(str(exc).split()) or type(exc).__name__
+            needed = {m for m in missing if f"{MISSING_ROOT}/{m}" in msg}
+            if needed or missing:  # every package the description includes unconditionally, not only the first
+                needed |= required_packages(path, index)
+            if needed:
+                raise MissingPackagesError(needed, f"cannot expand xacro {path.name}: ") from None
+            raise DescriptionError(f"cannot expand xacro {path.name}: {msg}") from None
     return doc.toxml()
 
 
@@ -260,9 +272,37 @@ class Description:
     joint_names: list[str] = field(default_factory=list)
     lower: np.ndarray = field(default_factory=lambda: np.zeros(0))
     upper: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    visual_report: object = None
+    root_height: float = 0.0
 
     def __repr__(self) -> str:
         return f"Description(model={self.model.name!r}, root={self.root!r}, nq={self.model.nq})"
+
+    def set_root_height(self, height: float) -> None:
+        """Raise the root chain by ``height`` [m]: the first root joint's placement gets the translation
+        (0, 0, height), so that a planar root moves its link in the plane z = height (a base whose link sits above
+        the ground, as most ROS descriptions' ``base_link`` does) and a floating root's z is measured from there.
+        The stored URDF text says the same (an ``<origin>`` on that joint)."""
+        height = float(height)
+        if not np.isfinite(height):
+            raise DescriptionError(f"root height {height}; expected a finite height in m")
+        chain = _ROOT_CHAINS[self.root]
+        if not chain:
+            if height:
+                raise DescriptionError(f"root height {height:g} m with a fixed root; expected a planar or floating root")
+            return
+        jid = self.model.getJointId(chain[0][0])
+        placement = self.model.jointPlacements[jid]
+        placement.translation = np.array([0.0, 0.0, height])
+        self.model.jointPlacements[jid] = placement
+        tree = ET.fromstring(self.urdf)
+        for joint in tree.findall("joint"):
+            if joint.get("name") == chain[0][0]:
+                for old in joint.findall("origin"):
+                    joint.remove(old)
+                ET.SubElement(joint, "origin", xyz=f"0 0 {height!r}", rpy="0 0 0")
+        self.urdf = ET.tostring(tree, encoding="unicode")
+        self.root_height = height
 
     def q_index(self, joint: str) -> int:
         """Index in ``q`` (and ``v``) of a one-degree-of-freedom joint."""
@@ -323,6 +363,9 @@ def build_description(
     package_dirs: list[str] | None = None,
     locked: dict[str, float] | None = None,
     massless: list[str] | None = None,
+    packages=None,
+    source: str | Path | None = None,
+    root_height: float = 0.0,
 ) -> Description:
     """Build a :class:`Description` from URDF text.
 
@@ -330,11 +373,21 @@ def build_description(
         urdf: URDF XML (already expanded from Xacro).
         root: Root joint kind: ``"fixed"``, ``"planar"`` (x, y, psi) or ``"floating"``
             (x, y, z, yaw, pitch, roll).
-        package_dirs: Where ``package://`` meshes are looked up.
+        package_dirs: Directories searched for the packages of ``package://`` meshes (used when ``packages`` is
+            not given) and from which meshes may be read.
         locked: Joints to lock (name -> value in m or rad): they become fixed, their bodies merge with the parent.
         massless: Links whose inertial is dropped (e.g. a third-party URDF's placeholder with a non-physical
             inertia tensor).
+        packages: A :class:`~robotdyn.ros_packages.PackageIndex` for ``package://`` meshes (default: one of
+            ``package_dirs`` and the environment's ROS paths).
+        source: The description file (relative mesh paths and the description's own tree; see
+            :mod:`robotdyn.visual_geometry`).
+        root_height: Height [m] of the root link's plane above the world's z = 0 (planar root), or of the
+            reference of the z coordinate (floating root); see :meth:`Description.set_root_height`.
     """
+    from .ros_packages import PackageIndex
+    from .visual_geometry import build_visual
+
     urdf = drop_inertials(urdf, massless)
     validate_urdf(urdf)
     text, _ = _naturalise(urdf, root)
@@ -344,10 +397,9 @@ def build_description(
         raise DescriptionError(f"Pinocchio cannot build the model: {' '.join(str(exc).split())}") from None
     if model.nq != model.nv:
         raise DescriptionError("internal: natural coordinates require nq == nv")
-    try:
-        visual = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.VISUAL, package_dirs=package_dirs or [])
-    except Exception:
-        visual = pin.GeometryModel()
+    index = packages if packages is not None else PackageIndex.create(dirs=package_dirs or [])
+    visual, report = build_visual(model, text, index, Path(source) if source is not None else None,
+                                  allowed=package_dirs or [])
     if locked:
         model, visual = lock_joints(model, visual, locked)
     names: list[str] = [""] * model.nq
@@ -356,5 +408,8 @@ def build_description(
         names[joint.idx_q] = model.names[jid]
     lower = np.where(model.lowerPositionLimit <= -_UNBOUNDED, -np.inf, model.lowerPositionLimit)
     upper = np.where(model.upperPositionLimit >= _UNBOUNDED, np.inf, model.upperPositionLimit)
-    return Description(model, visual, text, root, names, np.array(lower), np.array(upper))
+    out = Description(model, visual, text, root, names, np.array(lower), np.array(upper), visual_report=report)
+    if root_height:
+        out.set_root_height(root_height)
+    return out
 

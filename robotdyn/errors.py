@@ -45,3 +45,8 @@ class NonFiniteError(RobotDynError):
 
 class OutputError(RobotDynError):
     """An output file that cannot be written (missing directory, a directory, no permission, full disk, format)."""
+
+
+class RobotDynWarning(UserWarning):
+    """Something robotdyn worked around or could not check, said in one line (the CLI prints
+    ``robotdyn: warning: ...``): e.g. meshes not drawn, or a row dropped as redundant that a state violates."""

@@ -10,8 +10,9 @@ forward/inverse dynamics and energies. Configurations are natural coordinates na
 from __future__ import annotations
 
 import threading
+import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -19,9 +20,9 @@ import pinocchio as pin
 
 from .actuation import Motor
 from .constraint import ConstraintRows, KinematicState
-from .description import URDF_DIR, Description, build_description, expand_xacro
+from .description import _ROOT_CHAINS, URDF_DIR, Description, build_description, expand_xacro
 from .dynamics import energy
-from .errors import ConstraintError, InputError, NonFiniteError
+from .errors import ConstraintError, InputError, NonFiniteError, RobotDynWarning
 from .friction import make_law
 from .inputs import as_vector
 from .loop_closure import LoopClosure
@@ -140,6 +141,12 @@ class RobotSpec:
         operational: Minimal velocities that are not a subset of v (e.g. a platform twist in body axes): an object
             with ``build(description)`` returning a model with ``names`` and ``reduce(robot, q, nu, coriolis)``,
             such as :class:`robotdyn.operational_space.OperationalVelocities`; ``None``: ``independent`` is used.
+        packages: ROS packages by name (name -> directory) for ``$(find NAME)`` and ``package://NAME/`` (see
+            :mod:`robotdyn.ros_packages`; ``package_dirs``, ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH`` are
+            searched for the others).
+        root_height: Height [m] of the plane in which a planar root moves its link (the root link's height above
+            the ground, z = 0), or of the reference of a floating root's z; ``None``: found from the wheels for a
+            planar root (:meth:`Robot.root_height_from_wheels`; the default of constraint files), 0 otherwise.
     """
 
     name: str
@@ -161,6 +168,8 @@ class RobotSpec:
     massless: list[str] = field(default_factory=list)
     constraints: list[Callable] = field(default_factory=list)
     operational: object | None = None
+    packages: dict[str, str] = field(default_factory=dict)
+    root_height: float | None = 0.0
 
     def parameter(self, name: str) -> Parameter:
         for p in self.parameters:
@@ -197,9 +206,16 @@ class Robot:
         if not path.is_absolute():
             path = URDF_DIR / path
         xacro_args = {**spec.xacro_args, **{p.name: values[p.name] for p in spec.parameters if p.xacro}}
+        from .ros_packages import PackageIndex
+
+        dirs = [str(d) for d in spec.package_dirs]
+        self.packages = PackageIndex.create(spec.packages, dirs)
         self.description: Description = build_description(
-            expand_xacro(path, xacro_args), spec.root, [str(d) for d in spec.package_dirs], spec.locked, spec.massless
+            expand_xacro(path, xacro_args, self.packages), spec.root, dirs, spec.locked, spec.massless,
+            packages=self.packages, source=path, root_height=spec.root_height or 0.0,
         )
+        for message in self.description.visual_report.warnings:
+            warnings.warn(message, RobotDynWarning, stacklevel=2)
         self.model = self.description.model
         self._local = threading.local()  # per-thread Pinocchio data and compiled model (see ``data``)
         self.model.gravity.linear = np.array([0.0, 0.0, -float(values.get("g", 9.81))])
@@ -211,6 +227,13 @@ class Robot:
         self.constraints = [self._wheel(w) for w in spec.wheels] + [
             LoopClosure(self.description, c.frame1, c.frame2, c.components, c.name) for c in spec.closures
         ] + [make(self) for make in spec.constraints]
+        self.root_height_source = "given" if spec.root_height is not None else "none"
+        if spec.root_height is None and spec.root == "planar":
+            height, _ = self.root_height_from_wheels()
+            if height:  # the twin and copies of this robot (e.g. contact forces' floating twin) keep this height
+                self.description.set_root_height(height)
+                self.spec = spec = replace(spec, root_height=height)
+                self.root_height_source = "found from the wheels"
         self.motors = [Motor(self.description, m.name, m.joint, m.reaction) for m in spec.motors]
         if spec.independent is not None:
             self.independent_indices = np.array([self.coordinate_index(c) for c in spec.independent], dtype=int)
@@ -354,14 +377,63 @@ class Robot:
         return rows.residual[rows.holonomic]
 
     def check_constraints(self, q, tol: float = 1e-6) -> None:
-        """Raise :class:`ConstraintError` if q violates a holonomic constraint by more than ``tol``."""
+        """Raise :class:`ConstraintError` if q violates a holonomic constraint by more than ``tol``, with the advice
+        that fits: a root at the wrong height when every wheel misses the ground by the same amount, else the
+        wheels or closures that do not close."""
         rows = self.rows_at(q)
-        if rows.residual.size and np.max(np.abs(rows.residual)) > tol:
-            i = int(np.argmax(np.abs(rows.residual)))
+        if not (rows.residual.size and np.max(np.abs(rows.residual)) > tol):
+            return
+        i = int(np.argmax(np.abs(rows.residual)))
+        heights = self.wheel_heights(q)
+        values = np.array(list(heights.values()))
+        if rows.labels[i].rsplit(".", 1)[0] in heights and np.ptp(values) <= tol and self.spec.root != "fixed":
+            h = -float(np.mean(values)) + self.description.root_height
+            where = "above" if values[0] > 0 else "below"
+            fix = (f"set root_height = {h:.6g} in the constraint file (RobotSpec.root_height; leave it out to have it "
+                   "found from the wheels)" if self.spec.root == "planar" else
+                   f"set z = {q[self.coordinate_index('z')] - values[0]:.6g} (neutral = {{ z = ... }} in the "
+                   "constraint file)")
             raise ConstraintError(
-                f"q violates constraint {rows.labels[i]} by {rows.residual[i]:.3g}; expected |residual| <= {tol:g} "
-                "(solve the closures/contacts first)"
-            )
+                f"every wheel is {abs(values[0]):.6g} m {where} the ground at this configuration: the root link sits "
+                f"at the wrong height ({self.spec.root} root at {self.description.root_height:.6g} m); {fix}")
+        what = ("the wheels must touch the ground: check the radii and joint values, or solve the posture "
+                "(robotdyn.posture)" if rows.labels[i].rsplit(".", 1)[0] in heights else
+                "solve the closures first (robotdyn.posture solves the holonomic constraints for the free coordinates)")
+        raise ConstraintError(
+            f"q violates constraint {rows.labels[i]} by {rows.residual[i]:.3g}; expected |residual| <= {tol:g}; {what}"
+        )
+
+    def wheel_heights(self, q=None) -> dict[str, float]:
+        """Each wheel's contact-point height above the terrain [m] (its holonomic residual) at q (default: the
+        neutral configuration); 0 when it touches, positive when it floats above."""
+        kin = KinematicState(self.model, self.data, self.neutral() if q is None else np.asarray(q, float),
+                             np.zeros(self.model.nv))
+        out = {}
+        for c in self.constraints:
+            if hasattr(c, "contact"):
+                rows = c.jacobian(kin)
+                if rows.holonomic.any():
+                    out[rows.labels[0].rsplit(".", 1)[0]] = float(rows.residual[rows.holonomic][0])
+        return out
+
+    def root_height_from_wheels(self, tol: float = 1e-6) -> tuple[float, dict[str, float]]:
+        """How much to raise a planar root so that its wheels touch the ground at the neutral configuration.
+
+        Most ROS descriptions put ``base_link`` above the ground (at the wheel axles, or the chassis' bottom
+        plate), while a planar root moves the root link in the plane z = 0. When every wheel's contact point is the
+        same height d below (or above) the terrain at the neutral configuration, the root belongs at -d [m].
+
+        Returns:
+            ``(height, wheel heights)``: the height (0 when the wheels already touch, or when they disagree by
+            more than ``tol``: then no single height makes them all touch) and :meth:`wheel_heights`.
+        """
+        heights = self.wheel_heights()
+        if not heights:
+            return 0.0, heights
+        values = np.array(list(heights.values()))
+        if np.max(np.abs(values)) <= tol or np.ptp(values) > tol:
+            return 0.0, heights
+        return -float(np.mean(values)), heights
 
     # ------------------------------------------------------------------------------------------- dynamics
     def reduced(self, q, nu, coriolis: bool = False) -> ReducedDynamics:
@@ -384,9 +456,14 @@ class Robot:
         g = pin.computeGeneralizedGravity(self.model, self.data, q).copy()
         return M, C, g
 
-    def forward_dynamics(self, q, nu, tau) -> np.ndarray:
+    def forward_dynamics(self, q, nu, tau, check: bool = True) -> np.ndarray:
         """Independent accelerations :math:`\\dot\\nu = M_r^{-1}(B_r\\tau - C_r\\nu - g_r)` (with slipping
-        wheels, together with their normal loads and friction: :func:`robotdyn.sliding.forward`)."""
+        wheels, together with their normal loads and friction: :func:`robotdyn.sliding.forward`).
+
+        With ``check``, rows the projection dropped as redundant are checked at the velocity and acceleration
+        level (:mod:`robotdyn.redundancy`): where the mobility changes (e.g. steerable wheels all parallel) these
+        accelerations can violate them, and a :class:`~robotdyn.errors.RobotDynWarning` names each row and by
+        how much."""
         if sliding_now(self):
             return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
         red = self.reduced(q, nu)
@@ -394,7 +471,24 @@ class Robot:
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
                                  "what double precision holds)")
+        if check:
+            self._warn_dropped(red, out)
         return out
+
+    def redundant_row_violations(self, q, nu, nudot=None) -> list:
+        """The constraint rows dropped as redundant at q that the velocities ``nu`` (and the accelerations
+        ``nudot``, if given) violate: a list of :class:`~robotdyn.redundancy.RowViolation` (empty where the state is
+        consistent). See :mod:`robotdyn.redundancy`."""
+        from .redundancy import violations
+
+        return violations(self.reduced(q, nu), nudot)
+
+    def _warn_dropped(self, red, nudot) -> None:
+        from .redundancy import message, violations
+
+        found = violations(red, nudot)
+        if found:
+            warnings.warn(message(found), RobotDynWarning, stacklevel=3)
 
     def inverse_dynamics(self, q, nu, nudot) -> tuple[np.ndarray, np.ndarray, float]:
         """Generalised forces and motor torques for given independent accelerations.
@@ -406,6 +500,7 @@ class Robot:
         """
         red = self.reduced(q, nu)
         Q = red.M @ np.asarray(nudot, float) + red.h
+        self._warn_dropped(red, np.asarray(nudot, float))
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)
@@ -447,14 +542,56 @@ class Robot:
                              "(friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and friction')")
             if not np.any(np.abs(null[:, xy]) > 1e-9):
                 notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+        nearby = self._nearby_rank(rank)
+        if nearby > rank:
+            notes.append(f"the mobility changes at the neutral configuration: {self.nq - rank} here, "
+                         f"{self.nq - nearby} at configurations near it (rows that are independent nearby become "
+                         "dependent here, e.g. steerable wheels all parallel); the projection drops them as redundant, "
+                         "and velocities or accelerations that leave this configuration violate them (robotdyn warns, "
+                         "naming the row: Robot.redundant_row_violations)")
         return self.nq - rank, notes
+
+    def _nearby_rank(self, rank: int, samples: int = 3, step: float = 0.1) -> int:
+        """The largest rank of the constraint rows at a few valid configurations near the neutral one, to tell a
+        configuration where the mobility changes. Moved (by about ``step``) are the joint coordinates that no
+        holonomic row involves (e.g. steering and spin angles), so that the configurations stay valid; one that
+        does not (residual above 1e-6) is not counted."""
+        q0 = self.neutral()
+        rows = self.rows_at(q0)
+        root = {name for name, _, _ in _ROOT_CHAINS[self.spec.root]}
+        free = np.array([j not in root for j in self.description.joint_names])
+        if rows.A.size and rows.holonomic.any():
+            free &= ~np.any(np.abs(rows.A[rows.holonomic]) > 1e-12, axis=0)
+        if not free.any() or not rows.A.size:
+            return rank
+        rng = np.random.default_rng(0)
+        best = rank
+        lo, hi = self.description.lower, self.description.upper
+        for _ in range(samples):
+            q = np.clip(q0 + step * rng.standard_normal(self.nq) * free, lo, hi)
+            near = self.rows_at(q)
+            if near.residual.size and np.max(np.abs(near.residual)) > 1e-6:
+                continue
+            best = max(best, int(np.linalg.matrix_rank(near.A)))
+        return best
 
     def info(self) -> dict:
         """Coordinates, independent velocities, parameters (value, unit) and actuators, as plain data."""
         mobility, notes = self.mobility_check()
+        report = self.description.visual_report
+        heights = self.wheel_heights() if self.spec.root != "fixed" else {}
+        if heights and max(map(abs, heights.values())) > 1e-6:
+            listed = ", ".join(f"{k} {v:+.4g} m" for k, v in heights.items())
+            notes.append(f"at the neutral configuration the wheels do not all touch the ground (contact heights above "
+                         f"it: {listed}); a {self.spec.root} root cannot fix that with one height: check the radii, "
+                         "the joint values (neutral) or the terrain")
         return {
             "mobility_at_neutral": mobility,
             "mobility_notes": notes,
+            "root": self.spec.root,
+            "root_height": self.description.root_height,
+            "root_height_source": self.root_height_source,
+            "visual_warnings": report.warnings if report is not None else [],
             "robot": self.spec.name,
             "title": self.spec.title,
             "paper": self.spec.paper,

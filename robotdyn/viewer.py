@@ -8,7 +8,8 @@ frames. Every layer is a node of meshcat's scene tree, so it can be switched on 
 (:meth:`Viewer.show`) and from the browser (the "Open Controls" menu, folder Scene/meshcat/robotdyn).
 
 Scenes are recorded in-process, so :meth:`Viewer.static_html` (a standalone page with meshcat's JavaScript
-inlined: it opens offline, e.g. attached to a report) needs no server. ``live=True`` additionally starts meshcat's
+inlined: it opens offline, e.g. attached to a report; shared meshes stored once, compressed:
+:mod:`robotdyn.scene_page`) needs no server. ``live=True`` additionally starts meshcat's
 local server (``Viewer.url``) and mirrors every command to it, for interactive use.
 
 Animations use meshcat's (three.js) keyframe animations, so they play in the browser in real time: a trajectory
@@ -31,7 +32,6 @@ Example (in a notebook)::
 
 from __future__ import annotations
 
-import base64
 import html
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +41,7 @@ import pinocchio as pin
 
 from .errors import InputError, RobotDynError
 from .output import atomic_output
+from .scene_page import _meshcat, static_page
 
 _ROOT = "robotdyn"
 LAYERS = ("robot", "terrain", "contacts", "frames")
@@ -50,19 +51,6 @@ _CONTACT_COLOR = 0xD62728
 _TERRAIN_LOW = np.array([0.35, 0.55, 0.30])
 _TERRAIN_HIGH = np.array([0.80, 0.72, 0.50])
 _GROUND = np.array([0.78, 0.78, 0.74])
-
-
-def _meshcat():
-    """Import meshcat lazily, without its pyzmq DeprecationWarning."""
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        import meshcat
-        import meshcat.animation
-        import meshcat.geometry
-        import meshcat.servers.tree
-    return meshcat
 
 
 class _SceneRecorder:
@@ -119,7 +107,7 @@ class _SceneRecorder:
         return out + animations
 
     def get_scene(self) -> str:
-        return _static_page(self.commands())
+        return static_page(self.commands())
 
     def close(self) -> None:
         """Close the socket to the live server (dropping unsent messages, so that nothing waits for them at
@@ -134,49 +122,6 @@ class _SceneRecorder:
             proc.kill()
             proc.wait()
             self.live.server_proc = None
-
-
-def _static_page(commands: list[bytes], title: str = "robotdyn") -> str:
-    """A standalone HTML page: meshcat's viewer JavaScript inlined and the scene's commands applied in order,
-    synchronously (so a headless browser's screenshot sees the complete scene)."""
-    mc = _meshcat()
-    js = (Path(mc.__file__).parent / "viewer" / "dist" / "main.min.js").read_text(encoding="utf-8")
-    js = js.replace("</script", "<\\/script")
-    blobs = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in commands)
-    return f"""<!DOCTYPE html>
-<html>
-<head><meta charset="utf-8"><title>{html.escape(title)}</title>
-<style>body {{ margin: 0; }} #meshcat-pane {{ width: 100vw; height: 100vh; overflow: hidden; }}</style>
-</head>
-<body>
-<div id="meshcat-pane"></div>
-<script>
-{js}
-</script>
-<script>
-var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));
-var robotdyn_commands = [
-{blobs}
-];
-for (var i = 0; i < robotdyn_commands.length; i++) {{
-  var s = atob(robotdyn_commands[i]);
-  var b = new Uint8Array(s.length);
-  for (var j = 0; j < s.length; j++) b[j] = s.charCodeAt(j);
-  viewer.handle_command_bytearray(b);
-}}
-console.log("robotdyn: applied " + robotdyn_commands.length + " scene commands");
-// page.html#t=SECONDS opens an animation paused at that time
-var robotdyn_t = /[#&]t=([-+0-9.eE]+)/.exec(location.hash);
-if (robotdyn_t && viewer.animator.actions.length > 0) {{
-  viewer.animator.pause();
-  viewer.animator.seek(parseFloat(robotdyn_t[1]));
-  viewer.animator.display_progress(parseFloat(robotdyn_t[1]));
-  console.log("robotdyn: animation paused at t = " + parseFloat(robotdyn_t[1]) + " s");
-}}
-</script>
-</body>
-</html>
-"""
 
 
 @dataclass
@@ -492,7 +437,7 @@ class Viewer:
 
     def static_html(self) -> str:
         """The scene as a standalone HTML page (meshcat's JavaScript inlined; opens offline)."""
-        return _static_page(self._window.commands(), f"robotdyn: {self.robot.spec.name}")
+        return static_page(self._window.commands(), f"robotdyn: {self.robot.spec.name}")
 
     def save(self, path: str | Path) -> Path:
         """Write :meth:`static_html` to ``path`` and return the path."""

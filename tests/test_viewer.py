@@ -22,6 +22,7 @@ from robotdyn.cli import main
 from robotdyn.errors import InputError
 from robotdyn.robots import names
 from robotdyn.terrain import FlatTerrain, SineTerrain
+from robotdyn.scene_page import page_commands
 from robotdyn.viewer import Viewer
 
 ROBOTS = names()
@@ -42,8 +43,7 @@ def robots():
 # ----------------------------------------------------------------------------------------------- helpers
 def decode(page: str) -> list[dict]:
     """The scene commands of a static export, in the order the page applies them."""
-    block = page[page.index("var robotdyn_commands = [") : page.index("];", page.index("var robotdyn_commands"))]
-    return [umsgpack.unpackb(__import__("base64").b64decode(b)) for b in re.findall(r'"([A-Za-z0-9+/=]+)"', block)]
+    return [umsgpack.unpackb(c) for c in page_commands(page)]
 
 
 def transforms(cmds: list[dict]) -> dict[str, np.ndarray]:
@@ -244,7 +244,7 @@ def test_layers_toggle_and_bad_input_is_one_line(robots):
 
 def test_static_html_is_self_contained(robots):
     page = Viewer(robots("quasimoro")).static_html()
-    assert "MeshCat.Viewer" in page and "robotdyn_commands" in page
+    assert "MeshCat.Viewer" in page and "robotdyn_scene" in page
     assert not re.search(r"<script[^>]+src=|<link[^>]+href=|<iframe|<img[^>]+src=\s*[\"']?(https?:)?//", page)
     assert not re.search(r"(src|href)\s*=\s*[\"'](https?:)?//", page)
 

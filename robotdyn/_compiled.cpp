@@ -22,6 +22,8 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 
+#include <Eigen/SVD>
+
 #include <pybind11/pybind11.h>
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
@@ -671,7 +673,7 @@ class Evaluator {
       if (!Sd_.allFinite()) throw Fallback("singular");  // an exactly singular block (a zero pivot)
       for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -Sd_.row(r);
     }
-    if (A_.size()) {
+    if (A_.size() && S_.cols()) {  // (no independent velocity: nothing to check, and no maximum to take)
       AS_.noalias() = A_.lazyProduct(S_);
       if (!(AS_.cwiseAbs().maxCoeff() <= 1e-10 * scale)) throw Fallback("row choice no longer spans");  // NaN too
     }
@@ -694,7 +696,17 @@ class Evaluator {
         Ah.row(j) = A_.row(r);
         phi[j++] = residual_[r];
       }
-    out.head(nv_) -= alpha * Ah.completeOrthogonalDecomposition().solve(phi);
+    // truncated SVD: singular values below 1e-9 max(s_max, 1) count as zero (robotdyn/pull_back.py): rows with
+    // no rank, e.g. a wheel's normal row under a planar root, keep their residual as a constant offset
+    svd_.compute(Ah, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const VectorXd& s = svd_.singularValues();
+    const double cut = 1e-9 * std::max(s.size() ? s[0] : 0.0, 1.0);
+    int rank = 0;
+    while (rank < s.size() && s[rank] > cut) ++rank;
+    if (rank == 0) return;
+    VectorXd c = svd_.matrixU().leftCols(rank).transpose() * phi;
+    c.array() /= s.head(rank).array();
+    out.head(nv_).noalias() -= alpha * (svd_.matrixV().leftCols(rank) * c);
   }
 
   pin::Model model_;
@@ -719,6 +731,7 @@ class Evaluator {
   Matrix6x Jc_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   Eigen::LLT<MatrixXd> llt_;
+  Eigen::JacobiSVD<MatrixXd> svd_;
   double cond_ = 1.0;
   std::vector<Geometry> geo_;
   std::vector<Matrix6x> Jf_;

@@ -189,7 +189,8 @@ def cmd_simulate(args) -> int:
 
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops the run like Ctrl-C: results kept
         signal.signal(signal.SIGTERM, _interrupt)
-    traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet)
+    extra = {} if args.stabilisation is None else {"stabilisation": args.stabilisation}
+    traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")
     tr = None
     switches = traj.stats.get("switches")
@@ -237,6 +238,8 @@ def cmd_simulate(args) -> int:
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
             f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
             + ("; ..." if len(switches) > 10 else ""))
+    if "offsets" in traj.stats:  # holonomic residuals no coordinate can change (robotdyn.pull_back)
+        out["constant_offsets"] = traj.stats["offsets"]
     if "event" in traj.stats:
         out["stopped"] = traj.stats["event"]
         text.append(f"stopped early: {traj.stats['event']}")
@@ -255,6 +258,13 @@ def cmd_simulate(args) -> int:
         print(f"robotdyn: {partial}; wrote the partial results: {written}", file=sys.stderr)
         return 130
     return 0
+
+
+def _nonnegative(text: str) -> float:
+    value = float(text)
+    if not (np.isfinite(value) and value >= 0):
+        raise ValueError(text)
+    return value
 
 
 def _interrupt(signum, frame):
@@ -367,6 +377,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file")
     p.add_argument("--plot", help="save the paper's figures reproduced to this image file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--stabilisation", type=_nonnegative, default=None, metavar="ALPHA",
+                   help="gain [1/s] pulling holonomic residuals back (default 10; 0 turns the pull-back off)")
     p.add_argument("--mu", type=float, default=None,
                    help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
     p.add_argument("--traction-plot", metavar="FILE",

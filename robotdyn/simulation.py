@@ -23,6 +23,7 @@ import numpy as np
 from .compiled import Fallback, compiled_model
 from .errors import NonFiniteError, RobotDynError
 from .projection import solve
+from .pull_back import check_start, correction, describe_offsets, weakest
 from .reduced_dynamics import velocity
 from .sliding import forward as forward_sliding
 from .sliding import slipping_wheels
@@ -137,6 +138,7 @@ def simulate(
     q0 = robot.check_q(q0)
     nu0 = robot.check_nu(nu0)
     robot.check_constraints(q0)
+    offsets = _start_offsets(robot, q0, stabilisation)
     if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):  # exact switching: segment by segment
         from .stick_slip import simulate as simulate_stick_slip
 
@@ -200,7 +202,8 @@ def simulate(
         sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
     wall = time.perf_counter() - start
     if not sol.success:
-        raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}")
+        raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}"
+                            + _pull_back_note(robot, sol.y[:n, -1], stabilisation))
     stats_event = None
     if slipping and sol.status == 1:  # a slipping wheel's load reached zero: the contact model ends there
         t_ev, y_ev = sol.t_events[0][0], sol.y_events[0][0]
@@ -229,6 +232,8 @@ def simulate(
         stats["partial"] = interrupted
     if stats_event:
         stats["event"] = stats_event
+    if offsets:
+        stats["offsets"] = offsets
     return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
                       robot.units, sol.y[n + k][: len(times)] if slipping else None)
 
@@ -270,13 +275,42 @@ def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarra
                            status=status), interrupted
 
 
+def _start_offsets(robot, q0: np.ndarray, stabilisation: float) -> dict[str, float]:
+    """The holonomic residuals at q0 that no coordinate can change (reported once on stderr, kept as constant
+    offsets); raises where the pull-back cannot work (:func:`robotdyn.pull_back.check_start`)."""
+    rows = robot.rows_at(q0)
+    hol = rows.holonomic
+    found = check_start(rows.A[hol], rows.residual[hol], [lab for lab, h in zip(rows.labels, hol) if h],
+                        stabilisation)
+    if found:
+        print(f"simulate: {describe_offsets(found)}", file=sys.stderr, flush=True)
+    return found
+
+
+def _pull_back_note(robot, q: np.ndarray, stabilisation: float) -> str:
+    """Where an integration failed with the pull-back on and nearly rank-deficient holonomic rows: the rows and
+    their relative singular value (else empty)."""
+    if not stabilisation or not np.all(np.isfinite(q)):
+        return ""
+    try:
+        rows = robot.rows_at(q)
+    except RobotDynError:
+        return ""
+    hol = rows.holonomic
+    s, names = weakest(rows.A[hol], [lab for lab, h in zip(rows.labels, hol) if h])
+    if s > 1e-6:
+        return ""
+    return (f" (the holonomic pull-back is ill-conditioned there: rows {names} have a relative singular value "
+            f"{s:.3g}; stabilisation = 0 turns it off)")
+
+
 def _qdot(red, stabilisation: float) -> np.ndarray:
     """:math:`\\dot q = v - \\alpha A_h^+\\phi`: the velocity with the holonomic residuals pulled back."""
     qdot = red.v
     rows = red.jacobian_rows
     hol = rows.holonomic
     if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
-        qdot = qdot - stabilisation * np.linalg.lstsq(rows.A[hol], rows.residual[hol], rcond=None)[0]
+        qdot = qdot - stabilisation * correction(rows.A[hol], rows.residual[hol])
     return qdot
 
 

@@ -139,6 +139,7 @@ def main() -> None:
 
     forces_bench()
     startup_bench()
+    compiled_engine_bench()
 
 
 def startup_bench() -> None:
@@ -186,6 +187,32 @@ def forces_bench() -> None:
     t_roll = time.perf_counter() - start
     print(f"skid-steer 'straight', 2 s: slipping wheels {t_slip:.2f} s wall ({traj.stats['nfev']} evaluations), "
           f"rolling wheels {t_roll:.2f} s ({other.stats['nfev']}): ratio {t_slip / t_roll:.1f}")
+
+
+# ------------------------------------------------------------------ compiled simulation engine (issue 17, items 1, 2)
+def compiled_engine_bench() -> None:
+    """The whole simulation in C++ (robotdyn.compiled_simulation) against the scipy path on Quasimoro's rectilinear
+    manoeuvre (90 s, default tolerances rtol 1e-10, atol 1e-12): cost per simulated second (best of 5 whole
+    simulate() calls), evaluations, deviation from the scipy trajectory, energy drift after the pulse."""
+    robot = robotdyn.load("quasimoro")
+    sc = module("quasimoro").SCENARIOS["rectilinear"]
+    t_end = 90.0
+    print(f"\nquasimoro rectilinear {t_end:g} s, whole simulate() call (best of 5), default tolerances:")
+    print(f"{'engine':<28} {'ms / sim s':>11} {'evals':>7} {'max|q - q_scipy|':>17} {'max|nu - nu_scipy|':>19} "
+          f"{'energy drift':>13}")
+    ref = None
+    for label, kw in (("scipy (DOP853)", dict(engine="scipy")), ("compiled (adams)", {}),
+                      ("compiled (bulirsch_stoer)", dict(method="bulirsch_stoer")),
+                      ("compiled (dopri5)", dict(method="dopri5"))):
+        walls = []
+        for _ in range(1 if ref is None else 5):
+            start = time.perf_counter()
+            traj = sc.run(robot, t_end=t_end, progress=False, **kw)
+            walls.append(time.perf_counter() - start)
+        ref = traj if ref is None else ref
+        drift = float(np.ptp(traj.energy[traj.t > 1.0]))
+        print(f"{label:<28} {1e3 * min(walls) / t_end:>11.3f} {traj.stats['nfev']:>7d} "
+              f"{np.max(np.abs(traj.q - ref.q)):>17.2e} {np.max(np.abs(traj.nu - ref.nu)):>19.2e} {drift:>13.2e}")
 
 
 if __name__ == "__main__":

@@ -24,8 +24,12 @@
 
 #include <Eigen/SVD>
 
+#include "_integrator.hpp"
+#include "_torque_profile.hpp"
+
 #include <pybind11/pybind11.h>
 #include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -351,17 +355,157 @@ class Evaluator {
   // d/dt of (q, nu): (S nu - alpha A_h^+ phi, M_r^-1 (B_r tau - h_r)).
   VectorXd rhs(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                const Eigen::Ref<const VectorXd>& tau, double alpha) {
+    VectorXd out(nv_ + nu.size());
+    rhs_into(q, nu, tau, alpha, out);
+    return out;
+  }
+
+  void rhs_into(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+                const Eigen::Ref<const VectorXd>& tau, double alpha, Eigen::Ref<VectorXd> out) {
     configure(q);
     dynamics(nu);
     const int k = static_cast<int>(S_.cols());
     if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
-    VectorXd out(nv_ + k);
+    if (out.size() != nv_ + k) throw std::invalid_argument("state has the wrong length");
     out.head(nv_) = v_;
     if (alpha != 0.0) pull_back(alpha, out);
-    force_ = Br_ * tau - hr_;
+    force_.noalias() = Br_ * tau;
+    force_ -= hr_;
     llt_.compute(Mr_);
-    out.tail(k) = llt_.solve(force_);
-    return out;
+    llt_.solveInPlace(force_);
+    out.tail(k) = force_;
+  }
+
+  // ------------------------------------------------------------------------------------------ simulation
+  // Where the row choice stops working (Fallback), `rechoose(q, nu)` (Python, with the GIL) returns the Python
+  // path's new (rows, independent, dependent), or raises the Python path's error: as the scipy path, which
+  // evaluates that state in Python.
+  template <class Eval>
+  void with_rechoice(const double* y, const py::object& rechoose, Eval&& eval) {
+    try {
+      eval();
+    } catch (const Fallback&) {
+      if (rechoose.is_none()) throw;
+      {
+        py::gil_scoped_acquire gil;
+        const int k = mobility();
+        py::tuple sel = rechoose(VectorXd(Eigen::Map<const VectorXd>(y, nv_)),
+                                 VectorXd(Eigen::Map<const VectorXd>(y + nv_, k)));
+        rows_ = sel[0].cast<std::vector<int>>();
+        if (!operational_) {
+          independent_ = sel[1].cast<std::vector<int>>();
+          dependent_ = sel[2].cast<std::vector<int>>();
+        }
+      }
+      eval();
+    }
+  }
+
+  // The ODE of simulate() with the torques of a profile: y = (q, nu), dy = d/dt y.
+  void deriv(double t, const std::vector<double>& y, std::vector<double>& dy, double alpha,
+             const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
+    const int k = mobility();
+    tau_.resize(profile.motors());
+    profile.eval(t, tau_);
+    dy.resize(y.size());
+    with_rechoice(y.data(), rechoose, [&] {
+      rhs_into(Eigen::Map<const VectorXd>(y.data(), nv_), Eigen::Map<const VectorXd>(y.data() + nv_, k), tau_,
+               alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k));
+    });
+  }
+
+  // Total mechanical energy [J] (kinetic 1/2 v^T M v, potential -sum m_i g . c_i as Pinocchio's
+  // computePotentialEnergy) and the largest holonomic residual at a state y = (q, nu).
+  void observe(const double* y, double& energy, double& residual, const py::object& rechoose) {
+    with_rechoice(y, rechoose, [&] {
+      configure(Eigen::Map<const VectorXd>(y, nv_));
+      dynamics(Eigen::Map<const VectorXd>(y + nv_, mobility()));
+    });
+    double potential = 0.0;
+    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) {
+      const pin::Inertia& Y = model_.inertias[i];
+      potential -= Y.mass() * gravity_.linear().dot(data_.oMi[i].act(Y.lever()));
+    }
+    energy = 0.5 * v_.dot(data_.M * v_) + potential;
+    residual = 0.0;
+    for (size_t r = 0; r < holonomic_.size(); ++r)
+      if (holonomic_[r]) residual = std::max(residual, std::fabs(residual_[r]));
+  }
+
+  // A whole simulation (robotdyn/compiled_simulation.py) from (t0, q0, nu0) to t_end with samples at `samples`
+  // (those >= t0). Runs without the GIL; every ~50 ms it takes the GIL to check for signals (Ctrl-C: status
+  // INTERRUPTED, the samples so far kept) and to call progress(t) (None: no call).
+  py::dict simulate(const VectorXd& q0, const VectorXd& nu0, double t0, double t_end,
+                    const std::vector<double>& samples, double rtol, double atol, double alpha,
+                    const robotdyn::TorqueProfile& profile, const std::vector<double>& breaks,
+                    const std::string& method, py::object progress, py::object rechoose) {
+    const int k = mobility();
+    if (q0.size() != nv_ || nu0.size() != k) throw std::invalid_argument("q0 or nu0 has the wrong length");
+    if (profile.motors() != static_cast<int>(motors_.size()))
+      throw std::invalid_argument("the torque profile is for another number of motors");
+    const int dim = nv_ + k;
+    robotdyn::State y0(dim);
+    Eigen::Map<VectorXd>(y0.data(), nv_) = q0;
+    Eigen::Map<VectorXd>(y0.data() + nv_, k) = nu0;
+    std::vector<double> ts, ys, energy, residual;
+    ts.reserve(samples.size());
+    ys.reserve(samples.size() * dim);
+    long nfev = 0;
+    auto system = [&](const robotdyn::State& x, robotdyn::State& dxdt, double t) {
+      ++nfev;
+      deriv(t, x, dxdt, alpha, profile, rechoose);
+    };
+    auto observer = [&](double t, const robotdyn::State& x) {
+      ts.push_back(t);
+      ys.insert(ys.end(), x.begin(), x.end());
+    };
+    bool interrupted = false;
+    auto poll = [&](double t) -> bool {
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {
+        if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
+          PyErr_Clear();
+          interrupted = true;
+          return false;
+        }
+        throw py::error_already_set();
+      }
+      if (!progress.is_none()) {
+        try {
+          progress(t);
+        } catch (py::error_already_set& e) {
+          if (!e.matches(PyExc_KeyboardInterrupt)) throw;
+          interrupted = true;
+          return false;
+        }
+      }
+      return true;
+    };
+    size_t next = 0;
+    while (next < samples.size() && samples[next] < t0) ++next;
+    robotdyn::Outcome out;
+    {
+      py::gil_scoped_release release;
+      out = robotdyn::integrate(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol, observer, poll);
+      energy.resize(ts.size());
+      residual.resize(ts.size());
+      for (size_t i = 0; i < ts.size(); ++i) observe(ys.data() + i * dim, energy[i], residual[i], rechoose);
+    }
+    const long N = static_cast<long>(ts.size());
+    py::dict result;
+    result["t"] = py::array_t<double>(N, ts.data());
+    py::array_t<double> y({N, static_cast<long>(dim)});
+    std::copy(ys.begin(), ys.end(), y.mutable_data());
+    result["y"] = y;
+    result["energy"] = py::array_t<double>(N, energy.data());
+    result["residual"] = py::array_t<double>(N, residual.data());
+    result["status"] = interrupted ? static_cast<int>(robotdyn::INTERRUPTED) : out.status;
+    result["t_stop"] = out.t;
+    result["y_stop"] = py::array_t<double>(static_cast<long>(out.y.size()), out.y.data());
+    result["message"] = out.message;
+    result["nfev"] = nfev;
+    result["steps"] = out.steps;
+    return result;
   }
 
   // Many states: stacked M_r (N, k, k), h (N, k), g (N, k), S (N, n, k), w (N, n), B_r (N, k, motors).
@@ -392,7 +536,10 @@ class Evaluator {
  private:
   // A_d^-1 x in place, with the LU factors (P A_d = L U): vector triangular solves, no temporaries
   void lu_solve(Eigen::Ref<VectorXd> x) {
-    x = lu_.permutationP() * x;
+    const auto& perm = lu_.permutationP().indices();  // (P x)[perm[i]] = x[i], without a temporary
+    perm_.resize(x.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) perm_[perm[i]] = x[i];
+    x = perm_;
     lu_.matrixLU().triangularView<Eigen::UnitLower>().solveInPlace(x);
     lu_.matrixLU().triangularView<Eigen::Upper>().solveInPlace(x);
   }
@@ -400,7 +547,10 @@ class Evaluator {
   void lu_solve_transposed(Eigen::Ref<VectorXd> x) {
     lu_.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(x);
     lu_.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(x);
-    x = lu_.permutationP().transpose() * x;
+    const auto& perm = lu_.permutationP().indices();  // (P^T x)[i] = x[perm[i]]
+    perm_.resize(x.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) perm_[i] = x[perm[i]];
+    x = perm_;
   }
   // LAPACK's estimate of ||A_d^-1||_1 (Hager and Higham, as Eigen's rcond estimate) with the solves above
   double inverse_norm_estimate() {
@@ -679,7 +829,7 @@ class Evaluator {
     }
   }
 
-  void pull_back(double alpha, VectorXd& out) {
+  void pull_back(double alpha, Eigen::Ref<VectorXd> out) {
     int nh = 0;
     bool any = false;
     for (size_t r = 0; r < holonomic_.size(); ++r)
@@ -725,6 +875,7 @@ class Evaluator {
   int op_frame_ = -1;
   bool op_local_ = true, operational_ = false, selected_ = false;
   // state and work buffers (sized on first use, then reused)
+  VectorXd tau_, perm_;
   VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_, est_v_, est_s_, est_old_;
   MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
@@ -745,7 +896,17 @@ class Evaluator {
 PYBIND11_MODULE(_compiled, m) {
   m.doc() = "robotdyn's compiled reduced-model evaluator (see robotdyn.compiled)";
   py::register_exception<Fallback>(m, "Fallback", PyExc_RuntimeError);
+  py::class_<robotdyn::TorqueProfile>(m, "TorqueProfile",
+                                      "motor torques as data (robotdyn.torque_profile): sum of constant, sine, table terms")
+      .def(py::init<int, const std::vector<int>&, const std::vector<MatrixXd>&, const std::vector<std::vector<double>>&>())
+      .def_property_readonly("motors", &robotdyn::TorqueProfile::motors)
+      .def("__call__", [](const robotdyn::TorqueProfile& p, double t) {
+        VectorXd out(p.motors());
+        p.eval(t, out);
+        return out;
+      });
   py::class_<Evaluator>(m, "Evaluator")
+      .def(py::init<const Evaluator&>(), "a copy (its own Pinocchio data and buffers)")
       .def(py::init<const std::vector<std::string>&, const std::vector<int>&, const std::vector<MatrixXd>&,
                     const std::vector<Vector3d>&, const std::vector<VectorXd>&, const Vector3d&>())
       .def("add_frame", &Evaluator::add_frame)
@@ -767,6 +928,13 @@ PYBIND11_MODULE(_compiled, m) {
       .def_property_readonly("w", &Evaluator::w, py::return_value_policy::reference_internal)
       .def_property_readonly("v", &Evaluator::v, py::return_value_policy::reference_internal)
       .def("rhs", &Evaluator::rhs)
+      .def("simulate", &Evaluator::simulate)
+      .def("observe", [](Evaluator& ev, const VectorXd& y) {
+        if (y.size() != ev.nv() + ev.mobility()) throw std::invalid_argument("y has the wrong length");
+        double e, r;
+        ev.observe(y.data(), e, r, py::none());
+        return py::make_tuple(e, r);
+      })
       .def("evaluate_many", &Evaluator::evaluate_many)
       .def_property_readonly("condition", &Evaluator::condition,
                              "1-norm condition number of the last projection's block: LAPACK's estimate below 1e8, "

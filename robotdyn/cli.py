@@ -221,14 +221,16 @@ def cmd_simulate(args) -> int:
     final = dict(zip(traj.coordinates + traj.velocity_names, np.concatenate([traj.q[-1], traj.nu[-1]])))
     out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,
            "energy_start": float(traj.energy[0]), "energy_end": float(traj.energy[-1]),
-           "max_holonomic_residual": drift, "wall_time_s": traj.stats["wall"], "csv": args.csv, "plot": args.plot}
+           "max_holonomic_residual": drift, "wall_time_s": traj.stats["wall"], "csv": args.csv, "plot": args.plot,
+           "engine": traj.stats.get("engine")}
     if tr is not None:
         out["traction"] = {"summary": tr.summary(), "wheels": tr.wheels, "undetermined": list(tr.undetermined),
                            "events": [vars(e) for e in tr.events],
                            "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)},
                            "min_normal_load": {w: float(np.min(tr.normal[:, j])) for j, w in enumerate(tr.wheels)}}
     text = [f"{args.robot} / {sc.name}: {sc.description}",
-            f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations)",
+            f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations, "
+            f"{traj.stats.get('engine', 'scipy')} engine)",
             "final state:", *(f"  {k:<14} {v: .8g}" for k, v in final.items()),
             f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
     if tr is not None:

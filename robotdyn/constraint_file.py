@@ -73,6 +73,7 @@ from .friction import LAWS, make_law
 from .robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
 from .scenario import Scenario
 from .terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
+from .torque_profile import Constant
 
 
 class ConstraintFileError(RobotDynError):
@@ -598,7 +599,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs) ->
             label = coordinate(where, k)
             nu0[f"{labels.get(label, label)}_dot"] = r.number(where, v, k)
         scenarios[name] = Scenario(name, str(s.get("description", f"constant torques {tau.tolist()}")), t_end,
-                                   (lambda tau: (lambda t, q, nu: tau))(tau), q0, nu0)
+                                   Constant(tau), q0, nu0)  # torques as data: simulated compiled
     return ConstraintFile(path, spec, scenarios)
 
 

@@ -19,9 +19,11 @@ than chased. The compiled path does the same in C++ (``robotdyn/_compiled.cpp``,
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
-from .errors import ConstraintError
+from .errors import ConstraintError, RobotDynError
 from .projection import RANK_TOL
 
 OFFSET_TOL = 1e-12
@@ -115,4 +117,33 @@ def weakest(A_h: np.ndarray, labels) -> tuple[float, str]:
     return float(s[rank - 1] / max(s[0], 1.0)), ", ".join(heavy)
 
 
-__all__ = ["correction", "offsets", "check_start", "MAX_CORRECTION", "describe_offsets", "weakest", "RANK_TOL", "OFFSET_TOL"]
+def start_offsets(robot, q0: np.ndarray, stabilisation: float) -> dict[str, float]:
+    """The holonomic residuals at q0 that no coordinate can change (reported once on stderr, kept as constant
+    offsets); raises where the pull-back cannot work (:func:`robotdyn.pull_back.check_start`)."""
+    rows = robot.rows_at(q0)
+    hol = rows.holonomic
+    found = check_start(rows.A[hol], rows.residual[hol], [lab for lab, h in zip(rows.labels, hol) if h],
+                        stabilisation)
+    if found:
+        print(f"simulate: {describe_offsets(found)}", file=sys.stderr, flush=True)
+    return found
+
+
+def failure_note(robot, q: np.ndarray, stabilisation: float) -> str:
+    """Where an integration failed with the pull-back on and nearly rank-deficient holonomic rows: the rows and
+    their relative singular value (else empty)."""
+    if not stabilisation or not np.all(np.isfinite(q)):
+        return ""
+    try:
+        rows = robot.rows_at(q)
+    except RobotDynError:  # the state is beyond the model (the integration's own error says why)
+        return ""
+    hol = rows.holonomic
+    s, names = weakest(rows.A[hol], [lab for lab, h in zip(rows.labels, hol) if h])
+    if s > 1e-6:
+        return ""
+    return (f" (the holonomic pull-back is ill-conditioned there: rows {names} have a relative singular value "
+            f"{s:.3g}; stabilisation = 0 turns it off)")
+
+
+__all__ = ["correction", "offsets", "check_start", "start_offsets", "failure_note", "MAX_CORRECTION", "describe_offsets", "weakest", "RANK_TOL", "OFFSET_TOL"]

@@ -32,8 +32,12 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <thread>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -165,6 +169,7 @@ class Evaluator {
       Matrix3d I;
       I << in[4], in[5], in[6], in[5], in[7], in[8], in[6], in[8], in[9];
       model_.appendBodyToJoint(id, pin::Inertia(in[0], Vector3d(in[1], in[2], in[3]), I), pin::SE3::Identity());
+      model_.inertias[id] = pin::Inertia(in[0], Vector3d(in[1], in[2], in[3]), I);  // exactly (set_model_vector)
     }
     gravity_ = pin::Motion(gravity, Vector3d::Zero());
     model_.gravity.setZero();  // gravity enters through g_ (see configure), so RNEA gives C v alone
@@ -389,8 +394,8 @@ class Evaluator {
       {
         py::gil_scoped_acquire gil;
         const int k = mobility();
-        py::tuple sel = rechoose(VectorXd(Eigen::Map<const VectorXd>(y, nv_)),
-                                 VectorXd(Eigen::Map<const VectorXd>(y + nv_, k)));
+        VectorXd q(Eigen::Map<const VectorXd>(y, nv_)), nu(Eigen::Map<const VectorXd>(y + nv_, k));
+        py::tuple sel = run_ < 0 ? rechoose(q, nu) : rechoose(run_, q, nu);
         rows_ = sel[0].cast<std::vector<int>>();
         if (!operational_) {
           independent_ = sel[1].cast<std::vector<int>>();
@@ -417,19 +422,241 @@ class Evaluator {
   // Total mechanical energy [J] (kinetic 1/2 v^T M v, potential -sum m_i g . c_i as Pinocchio's
   // computePotentialEnergy) and the largest holonomic residual at a state y = (q, nu).
   void observe(const double* y, double& energy, double& residual, const py::object& rechoose) {
-    with_rechoice(y, rechoose, [&] {
-      configure(Eigen::Map<const VectorXd>(y, nv_));
-      dynamics(Eigen::Map<const VectorXd>(y + nv_, mobility()));
-    });
+    with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
+    v_.noalias() = S_ * Eigen::Map<const VectorXd>(y + nv_, mobility());  // (no dynamics needed)
     double potential = 0.0;
     for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) {
       const pin::Inertia& Y = model_.inertias[i];
       potential -= Y.mass() * gravity_.linear().dot(data_.oMi[i].act(Y.lever()));
     }
-    energy = 0.5 * v_.dot(data_.M * v_) + potential;
+    energy = 0.5 * v_.dot(data_.M.selfadjointView<Eigen::Upper>() * v_) + potential;  // CRBA fills the upper part
     residual = 0.0;
     for (size_t r = 0; r < holonomic_.size(); ++r)
       if (holonomic_[r]) residual = std::max(residual, std::fabs(residual_[r]));
+  }
+
+  // ------------------------------------------------------------------------------------------ model vector
+  // The numbers this model is built from, in one vector (robotdyn/model_variants.py reads and writes the same
+  // layout): per joint its placement (R row-major, p: 12) and inertia (mass, lever, Ixx Ixy Ixz Iyy Iyz Izz about
+  // the centre of mass: 10); per frame its placement (12); per wheel its radius and axle (4); per coupling its law
+  // (amplitude, rate, phase, offset); the gravity (3).
+  VectorXd model_vector() const {
+    VectorXd x(model_vector_size());
+    Eigen::Index i = 0;
+    auto put_se3 = [&](const pin::SE3& M) {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) x[i++] = M.rotation()(r, c);
+      for (int r = 0; r < 3; ++r) x[i++] = M.translation()[r];
+    };
+    for (pin::JointIndex j = 1; j < static_cast<pin::JointIndex>(model_.njoints); ++j) {
+      put_se3(model_.jointPlacements[j]);
+      const pin::Inertia& Y = model_.inertias[j];
+      x[i++] = Y.mass();
+      for (int r = 0; r < 3; ++r) x[i++] = Y.lever()[r];
+      const Matrix3d I = Y.inertia().matrix();
+      for (auto [r, c] : {std::pair{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}}) x[i++] = I(r, c);
+    }
+    for (int f : frames_) put_se3(model_.frames[f].placement);
+    for (const Wheel& w : wheels_) {
+      x[i++] = w.radius;
+      for (int r = 0; r < 3; ++r) x[i++] = w.axis[r];
+    }
+    for (const Coupling& c : couplings_) {
+      x[i++] = c.amplitude;
+      x[i++] = c.rate;
+      x[i++] = c.phase;
+      x[i++] = c.offset;
+    }
+    for (int r = 0; r < 3; ++r) x[i++] = gravity_.linear()[r];
+    return x;
+  }
+  Eigen::Index model_vector_size() const {
+    return 22 * (model_.njoints - 1) + 12 * static_cast<Eigen::Index>(frames_.size()) +
+           4 * static_cast<Eigen::Index>(wheels_.size()) + 4 * static_cast<Eigen::Index>(couplings_.size()) + 3;
+  }
+  void set_model_vector(const double* x) {
+    Eigen::Index i = 0;
+    auto get_se3 = [&]() {
+      Matrix3d R;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R(r, c) = x[i++];
+      Vector3d p(x[i], x[i + 1], x[i + 2]);
+      i += 3;
+      return pin::SE3(R, p);
+    };
+    for (pin::JointIndex j = 1; j < static_cast<pin::JointIndex>(model_.njoints); ++j) {
+      model_.jointPlacements[j] = get_se3();
+      const double mass = x[i];
+      const Vector3d lever(x[i + 1], x[i + 2], x[i + 3]);
+      Matrix3d I;
+      I << x[i + 4], x[i + 5], x[i + 6], x[i + 5], x[i + 7], x[i + 8], x[i + 6], x[i + 8], x[i + 9];
+      i += 10;
+      model_.inertias[j] = pin::Inertia(mass, lever, I);
+    }
+    for (int f : frames_) model_.frames[f].placement = get_se3();
+    for (Wheel& w : wheels_) {
+      w.radius = x[i];
+      w.axis = Vector3d(x[i + 1], x[i + 2], x[i + 3]);
+      i += 4;
+    }
+    for (Coupling& c : couplings_) {
+      c.amplitude = x[i];
+      c.rate = x[i + 1];
+      c.phase = x[i + 2];
+      c.offset = x[i + 3];
+      i += 4;
+    }
+    gravity_ = pin::Motion(Vector3d(x[i], x[i + 1], x[i + 2]), Vector3d::Zero());
+  }
+  void set_model_vector_py(const VectorXd& x) {
+    if (x.size() != model_vector_size()) throw std::invalid_argument("model vector has the wrong length");
+    set_model_vector(x.data());
+  }
+
+  // ------------------------------------------------------------------------------------------ many runs
+  // N simulations on `threads` threads (robotdyn/batch.py: simulate_many), each thread with its own copy of this
+  // evaluator, the runs handed out one at a time; every run starts from this evaluator's row choice and, where
+  // `models` has rows, with its own model vector, so that its result does not depend on the thread or on the
+  // runs before it (the same numbers as Evaluator.simulate alone). A run that fails (constraints violated at its
+  // start, a non-finite state, a vanishing step, an error of the Python path where its rows had to be re-chosen)
+  // is recorded with its message; the others go on. The main thread waits without the GIL and takes it every
+  // 50 ms for signals (Ctrl-C: the runs under way stop, finished runs are kept) and progress(done).
+  py::dict simulate_many(const Eigen::Ref<const RowMat>& Q0, const Eigen::Ref<const RowMat>& NU0,
+                         const Eigen::Ref<const RowMat>& models, const std::vector<robotdyn::TorqueProfile*>& profiles,
+                         const std::vector<std::vector<double>>& breaks, double t_end,
+                         const std::vector<double>& samples, double rtol, double atol, double alpha,
+                         const std::string& method, int threads, py::object progress, py::object rechoose) {
+    const long N = static_cast<long>(Q0.rows());
+    const int k = mobility(), dim = nv_ + k;
+    const long S = static_cast<long>(samples.size());
+    if (Q0.cols() != nv_ || NU0.rows() != N || NU0.cols() != k) throw std::invalid_argument("q0 or nu0 shapes");
+    if (static_cast<long>(profiles.size()) != N || static_cast<long>(breaks.size()) != N)
+      throw std::invalid_argument("one torque profile and one breakpoint list per run expected");
+    if (models.rows() != 0 && (models.rows() != N || models.cols() != model_vector_size()))
+      throw std::invalid_argument("one model vector per run expected");
+    for (const auto* p : profiles)
+      if (p == nullptr || p->motors() != static_cast<int>(motors_.size()))
+        throw std::invalid_argument("a torque profile for another number of motors");
+    if (!selected_) throw Fallback("no projection chosen yet");
+    py::array_t<double> Y({N, S, static_cast<long>(dim)}), E({N, S}), R({N, S});
+    py::array_t<long> emitted(N), nfev(N), steps(N);
+    py::array_t<int> status(N);
+    std::vector<std::string> messages(N);
+    double* y_out = Y.mutable_data();
+    double* e_out = E.mutable_data();
+    double* r_out = R.mutable_data();
+    long* emitted_out = emitted.mutable_data();
+    long* nfev_out = nfev.mutable_data();
+    long* steps_out = steps.mutable_data();
+    int* status_out = status.mutable_data();
+    std::fill(emitted_out, emitted_out + N, 0L);
+    std::fill(nfev_out, nfev_out + N, 0L);
+    std::fill(steps_out, steps_out + N, 0L);
+    std::fill(status_out, status_out + N, -1);  // not run
+    std::atomic<long> next_run{0}, done{0};
+    std::atomic<bool> stop{false};
+    const int nthreads = std::max(1, std::min<int>(threads, static_cast<int>(std::max<long>(N, 1))));
+    auto worker = [&]() {
+      Evaluator ev(*this);
+      for (long i = next_run++; i < N && !stop.load(); i = next_run++) {
+        ev.run_ = static_cast<int>(i);
+        ev.rows_ = rows_;
+        ev.independent_ = independent_;
+        ev.dependent_ = dependent_;
+        if (models.rows()) ev.set_model_vector(models.row(i).data());
+        double* yi = y_out + i * S * dim;
+        double* ei = e_out + i * S;
+        double* ri = r_out + i * S;
+        long count = 0, evals = 0;
+        try {
+          robotdyn::State y0(dim);
+          Eigen::Map<VectorXd>(y0.data(), nv_) = Q0.row(i).transpose();
+          Eigen::Map<VectorXd>(y0.data() + nv_, k) = NU0.row(i).transpose();
+          ev.check_start(y0.data(), rechoose);
+          auto system = [&](const robotdyn::State& x, robotdyn::State& dxdt, double t) {
+            ++evals;
+            ev.deriv(t, x, dxdt, alpha, *profiles[i], rechoose);
+          };
+          auto observer = [&](double, const robotdyn::State& x) {
+            std::copy(x.begin(), x.end(), yi + count * dim);
+            ++count;
+          };
+          auto poll = [&](double) { return !stop.load(); };
+          size_t next = 0;
+          robotdyn::Outcome out = robotdyn::integrate(method, system, y0, 0.0, t_end, samples, next, breaks[i], rtol,
+                                                      atol, observer, poll);
+          for (long j = 0; j < count; ++j) ev.observe(yi + j * dim, ei[j], ri[j], rechoose);
+          status_out[i] = out.status;
+          if (out.status == robotdyn::FAILED)
+            messages[i] = "integration failed at t = " + std::to_string(out.t) + " s: " + out.message;
+          else if (out.status == robotdyn::INTERRUPTED)
+            messages[i] = "interrupted at t = " + std::to_string(out.t) + " s";
+          steps_out[i] = out.steps;
+        } catch (py::error_already_set& e) {
+          py::gil_scoped_acquire gil;
+          status_out[i] = robotdyn::FAILED;
+          messages[i] = e.what();
+        } catch (const std::exception& e) {
+          status_out[i] = robotdyn::FAILED;
+          messages[i] = e.what();
+        }
+        emitted_out[i] = count;
+        nfev_out[i] = evals;
+        ++done;
+      }
+    };
+    bool interrupted = false;
+    std::optional<py::error_already_set> pending;  // an exception of a signal handler or of progress
+    {
+      py::gil_scoped_release release;
+      std::vector<std::thread> pool;
+      for (int t = 0; t < nthreads; ++t) pool.emplace_back(worker);
+      long reported = -1;
+      while (done.load() < N && !stop.load()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) {
+          if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
+            PyErr_Clear();
+            interrupted = true;
+          } else {
+            pending.emplace();  // fetches the error
+          }
+          stop = true;
+        } else if (!progress.is_none() && done.load() != reported) {
+          reported = done.load();
+          try {
+            progress(reported, N);
+          } catch (py::error_already_set& e) {
+            if (e.matches(PyExc_KeyboardInterrupt)) interrupted = true;
+            else pending.emplace(e);
+            stop = true;
+          }
+        }
+      }
+      for (auto& th : pool) th.join();  // without the GIL: a run may need it to re-choose its rows
+    }
+    if (pending) throw *pending;
+    py::dict result;
+    result["y"] = Y;
+    result["energy"] = E;
+    result["residual"] = R;
+    result["emitted"] = emitted;
+    result["nfev"] = nfev;
+    result["steps"] = steps;
+    result["status"] = status;
+    result["messages"] = messages;
+    result["interrupted"] = interrupted;
+    return result;
+  }
+
+  // The start of a run: the holonomic residuals within 1e-6 (Robot.check_constraints' tolerance).
+  void check_start(const double* y, const py::object& rechoose) {
+    with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
+    for (size_t r = 0; r < holonomic_.size(); ++r)
+      if (holonomic_[r] && !(std::fabs(residual_[r]) <= 1e-6))
+        throw std::invalid_argument("q0 violates holonomic row #" + std::to_string(r) + " by " +
+                                    std::to_string(residual_[r]) + "; expected |residual| <= 1e-06");
   }
 
   // A whole simulation (robotdyn/compiled_simulation.py) from (t0, q0, nu0) to t_end with samples at `samples`
@@ -536,20 +763,42 @@ class Evaluator {
  private:
   // A_d^-1 x in place, with the LU factors (P A_d = L U): vector triangular solves, no temporaries
   void lu_solve(Eigen::Ref<VectorXd> x) {
-    const auto& perm = lu_.permutationP().indices();  // (P x)[perm[i]] = x[i], without a temporary
-    perm_.resize(x.size());
-    for (Eigen::Index i = 0; i < x.size(); ++i) perm_[perm[i]] = x[i];
+    // substitutions written out: for the small blocks of a projection they cost a fraction of Eigen's generic
+    // triangular solvers
+    const MatrixXd& LU = lu_.matrixLU();
+    const auto& perm = lu_.permutationP().indices();  // (P x)[perm[i]] = x[i]
+    const Eigen::Index n = x.size();
+    perm_.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) perm_[perm[i]] = x[i];
+    for (Eigen::Index i = 1; i < n; ++i) {  // L (unit lower)
+      double s = perm_[i];
+      for (Eigen::Index j = 0; j < i; ++j) s -= LU(i, j) * perm_[j];
+      perm_[i] = s;
+    }
+    for (Eigen::Index i = n - 1; i >= 0; --i) {  // U
+      double s = perm_[i];
+      for (Eigen::Index j = i + 1; j < n; ++j) s -= LU(i, j) * perm_[j];
+      perm_[i] = s / LU(i, i);
+    }
     x = perm_;
-    lu_.matrixLU().triangularView<Eigen::UnitLower>().solveInPlace(x);
-    lu_.matrixLU().triangularView<Eigen::Upper>().solveInPlace(x);
   }
-  // A_d^-T x in place
+  // A_d^-T x in place (A_d = P^T L U, so A_d^T = U^T L^T P)
   void lu_solve_transposed(Eigen::Ref<VectorXd> x) {
-    lu_.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(x);
-    lu_.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(x);
+    const MatrixXd& LU = lu_.matrixLU();
+    const Eigen::Index n = x.size();
+    for (Eigen::Index i = 0; i < n; ++i) {  // U^T (lower)
+      double s = x[i];
+      for (Eigen::Index j = 0; j < i; ++j) s -= LU(j, i) * x[j];
+      x[i] = s / LU(i, i);
+    }
+    for (Eigen::Index i = n - 2; i >= 0; --i) {  // L^T (unit upper)
+      double s = x[i];
+      for (Eigen::Index j = i + 1; j < n; ++j) s -= LU(j, i) * x[j];
+      x[i] = s;
+    }
     const auto& perm = lu_.permutationP().indices();  // (P^T x)[i] = x[perm[i]]
-    perm_.resize(x.size());
-    for (Eigen::Index i = 0; i < x.size(); ++i) perm_[i] = x[perm[i]];
+    perm_.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) perm_[i] = x[perm[i]];
     x = perm_;
   }
   // LAPACK's estimate of ||A_d^-1||_1 (Hager and Higham, as Eigen's rcond estimate) with the solves above
@@ -888,6 +1137,7 @@ class Evaluator {
   std::vector<Matrix6x> Jf_;
   std::vector<MatrixXd> Aw_;
   const double* buffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  int run_ = -1;  // the run a batch thread is on (its rechoice callback gets it), -1 alone
   long generation_ = 0;
 };
 
@@ -929,6 +1179,9 @@ PYBIND11_MODULE(_compiled, m) {
       .def_property_readonly("v", &Evaluator::v, py::return_value_policy::reference_internal)
       .def("rhs", &Evaluator::rhs)
       .def("simulate", &Evaluator::simulate)
+      .def("simulate_many", &Evaluator::simulate_many)
+      .def("model_vector", &Evaluator::model_vector)
+      .def("set_model_vector", &Evaluator::set_model_vector_py)
       .def("observe", [](Evaluator& ev, const VectorXd& y) {
         if (y.size() != ev.nv() + ev.mobility()) throw std::invalid_argument("y has the wrong length");
         double e, r;

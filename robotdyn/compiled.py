@@ -185,6 +185,8 @@ class CompiledModel:
                 frames[fid] = ev.add_frame(int(f.parentJoint), _placement(f.placement))
             return frames[fid]
 
+        self.wheels = [c for c in self.constraints if isinstance(c, RollingWheel)]
+        self.couplings = [c for c in self.constraints if isinstance(c, JointCoupling)]
         for c in self.constraints:
             if isinstance(c, RollingWheel):
                 ev.set_terrain(*_terrain_code(c.terrain))
@@ -202,6 +204,7 @@ class CompiledModel:
             tw = self.operational.twist
             self._op = (frame(tw.fid), [int(s) for s in tw.select], tw.axes == "local")
         self.ev = ev
+        self.frame_ids = sorted(frames, key=frames.get)  # Pinocchio frame ids in the evaluator's order
         rows = robot.rows_at(robot.neutral())
         self.labels, self.holonomic = rows.labels, rows.holonomic
         self._check_model()

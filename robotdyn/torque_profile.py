@@ -44,7 +44,14 @@ class TorqueProfile:
     @property
     def motors(self) -> int:
         """Number of motors (length of the torque vector)."""
-        return self._terms()[0][1].shape[-1]
+        return self._all()[0][1].shape[-1]
+
+    def _all(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        """:meth:`_terms`, built once (profiles are not changed after construction)."""
+        terms = self.__dict__.get("_cache")
+        if terms is None:
+            terms = self.__dict__["_cache"] = self._terms()
+        return terms
 
     def _terms(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
         """``(kind, coefficients, parameters)`` per term (see :meth:`encode`)."""
@@ -53,8 +60,9 @@ class TorqueProfile:
     def __call__(self, t: float, q=None, nu=None) -> np.ndarray:
         """The motor torques at time t [s] (q, nu ignored: the scipy path's ``tau(t, q, nu)`` signature)."""
         t = float(t)
-        out = np.zeros(self.motors)
-        for kind, coef, par in self._terms():
+        terms = self._all()
+        out = np.zeros(terms[0][1].shape[-1])
+        for kind, coef, par in terms:
             if kind == CONSTANT:
                 out = out + coef
             elif kind == SINE:
@@ -67,7 +75,7 @@ class TorqueProfile:
     def breakpoints(self) -> np.ndarray:
         """Sorted times [s] where the profile or its derivative jumps (window edges, table knots)."""
         points = []
-        for kind, _, par in self._terms():
+        for kind, _, par in self._all():
             if kind == SINE:
                 points += [x for x in par[2:4] if math.isfinite(x)]
             elif kind == TABLE:
@@ -77,7 +85,7 @@ class TorqueProfile:
     def encode(self) -> tuple[list[int], list[np.ndarray], list[np.ndarray]]:
         """The terms as the C++ side reads them: kinds, coefficient arrays ((motors,) or (points, motors)) and
         parameter arrays (sine: omega [rad/s], phase [rad], window start and end [s]; table: the times [s])."""
-        terms = self._terms()
+        terms = self._all()
         return ([k for k, _, _ in terms], [np.ascontiguousarray(c, float) for _, c, _ in terms],
                 [np.ascontiguousarray(p, float) for _, _, p in terms])
 
@@ -89,7 +97,7 @@ class TorqueProfile:
     def __eq__(self, other) -> bool:
         if not isinstance(other, TorqueProfile):
             return NotImplemented
-        a, b = self._terms(), other._terms()
+        a, b = self._all(), other._all()
         return len(a) == len(b) and all(ka == kb and np.array_equal(ca, cb) and np.array_equal(pa, pb)
                                         for (ka, ca, pa), (kb, cb, pb) in zip(a, b))
 

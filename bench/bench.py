@@ -140,6 +140,7 @@ def main() -> None:
     forces_bench()
     startup_bench()
     compiled_engine_bench()
+    compiled_forces_bench()
     simulate_many_bench()
 
 
@@ -216,6 +217,28 @@ def compiled_engine_bench() -> None:
         drift = float(np.ptp(traj.energy[traj.t > 1.0]))
         print(f"{label:<28} {1e3 * min(walls) / t_end:>11.3f} {traj.stats['nfev']:>7d} "
               f"{np.max(np.abs(traj.q - ref.q)):>17.2e} {np.max(np.abs(traj.nu - ref.nu)):>19.2e} {drift:>13.2e}")
+
+
+def compiled_forces_bench() -> None:
+    """Constraint forces in the compiled evaluation (CompiledModel.forces: forward dynamics, lambda on the
+    projection's rows by the LU factors of A_d, per-wheel contact-frame forces) against the compiled evaluation
+    alone (CompiledModel.compute), both returning views: median of 7 batches of 5000 calls, interleaved."""
+    print(f"\n{'robot':<20} {'compute [us]':>13} {'forces [us]':>12} {'added':>7}   robot.contact_forces [us]")
+    for name in names():
+        robot = robotdyn.load(name)
+        rng = np.random.default_rng(3)
+        q, nu = robot.neutral(), 0.3 * rng.normal(size=robot.mobility)
+        tau = 0.1 * rng.normal(size=len(robot.motors))
+        fast = compiled_model(robot)
+        if fast is None:
+            continue
+        fast.forces(q, nu, tau)
+        pairs = [(timeit(lambda: fast.compute(q, nu), repeat=1, number=5000),
+                  timeit(lambda: fast.forces(q, nu, tau), repeat=1, number=5000)) for _ in range(7)]
+        t_c = statistics.median(p[0] for p in pairs)
+        t_f = statistics.median(p[1] for p in pairs)
+        t_api = timeit(lambda: robot.contact_forces(q, nu, tau=tau), number=50)
+        print(f"{name:<20} {t_c * 1e6:>13.2f} {t_f * 1e6:>12.2f} {100 * (t_f / t_c - 1):>6.0f}%   {t_api * 1e6:>8.0f}")
 
 
 def simulate_many_bench(runs: int = 10_000) -> None:

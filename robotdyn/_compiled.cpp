@@ -22,6 +22,7 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 
+#include <Eigen/QR>
 #include <Eigen/SVD>
 
 #include "_integrator.hpp"
@@ -135,6 +136,8 @@ struct Geometry {  // configuration-level quantities of one wheel
   Vector3d a, u, n, t1, t2;
   Matrix3d N;  // dn/dp on a curved terrain
   double na, nw, nc1, R;
+  Vector3d p;  // contact point (world)
+  int row;     // the wheel's first row
 };
 
 inline Matrix3d skew(const Vector3d& x) {
@@ -434,6 +437,102 @@ class Evaluator {
     for (size_t r = 0; r < holonomic_.size(); ++r)
       if (holonomic_[r]) residual = std::max(residual, std::fabs(residual_[r]));
   }
+
+  // ------------------------------------------------------------------------------------------ constraint forces
+  // lambda of A^T lambda = e, e = M a + C v + g - B tau (robotdyn/contact_forces.py), on the rows the projection
+  // uses: with the LU factors of A_d (the projection's own factorisation), A_d^T lambda_r = e_d; with operational
+  // velocities by the projection's K^-1 (K = [A_r; J_o]). Rows outside the projection's choice (redundant ones) get zero: lambda is the
+  // basic solution, equal to every other solution on the rows that rigid-body dynamics determine (the Python side
+  // reports the others with the null space of A^T). After dynamics() (forward: nudot from the torques) or with a
+  // given full acceleration a (forces_at).
+  void lambda_from(const Eigen::Ref<const VectorXd>& tau) {
+    force_.noalias() = B_ * tau;
+    e_ -= force_;
+    lambda_.setZero(nrows());
+    const int nr = static_cast<int>(rows_.size());
+    if (!nr) return;
+    if (operational_) {  // K = [A_r; J_o] with K S = [0; I]: K^T (lambda_r, 0) = e, so lambda_r = (K^-T e)_head
+      lr_.noalias() = Kinv_.transpose() * e_;
+      lr_.conservativeResize(nr);
+    } else {
+      lr_.resize(nr);
+      for (int r = 0; r < nr; ++r) lr_[r] = e_[dependent_[r]];
+      lu_solve_transposed(lr_);
+    }
+    for (int r = 0; r < nr; ++r) lambda_[rows_[r]] = lr_[r];
+  }
+
+  // Forward dynamics at (q, nu, tau) and the constraint forces, into buffers read through the views nudot, lam,
+  // e, wheel_local (nw, 3) along (t1, t2, n), wheel_world, wheel_frames (nw, 9: t1, t2, n), contact_points; returns
+  // a counter that changes whenever a buffer moved (as compute).
+  long forces(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+              const Eigen::Ref<const VectorXd>& tau) {
+    if (tau.size() != static_cast<Eigen::Index>(motors_.size())) throw std::invalid_argument("tau has the wrong length");
+    configure(q);
+    dynamics(nu);
+    force_.noalias() = Br_ * tau;
+    force_ -= hr_;
+    llt_.compute(Mr_);
+    if (llt_.info() != Eigen::Success) throw Fallback("reduced mass matrix not positive definite");
+    nudot_ = force_;
+    llt_.solveInPlace(nudot_);
+    a_ = w_;
+    a_.noalias() += S_ * nudot_;
+    e_ = data_.tau;  // C v + g (dynamics)
+    e_.noalias() += data_.M * a_;
+    lambda_from(tau);
+    fill_wheel_forces();
+    const double* now[7] = {nudot_.data(), lambda_.data(), e_.data(), wl_.data(), ww_.data(), wf_.data(), wp_.data()};
+    for (int i = 0; i < 7; ++i)
+      if (now[i] != fbuffers_[i]) {
+        std::copy(now, now + 7, fbuffers_);
+        ++fgeneration_;
+        break;
+      }
+    return fgeneration_;
+  }
+
+  // The same for given full velocities v and accelerations a (inverse dynamics): (lambda, e, wheel forces, A).
+  py::tuple forces_at(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& v,
+                      const Eigen::Ref<const VectorXd>& a, const Eigen::Ref<const VectorXd>& tau) {
+    if (v.size() != nv_ || a.size() != nv_ || tau.size() != static_cast<Eigen::Index>(motors_.size()))
+      throw std::invalid_argument("v, a or tau has the wrong length");
+    configure(q);
+    pin::rnea(model_, data_, q_, v, a);  // without gravity: M a + C v
+    e_ = data_.tau + g_;
+    lambda_from(tau);
+    return py::make_tuple(lambda_, e_, wheel_forces(), A_);
+  }
+
+  // Per wheel: the force along (t1, t2, n), the same in world axes, the contact frame (rows t1, t2, n: (nw, 9),
+  // row-major) and the contact point (nw, 3).
+  void fill_wheel_forces() {
+    const int nw = static_cast<int>(wheels_.size());
+    wl_.resize(nw, 3);
+    ww_.resize(nw, 3);
+    wf_.resize(nw, 9);
+    wp_.resize(nw, 3);
+    for (int i = 0; i < nw; ++i) {
+      const Geometry& g = geo_[i];
+      const Wheel& wh = wheels_[i];
+      const Vector3d f = wh.D.transpose() * lambda_.segment(g.row, wh.D.rows());
+      wl_.row(i) = f.transpose();
+      ww_.row(i) = (f[0] * g.t1 + f[1] * g.t2 + f[2] * g.n).transpose();
+      wf_.row(i) << g.t1.transpose(), g.t2.transpose(), g.n.transpose();
+      wp_.row(i) = g.p.transpose();
+    }
+  }
+  py::tuple wheel_forces() {
+    fill_wheel_forces();
+    return py::make_tuple(wl_, ww_, wf_, wp_);
+  }
+  const VectorXd& nudot() const { return nudot_; }
+  const VectorXd& lam() const { return lambda_; }
+  const VectorXd& e() const { return e_; }
+  const RowMat& wheel_local() const { return wl_; }
+  const RowMat& wheel_world() const { return ww_; }
+  const RowMat& wheel_frames() const { return wf_; }
+  const RowMat& contact_points() const { return wp_; }
 
   // ------------------------------------------------------------------------------------------ model vector
   // The numbers this model is built from, in one vector (robotdyn/model_variants.py reads and writes the same
@@ -849,6 +948,7 @@ class Evaluator {
     const Wheel& wh = wheels_[i];
     const pin::SE3& oMf = data_.oMf[frames_[wh.frame]];
     Geometry& g = geo_[i];
+    g.row = row;
     g.R = wh.radius;
     if (wh.radius_index >= 0) {
       g.R += q_[wh.radius_index];
@@ -881,6 +981,7 @@ class Evaluator {
     }
     if (it == 100) throw Fallback("contact point did not converge");
     g.n = n;
+    g.p = p;
     double f;
     Eigen::Vector2d grad;
     Eigen::Matrix2d H;
@@ -1124,7 +1225,10 @@ class Evaluator {
   int op_frame_ = -1;
   bool op_local_ = true, operational_ = false, selected_ = false;
   // state and work buffers (sized on first use, then reused)
-  VectorXd tau_, perm_;
+  VectorXd tau_, perm_, e_, lambda_, lr_, nudot_, a_;
+  RowMat wl_, ww_, wf_, wp_;
+  const double* fbuffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  long fgeneration_ = 0;
   VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_, est_v_, est_s_, est_old_;
   MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
@@ -1180,6 +1284,16 @@ PYBIND11_MODULE(_compiled, m) {
       .def("rhs", &Evaluator::rhs)
       .def("simulate", &Evaluator::simulate)
       .def("simulate_many", &Evaluator::simulate_many)
+      .def("forces", &Evaluator::forces)
+      .def_property_readonly("nudot", &Evaluator::nudot, py::return_value_policy::reference_internal)
+      .def_property_readonly("lam", &Evaluator::lam, py::return_value_policy::reference_internal)
+      .def_property_readonly("e", &Evaluator::e, py::return_value_policy::reference_internal)
+      .def_property_readonly("wheel_local", &Evaluator::wheel_local, py::return_value_policy::reference_internal)
+      .def_property_readonly("wheel_world", &Evaluator::wheel_world, py::return_value_policy::reference_internal)
+      .def_property_readonly("wheel_frames", &Evaluator::wheel_frames, py::return_value_policy::reference_internal)
+      .def_property_readonly("contact_points", &Evaluator::contact_points,
+                             py::return_value_policy::reference_internal)
+      .def("forces_at", &Evaluator::forces_at)
       .def("model_vector", &Evaluator::model_vector)
       .def("set_model_vector", &Evaluator::set_model_vector_py)
       .def("observe", [](Evaluator& ev, const VectorXd& y) {

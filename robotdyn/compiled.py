@@ -319,6 +319,40 @@ class CompiledModel:
             self._choose(q, nu)
         return self.ev.rhs(q, nu, tau, stabilisation)
 
+    def forces(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tuple:
+        """Forward dynamics and constraint forces in one call, without copies (views overwritten by the next call,
+        as :meth:`compute`): ``(nudot, lambda, e, wheel forces (nw, 3) along (t1, t2, n), the same in world axes,
+        contact frames (nw, 9: rows t1, t2, n), contact points (nw, 3))``, with
+        :math:`A^T\\lambda = e = Ma + Cv + g - B\\tau` solved on the projection's rows by the LU factors of
+        :math:`A_d` (the projection's own factorisation; operational velocities: its :math:`K^{-1}`) and zero on
+        redundant rows (the basic solution: equal to any other on the rows rigid-body dynamics determine;
+        :mod:`robotdyn.contact_forces` reports the others).
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, nu)
+        generation = self.ev.forces(q, nu, tau)
+        if generation != getattr(self, "_fgeneration", None):
+            ev = self.ev
+            self._fviews = (ev.nudot, ev.lam, ev.e, ev.wheel_local, ev.wheel_world, ev.wheel_frames,
+                            ev.contact_points)
+            self._fgeneration = generation
+        return self._fviews
+
+    def forces_at(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau: np.ndarray) -> tuple:
+        """The constraint forces at given full velocities v and accelerations a (inverse dynamics):
+        ``(lambda, e, (wheel forces, world forces, frames, points), A)`` as :meth:`forces` (copies), with the
+        constraint rows A (rows in :attr:`labels`' order).
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, np.zeros(self.robot.mobility))
+        return self.ev.forces_at(q, v, a, tau)
+
     def evaluate_many(self, Q: np.ndarray, NU: np.ndarray) -> tuple:
         """Many states in one call: ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n),
         B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path."""

@@ -285,12 +285,17 @@ class Evaluator {
         B_(mo.index, j) = 1.0;
         continue;
       }
-      Jc_.setZero(6, nv_);
-      pin::getJointJacobian(model_, data_, mo.joint, pin::LOCAL_WORLD_ALIGNED, Jc_);
-      Vector3d ang = Jc_.block<3, 1>(3, mo.index);
-      Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(Jc_.block<3, 1>(0, mo.index));
-      B_.col(j).noalias() = Jc_.bottomRows<3>().transpose() * axis;
-      B_.col(j).noalias() -= Jf_[mo.reaction].bottomRows<3>().transpose() * axis;
+      // the joint's angular Jacobian is CRBA's world one (data_.J) on its supporting joints' columns (an angular
+      // velocity does not depend on the reference point), so no Jacobian of the joint is assembled; a prismatic
+      // joint's column is its axis in either convention
+      const Vector3d ang = data_.J.col(mo.index).tail<3>();
+      const Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(data_.J.col(mo.index).head<3>());
+      B_.col(j).noalias() = -(Jf_[mo.reaction].bottomRows<3>().transpose() * axis);
+      for (const pin::JointIndex s : model_.supports[mo.joint]) {
+        if (s == 0) continue;
+        const int c0 = model_.joints[s].idx_v();
+        for (int c = c0; c < c0 + model_.joints[s].nv(); ++c) B_(c, j) += data_.J.col(c).tail<3>().dot(axis);
+      }
     }
     project();
   }

@@ -18,7 +18,9 @@ a plane, a sine or a bump terrain of :mod:`robotdyn.terrain`, loop closures and 
 the Python path. The row choice of the projection is the Python path's (its last projection); where that choice
 stops working (a singular block, rows that no longer span, a wheel lying flat) the evaluation falls back to the
 Python path, which re-chooses or raises its usual error. ``ROBOTDYN_COMPILED=0`` in the environment, or
-:func:`use_compiled` ``(False)``, turns the fast path off. ``tests/test_compiled.py`` checks every output against
+:func:`use_compiled` ``(False)``, turns the fast path off. The same C++ object also runs whole simulations
+(:mod:`robotdyn.compiled_simulation`, :mod:`robotdyn.many_runs`) and gives the constraint forces
+(:meth:`CompiledModel.forces`). ``tests/test_compiled.py`` checks every output against
 the Python path on every robot.
 """
 

@@ -25,6 +25,7 @@ against it to 1e-8 on every compiled robot.
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +34,9 @@ from .errors import NonFiniteError, RobotDynError
 from .pull_back import failure_note
 from .sliding import slipping_wheels
 from .torque_profile import TorqueProfile, as_profile
+
+if TYPE_CHECKING:
+    from .simulation import Trajectory
 
 METHODS = ("adams", "bulirsch_stoer", "dopri5")
 """The compiled integrators (Boost.Odeint steppers); the first is the default."""

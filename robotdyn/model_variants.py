@@ -72,8 +72,6 @@ def variant(robot, vector: np.ndarray):
         robot: A :class:`~robotdyn.robot.Robot` with a compiled model.
         vector: A model vector of its layout (:func:`model_vector`).
     """
-    from .compiled import CompiledModel  # noqa: F401  (the layout is the compiled model's)
-
     fast = _fast(robot)
     vector = np.asarray(vector, float)
     if vector.shape != (fast.ev.model_vector().size,):

@@ -5,7 +5,6 @@ values; what cannot vary without a rebuild is refused in one line."""
 
 from __future__ import annotations
 
-import os
 import pickle
 import signal
 import subprocess

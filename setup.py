@@ -30,6 +30,7 @@ def _extension() -> list[Extension]:
         Extension(
             "robotdyn._compiled",
             ["robotdyn/_compiled.cpp"],
+            depends=["robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp"],
             include_dirs=[pybind11.get_include(), *pinocchio, *(str(Path(e) / "eigen3") for e in eigen)],
             define_macros=[
                 ("NDEBUG", None),
@@ -38,7 +39,8 @@ def _extension() -> list[Extension]:
                 ("BOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", None),
                 ("BOOST_FUSION_INVOKE_MAX_ARITY", "12"),
             ],
-            extra_compile_args=["-std=c++17", "-O2", "-g0", "-fvisibility=hidden", "-w"],
+            extra_compile_args=["-std=c++17", "-O2", "-g0", "-fvisibility=hidden", "-w",
+                                "-ffp-contract=off"],  # torque profiles: the same bits as in Python
             language="c++",
             optional=True,
         )

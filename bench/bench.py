@@ -139,6 +139,9 @@ def main() -> None:
 
     forces_bench()
     startup_bench()
+    compiled_engine_bench()
+    compiled_forces_bench()
+    simulate_many_bench()
 
 
 def startup_bench() -> None:
@@ -186,6 +189,78 @@ def forces_bench() -> None:
     t_roll = time.perf_counter() - start
     print(f"skid-steer 'straight', 2 s: slipping wheels {t_slip:.2f} s wall ({traj.stats['nfev']} evaluations), "
           f"rolling wheels {t_roll:.2f} s ({other.stats['nfev']}): ratio {t_slip / t_roll:.1f}")
+
+
+# ------------------------------------------------------------------ compiled simulation engine (issue 17, items 1, 2)
+def compiled_engine_bench() -> None:
+    """The whole simulation in C++ (robotdyn.compiled_simulation) against the scipy path on Quasimoro's rectilinear
+    manoeuvre (90 s, default tolerances rtol 1e-10, atol 1e-12): cost per simulated second (best of 5 whole
+    simulate() calls, 2 for scipy, after a warm-up), evaluations, deviation from the scipy trajectory, energy drift
+    after the pulse."""
+    robot = robotdyn.load("quasimoro")
+    sc = module("quasimoro").SCENARIOS["rectilinear"]
+    t_end = 90.0
+    print(f"\nquasimoro rectilinear {t_end:g} s, whole simulate() call (best of 5; scipy: of 2), default tolerances:")
+    print(f"{'engine':<28} {'ms / sim s':>11} {'evals':>7} {'max|q - q_scipy|':>17} {'max|nu - nu_scipy|':>19} "
+          f"{'energy drift':>13}")
+    ref = None
+    for label, kw in (("scipy (DOP853)", dict(engine="scipy")), ("compiled (adams)", {}),
+                      ("compiled (bulirsch_stoer)", dict(method="bulirsch_stoer")),
+                      ("compiled (dopri5)", dict(method="dopri5"))):
+        sc.run(robot, t_end=1.0, progress=False, **kw)  # warm: imports, the compiled model, the projection
+        walls = []
+        for _ in range(2 if ref is None else 5):
+            start = time.perf_counter()
+            traj = sc.run(robot, t_end=t_end, progress=False, **kw)
+            walls.append(time.perf_counter() - start)
+        ref = traj if ref is None else ref
+        drift = float(np.ptp(traj.energy[traj.t > 1.0]))
+        print(f"{label:<28} {1e3 * min(walls) / t_end:>11.3f} {traj.stats['nfev']:>7d} "
+              f"{np.max(np.abs(traj.q - ref.q)):>17.2e} {np.max(np.abs(traj.nu - ref.nu)):>19.2e} {drift:>13.2e}")
+
+
+def compiled_forces_bench() -> None:
+    """Constraint forces in the compiled evaluation (CompiledModel.forces: forward dynamics, lambda on the
+    projection's rows by the LU factors of A_d, per-wheel contact-frame forces) against the compiled evaluation
+    alone (CompiledModel.compute), both returning views: median of 7 batches of 5000 calls, interleaved."""
+    print(f"\n{'robot':<20} {'compute [us]':>13} {'forces [us]':>12} {'added':>7}   robot.contact_forces [us]")
+    for name in names():
+        robot = robotdyn.load(name)
+        rng = np.random.default_rng(3)
+        q, nu = robot.neutral(), 0.3 * rng.normal(size=robot.mobility)
+        tau = 0.1 * rng.normal(size=len(robot.motors))
+        fast = compiled_model(robot)
+        if fast is None:
+            continue
+        fast.forces(q, nu, tau)
+        pairs = [(timeit(lambda: fast.compute(q, nu), repeat=1, number=5000),
+                  timeit(lambda: fast.forces(q, nu, tau), repeat=1, number=5000)) for _ in range(7)]
+        t_c = statistics.median(p[0] for p in pairs)
+        t_f = statistics.median(p[1] for p in pairs)
+        t_api = timeit(lambda: robot.contact_forces(q, nu, tau=tau), number=50)
+        print(f"{name:<20} {t_c * 1e6:>13.2f} {t_f * 1e6:>12.2f} {100 * (t_f / t_c - 1):>6.0f}%   {t_api * 1e6:>8.0f}")
+
+
+def simulate_many_bench(runs: int = 10_000) -> None:
+    """robotdyn.batch.simulate_many: ten-second Quasimoro runs (the eq 19 pulse) with six parameters varied per run
+    (M, m, d, r, J1, J2, uniform in physical ranges), 201 samples each, on 1 thread (a tenth of the runs) and 2."""
+    from robotdyn.batch import simulate_many
+
+    robot = robotdyn.load("quasimoro")
+    pulse = module("quasimoro").SCENARIOS["rectilinear"].torque
+    rng = np.random.default_rng(0)
+    ranges = {"M": (4.5, 5.5), "m": (0.4, 0.6), "d": (0.15, 0.22), "r": (0.27, 0.33), "J1": (0.18, 0.22),
+              "J2": (0.38, 0.42)}
+    params = {k: rng.uniform(a, b, runs) for k, (a, b) in ranges.items()}
+    simulate_many(robot, 10.0, torque=pulse, params={k: v[:50] for k, v in params.items()}, bounds=ranges)  # fit
+    print(f"\nsimulate_many: {runs:,} ten-second Quasimoro runs, 6 parameters varied per run, 201 samples each")
+    for threads, n in ((1, runs // 10), (2, runs)):
+        start = time.perf_counter()
+        out = simulate_many(robot, 10.0, torque=pulse, params={k: v[:n] for k, v in params.items()}, bounds=ranges,
+                            n_out=201, threads=threads)
+        wall = time.perf_counter() - start
+        print(f"  {threads} thread(s): {n:,} runs in {wall:.2f} s ({n / wall:,.0f} runs/s; {int(out.ok.sum()):,} ok, "
+              f"{out.nfev.mean():.0f} evaluations per run)")
 
 
 if __name__ == "__main__":

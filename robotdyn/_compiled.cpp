@@ -22,12 +22,23 @@
 #include <pinocchio/algorithm/kinematics.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
+#include "_integrator.hpp"
+#include "_torque_profile.hpp"
+
 #include <pybind11/pybind11.h>
 #include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <thread>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -125,6 +136,8 @@ struct Geometry {  // configuration-level quantities of one wheel
   Vector3d a, u, n, t1, t2;
   Matrix3d N;  // dn/dp on a curved terrain
   double na, nw, nc1, R;
+  Vector3d p;  // contact point (world)
+  int row;     // the wheel's first row
 };
 
 inline Matrix3d skew(const Vector3d& x) {
@@ -159,6 +172,7 @@ class Evaluator {
       Matrix3d I;
       I << in[4], in[5], in[6], in[5], in[7], in[8], in[6], in[8], in[9];
       model_.appendBodyToJoint(id, pin::Inertia(in[0], Vector3d(in[1], in[2], in[3]), I), pin::SE3::Identity());
+      model_.inertias[id] = pin::Inertia(in[0], Vector3d(in[1], in[2], in[3]), I);  // exactly (set_model_vector)
     }
     gravity_ = pin::Motion(gravity, Vector3d::Zero());
     model_.gravity.setZero();  // gravity enters through g_ (see configure), so RNEA gives C v alone
@@ -271,12 +285,17 @@ class Evaluator {
         B_(mo.index, j) = 1.0;
         continue;
       }
-      Jc_.setZero(6, nv_);
-      pin::getJointJacobian(model_, data_, mo.joint, pin::LOCAL_WORLD_ALIGNED, Jc_);
-      Vector3d ang = Jc_.block<3, 1>(3, mo.index);
-      Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(Jc_.block<3, 1>(0, mo.index));
-      B_.col(j).noalias() = Jc_.bottomRows<3>().transpose() * axis;
-      B_.col(j).noalias() -= Jf_[mo.reaction].bottomRows<3>().transpose() * axis;
+      // the joint's angular Jacobian is CRBA's world one (data_.J) on its supporting joints' columns (an angular
+      // velocity does not depend on the reference point), so no Jacobian of the joint is assembled; a prismatic
+      // joint's column is its axis in either convention
+      const Vector3d ang = data_.J.col(mo.index).tail<3>();
+      const Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(data_.J.col(mo.index).head<3>());
+      B_.col(j).noalias() = -(Jf_[mo.reaction].bottomRows<3>().transpose() * axis);
+      for (const pin::JointIndex s : model_.supports[mo.joint]) {
+        if (s == 0) continue;
+        const int c0 = model_.joints[s].idx_v();
+        for (int c = c0; c < c0 + model_.joints[s].nv(); ++c) B_(c, j) += data_.J.col(c).tail<3>().dot(axis);
+      }
     }
     project();
   }
@@ -349,17 +368,475 @@ class Evaluator {
   // d/dt of (q, nu): (S nu - alpha A_h^+ phi, M_r^-1 (B_r tau - h_r)).
   VectorXd rhs(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                const Eigen::Ref<const VectorXd>& tau, double alpha) {
+    VectorXd out(nv_ + nu.size());
+    rhs_into(q, nu, tau, alpha, out);
+    return out;
+  }
+
+  void rhs_into(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+                const Eigen::Ref<const VectorXd>& tau, double alpha, Eigen::Ref<VectorXd> out) {
     configure(q);
     dynamics(nu);
     const int k = static_cast<int>(S_.cols());
     if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
-    VectorXd out(nv_ + k);
+    if (out.size() != nv_ + k) throw std::invalid_argument("state has the wrong length");
     out.head(nv_) = v_;
     if (alpha != 0.0) pull_back(alpha, out);
-    force_ = Br_ * tau - hr_;
+    force_.noalias() = Br_ * tau;
+    force_ -= hr_;
     llt_.compute(Mr_);
-    out.tail(k) = llt_.solve(force_);
-    return out;
+    llt_.solveInPlace(force_);
+    out.tail(k) = force_;
+  }
+
+  // ------------------------------------------------------------------------------------------ simulation
+  // Where the row choice stops working (Fallback), `rechoose(q, nu)` (Python, with the GIL) returns the Python
+  // path's new (rows, independent, dependent), or raises the Python path's error: as the scipy path, which
+  // evaluates that state in Python.
+  template <class Eval>
+  void with_rechoice(const double* y, const py::object& rechoose, Eval&& eval) {
+    try {
+      eval();
+    } catch (const Fallback&) {
+      if (rechoose.is_none()) throw;
+      {
+        py::gil_scoped_acquire gil;
+        const int k = mobility();
+        VectorXd q(Eigen::Map<const VectorXd>(y, nv_)), nu(Eigen::Map<const VectorXd>(y + nv_, k));
+        py::tuple sel = run_ < 0 ? rechoose(q, nu) : rechoose(run_, q, nu);
+        rows_ = sel[0].cast<std::vector<int>>();
+        if (!operational_) {
+          independent_ = sel[1].cast<std::vector<int>>();
+          dependent_ = sel[2].cast<std::vector<int>>();
+        }
+      }
+      eval();
+    }
+  }
+
+  // The ODE of simulate() with the torques of a profile: y = (q, nu), dy = d/dt y.
+  void deriv(double t, const std::vector<double>& y, std::vector<double>& dy, double alpha,
+             const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
+    const int k = mobility();
+    tau_.resize(profile.motors());
+    profile.eval(t, tau_);
+    dy.resize(y.size());
+    with_rechoice(y.data(), rechoose, [&] {
+      rhs_into(Eigen::Map<const VectorXd>(y.data(), nv_), Eigen::Map<const VectorXd>(y.data() + nv_, k), tau_,
+               alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k));
+    });
+  }
+
+  // Total mechanical energy [J] (kinetic 1/2 v^T M v, potential -sum m_i g . c_i as Pinocchio's
+  // computePotentialEnergy) and the largest holonomic residual at a state y = (q, nu).
+  void observe(const double* y, double& energy, double& residual, const py::object& rechoose) {
+    with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
+    v_.noalias() = S_ * Eigen::Map<const VectorXd>(y + nv_, mobility());  // (no dynamics needed)
+    double potential = 0.0;
+    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) {
+      const pin::Inertia& Y = model_.inertias[i];
+      potential -= Y.mass() * gravity_.linear().dot(data_.oMi[i].act(Y.lever()));
+    }
+    energy = 0.5 * v_.dot(data_.M.selfadjointView<Eigen::Upper>() * v_) + potential;  // CRBA fills the upper part
+    residual = 0.0;
+    for (size_t r = 0; r < holonomic_.size(); ++r)
+      if (holonomic_[r]) residual = std::max(residual, std::fabs(residual_[r]));
+  }
+
+  // ------------------------------------------------------------------------------------------ constraint forces
+  // lambda of A^T lambda = e, e = M a + C v + g - B tau (robotdyn/contact_forces.py), on the rows the projection
+  // uses: with the LU factors of A_d (the projection's own factorisation), A_d^T lambda_r = e_d; with operational
+  // velocities by the projection's K^-1 (K = [A_r; J_o]). Rows outside the projection's choice (redundant ones) get zero: lambda is the
+  // basic solution, equal to every other solution on the rows that rigid-body dynamics determine (the Python side
+  // reports the others with the null space of A^T). After dynamics() (forward: nudot from the torques) or with a
+  // given full acceleration a (forces_at).
+  void lambda_from(const Eigen::Ref<const VectorXd>& tau) {
+    force_.noalias() = B_ * tau;
+    e_ -= force_;
+    lambda_.setZero(nrows());
+    const int nr = static_cast<int>(rows_.size());
+    if (!nr) return;
+    if (operational_) {  // K = [A_r; J_o] with K S = [0; I]: K^T (lambda_r, 0) = e, so lambda_r = (K^-T e)_head
+      lr_.noalias() = Kinv_.transpose() * e_;
+      lr_.conservativeResize(nr);
+    } else {
+      lr_.resize(nr);
+      for (int r = 0; r < nr; ++r) lr_[r] = e_[dependent_[r]];
+      lu_solve_transposed(lr_);
+    }
+    for (int r = 0; r < nr; ++r) lambda_[rows_[r]] = lr_[r];
+  }
+
+  // Forward dynamics at (q, nu, tau) and the constraint forces, into buffers read through the views nudot, lam,
+  // e, wheel_local (nw, 3) along (t1, t2, n), wheel_world, wheel_frames (nw, 9: t1, t2, n), contact_points; returns
+  // a counter that changes whenever a buffer moved (as compute).
+  long forces(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+              const Eigen::Ref<const VectorXd>& tau) {
+    if (tau.size() != static_cast<Eigen::Index>(motors_.size())) throw std::invalid_argument("tau has the wrong length");
+    configure(q);
+    dynamics(nu);
+    force_.noalias() = Br_ * tau;
+    force_ -= hr_;
+    llt_.compute(Mr_);
+    if (llt_.info() != Eigen::Success) throw Fallback("reduced mass matrix not positive definite");
+    nudot_ = force_;
+    llt_.solveInPlace(nudot_);
+    a_ = w_;
+    a_.noalias() += S_ * nudot_;
+    e_ = data_.tau;  // C v + g (dynamics)
+    e_.noalias() += data_.M * a_;
+    lambda_from(tau);
+    fill_wheel_forces();
+    const double* now[7] = {nudot_.data(), lambda_.data(), e_.data(), wl_.data(), ww_.data(), wf_.data(), wp_.data()};
+    for (int i = 0; i < 7; ++i)
+      if (now[i] != fbuffers_[i]) {
+        std::copy(now, now + 7, fbuffers_);
+        ++fgeneration_;
+        break;
+      }
+    return fgeneration_;
+  }
+
+  // The same for given full velocities v and accelerations a (inverse dynamics): (lambda, e, wheel forces, A).
+  py::tuple forces_at(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& v,
+                      const Eigen::Ref<const VectorXd>& a, const Eigen::Ref<const VectorXd>& tau) {
+    if (v.size() != nv_ || a.size() != nv_ || tau.size() != static_cast<Eigen::Index>(motors_.size()))
+      throw std::invalid_argument("v, a or tau has the wrong length");
+    configure(q);
+    pin::rnea(model_, data_, q_, v, a);  // without gravity: M a + C v
+    e_ = data_.tau + g_;
+    lambda_from(tau);
+    return py::make_tuple(lambda_, e_, wheel_forces(), A_);
+  }
+
+  // Per wheel: the force along (t1, t2, n), the same in world axes, the contact frame (rows t1, t2, n: (nw, 9),
+  // row-major) and the contact point (nw, 3).
+  void fill_wheel_forces() {
+    const int nw = static_cast<int>(wheels_.size());
+    wl_.resize(nw, 3);
+    ww_.resize(nw, 3);
+    wf_.resize(nw, 9);
+    wp_.resize(nw, 3);
+    for (int i = 0; i < nw; ++i) {
+      const Geometry& g = geo_[i];
+      const Wheel& wh = wheels_[i];
+      const Vector3d f = wh.D.transpose() * lambda_.segment(g.row, wh.D.rows());
+      wl_.row(i) = f.transpose();
+      ww_.row(i) = (f[0] * g.t1 + f[1] * g.t2 + f[2] * g.n).transpose();
+      wf_.row(i) << g.t1.transpose(), g.t2.transpose(), g.n.transpose();
+      wp_.row(i) = g.p.transpose();
+    }
+  }
+  py::tuple wheel_forces() {
+    fill_wheel_forces();
+    return py::make_tuple(wl_, ww_, wf_, wp_);
+  }
+  const VectorXd& nudot() const { return nudot_; }
+  const VectorXd& lam() const { return lambda_; }
+  const VectorXd& e() const { return e_; }
+  const RowMat& wheel_local() const { return wl_; }
+  const RowMat& wheel_world() const { return ww_; }
+  const RowMat& wheel_frames() const { return wf_; }
+  const RowMat& contact_points() const { return wp_; }
+
+  // ------------------------------------------------------------------------------------------ model vector
+  // The numbers this model is built from, in one vector (robotdyn/model_variants.py reads and writes the same
+  // layout): per joint its placement (R row-major, p: 12) and inertia (mass, lever, Ixx Ixy Ixz Iyy Iyz Izz about
+  // the centre of mass: 10); per frame its placement (12); per wheel its radius and axle (4); per coupling its law
+  // (amplitude, rate, phase, offset); the gravity (3).
+  VectorXd model_vector() const {
+    VectorXd x(model_vector_size());
+    Eigen::Index i = 0;
+    auto put_se3 = [&](const pin::SE3& M) {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) x[i++] = M.rotation()(r, c);
+      for (int r = 0; r < 3; ++r) x[i++] = M.translation()[r];
+    };
+    for (pin::JointIndex j = 1; j < static_cast<pin::JointIndex>(model_.njoints); ++j) {
+      put_se3(model_.jointPlacements[j]);
+      const pin::Inertia& Y = model_.inertias[j];
+      x[i++] = Y.mass();
+      for (int r = 0; r < 3; ++r) x[i++] = Y.lever()[r];
+      const Matrix3d I = Y.inertia().matrix();
+      for (auto [r, c] : {std::pair{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}}) x[i++] = I(r, c);
+    }
+    for (int f : frames_) put_se3(model_.frames[f].placement);
+    for (const Wheel& w : wheels_) {
+      x[i++] = w.radius;
+      for (int r = 0; r < 3; ++r) x[i++] = w.axis[r];
+    }
+    for (const Coupling& c : couplings_) {
+      x[i++] = c.amplitude;
+      x[i++] = c.rate;
+      x[i++] = c.phase;
+      x[i++] = c.offset;
+    }
+    for (int r = 0; r < 3; ++r) x[i++] = gravity_.linear()[r];
+    return x;
+  }
+  Eigen::Index model_vector_size() const {
+    return 22 * (model_.njoints - 1) + 12 * static_cast<Eigen::Index>(frames_.size()) +
+           4 * static_cast<Eigen::Index>(wheels_.size()) + 4 * static_cast<Eigen::Index>(couplings_.size()) + 3;
+  }
+  void set_model_vector(const double* x) {
+    Eigen::Index i = 0;
+    auto get_se3 = [&]() {
+      Matrix3d R;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R(r, c) = x[i++];
+      Vector3d p(x[i], x[i + 1], x[i + 2]);
+      i += 3;
+      return pin::SE3(R, p);
+    };
+    for (pin::JointIndex j = 1; j < static_cast<pin::JointIndex>(model_.njoints); ++j) {
+      model_.jointPlacements[j] = get_se3();
+      const double mass = x[i];
+      const Vector3d lever(x[i + 1], x[i + 2], x[i + 3]);
+      Matrix3d I;
+      I << x[i + 4], x[i + 5], x[i + 6], x[i + 5], x[i + 7], x[i + 8], x[i + 6], x[i + 8], x[i + 9];
+      i += 10;
+      model_.inertias[j] = pin::Inertia(mass, lever, I);
+    }
+    for (int f : frames_) model_.frames[f].placement = get_se3();
+    for (Wheel& w : wheels_) {
+      w.radius = x[i];
+      w.axis = Vector3d(x[i + 1], x[i + 2], x[i + 3]);
+      i += 4;
+    }
+    for (Coupling& c : couplings_) {
+      c.amplitude = x[i];
+      c.rate = x[i + 1];
+      c.phase = x[i + 2];
+      c.offset = x[i + 3];
+      i += 4;
+    }
+    gravity_ = pin::Motion(Vector3d(x[i], x[i + 1], x[i + 2]), Vector3d::Zero());
+  }
+  void set_model_vector_py(const VectorXd& x) {
+    if (x.size() != model_vector_size()) throw std::invalid_argument("model vector has the wrong length");
+    set_model_vector(x.data());
+  }
+
+  // ------------------------------------------------------------------------------------------ many runs
+  // N simulations on `threads` threads (robotdyn/batch.py: simulate_many), each thread with its own copy of this
+  // evaluator, the runs handed out one at a time; every run starts from this evaluator's row choice and, where
+  // `models` has rows, with its own model vector, so that its result does not depend on the thread or on the
+  // runs before it (the same numbers as Evaluator.simulate alone). A run that fails (constraints violated at its
+  // start, a non-finite state, a vanishing step, an error of the Python path where its rows had to be re-chosen)
+  // is recorded with its message; the others go on. The main thread waits without the GIL and takes it every
+  // 50 ms for signals (Ctrl-C: the runs under way stop, finished runs are kept) and progress(done).
+  py::dict simulate_many(const Eigen::Ref<const RowMat>& Q0, const Eigen::Ref<const RowMat>& NU0,
+                         const Eigen::Ref<const RowMat>& models, const std::vector<robotdyn::TorqueProfile*>& profiles,
+                         const std::vector<std::vector<double>>& breaks, double t_end,
+                         const std::vector<double>& samples, double rtol, double atol, double alpha,
+                         const std::string& method, int threads, py::object progress, py::object rechoose) {
+    const long N = static_cast<long>(Q0.rows());
+    const int k = mobility(), dim = nv_ + k;
+    const long S = static_cast<long>(samples.size());
+    if (Q0.cols() != nv_ || NU0.rows() != N || NU0.cols() != k) throw std::invalid_argument("q0 or nu0 shapes");
+    if (static_cast<long>(profiles.size()) != N || static_cast<long>(breaks.size()) != N)
+      throw std::invalid_argument("one torque profile and one breakpoint list per run expected");
+    if (models.rows() != 0 && (models.rows() != N || models.cols() != model_vector_size()))
+      throw std::invalid_argument("one model vector per run expected");
+    for (const auto* p : profiles)
+      if (p == nullptr || p->motors() != static_cast<int>(motors_.size()))
+        throw std::invalid_argument("a torque profile for another number of motors");
+    if (!selected_) throw Fallback("no projection chosen yet");
+    py::array_t<double> Y({N, S, static_cast<long>(dim)}), E({N, S}), R({N, S});
+    py::array_t<long> emitted(N), nfev(N), steps(N);
+    py::array_t<int> status(N);
+    std::vector<std::string> messages(N);
+    double* y_out = Y.mutable_data();
+    double* e_out = E.mutable_data();
+    double* r_out = R.mutable_data();
+    long* emitted_out = emitted.mutable_data();
+    long* nfev_out = nfev.mutable_data();
+    long* steps_out = steps.mutable_data();
+    int* status_out = status.mutable_data();
+    std::fill(emitted_out, emitted_out + N, 0L);
+    std::fill(nfev_out, nfev_out + N, 0L);
+    std::fill(steps_out, steps_out + N, 0L);
+    std::fill(status_out, status_out + N, -1);  // not run
+    std::atomic<long> next_run{0}, done{0};
+    std::atomic<bool> stop{false};
+    const int nthreads = std::max(1, std::min<int>(threads, static_cast<int>(std::max<long>(N, 1))));
+    auto worker = [&]() {
+      Evaluator ev(*this);
+      for (long i = next_run++; i < N && !stop.load(); i = next_run++) {
+        ev.run_ = static_cast<int>(i);
+        ev.rows_ = rows_;
+        ev.independent_ = independent_;
+        ev.dependent_ = dependent_;
+        if (models.rows()) ev.set_model_vector(models.row(i).data());
+        double* yi = y_out + i * S * dim;
+        double* ei = e_out + i * S;
+        double* ri = r_out + i * S;
+        long count = 0, evals = 0;
+        try {
+          robotdyn::State y0(dim);
+          Eigen::Map<VectorXd>(y0.data(), nv_) = Q0.row(i).transpose();
+          Eigen::Map<VectorXd>(y0.data() + nv_, k) = NU0.row(i).transpose();
+          ev.check_start(y0.data(), rechoose);
+          auto system = [&](const robotdyn::State& x, robotdyn::State& dxdt, double t) {
+            ++evals;
+            ev.deriv(t, x, dxdt, alpha, *profiles[i], rechoose);
+          };
+          auto observer = [&](double, const robotdyn::State& x) {
+            std::copy(x.begin(), x.end(), yi + count * dim);
+            ++count;
+          };
+          auto poll = [&](double) { return !stop.load(); };
+          size_t next = 0;
+          robotdyn::Outcome out = robotdyn::integrate(method, system, y0, 0.0, t_end, samples, next, breaks[i], rtol,
+                                                      atol, observer, poll);
+          for (long j = 0; j < count; ++j) ev.observe(yi + j * dim, ei[j], ri[j], rechoose);
+          status_out[i] = out.status;
+          if (out.status == robotdyn::FAILED)
+            messages[i] = "integration failed at t = " + std::to_string(out.t) + " s: " + out.message;
+          else if (out.status == robotdyn::INTERRUPTED)
+            messages[i] = "interrupted at t = " + std::to_string(out.t) + " s";
+          steps_out[i] = out.steps;
+        } catch (py::error_already_set& e) {
+          py::gil_scoped_acquire gil;
+          status_out[i] = robotdyn::FAILED;
+          messages[i] = e.what();
+        } catch (const std::exception& e) {
+          status_out[i] = robotdyn::FAILED;
+          messages[i] = e.what();
+        }
+        emitted_out[i] = count;
+        nfev_out[i] = evals;
+        ++done;
+      }
+    };
+    bool interrupted = false;
+    std::optional<py::error_already_set> pending;  // an exception of a signal handler or of progress
+    {
+      py::gil_scoped_release release;
+      std::vector<std::thread> pool;
+      for (int t = 0; t < nthreads; ++t) pool.emplace_back(worker);
+      long reported = -1;
+      while (done.load() < N && !stop.load()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) {
+          if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
+            PyErr_Clear();
+            interrupted = true;
+          } else {
+            pending.emplace();  // fetches the error
+          }
+          stop = true;
+        } else if (!progress.is_none() && done.load() != reported) {
+          reported = done.load();
+          try {
+            progress(reported, N);
+          } catch (py::error_already_set& e) {
+            if (e.matches(PyExc_KeyboardInterrupt)) interrupted = true;
+            else pending.emplace(e);
+            stop = true;
+          }
+        }
+      }
+      for (auto& th : pool) th.join();  // without the GIL: a run may need it to re-choose its rows
+    }
+    if (pending) throw *pending;
+    py::dict result;
+    result["y"] = Y;
+    result["energy"] = E;
+    result["residual"] = R;
+    result["emitted"] = emitted;
+    result["nfev"] = nfev;
+    result["steps"] = steps;
+    result["status"] = status;
+    result["messages"] = messages;
+    result["interrupted"] = interrupted;
+    return result;
+  }
+
+  // The start of a run: the holonomic residuals within 1e-6 (Robot.check_constraints' tolerance).
+  void check_start(const double* y, const py::object& rechoose) {
+    with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
+    for (size_t r = 0; r < holonomic_.size(); ++r)
+      if (holonomic_[r] && !(std::fabs(residual_[r]) <= 1e-6))
+        throw std::invalid_argument("q0 violates holonomic row #" + std::to_string(r) + " by " +
+                                    std::to_string(residual_[r]) + "; expected |residual| <= 1e-06");
+  }
+
+  // A whole simulation (robotdyn/compiled_simulation.py) from (t0, q0, nu0) to t_end with samples at `samples`
+  // (those >= t0). Runs without the GIL; every ~50 ms it takes the GIL to check for signals (Ctrl-C: status
+  // INTERRUPTED, the samples so far kept) and to call progress(t) (None: no call).
+  py::dict simulate(const VectorXd& q0, const VectorXd& nu0, double t0, double t_end,
+                    const std::vector<double>& samples, double rtol, double atol, double alpha,
+                    const robotdyn::TorqueProfile& profile, const std::vector<double>& breaks,
+                    const std::string& method, py::object progress, py::object rechoose) {
+    const int k = mobility();
+    if (q0.size() != nv_ || nu0.size() != k) throw std::invalid_argument("q0 or nu0 has the wrong length");
+    if (profile.motors() != static_cast<int>(motors_.size()))
+      throw std::invalid_argument("the torque profile is for another number of motors");
+    const int dim = nv_ + k;
+    robotdyn::State y0(dim);
+    Eigen::Map<VectorXd>(y0.data(), nv_) = q0;
+    Eigen::Map<VectorXd>(y0.data() + nv_, k) = nu0;
+    std::vector<double> ts, ys, energy, residual;
+    ts.reserve(samples.size());
+    ys.reserve(samples.size() * dim);
+    long nfev = 0;
+    auto system = [&](const robotdyn::State& x, robotdyn::State& dxdt, double t) {
+      ++nfev;
+      deriv(t, x, dxdt, alpha, profile, rechoose);
+    };
+    auto observer = [&](double t, const robotdyn::State& x) {
+      ts.push_back(t);
+      ys.insert(ys.end(), x.begin(), x.end());
+    };
+    bool interrupted = false;
+    auto poll = [&](double t) -> bool {
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {
+        if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {
+          PyErr_Clear();
+          interrupted = true;
+          return false;
+        }
+        throw py::error_already_set();
+      }
+      if (!progress.is_none()) {
+        try {
+          progress(t);
+        } catch (py::error_already_set& e) {
+          if (!e.matches(PyExc_KeyboardInterrupt)) throw;
+          interrupted = true;
+          return false;
+        }
+      }
+      return true;
+    };
+    size_t next = 0;
+    while (next < samples.size() && samples[next] < t0) ++next;
+    robotdyn::Outcome out;
+    {
+      py::gil_scoped_release release;
+      out = robotdyn::integrate(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol, observer, poll);
+      energy.resize(ts.size());
+      residual.resize(ts.size());
+      for (size_t i = 0; i < ts.size(); ++i) observe(ys.data() + i * dim, energy[i], residual[i], rechoose);
+    }
+    const long N = static_cast<long>(ts.size());
+    py::dict result;
+    result["t"] = py::array_t<double>(N, ts.data());
+    py::array_t<double> y({N, static_cast<long>(dim)});
+    std::copy(ys.begin(), ys.end(), y.mutable_data());
+    result["y"] = y;
+    result["energy"] = py::array_t<double>(N, energy.data());
+    result["residual"] = py::array_t<double>(N, residual.data());
+    result["status"] = interrupted ? static_cast<int>(robotdyn::INTERRUPTED) : out.status;
+    result["t_stop"] = out.t;
+    result["y_stop"] = py::array_t<double>(static_cast<long>(out.y.size()), out.y.data());
+    result["message"] = out.message;
+    result["nfev"] = nfev;
+    result["steps"] = out.steps;
+    return result;
   }
 
   // Many states: stacked M_r (N, k, k), h (N, k), g (N, k), S (N, n, k), w (N, n), B_r (N, k, motors).
@@ -390,15 +867,43 @@ class Evaluator {
  private:
   // A_d^-1 x in place, with the LU factors (P A_d = L U): vector triangular solves, no temporaries
   void lu_solve(Eigen::Ref<VectorXd> x) {
-    x = lu_.permutationP() * x;
-    lu_.matrixLU().triangularView<Eigen::UnitLower>().solveInPlace(x);
-    lu_.matrixLU().triangularView<Eigen::Upper>().solveInPlace(x);
+    // substitutions written out: for the small blocks of a projection they cost a fraction of Eigen's generic
+    // triangular solvers
+    const MatrixXd& LU = lu_.matrixLU();
+    const auto& perm = lu_.permutationP().indices();  // (P x)[perm[i]] = x[i]
+    const Eigen::Index n = x.size();
+    perm_.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) perm_[perm[i]] = x[i];
+    for (Eigen::Index i = 1; i < n; ++i) {  // L (unit lower)
+      double s = perm_[i];
+      for (Eigen::Index j = 0; j < i; ++j) s -= LU(i, j) * perm_[j];
+      perm_[i] = s;
+    }
+    for (Eigen::Index i = n - 1; i >= 0; --i) {  // U
+      double s = perm_[i];
+      for (Eigen::Index j = i + 1; j < n; ++j) s -= LU(i, j) * perm_[j];
+      perm_[i] = s / LU(i, i);
+    }
+    x = perm_;
   }
-  // A_d^-T x in place
+  // A_d^-T x in place (A_d = P^T L U, so A_d^T = U^T L^T P)
   void lu_solve_transposed(Eigen::Ref<VectorXd> x) {
-    lu_.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(x);
-    lu_.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(x);
-    x = lu_.permutationP().transpose() * x;
+    const MatrixXd& LU = lu_.matrixLU();
+    const Eigen::Index n = x.size();
+    for (Eigen::Index i = 0; i < n; ++i) {  // U^T (lower)
+      double s = x[i];
+      for (Eigen::Index j = 0; j < i; ++j) s -= LU(j, i) * x[j];
+      x[i] = s / LU(i, i);
+    }
+    for (Eigen::Index i = n - 2; i >= 0; --i) {  // L^T (unit upper)
+      double s = x[i];
+      for (Eigen::Index j = i + 1; j < n; ++j) s -= LU(j, i) * x[j];
+      x[i] = s;
+    }
+    const auto& perm = lu_.permutationP().indices();  // (P^T x)[i] = x[perm[i]]
+    perm_.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) perm_[i] = x[perm[i]];
+    x = perm_;
   }
   // LAPACK's estimate of ||A_d^-1||_1 (Hager and Higham, as Eigen's rcond estimate) with the solves above
   double inverse_norm_estimate() {
@@ -448,6 +953,7 @@ class Evaluator {
     const Wheel& wh = wheels_[i];
     const pin::SE3& oMf = data_.oMf[frames_[wh.frame]];
     Geometry& g = geo_[i];
+    g.row = row;
     g.R = wh.radius;
     if (wh.radius_index >= 0) {
       g.R += q_[wh.radius_index];
@@ -480,6 +986,7 @@ class Evaluator {
     }
     if (it == 100) throw Fallback("contact point did not converge");
     g.n = n;
+    g.p = p;
     double f;
     Eigen::Vector2d grad;
     Eigen::Matrix2d H;
@@ -671,13 +1178,13 @@ class Evaluator {
       if (!Sd_.allFinite()) throw Fallback("singular");  // an exactly singular block (a zero pivot)
       for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -Sd_.row(r);
     }
-    if (A_.size()) {
+    if (A_.size() && S_.cols()) {  // (no independent velocity: nothing to check, and no maximum to take)
       AS_.noalias() = A_.lazyProduct(S_);
       if (!(AS_.cwiseAbs().maxCoeff() <= 1e-10 * scale)) throw Fallback("row choice no longer spans");  // NaN too
     }
   }
 
-  void pull_back(double alpha, VectorXd& out) {
+  void pull_back(double alpha, Eigen::Ref<VectorXd> out) {
     int nh = 0;
     bool any = false;
     for (size_t r = 0; r < holonomic_.size(); ++r)
@@ -694,7 +1201,17 @@ class Evaluator {
         Ah.row(j) = A_.row(r);
         phi[j++] = residual_[r];
       }
-    out.head(nv_) -= alpha * Ah.completeOrthogonalDecomposition().solve(phi);
+    // truncated SVD: singular values below 1e-9 max(s_max, 1) count as zero (robotdyn/pull_back.py): rows with
+    // no rank, e.g. a wheel's normal row under a planar root, keep their residual as a constant offset
+    svd_.compute(Ah, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const VectorXd& s = svd_.singularValues();
+    const double cut = 1e-9 * std::max(s.size() ? s[0] : 0.0, 1.0);
+    int rank = 0;
+    while (rank < s.size() && s[rank] > cut) ++rank;
+    if (rank == 0) return;
+    VectorXd c = svd_.matrixU().leftCols(rank).transpose() * phi;
+    c.array() /= s.head(rank).array();
+    out.head(nv_).noalias() -= alpha * (svd_.matrixV().leftCols(rank) * c);
   }
 
   pin::Model model_;
@@ -713,17 +1230,23 @@ class Evaluator {
   int op_frame_ = -1;
   bool op_local_ = true, operational_ = false, selected_ = false;
   // state and work buffers (sized on first use, then reused)
+  VectorXd tau_, perm_, e_, lambda_, lr_, nudot_, a_;
+  RowMat wl_, ww_, wf_, wp_;
+  const double* fbuffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  long fgeneration_ = 0;
   VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_, est_v_, est_s_, est_old_;
   MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
   Matrix6x Jc_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   Eigen::LLT<MatrixXd> llt_;
+  Eigen::JacobiSVD<MatrixXd> svd_;
   double cond_ = 1.0;
   std::vector<Geometry> geo_;
   std::vector<Matrix6x> Jf_;
   std::vector<MatrixXd> Aw_;
   const double* buffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  int run_ = -1;  // the run a batch thread is on (its rechoice callback gets it), -1 alone
   long generation_ = 0;
 };
 
@@ -732,7 +1255,17 @@ class Evaluator {
 PYBIND11_MODULE(_compiled, m) {
   m.doc() = "robotdyn's compiled reduced-model evaluator (see robotdyn.compiled)";
   py::register_exception<Fallback>(m, "Fallback", PyExc_RuntimeError);
+  py::class_<robotdyn::TorqueProfile>(m, "TorqueProfile",
+                                      "motor torques as data (robotdyn.torque_profile): sum of constant, sine, table terms")
+      .def(py::init<int, const std::vector<int>&, const std::vector<MatrixXd>&, const std::vector<std::vector<double>>&>())
+      .def_property_readonly("motors", &robotdyn::TorqueProfile::motors)
+      .def("__call__", [](const robotdyn::TorqueProfile& p, double t) {
+        VectorXd out(p.motors());
+        p.eval(t, out);
+        return out;
+      });
   py::class_<Evaluator>(m, "Evaluator")
+      .def(py::init<const Evaluator&>(), "a copy (its own Pinocchio data and buffers)")
       .def(py::init<const std::vector<std::string>&, const std::vector<int>&, const std::vector<MatrixXd>&,
                     const std::vector<Vector3d>&, const std::vector<VectorXd>&, const Vector3d&>())
       .def("add_frame", &Evaluator::add_frame)
@@ -754,6 +1287,26 @@ PYBIND11_MODULE(_compiled, m) {
       .def_property_readonly("w", &Evaluator::w, py::return_value_policy::reference_internal)
       .def_property_readonly("v", &Evaluator::v, py::return_value_policy::reference_internal)
       .def("rhs", &Evaluator::rhs)
+      .def("simulate", &Evaluator::simulate)
+      .def("simulate_many", &Evaluator::simulate_many)
+      .def("forces", &Evaluator::forces)
+      .def_property_readonly("nudot", &Evaluator::nudot, py::return_value_policy::reference_internal)
+      .def_property_readonly("lam", &Evaluator::lam, py::return_value_policy::reference_internal)
+      .def_property_readonly("e", &Evaluator::e, py::return_value_policy::reference_internal)
+      .def_property_readonly("wheel_local", &Evaluator::wheel_local, py::return_value_policy::reference_internal)
+      .def_property_readonly("wheel_world", &Evaluator::wheel_world, py::return_value_policy::reference_internal)
+      .def_property_readonly("wheel_frames", &Evaluator::wheel_frames, py::return_value_policy::reference_internal)
+      .def_property_readonly("contact_points", &Evaluator::contact_points,
+                             py::return_value_policy::reference_internal)
+      .def("forces_at", &Evaluator::forces_at)
+      .def("model_vector", &Evaluator::model_vector)
+      .def("set_model_vector", &Evaluator::set_model_vector_py)
+      .def("observe", [](Evaluator& ev, const VectorXd& y) {
+        if (y.size() != ev.nv() + ev.mobility()) throw std::invalid_argument("y has the wrong length");
+        double e, r;
+        ev.observe(y.data(), e, r, py::none());
+        return py::make_tuple(e, r);
+      })
       .def("evaluate_many", &Evaluator::evaluate_many)
       .def_property_readonly("condition", &Evaluator::condition,
                              "1-norm condition number of the last projection's block: LAPACK's estimate below 1e8, "

@@ -1,4 +1,9 @@
-"""Batch evaluation of the reduced model at many states (design sweeps, learning data sets).
+"""Many evaluations or simulations in one call (design sweeps, learning data sets).
+
+:func:`simulate_many` (from :mod:`robotdyn.many_runs`) runs N simulations of one robot's variants -- per-run
+parameters (masses, inertias, lengths: :mod:`robotdyn.model_variants`) or built robots, initial states and torque
+profiles -- in C++ on the machine's cores (threads, the GIL released, one model copy per thread), returning arrays
+per run (:class:`ManyRuns`).
 
 :func:`evaluate` returns stacked arrays, ``M`` (N, k, k), ``h`` (N, k), ``g`` (N, k), ``B`` (N, k, m) and ``S``
 (N, n, k), for N states, optionally spread over worker processes (one robot copy per process, inherited by
@@ -118,3 +123,8 @@ def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
     finally:
         _WORKER_ROBOT = None
     return Batch(*(np.concatenate([p[j] for p in parts]) for j in range(5)))
+
+
+from .many_runs import ManyRuns, simulate_many  # noqa: E402  (many simulations: robotdyn.many_runs)
+
+__all__ = ["Batch", "evaluate", "ManyRuns", "simulate_many"]

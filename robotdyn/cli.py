@@ -247,7 +247,8 @@ def cmd_simulate(args) -> int:
 
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops the run like Ctrl-C: results kept
         signal.signal(signal.SIGTERM, _interrupt)
-    traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet)
+    extra = {} if args.stabilisation is None else {"stabilisation": args.stabilisation}
+    traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")
     tr = None
     switches = traj.stats.get("switches")
@@ -278,14 +279,16 @@ def cmd_simulate(args) -> int:
     final = dict(zip(traj.coordinates + traj.velocity_names, np.concatenate([traj.q[-1], traj.nu[-1]])))
     out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,
            "energy_start": float(traj.energy[0]), "energy_end": float(traj.energy[-1]),
-           "max_holonomic_residual": drift, "wall_time_s": traj.stats["wall"], "csv": args.csv, "plot": args.plot}
+           "max_holonomic_residual": drift, "wall_time_s": traj.stats["wall"], "csv": args.csv, "plot": args.plot,
+           "engine": traj.stats.get("engine")}
     if tr is not None:
         out["traction"] = {"summary": tr.summary(), "wheels": tr.wheels, "undetermined": list(tr.undetermined),
                            "events": [vars(e) for e in tr.events],
                            "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)},
                            "min_normal_load": {w: float(np.min(tr.normal[:, j])) for j, w in enumerate(tr.wheels)}}
     text = [f"{args.robot} / {sc.name}: {sc.description}",
-            f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations)",
+            f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations, "
+            f"{traj.stats.get('engine', 'scipy')} engine)",
             "final state:", *(f"  {k:<14} {v: .8g}" for k, v in final.items()),
             f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
     if tr is not None:
@@ -295,6 +298,8 @@ def cmd_simulate(args) -> int:
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
             f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
             + ("; ..." if len(switches) > 10 else ""))
+    if "offsets" in traj.stats:  # holonomic residuals no coordinate can change (robotdyn.pull_back)
+        out["constant_offsets"] = traj.stats["offsets"]
     if "event" in traj.stats:
         out["stopped"] = traj.stats["event"]
         text.append(f"stopped early: {traj.stats['event']}")
@@ -313,6 +318,13 @@ def cmd_simulate(args) -> int:
         print(f"robotdyn: {partial}; wrote the partial results: {written}", file=sys.stderr)
         return 130
     return 0
+
+
+def _nonnegative(text: str) -> float:
+    value = float(text)
+    if not (np.isfinite(value) and value >= 0):
+        raise ValueError(text)
+    return value
 
 
 def _interrupt(signum, frame):
@@ -433,6 +445,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file")
     p.add_argument("--plot", help="save the paper's figures reproduced to this image file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--stabilisation", type=_nonnegative, default=None, metavar="ALPHA",
+                   help="gain [1/s] pulling holonomic residuals back (default 10; 0 turns the pull-back off)")
     p.add_argument("--mu", type=float, default=None,
                    help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
     p.add_argument("--traction-plot", metavar="FILE",

@@ -18,7 +18,9 @@ a plane, a sine or a bump terrain of :mod:`robotdyn.terrain`, loop closures and 
 the Python path. The row choice of the projection is the Python path's (its last projection); where that choice
 stops working (a singular block, rows that no longer span, a wheel lying flat) the evaluation falls back to the
 Python path, which re-chooses or raises its usual error. ``ROBOTDYN_COMPILED=0`` in the environment, or
-:func:`use_compiled` ``(False)``, turns the fast path off. ``tests/test_compiled.py`` checks every output against
+:func:`use_compiled` ``(False)``, turns the fast path off. The same C++ object also runs whole simulations
+(:mod:`robotdyn.compiled_simulation`, :mod:`robotdyn.many_runs`) and gives the constraint forces
+(:meth:`CompiledModel.forces`). ``tests/test_compiled.py`` checks every output against
 the Python path on every robot.
 """
 
@@ -185,6 +187,8 @@ class CompiledModel:
                 frames[fid] = ev.add_frame(int(f.parentJoint), _placement(f.placement))
             return frames[fid]
 
+        self.wheels = [c for c in self.constraints if isinstance(c, RollingWheel)]
+        self.couplings = [c for c in self.constraints if isinstance(c, JointCoupling)]
         for c in self.constraints:
             if isinstance(c, RollingWheel):
                 ev.set_terrain(*_terrain_code(c.terrain))
@@ -202,6 +206,7 @@ class CompiledModel:
             tw = self.operational.twist
             self._op = (frame(tw.fid), [int(s) for s in tw.select], tw.axes == "local")
         self.ev = ev
+        self.frame_ids = sorted(frames, key=frames.get)  # Pinocchio frame ids in the evaluator's order
         rows = robot.rows_at(robot.neutral())
         self.labels, self.holonomic = rows.labels, rows.holonomic
         self._check_model()
@@ -315,6 +320,40 @@ class CompiledModel:
         if self._hint is None:
             self._choose(q, nu)
         return self.ev.rhs(q, nu, tau, stabilisation)
+
+    def forces(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tuple:
+        """Forward dynamics and constraint forces in one call, without copies (views overwritten by the next call,
+        as :meth:`compute`): ``(nudot, lambda, e, wheel forces (nw, 3) along (t1, t2, n), the same in world axes,
+        contact frames (nw, 9: rows t1, t2, n), contact points (nw, 3))``, with
+        :math:`A^T\\lambda = e = Ma + Cv + g - B\\tau` solved on the projection's rows by the LU factors of
+        :math:`A_d` (the projection's own factorisation; operational velocities: its :math:`K^{-1}`) and zero on
+        redundant rows (the basic solution: equal to any other on the rows rigid-body dynamics determine;
+        :mod:`robotdyn.contact_forces` reports the others).
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, nu)
+        generation = self.ev.forces(q, nu, tau)
+        if generation != getattr(self, "_fgeneration", None):
+            ev = self.ev
+            self._fviews = (ev.nudot, ev.lam, ev.e, ev.wheel_local, ev.wheel_world, ev.wheel_frames,
+                            ev.contact_points)
+            self._fgeneration = generation
+        return self._fviews
+
+    def forces_at(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau: np.ndarray) -> tuple:
+        """The constraint forces at given full velocities v and accelerations a (inverse dynamics):
+        ``(lambda, e, (wheel forces, world forces, frames, points), A)`` as :meth:`forces` (copies), with the
+        constraint rows A (rows in :attr:`labels`' order).
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, np.zeros(self.robot.mobility))
+        return self.ev.forces_at(q, v, a, tau)
 
     def evaluate_many(self, Q: np.ndarray, NU: np.ndarray) -> tuple:
         """Many states in one call: ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n),

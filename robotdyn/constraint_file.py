@@ -90,6 +90,7 @@ from .ros_packages import HINT, PackageIndex
 from .scenario import Scenario
 from .sliding import SLIP_DIRECTIONS
 from .terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
+from .torque_profile import Constant
 
 
 class ConstraintFileError(RobotDynError):
@@ -691,7 +692,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
             label = coordinate(where, k)
             nu0[f"{labels.get(label, label)}_dot"] = r.number(where, v, k)
         scenarios[name] = Scenario(name, str(s.get("description", f"constant torques {tau.tolist()}")), t_end,
-                                   (lambda tau: (lambda t, q, nu: tau))(tau), q0, nu0)
+                                   Constant(tau), q0, nu0)  # torques as data: simulated compiled
     return ConstraintFile(path, spec, scenarios)
 
 

@@ -36,7 +36,8 @@ import numpy as np
 import pinocchio as pin
 
 from .actuation import input_matrix
-from .constraint import KinematicState
+from .compiled import compiled_model
+from .constraint import ConstraintRows, KinematicState
 from .errors import InputError, NonFiniteError
 from .loop_closure import LoopClosure
 from .rolling_contact import RollingWheel
@@ -293,16 +294,33 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
 
 def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     """:math:`A^T\\lambda = \\mathrm{RNEA}(q, v, a) - B\\tau - \\sum J_t^T F_t` and the per-wheel and per-closure
-    forces, at a state whose accelerations are known."""
-    model, data = robot.model, robot.data
-    kin = KinematicState(model, data, q, v)
-    B = input_matrix(robot.motors, kin)
-    e = pin.rnea(model, data, q, v, a) - B @ tau
-    for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
-        e -= Jt.T @ force
+    forces, at a state whose accelerations are known (``rows``: the constraint rows there, ``None``: computed here).
+    Without friction forces and where the robot's compiled model serves, e, :math:`\\lambda` on the projection's
+    rows and the wheels' contact frames come from one compiled call (:meth:`robotdyn.compiled.CompiledModel.
+    forces_at`) and :math:`\\lambda` is made minimum-norm with the null space of :math:`A^T` (:func:`_from_basic`),
+    the Python path's choice on undetermined rows; else all of it in Python."""
+    served = None if friction else _compiled_forces(robot, q, v, a, tau)
+    if rows is None:  # the rows at (q, v): the compiled evaluation's, else the Python path's
+        if served is not None:
+            fast = compiled_model(robot)
+            rows = ConstraintRows(served[3], None, np.zeros(len(fast.labels)), fast.holonomic, list(fast.labels))
+        else:
+            rows = robot.constraint_rows(KinematicState(robot.model, robot.data, q, v))
     A = rows.A
-    with np.errstate(all="ignore"):  # an overflow is refused below as a NonFiniteError, in one line
-        lam, N, rank, residual, condition = _solve_transpose(A, e)
+    if served is not None:  # lambda on the projection's rows and the wheels' contact frames, in C++
+        lam_basic, e, (_, _, frames, points), _ = served
+        geometry = {id(w): (f.reshape(3, 3).T, p) for w, f, p in zip(compiled_model(robot).wheels, frames, points)}
+        with np.errstate(all="ignore"):
+            lam, N, rank, residual, condition = _from_basic(A, e, lam_basic)
+    else:
+        model, data = robot.model, robot.data
+        kin = KinematicState(model, data, q, v)
+        B = input_matrix(robot.motors, kin)
+        e = pin.rnea(model, data, q, v, a) - B @ tau
+        for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
+            e -= Jt.T @ force
+        with np.errstate(all="ignore"):  # an overflow is refused below as a NonFiniteError, in one line
+            lam, N, rank, residual, condition = _solve_transpose(A, e)
     determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
     out = ConstraintForces(list(rows.labels), lam, determined, N, rank, residual, nudot, tau)
     out.condition = condition
@@ -314,7 +332,12 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     for c in robot.constraints:
         if isinstance(c, RollingWheel):
             fr = friction.get(c.name, (None, None))[1]
-            out.wheels.append(_wheel_force(c, kin, index, lam, N, fr))
+            if served is not None:
+                E, p = geometry[id(c)]
+            else:
+                geo = c._geometry(kin)
+                E, p = geo[9], geo[5]
+            out.wheels.append(_wheel_force(c, E, p, index, lam, N, fr))
             out._tangential.append(([index[lab] for lab in c._labels()], c._directions, fr))
         elif isinstance(c, LoopClosure):
             out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
@@ -356,8 +379,7 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
         return out
 
     qt, vt, at = lift(q), lift(v), lift(a)
-    rows = twin.constraint_rows(KinematicState(twin.model, twin.data, qt, vt))
-    out = _forces(twin, qt, vt, at, tau, rows, {}, nudot)
+    out = _forces(twin, qt, vt, at, tau, None, {}, nudot)  # (the twin's rows: compiled where it serves)
     if out.residual > TWIN_RESIDUAL:
         planar.undetermined_reason.append(
             f"the wheels cannot hold this planar model's out-of-plane equilibrium (relative residual "
@@ -367,6 +389,39 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
     out.notes.append("normal loads from the out-of-plane equilibrium (vertical force, roll and pitch moments) of the "
                      "same description on a floating root: the planar root's z, roll and pitch are held by the ground")
     return out
+
+
+def _compiled_forces(robot, q, v, a, tau):
+    """``(lambda on the projection's rows, e, wheel forces and frames)`` by the robot's compiled model
+    (:meth:`robotdyn.compiled.CompiledModel.forces_at`), or ``None`` where it does not serve."""
+    from .compiled import Fallback
+
+    fast = compiled_model(robot)
+    if fast is None:
+        return None
+    try:
+        return fast.forces_at(np.asarray(q, float), np.asarray(v, float), np.asarray(a, float),
+                              np.asarray(tau, float))
+    except Fallback:
+        return None
+
+
+def _from_basic(A: np.ndarray, e: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float, float]:
+    """As :func:`_solve_transpose`, from a solution ``lam`` of :math:`A^T\\lambda = e` (the compiled one, zero on
+    redundant rows): the same null space, rank and condition number (SVD), and the minimum-norm solution
+    :math:`\\lambda - NN^T\\lambda` (the same values on the determined rows; the Python path's choice on the
+    others)."""
+    m = A.shape[0]
+    if m == 0:
+        return np.zeros(0), np.zeros((0, 0)), 0, float(np.linalg.norm(e) / max(1.0, np.linalg.norm(e))), 1.0
+    _, s, Vt = np.linalg.svd(A.T, full_matrices=True)
+    tol = s.max(initial=0.0) * max(A.shape) * np.finfo(float).eps
+    rank = int(np.sum(s > tol))
+    N = Vt[rank:].T
+    lam = lam - N @ (N.T @ lam)
+    scale = max(np.linalg.norm(e), 1.0)
+    condition = float(s[0] / s[rank - 1]) if rank else 1.0
+    return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale), condition
 
 
 def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float, float]:
@@ -386,12 +441,10 @@ def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale), condition
 
 
-def _wheel_force(wheel: RollingWheel, kin: KinematicState, index: dict, lam: np.ndarray,
+def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict, lam: np.ndarray,
                  N: np.ndarray, friction: np.ndarray | None = None) -> WheelForce:
-    """A wheel's force in its contact frame, from its rows' multipliers (row i acts along D[i] of (t1, t2, n));
-    a slipping wheel's tangential part is its friction force (t1, t2)."""
-    geo = wheel._geometry(kin)
-    E, p = geo[9], geo[5]
+    """A wheel's force in its contact frame (E: columns t1, t2, n; contact point p), from its rows' multipliers
+    (row i acts along D[i] of (t1, t2, n)); a slipping wheel's tangential part is its friction force (t1, t2)."""
     labels = wheel._labels()
     idx = [index[lab] for lab in labels]
     D = wheel._directions

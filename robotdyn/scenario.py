@@ -19,7 +19,8 @@ class Scenario:
         name: Identifier (``robotdyn simulate ROBOT --scenario NAME``).
         description: One line, citing the paper's section.
         t_end: Default duration [s].
-        torque: Motor torques ``tau(t, q, nu)`` (None: unactuated).
+        torque: Motor torques: a :class:`~robotdyn.torque_profile.TorqueProfile` (simulated by the compiled engine)
+            or any ``tau(t, q, nu)`` (the scipy engine); None: unactuated.
         q0, nu0: Initial coordinates and independent velocities by name (missing entries are zero).
         n_out: Default number of output samples.
         plot: Columns to plot (the paper's figures); default all independent velocities.

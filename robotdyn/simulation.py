@@ -4,11 +4,12 @@ State: natural coordinates q (n) and independent velocities nu (k). The ODE is
 
 .. math:: \\dot q = S(q)\\nu - \\alpha\\, A_h^+ \\phi(q),\\qquad M_r \\dot\\nu = B_r \\tau(t, q, \\nu) - C_r\\nu - g_r,
 
-integrated with scipy's ``solve_ivp``; the right-hand side is one call of the robot's compiled model
-(:mod:`robotdyn.compiled`) where it serves the robot, else the Python path. Velocity constraints hold exactly
-(v = S nu by construction); the position residuals :math:`\\phi` of holonomic rows (loop closures, contacts on a
-sloped or curved terrain) are pulled back with the stabilisation gain :math:`\\alpha` [1/s] (0 disables it) and
-reported.
+integrated either wholly in C++ (:mod:`robotdyn.compiled_simulation`, where the robot is compiled and the torques
+are a :class:`~robotdyn.torque_profile.TorqueProfile`) or by scipy's ``solve_ivp`` loop (the reference), whose
+right-hand side is one call of the robot's compiled model (:mod:`robotdyn.compiled`) where it serves the robot,
+else the Python path. Velocity constraints hold exactly (v = S nu by construction); the position residuals
+:math:`\\phi` of holonomic rows (loop closures, contacts on a sloped or curved terrain) are pulled back with the
+stabilisation gain :math:`\\alpha` [1/s] (0 disables it, :mod:`robotdyn.pull_back`) and reported.
 """
 
 from __future__ import annotations
@@ -21,11 +22,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .compiled import Fallback, compiled_model
+from .compiled_simulation import METHODS, choose_engine, simulate_compiled
 from .errors import NonFiniteError, RobotDynError
 from .projection import solve
+from .pull_back import correction, failure_note, start_offsets
 from .reduced_dynamics import velocity
 from .sliding import forward as forward_sliding
 from .sliding import slipping_wheels
+from .torque_profile import TorqueProfile, as_profile
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
@@ -111,22 +115,34 @@ def simulate(
     n_out: int = 1001,
     rtol: float = 1e-10,
     atol: float = 1e-12,
-    method: str = "DOP853",
+    method: str | None = None,
     stabilisation: float = 10.0,
     progress: bool = True,
+    engine: str = "auto",
 ) -> Trajectory:
     """Integrate the reduced equations from (q0, nu0) over [0, t_end].
+
+    Two engines integrate the same ODE: the compiled one (:mod:`robotdyn.compiled_simulation`: the whole run in
+    C++, Boost.Odeint's adaptive Adams-Bashforth-Moulton by default) and scipy's (``solve_ivp``'s DOP853 loop, the
+    reference, with a Python call per evaluation). Both restart at the breakpoints of a torque profile. ``engine="auto"`` takes the compiled one where the robot has a compiled
+    model (:func:`robotdyn.compiled.why_not`), no slipping wheels, and the torques are ``None`` or a
+    :class:`~robotdyn.torque_profile.TorqueProfile` (a Python callable needs the scipy engine); ``stats["engine"]``
+    says which ran.
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot`.
         t_end: Final time [s] (> 0).
         q0: Initial natural coordinates (must satisfy the holonomic constraints).
         nu0: Initial independent velocities.
-        torque: Motor torques ``tau(t, q, nu)``; ``None`` for no actuation.
+        torque: Motor torques: a :class:`~robotdyn.torque_profile.TorqueProfile`, any callable ``tau(t, q, nu)``
+            (scipy engine), or ``None`` for no actuation.
         n_out: Number of output samples.
-        rtol, atol, method: Passed to ``scipy.integrate.solve_ivp``.
-        stabilisation: Gain [1/s] pulling holonomic residuals back to zero.
+        rtol, atol: Error tolerances (relative, absolute per component) of either engine.
+        method: The integrator: a ``scipy.integrate.solve_ivp`` method (default DOP853) or one of
+            :data:`robotdyn.compiled_simulation.METHODS` (default adams); it selects the engine too.
+        stabilisation: Gain [1/s] pulling holonomic residuals back to zero (:mod:`robotdyn.pull_back`).
         progress: Print progress to stderr on long runs.
+        engine: ``auto``, ``compiled`` (an error naming why where it cannot run) or ``scipy``.
     """
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
@@ -136,12 +152,20 @@ def simulate(
                             f"expected 2 to {MAX_SAMPLES:,} samples: give a shorter duration or fewer samples")
     q0 = robot.check_q(q0)
     nu0 = robot.check_nu(nu0)
+    if isinstance(torque, TorqueProfile):
+        as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
     robot.check_constraints(q0)
+    offsets = start_offsets(robot, q0, stabilisation)
+    compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.compiled_simulation
     if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):  # exact switching: segment by segment
         from .stick_slip import simulate as simulate_stick_slip
 
-        return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol, method,
-                                   stabilisation, progress)
+        return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
+                                   method or "DOP853", stabilisation, progress)
+    if compiled_engine:
+        return simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
+                                 stabilisation, progress, offsets)
+    method = method or "DOP853"
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
     report = _Progress(t_end, progress)
@@ -195,12 +219,14 @@ def simulate(
     y0 = np.concatenate([q0, nu0, [0.0] if slipping else []])
     interrupted = None
     if events is None:
-        sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol)
+        breaks = torque.breakpoints() if isinstance(torque, TorqueProfile) else ()
+        sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks)
     else:
         sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
     wall = time.perf_counter() - start
     if not sol.success:
-        raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}")
+        raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}"
+                            + failure_note(robot, sol.y[:n, -1], stabilisation))
     stats_event = None
     if slipping and sol.status == 1:  # a slipping wheel's load reached zero: the contact model ends there
         t_ev, y_ev = sol.t_events[0][0], sol.y_events[0][0]
@@ -224,49 +250,64 @@ def simulate(
         times, q, nu, energy, residual = sol.t[:i], q[:i], nu[:i], energy[:i], residual[:i]
         interrupted = (f"interrupted after the integration, while computing energies: samples up to t = "
                        f"{times[-1] if i else 0.0:.6g} s of {t_end:g} s")
-    stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol}
+    stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol, "engine": f"scipy ({method})"}
     if interrupted is not None:
         stats["partial"] = interrupted
     if stats_event:
         stats["event"] = stats_event
+    if offsets:
+        stats["offsets"] = offsets
     return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
                       robot.units, sol.y[n + k][: len(times)] if slipping else None)
 
 
-def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarray, rtol: float, atol: float):
+def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarray, rtol: float, atol: float,
+               breaks=()):
     """scipy's ``solve_ivp`` loop (the same solver, steps and dense output at ``t_eval``, so the same numbers),
     written out so that an interruption (Ctrl-C, SIGTERM) keeps what was computed: returns the solution object
-    and, if interrupted, a message saying up to which time the samples reach."""
+    and, if interrupted, a message saying up to which time the samples reach. The solver is restarted at each of
+    ``breaks`` inside (0, t_end) (the kinks of a torque profile), so that no step spans one."""
     from types import SimpleNamespace
 
-    from scipy.integrate._ivp.ivp import METHODS
+    from scipy.integrate._ivp.ivp import METHODS as SCIPY
 
-    solver = METHODS[method](rhs, 0.0, y0, t_end, rtol=rtol, atol=atol)
-    ts, ys, i, status, message, interrupted = [], [], 0, None, "", None
+    bounds = [0.0, *sorted(float(b) for b in breaks if 0.0 < b < t_end), t_end]
+    ts, ys, i, status, message, interrupted, nfev = [], [], 0, None, "", None, 0
+    y, solver = y0, None
     try:
-        while status is None:
-            message = solver.step()
-            if solver.status == "finished":
-                status = 0
-            elif solver.status == "failed":
-                status = -1
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            if solver is not None:
+                nfev += solver.nfev
+            solver = SCIPY[method](rhs, a, y, b, rtol=rtol, atol=atol)
+            status = None
+            while status is None:
+                message = solver.step()
+                if solver.status == "finished":
+                    status = 0
+                elif solver.status == "failed":
+                    status = -1
+                    break
+                j = np.searchsorted(t_eval, solver.t, side="right")
+                if j > i:
+                    dense = solver.dense_output()
+                    ts.append(t_eval[i:j])
+                    ys.append(np.atleast_2d(dense(t_eval[i:j])).reshape(len(y0), j - i))
+                    i = j
+            if status == -1:
                 break
-            j = np.searchsorted(t_eval, solver.t, side="right")
-            if j > i:
-                dense = solver.dense_output()
-                ts.append(t_eval[i:j])
-                ys.append(np.atleast_2d(dense(t_eval[i:j])).reshape(len(y0), j - i))
-                i = j
+            y = solver.y
     except KeyboardInterrupt:
         status = 0
         del ts[len(ys):], ys[len(ts):]  # the signal may fall between the two appends
         reached = float(ts[-1][-1]) if ts else 0.0
-        interrupted = f"interrupted at t = {solver.t:.6g} s: samples up to t = {reached:.6g} s of {t_end:g} s"
+        now = solver.t if solver is not None else 0.0
+        interrupted = f"interrupted at t = {now:.6g} s: samples up to t = {reached:.6g} s of {t_end:g} s"
+    nfev += solver.nfev if solver is not None else 0
     t = np.concatenate(ts) if ts else np.zeros(0)
     y = np.hstack(ys) if ys else np.zeros((len(y0), 0))
     if status == -1:
         t, y = np.append(t, solver.t), np.column_stack([y, solver.y]) if y.size else solver.y[:, None]
-    return SimpleNamespace(t=t, y=y, success=status >= 0, message=message or "", nfev=solver.nfev,
+    return SimpleNamespace(t=t, y=y, success=status >= 0, message=message or "", nfev=nfev,
                            status=status), interrupted
 
 
@@ -276,7 +317,7 @@ def _qdot(red, stabilisation: float) -> np.ndarray:
     rows = red.jacobian_rows
     hol = rows.holonomic
     if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
-        qdot = qdot - stabilisation * np.linalg.lstsq(rows.A[hol], rows.residual[hol], rcond=None)[0]
+        qdot = qdot - stabilisation * correction(rows.A[hol], rows.residual[hol])
     return qdot
 
 

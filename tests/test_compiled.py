@@ -527,12 +527,12 @@ def test_simulate_rectilinear_equals_python(quasimoro_m):
     fast = compiled_model(rob)
     spy = _Spy(fast, "rhs")
     try:
-        fast_traj = scenario.run(rob, t_end=3.0, progress=False)
+        fast_traj = scenario.run(rob, t_end=3.0, progress=False, engine="scipy")  # scipy's loop, compiled rhs
     finally:
         spy.remove()
     assert spy.served > 50 and spy.served == spy.calls
     with use_compiled(False):
-        ref = scenario.run(rob, t_end=3.0, progress=False)
+        ref = scenario.run(rob, t_end=3.0, progress=False, engine="scipy")
     assert fast_traj.q.shape == ref.q.shape
     assert np.abs(fast_traj.q - ref.q).max() <= 1e-8
     assert np.abs(fast_traj.nu - ref.nu).max() <= 1e-8
@@ -557,7 +557,7 @@ def test_simulate_energy_conserved(name, coordinate, value, nu0):
     fast = compiled_model(rob)
     spy = _Spy(fast, "rhs")
     try:
-        traj = simulate(rob, 3.0, q0, nu0, None, n_out=301, progress=False)
+        traj = simulate(rob, 3.0, q0, nu0, None, n_out=301, progress=False, engine="scipy")
     finally:
         spy.remove()
     assert spy.served == spy.calls > 0

@@ -40,6 +40,7 @@ from ..scenario import Scenario
 from ..sliding import SlippingWheel
 from ..statics import solve_contact_forces
 from ..terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
+from ..torque_profile import Constant
 
 WHEELS = ("fr", "fl", "r")
 """Wheel tags: front right, front left, rear (eq 8)."""
@@ -826,7 +827,7 @@ class HoldScenario(Scenario):
         red = robot.reduced(q0, np.zeros(robot.mobility))
         tau, *_ = np.linalg.lstsq(red.B, red.g, rcond=None)
         self.holding = tau
-        self.torque = lambda t, q, nu: tau
+        self.torque = Constant(tau)  # torques as data: simulated by the compiled engine
         return q0, np.zeros(robot.mobility)
 
 

@@ -18,6 +18,7 @@ import numpy as np
 from ..comparison import Comparison, quadratic_coefficients
 from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
 from ..scenario import Scenario
+from ..torque_profile import Sine
 
 SPEC = RobotSpec(
     name="quasimoro",
@@ -50,7 +51,13 @@ PULSE_AMPLITUDE = 0.1
 
 def _pulse(t: float) -> float:
     """Eq 19: m° sin(pi t) for 0 <= t <= 1 s, zero afterwards."""
-    return PULSE_AMPLITUDE * np.sin(np.pi * t) if t <= 1.0 else 0.0
+    return PULSE_AMPLITUDE * np.sin(np.pi * t) if 0.0 <= t <= 1.0 else 0.0
+
+
+def pulse(signs: tuple[float, float]) -> Sine:
+    """Eq 19 on both motors as a torque profile (compiled: robotdyn.torque_profile): m_i = sign_i m° sin(pi t) for
+    0 <= t <= 1 s, zero afterwards."""
+    return Sine([signs[0] * PULSE_AMPLITUDE, signs[1] * PULSE_AMPLITUDE], np.pi, start=0.0, stop=1.0)
 
 
 SCENARIOS = {
@@ -58,7 +65,7 @@ SCENARIOS = {
         "rectilinear",
         "section 3, 1°: m1 = m2 = 0.1 sin(pi t) N m for t <= 1 s, then free; robot initially at rest (90 s)",
         90.0,
-        torque=lambda t, q, nu: np.array([_pulse(t), _pulse(t)]),
+        torque=pulse((1.0, 1.0)),
         plot=["theta1", "theta3", "theta1_dot", "theta3_dot"],  # Figs. 2-9
         zoom=4.0,  # the paper's window 0 .. dt + 3 s
         references={"theta3": [(0.0129, "paper: +-0.0129 rad"), (-0.0129, "")]},
@@ -67,7 +74,7 @@ SCENARIOS = {
         "pure_rotation",
         "section 3, 2°: m1 = -m2 = 0.1 sin(pi t) N m for t <= 1 s, then free; robot initially at rest (90 s)",
         90.0,
-        torque=lambda t, q, nu: np.array([_pulse(t), -_pulse(t)]),
+        torque=pulse((1.0, -1.0)),
         plot=["theta1", "theta1_dot", "psi", "theta3"],  # Figs. 10-13, plus psi and the level body
         zoom=4.0,
     ),

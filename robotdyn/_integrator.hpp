@@ -1,0 +1,213 @@
+// A whole simulation in C++: Boost.Odeint's error-controlled steppers driven to the requested sample times
+// (robotdyn/compiled_simulation.py is the Python side; robotdyn/simulation.py's scipy loop the reference).
+//
+// Two drivers:
+//  - run_sampled, for odeint's variable-step, variable-order Adams-Bashforth-Moulton (controlled_adams_bashforth_
+//    moulton, orders 1..8, PECE with a PI step-size controller; the default): it steps exactly onto every sample
+//    time (no interpolation) and every breakpoint, where it restarts the multistep history (a kink of the torque
+//    profile must not lie inside the interpolation that Adams formulas rest on);
+//  - run_dense, for dense-output steppers (bulirsch_stoer_dense_out: Bulirsch-Stoer extrapolation; dopri5:
+//    Dormand-Prince 5(4)): the samples inside each accepted step are interpolated (the steps do not depend on the
+//    sampling); the stepper is restarted at breakpoints too.
+// Both call `poll` every ~50 ms of wall time (progress, Ctrl-C, a stop flag), refuse a vanishing step size and a
+// non-finite state (FAILED), and let an exception of the right-hand side propagate.
+#pragma once
+
+#include <boost/numeric/odeint/stepper/bulirsch_stoer_dense_out.hpp>
+#include <boost/numeric/odeint/stepper/dense_output_runge_kutta.hpp>
+#include <boost/numeric/odeint/stepper/generation.hpp>
+#include <boost/numeric/odeint/stepper/runge_kutta_dopri5.hpp>
+#include <boost/numeric/odeint/stepper/adaptive_adams_bashforth_moulton.hpp>
+#include <boost/numeric/odeint/stepper/controlled_adams_bashforth_moulton.hpp>
+#include <boost/numeric/odeint/util/odeint_error.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace robotdyn {
+
+namespace odeint = boost::numeric::odeint;
+using State = std::vector<double>;
+
+enum Status { DONE = 0, INTERRUPTED = 1, FAILED = 3 };
+
+// How a run ended: DONE (t_end reached), INTERRUPTED (poll said stop), FAILED (the step size vanished or the
+// state became non-finite).
+struct Outcome {
+  int status = DONE;
+  double t = 0.0;  // time of the last accepted step
+  State y;         // state there
+  std::string message;
+  long steps = 0;
+};
+
+// One error-controlled run from (t0, y0) to t_end. `samples` are the requested output times (sorted), `next`
+// the index of the first one still to emit (updated); observer(t, y) receives them in order. `breaks`: sorted
+// times never stepped across.
+template <class Stepper, class System, class Observer, class Poll>
+Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, double t_end,
+                  const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
+                  double dt0, Observer&& observer, Poll&& poll) {
+  Outcome out;
+  out.t = t0;
+  out.y = y0;
+  const double eps = std::numeric_limits<double>::epsilon();
+  auto reached = [&](double t, double target) { return target - t <= 8.0 * eps * std::max(1.0, std::fabs(target)); };
+  size_t b = 0;
+  while (b < breaks.size() && breaks[b] <= t0 + 8.0 * eps * std::max(1.0, std::fabs(t0))) ++b;
+  // samples at the start time itself
+  while (next < samples.size() && samples[next] <= t0) observer(samples[next++], y0);
+  auto sys = [&system](const State& x, State& dxdt, double t) { system(x, dxdt, t); };
+  double limit = std::min(b < breaks.size() ? breaks[b] : t_end, t_end);
+  stepper.initialize(y0, t0, std::min(dt0, limit - t0));
+  State y(y0.size());
+  auto clock = std::chrono::steady_clock::now();
+  while (!reached(stepper.current_time(), t_end)) {
+    const double tc = stepper.current_time();
+    if (reached(tc, limit)) {  // a breakpoint: restart there (the stepper's memory spans a kink otherwise)
+      ++b;
+      limit = std::min(b < breaks.size() ? breaks[b] : t_end, t_end);
+      stepper.initialize(State(stepper.current_state()), tc, std::min(stepper.current_time_step(), limit - tc));
+      continue;
+    }
+    if (tc + stepper.current_time_step() > limit)
+      stepper.initialize(State(stepper.current_state()), tc, limit - tc);
+    const double h = stepper.current_time_step();
+    if (!(h > 8.0 * eps * std::max(1.0, std::fabs(tc)))) {
+      out.status = FAILED;
+      out.message = "Required step size is less than spacing between numbers.";
+      return out;
+    }
+    try {
+      stepper.do_step(sys);
+    } catch (const odeint::step_adjustment_error& e) {  // odeint: too many failed steps in a row
+      out.status = FAILED;
+      out.message = e.what();
+      return out;
+    }
+    const double t1 = stepper.current_time();
+    const State& x1 = stepper.current_state();
+    for (double v : x1)
+      if (!std::isfinite(v)) {
+        out.status = FAILED;
+        out.message = "the state became non-finite";
+        return out;
+      }
+    ++out.steps;
+    while (next < samples.size() && (samples[next] <= t1 || (samples[next] <= t_end && reached(t1, t_end)))) {
+      const double ts = samples[next++];
+      if (ts >= t1) {
+        observer(ts, x1);
+      } else {
+        stepper.calc_state(ts, y);
+        observer(ts, y);
+      }
+    }
+    out.t = t1;
+    out.y = x1;
+    if ((out.steps & 15) == 0) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - clock > std::chrono::milliseconds(50)) {
+        clock = now;
+        if (!poll(t1)) {
+          out.status = INTERRUPTED;
+          return out;
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// A controlled multistep stepper (Adams) stepping exactly onto every sample (no interpolation) and breakpoint, and
+// restarted (reset) at breakpoints. A step that would end within 1 % of a target is stretched onto it.
+template <class Stepper, class System, class Observer, class Poll>
+Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0, double t_end,
+                    const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
+                    double dt0, Observer&& observer, Poll&& poll) {
+  Outcome out;
+  const double eps = std::numeric_limits<double>::epsilon();
+  auto reached = [&](double t, double target) { return target - t <= 8.0 * eps * std::max(1.0, std::fabs(target)); };
+  size_t b = 0;
+  while (b < breaks.size() && breaks[b] <= t0) ++b;
+  while (next < samples.size() && samples[next] <= t0) observer(samples[next++], y0);
+  auto sys = [&system](const State& x, State& dxdt, double t) { system(x, dxdt, t); };
+  State x = y0;
+  double t = t0, dt_nat = dt0;
+  int rejected = 0;
+  auto clock = std::chrono::steady_clock::now();
+  while (!reached(t, t_end)) {
+    double target = t_end;
+    if (next < samples.size()) target = std::min(target, samples[next]);
+    if (b < breaks.size()) target = std::min(target, breaks[b]);
+    const bool truncated = t + 1.01 * dt_nat >= target;
+    double dt = truncated ? target - t : dt_nat;
+    if (!(dt > 8.0 * eps * std::max(1.0, std::fabs(t)))) {
+      out.status = FAILED;
+      out.message = "Required step size is less than spacing between numbers.";
+      break;
+    }
+    if (stepper.try_step(sys, x, t, dt) != odeint::success) {
+      dt_nat = dt;
+      if (++rejected > 1000) {
+        out.status = FAILED;
+        out.message = "1000 rejected steps in a row";
+        break;
+      }
+      continue;
+    }
+    rejected = 0;
+    dt_nat = truncated ? std::max(dt, dt_nat) : dt;
+    ++out.steps;
+    if (truncated) t = target;  // land exactly
+    if (b < breaks.size() && reached(t, breaks[b])) {  // a kink: the multistep history must not span it
+      while (b < breaks.size() && reached(t, breaks[b])) ++b;
+      stepper.reset();
+      dt_nat = std::min(dt_nat, dt0);
+    }
+    while (next < samples.size() && reached(t, samples[next])) observer(samples[next++], x);
+    if ((out.steps & 15) == 0) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - clock > std::chrono::milliseconds(50)) {
+        clock = now;
+        if (!poll(t)) {
+          out.status = INTERRUPTED;
+          break;
+        }
+      }
+    }
+  }
+  out.t = t;
+  out.y = x;
+  return out;
+}
+
+// Adams (default), Bulirsch-Stoer or Dormand-Prince 5(4) at tolerances rtol, atol on every component (odeint's
+// error checkers, max norm: |err_i| <= atol + rtol (|y_i| + dt |dy_i/dt|) for adams and dopri5,
+// atol + rtol |y_i| for bulirsch_stoer).
+template <class System, class Observer, class Poll>
+Outcome integrate(const std::string& method, System& system, const State& y0, double t0, double t_end,
+                  const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks, double rtol,
+                  double atol, Observer&& observer, Poll&& poll) {
+  const double dt0 = std::min(1e-3, 1e-3 * (t_end - t0));
+  if (method == "bulirsch_stoer") {
+    odeint::bulirsch_stoer_dense_out<State> stepper(atol, rtol, 1.0, 0.0);
+    return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll);
+  }
+  if (method == "dopri5") {
+    auto stepper = odeint::make_dense_output(atol, rtol, odeint::runge_kutta_dopri5<State>());
+    return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll);
+  }
+  if (method == "adams") {
+    using Adams = odeint::controlled_adams_bashforth_moulton<odeint::adaptive_adams_bashforth_moulton<8, State>>;
+    Adams stepper(typename Adams::step_adjuster_type(atol, rtol, 1.0));
+    return run_sampled(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll);
+  }
+  throw std::invalid_argument("unknown compiled integrator " + method + "; expected adams, bulirsch_stoer or dopri5");
+}
+
+}  // namespace robotdyn

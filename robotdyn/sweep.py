@@ -34,6 +34,8 @@ from .sweep_chunk import RunContext, load_source, run_chunk
 from .sweep_plan import Plan, plan
 from .sweep_spec import RunInput, SweepSpec, from_toml
 
+CONNECT_TIMEOUT = "20s"
+"""How long to try reaching a Dask scheduler given by address."""
 load = sweep_store.load
 load_trajectory = sweep_store.load_trajectory
 
@@ -110,7 +112,7 @@ def _connect(stack: ExitStack, workers: int, scheduler: str | None):
 
     if scheduler is not None:
         try:
-            client = stack.enter_context(Client(scheduler, timeout="20s"))
+            client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT))
         except (OSError, TimeoutError, ValueError) as exc:
             raise RobotDynError(f"cannot reach the Dask scheduler at {scheduler!r} ({exc}); expected an address "
                                 "like tcp://HOST:8786 of a running scheduler") from None
@@ -128,7 +130,8 @@ def _connect(stack: ExitStack, workers: int, scheduler: str | None):
     if workers < 1:
         raise RobotDynError(f"workers = {workers}; expected at least 1 (or 0: in this process, without Dask)")
     cluster = stack.enter_context(LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+        n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",  # the scheduler's HTTP server on a free local port, never a fixed one
         silence_logs=logging.ERROR, preload=["robotdyn.sweep_chunk"]))  # each worker imports robotdyn once
     return stack.enter_context(Client(cluster))
 

@@ -198,13 +198,14 @@ def _one(ctx: RunContext, run: RunInput) -> tuple[dict, dict | None]:
     traj_out = None
     try:
         robot, traj, torque = simulate_run(ctx, run)
+        if "partial" in traj.stats:  # simulate() kept what it had when interrupted: the sweep stops, not the run
+            raise KeyboardInterrupt
         row.update(summary(load_source(ctx.source), robot, traj, torque, ctx.columns))
         bad = [k for k, v in row.items() if isinstance(v, float) and not np.isfinite(v) and k != "wall"]
         if bad:
             raise RobotDynError(f"non-finite result ({', '.join(bad[:3])}): the dynamics blew up")
-        for key in ("event", "partial"):
-            if key in traj.stats:
-                row["status"], row["error"] = "stopped", str(traj.stats[key])
+        if "event" in traj.stats:  # e.g. a slipping wheel lifting off: the run ends there by the model's rules
+            row["status"], row["error"] = "stopped", str(traj.stats["event"])
         if ctx.trajectories:
             traj_out = {"t": traj.t, **{c: traj.q[:, i] for i, c in enumerate(traj.coordinates)},
                         **{c: traj.nu[:, i] for i, c in enumerate(traj.velocity_names)},

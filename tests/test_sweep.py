@@ -269,3 +269,24 @@ def test_cli_end_to_end(tmp_path):
              "print('dask' in sys.modules, 'pyarrow' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True).stdout.split() == [
         "False", "False"]  # the sweep command costs the other commands no start-up time
+
+
+def test_sigterm_stops_the_sweep_and_keeps_what_finished(tmp_path):
+    """SIGTERM (like Ctrl-C) during a run stops the sweep, not just that run (simulate() keeps partial results of
+    an interruption: the sweep must not record them as a finished run); exit status 130, a rerun resumes."""
+    import signal
+    import time
+
+    out = tmp_path / "s"
+    argv = [sys.executable, "-m", "robotdyn", "sweep", "quasimoro", "--vary", "torque_scale=1,1e300,1e299",
+            "--t-end", "0.5", "--workers", "0", "--chunk-size", "1", "--out", str(out), "--quiet", "--no-plot"]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list((out / "runs").glob("part-*.parquet")) and time.monotonic() < deadline:
+        time.sleep(0.2)  # the first run (torques x 1) is written; the second one crawls
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "interrupted after 1 of 3 runs; run the same sweep again to resume" in err
+    assert sweep.load(out).status.tolist() == ["ok"]

@@ -100,14 +100,19 @@ def sweep_throughput(n: int | None = None, t_end: float = 2.0) -> None:
           f"robotdyn.sweep.run on a local Dask cluster (cluster start included)")
     tables, rates = {}, {}
     for workers in (1, 2):
+        before = os.times()
         with tempfile.TemporaryDirectory() as out:
             res = sweep.run(spec, out, workers=workers, progress=False, plot=False)
+        after = os.times()  # the workers' CPU time: they are this process's (reaped) descendants
+        cpu = after.children_user + after.children_system - before.children_user - before.children_system
         rates[workers] = res.computed / res.wall
         tables[workers] = {k: v for k, v in res.table.to_pydict().items() if k not in ("wall", "run_wall")}
-        print(f"  {workers} worker(s): {res.wall:7.1f} s wall, {rates[workers]:7.1f} runs/s ({res.statuses})")
+        print(f"  {workers} worker(s): {res.wall:7.1f} s wall, {rates[workers]:7.1f} runs/s, workers' CPU {cpu:.1f} s "
+              f"({cpu / res.wall:.2f} cores busy on average; {res.statuses})")
     same = tables[1] == tables[2]
     print(f"  2 workers / 1 worker: {rates[2] / rates[1]:.2f}x (target >= 1.8x); results bit-for-bit identical: "
-          f"{'yes' if same else 'NO'}")
+          f"{'yes' if same else 'NO'}  (machine load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores: "
+          "fewer cores busy than workers means other processes took them)")
 
 
 def side_by_side() -> None:

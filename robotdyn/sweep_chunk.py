@@ -62,7 +62,8 @@ class RunTimeLimit(RobotDynError):
 
 @functools.lru_cache(maxsize=8)
 def _load(source_key: tuple):
-    """The robot module or constraint file of a source (cached per process)."""
+    """The robot module or constraint file of a source (cached per process; a constraint file's source holds
+    the digest of its bytes, so an edited file is read again)."""
     source = dict(source_key)
     if "robot" in source:
         from .robots import module
@@ -138,13 +139,19 @@ def _limited(torque, motors: int, limit: float | None, t_end: float):
     return tau
 
 
+SCENARIO_LAW = "the scenario's own torque law"
+"""The torque law a :func:`simulate_run` reports for scenarios that build theirs inside their ``run``."""
+
+
 def simulate_run(ctx: RunContext, run: RunInput):
-    """Simulate one run: (robot, trajectory, torque law or ``None`` when the scenario builds its own)."""
+    """Simulate one run: (robot, trajectory, torque law: a function, ``None`` without torques, or
+    :data:`SCENARIO_LAW` when the scenario builds its own)."""
     from .simulation import simulate
 
     robot, scenario, t_end, n_out = prepare(ctx, run)
     if overrides_run(scenario):
-        return robot, scenario.run(robot, t_end=t_end, n_out=n_out, progress=False, **ctx.tolerances), None
+        traj = scenario.run(robot, t_end=t_end, n_out=n_out, progress=False, **ctx.tolerances)
+        return robot, traj, SCENARIO_LAW
     q0, nu0 = scenario.initial_state(robot)  # may set the scenario's torque law (it is a copy)
     torque = _scaled(scenario.torque, run.torque_scale)
     limited = _limited(torque, len(robot.motors), ctx.time_limit, t_end)
@@ -156,9 +163,9 @@ def energy_drift(traj, torque) -> float | None:
     """Largest :math:`|E(t) - E(t_0)|` [J] over the output samples from the first one after which the motor
     torques are zero at every sample (the whole run without torques), with the friction work of slipping wheels
     added back; ``None`` when the torques never stop or are built by the scenario itself."""
+    if torque is SCENARIO_LAW:
+        return None
     if torque is None:
-        if traj.stats.get("controller") is not None:
-            return None
         start = 0
     else:
         active = [bool(np.any(np.asarray(torque(t, q, nu), float) != 0.0))

@@ -61,10 +61,13 @@ def _source(spec: SweepSpec) -> tuple[dict, dict]:
         if spec.urdf is not None:
             raise SweepSpecError("urdf = ... goes with constraints = FILE, not with a registered robot")
         return {"robot": spec.robot}, {"robot": spec.robot}
-    source = {"constraints": str(Path(spec.constraints).resolve()), "urdf": spec.urdf,
-              "xacro_args": dict(spec.xacro_args)}
+    path = Path(spec.constraints).resolve()
+    if not path.is_file():
+        raise SweepSpecError(f"constraint file {spec.constraints!r} not found")
+    source = {"constraints": str(path), "urdf": spec.urdf, "xacro_args": dict(spec.xacro_args),
+              "digest": _digest(path)}
     description = load_source(source).SPEC.xacro
-    return source, {"constraints": _digest(source["constraints"]), "description": _digest(description),
+    return source, {"constraints": source["digest"], "description": _digest(description),
                     "xacro_args": dict(spec.xacro_args)}
 
 
@@ -94,7 +97,7 @@ def _terrain(mod, item, scenarios) -> tuple[str, tuple]:
         values = {k: float(v) for k, v in args.items()}
     except (TypeError, ValueError):
         raise SweepSpecError(f"terrain {item!r}: arguments must be numbers") from None
-    label = kind + ("(" + ", ".join(f"{k}={v:g}" for k, v in values.items()) + ")" if values else "")
+    label = kind + ("(" + ", ".join(f"{k}={v!r}" for k, v in values.items()) + ")" if values else "")
     definition = ("kind", kind, values)
     try:
         build_terrain(mod, definition)
@@ -147,6 +150,8 @@ def plan(spec: SweepSpec) -> Plan:
             raise SweepSpecError(f"robot {robot.spec.name!r} has no wheel on a terrain; expected no terrains")
         for item in spec.terrains:
             label, definition = _terrain(mod, item, chosen)
+            if label in terrains:
+                raise SweepSpecError(f"terrain {label!r} listed twice; expected distinct terrains")
             terrains[label] = definition
     names = robot.coordinates + robot.velocity_names
     columns = spec.columns or names

@@ -5,9 +5,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .sweep_spec import TORQUE_SCALE
-
-
 def default_column(plan) -> str:
     """The column plotted when the spec names none: the maximum of the first chosen column, else the final
     value of the first coordinate."""
@@ -44,9 +41,8 @@ def plot_summary(table, plan, path, column: str | None = None) -> Path:
     unit = plan.units.get(column, "")
     for k, name in enumerate(xs):
         ax = axes[k // cols][k % cols]
-        key = name if name != TORQUE_SCALE else "torque_scale"
         for label, idx in groups.items():
-            ax.plot([data[key][i] for i in idx], [data[column][i] for i in idx], "o", ms=3, alpha=0.7, label=label)
+            ax.plot([data[name][i] for i in idx], [data[column][i] for i in idx], "o", ms=3, alpha=0.7, label=label)
         xunit = plan.units.get(name, "")
         ax.set_xlabel(f"{name} [{xunit}]" if xunit and xunit != "-" else name)
         ax.set_ylabel(f"{column} [{unit}]" if unit else column)

@@ -46,7 +46,9 @@ DEFAULT_TIME_LIMIT = 600.0
 """Wall-clock limit [s] of one run by default (0 or ``None``: none): a crawling run becomes an error row."""
 MAX_RUNS = 1_000_000
 """Largest number of runs of one sweep (a larger one is refused before anything runs)."""
-RESERVED = ("run_id", "run_index", "robot", "scenario", "terrain", "status", "error", "t_end")
+RESERVED = ("run_id", "run_index", "robot", "scenario", "terrain", "status", "error", "t_end", "t_reached", "drift",
+            "nfev", "wall", "run_wall")
+"""Column names of the results that no varied parameter may take."""
 TOP_KEYS = ("robot", "constraints", "urdf", "xacro_args", "fixed", "parameters", "scenarios", "terrains", "sample",
             "n", "seed", "t_end", "n_out", "rtol", "atol", "columns", "trajectories", "plot_column", "time_limit")
 _VALUE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*")
@@ -300,6 +302,9 @@ def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
     if spec.sample not in SAMPLERS:
         raise SweepSpecError(f"sample = {spec.sample!r}; expected one of {', '.join(SAMPLERS)}")
     if spec.sample == "grid":
+        if spec.n is not None:
+            raise SweepSpecError(f"n = {spec.n} samples with sample = 'grid'; expected sample = 'lhs' or 'random' "
+                                 "(a grid's size is its axes' points)")
         grids = [a.grid() for a in axes]
         return [dict(zip([a.name for a in axes], combo)) for combo in itertools.product(*grids)]
     ranged = [a for a in axes if a.ranged]

@@ -104,6 +104,20 @@ def test_dask_gives_the_same_bits_and_leaves_nothing_running(reference, tmp_path
     assert _listening(me) - ports == set()  # and so are its ports
 
 
+def test_on_a_running_cluster_by_its_address(reference, tmp_path):
+    """--scheduler ADDRESS: the sweep connects to a cluster it did not start (here one of threads in this
+    process), checks that its workers run this robotdyn, and leaves the cluster running."""
+    import logging
+
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address="127.0.0.1:0",
+                      silence_logs=logging.ERROR) as cluster:
+        res = sweep.run(small_spec(), tmp_path, scheduler=cluster.scheduler_address, progress=False, plot=False)
+        assert numbers(res.table) == numbers(reference.table)
+        assert cluster.scheduler.status.name == "running" and len(cluster.workers) == 1
+
+
 def test_interrupted_sweep_resumes_without_recomputing(reference, tmp_path, monkeypatch):
     calls = []
 

@@ -30,7 +30,8 @@ class RunContext:
     """What every run of a sweep shares, sent with each chunk.
 
     Attributes:
-        source: ``{"robot": name}`` or ``{"constraints": path, "urdf": path | None, "xacro_args": {...}}``.
+        source: ``{"robot": name}`` or ``{"constraints": path, "urdf": path | None, "xacro_args": {...},
+            "digest": sha256 of the file}`` (workers read the file by its path: on a cluster, a shared one).
         fixed: Parameter values held for every run (name -> value text).
         terrains: Terrain definitions by label: ``("named", name)`` (the robot module's ``TERRAINS``) or
             ``("kind", kind, {arg: value})`` (:data:`robotdyn.constraint_file.TERRAINS`).

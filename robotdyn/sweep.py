@@ -181,7 +181,8 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
         out: The sweep directory (created; a rerun there resumes: finished runs are not computed again).
         workers: Worker processes of the local Dask cluster (0: in this process, without Dask).
         scheduler: Address of a running Dask scheduler (e.g. ``tcp://host:8786``) instead of a local cluster.
-        chunk_size: Runs per Dask task (default: about 8 tasks per worker, at most 64 runs each).
+        chunk_size: Runs per Dask task (default: about 32 tasks per worker, at most 32 runs each,
+            so that the last tasks leave no worker idle for long).
         progress: Progress lines on stderr.
         retry_errors: Compute the runs again whose rows on disk are errors (others are kept).
         plot: Write ``summary.png`` (the plot column against each varied parameter).
@@ -202,7 +203,7 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     n_workers = workers
     if client is not None:
         n_workers = len(client.scheduler_info()["workers"]) or 1
-    size = chunk_size or max(1, min(64, math.ceil(len(todo) / (8 * max(n_workers, 1)))))
+    size = chunk_size or max(1, min(32, math.ceil(len(todo) / (32 * max(n_workers, 1)))))
     if size < 1:
         raise RobotDynError(f"chunk_size = {chunk_size}; expected at least 1 run per chunk")
     report = _Progress(len(p.runs), resumed, progress)

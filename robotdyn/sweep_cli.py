@@ -49,7 +49,7 @@ def register(sub, parents) -> None:
     p.add_argument("--workers", type=int, default=None,
                    help="worker processes of the local Dask cluster (default: one per CPU; 0: in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786")
-    p.add_argument("--chunk-size", type=int, help="runs per Dask task (default: about 8 tasks per worker)")
+    p.add_argument("--chunk-size", type=int, help="runs per Dask task (default: about 32 tasks per worker)")
     p.add_argument("--time-limit", type=float, metavar="SECONDS",
                    help="wall-clock limit of one run (default 600; 0: none): beyond it the run is an error row")
     p.add_argument("--retry-errors", action="store_true", help="compute again the runs that ended in an error")

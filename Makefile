@@ -51,8 +51,10 @@ docs: $(DOCS_STAMP)
 	$(PY) -m sphinx -b html -W --keep-going -c docs $(SPHINXOPTS) . docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"
 
-## make bench: speed of the reduced model against raw Pinocchio, side by side in one run
+## make bench: speed of the reduced model against raw Pinocchio, side by side in one run; MuJoCo on the same
+## manoeuvre and sweep throughput on Dask (the `bench` extra of pyproject.toml, installed here without a rebuild)
 bench: $(STAMP)
+	$(PY) -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['bench']))" | xargs $(PY) -m pip install --quiet
 	$(PY) bench/bench.py
 
 clean:

@@ -5,7 +5,9 @@ the compiled model (robotdyn.compiled, views of its buffers), by robot.reduced (
 by the Python path -- next to Pinocchio's CRBA + RNEA on the same model, their ratios; for Quasimoro also the sympy-derived model lambdified
 with numpy (tests/oracles); and simulated seconds per wall-clock second of the robot's first scenario with the
 constraint drift at the end (for Quasimoro also DOP853 at rtol 1e-8 and LSODA at rtol 1e-10, each with its
-deviation from the default DOP853 rtol 1e-10 run); the batch API next to robot.reduced in a loop. This is a benchmark, not a test: it asserts nothing.
+deviation from the default DOP853 rtol 1e-10 run); the batch API next to robot.reduced in a loop; Quasimoro's
+'rectilinear' manoeuvre side by side with MuJoCo and sweep throughput on Dask (side_by_side.py). This is a
+benchmark, not a test: it asserts nothing.
 """
 
 from __future__ import annotations
@@ -138,10 +140,19 @@ def main() -> None:
                       f"{drift_fn(robot, other):>9.1e}  (max |q - q(default)| = {dev:.1e})")
 
     forces_bench()
+    side_by_side_bench()
     startup_bench()
     compiled_engine_bench()
     compiled_forces_bench()
     simulate_many_bench()
+
+
+def side_by_side_bench() -> None:
+    """Quasimoro's manoeuvre by robotdyn and by MuJoCo, and sweep throughput on 1 and 2 Dask workers (issue 17;
+    bench/side_by_side.py, bench/mujoco_quasimoro.py)."""
+    from side_by_side import side_by_side
+
+    side_by_side()
 
 
 def startup_bench() -> None:

@@ -1,4 +1,4 @@
-"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view`` plus robot-specific commands
+"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep`` plus robot-specific commands
 (every command has ``--json``).
 
 Robot modules may add their own subcommands by defining ``register_cli(subparsers, parents)``; each such
@@ -463,6 +463,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--open", action="store_true", help="open the live viewer in the default web browser")
     p.add_argument("--quiet", action="store_true", help="no simulation progress on stderr")
     p.set_defaults(func=cmd_view)
+    from .sweep_cli import register as register_sweep  # the command imports Dask only when it runs
+
+    register_sweep(sub, [common, robot_args])
 
     from .robots import module, names
 

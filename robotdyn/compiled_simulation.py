@@ -134,15 +134,16 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
 def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, stabilisation, progress,
                        offsets) -> Trajectory:
     """:func:`robotdyn.simulation.simulate` on the compiled engine (:func:`run`), after its checks: a
-    :class:`~robotdyn.simulation.Trajectory` with ``stats["engine"]``."""
-    from .simulation import Trajectory, _Progress
+    :class:`~robotdyn.simulation.Trajectory` with ``stats["engine"]``. ``progress`` is the run's reporter
+    (``robotdyn.simulation._Progress``: prints, and raises past the run's time limit)."""
+    from .simulation import Trajectory
 
     profile = as_profile(torque, len(robot.motors))
     robot.forward_dynamics(q0, nu0, profile(0.0))  # regular where the run starts (raises the Python path's error)
     fast = compiled_model(robot)
     start = time.perf_counter()
     out = run(robot, fast, t_end, q0, nu0, profile, np.linspace(0.0, t_end, n_out), rtol, atol,
-                       stabilisation, method, _Progress(t_end, True) if progress else None)
+                       stabilisation, method, progress if progress.needed else None)
     wall = time.perf_counter() - start
     n = robot.nq
     stats = {"nfev": out["nfev"], "steps": out["steps"], "wall": wall, "method": method, "rtol": rtol,

@@ -43,6 +43,10 @@ class NonFiniteError(RobotDynError):
     """A computed result that is not finite (NaN or infinite): never returned as a number."""
 
 
+class TimeLimitError(RobotDynError):
+    """A simulation that exceeded its wall-clock time limit (``simulate(..., time_limit=...)``)."""
+
+
 class OutputError(RobotDynError):
     """An output file that cannot be written (missing directory, a directory, no permission, full disk, format)."""
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from .compiled import Fallback, compiled_model
 from .compiled_simulation import METHODS, choose_engine, simulate_compiled
-from .errors import NonFiniteError, RobotDynError
+from .errors import NonFiniteError, RobotDynError, TimeLimitError
 from .projection import solve
 from .pull_back import correction, failure_note, start_offsets
 from .reduced_dynamics import velocity
@@ -91,17 +91,26 @@ class Trajectory:
 
 
 class _Progress:
-    """Prints the simulated time to stderr at most once a second, once the run has taken more than a second."""
+    """Prints the simulated time to stderr at most once a second, once the run has taken more than a second, and
+    raises :class:`~robotdyn.errors.TimeLimitError` once the run has taken longer than its wall-clock limit."""
 
-    def __init__(self, t_end: float, enabled: bool) -> None:
-        self.t_end, self.enabled = t_end, enabled
+    def __init__(self, t_end: float, enabled: bool, time_limit: float | None = None) -> None:
+        self.t_end, self.enabled, self.time_limit = t_end, enabled, time_limit
         self.start = self.last = time.perf_counter()
 
+    @property
+    def needed(self) -> bool:
+        """Whether calling it can do anything (print or stop)."""
+        return self.enabled or self.time_limit is not None
+
     def __call__(self, t: float) -> None:
-        if not self.enabled:
+        if not self.needed:
             return
         now = time.perf_counter()
-        if now - self.last >= 1.0:
+        if self.time_limit is not None and now - self.start > self.time_limit:
+            raise TimeLimitError(f"the run exceeded its time limit of {self.time_limit:g} s at t = {t:.3g} s of "
+                                 f"{self.t_end:g} s (a stiff or blown-up run; a longer time limit allows more)")
+        if self.enabled and now - self.last >= 1.0:
             self.last = now
             print(f"simulate: t = {t:.2f} / {self.t_end:g} s ({100 * t / self.t_end:.0f}%)", file=sys.stderr, flush=True)
 
@@ -119,6 +128,7 @@ def simulate(
     stabilisation: float = 10.0,
     progress: bool = True,
     engine: str = "auto",
+    time_limit: float | None = None,
 ) -> Trajectory:
     """Integrate the reduced equations from (q0, nu0) over [0, t_end].
 
@@ -143,9 +153,14 @@ def simulate(
         stabilisation: Gain [1/s] pulling holonomic residuals back to zero (:mod:`robotdyn.pull_back`).
         progress: Print progress to stderr on long runs.
         engine: ``auto``, ``compiled`` (an error naming why where it cannot run) or ``scipy``.
+        time_limit: Wall-clock limit of the run [s] (None: none): past it the run raises
+            :class:`~robotdyn.errors.TimeLimitError` (checked at every evaluation on the Python paths, about every
+            50 ms on the compiled engine), so that a stiff or blown-up run in a sweep cannot stall it.
     """
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
+    if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
+        raise RobotDynError(f"time_limit = {time_limit} s; expected a positive wall-clock duration or None")
     if not 2 <= n_out <= MAX_SAMPLES:
         width = 2 * robot.nq + 3
         raise RobotDynError(f"{n_out:.3g} output samples for t_end = {t_end:g} s ({8 * width * n_out / 1e9:.3g} GB); "
@@ -161,14 +176,14 @@ def simulate(
         from .stick_slip import simulate as simulate_stick_slip
 
         return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
-                                   method or "DOP853", stabilisation, progress)
+                                   method or "DOP853", stabilisation, progress, time_limit=time_limit)
     if compiled_engine:
         return simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
-                                 stabilisation, progress, offsets)
+                                 stabilisation, _Progress(t_end, progress, time_limit), offsets)
     method = method or "DOP853"
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
-    report = _Progress(t_end, progress)
+    report = _Progress(t_end, progress, time_limit)
 
     from scipy.integrate import solve_ivp
 

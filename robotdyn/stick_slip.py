@@ -100,7 +100,7 @@ def _forces(robot, q, nu, tau):
 
 def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: float = 1e-10,
              atol: float = 1e-12, method: str = "DOP853", stabilisation: float = 10.0, progress: bool = True,
-             max_switches: int = 10_000):
+             max_switches: int = 10_000, time_limit: float | None = None):
     """Integrate a robot with stick-slip wheels over [0, t_end] from (q0, v0), switching phases exactly.
 
     Args:
@@ -111,6 +111,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         torque: Motor torques ``tau(t, q, nu)`` (None: unactuated); nu are the current phase's independent
             velocities, so torque laws should use q (or the returned full velocities) only.
         max_switches: Bound on the number of phase switches (Zeno behaviour stops the run with a message).
+        time_limit: Wall-clock limit [s] (None: none), as in :func:`robotdyn.simulation.simulate`.
 
     Returns:
         A :class:`~robotdyn.simulation.Trajectory` whose velocity columns are the full velocities v (named
@@ -119,7 +120,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     """
     from scipy.integrate import solve_ivp
 
-    from .simulation import Trajectory, _qdot
+    from .simulation import Trajectory, _Progress, _qdot
 
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
@@ -141,6 +142,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     start = time.perf_counter()
     nfev = 0
     last_report = start
+    limit = _Progress(t_end, False, time_limit)  # raises past the time limit (the reports are printed below)
     while True:
         robot._stick_slip_q = q
         _configure(robot)
@@ -172,6 +174,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
             nfev += 1
             qq, nn = y[:n], y[n:n + k]
             tau = tau_at(tt, qq, nn)
+            limit(tt)
             if progress and time.perf_counter() - last_report > 1.0:
                 last_report = time.perf_counter()
                 print(f"simulate: t = {tt:.3f} / {t_end:g} s", file=sys.stderr, flush=True)

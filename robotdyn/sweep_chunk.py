@@ -23,6 +23,7 @@ import numpy as np
 from .errors import RobotDynError
 from .scenario import Scenario
 from .sweep_spec import RunInput
+from .torque_profile import TorqueProfile
 
 
 @dataclass(frozen=True)
@@ -40,9 +41,9 @@ class RunContext:
         columns: Columns whose maximum and minimum are summarised.
         trajectories: Also return each run's trajectory.
         compiled: Whether the compiled fast path is on (as in the process that planned the sweep).
-        time_limit: Wall-clock limit [s] of one run (``None``: none), checked at every evaluation of a torque
-            profile (not in scenarios that build their own torque law): a run that crawls (a stiff or blown-up
-            state) becomes an error row instead of stalling the sweep.
+        time_limit: Wall-clock limit [s] of one run (``None``: none), ``simulate(..., time_limit=...)`` (not in
+            scenarios that build their own torque law): a run that crawls (a stiff or blown-up state) becomes an
+            error row instead of stalling the sweep.
     """
 
     source: dict
@@ -55,10 +56,6 @@ class RunContext:
     trajectories: bool = False
     compiled: bool = True
     time_limit: float | None = None
-
-
-class RunTimeLimit(RobotDynError):
-    """A run that exceeded the sweep's time limit per run."""
 
 
 @functools.lru_cache(maxsize=8)
@@ -118,26 +115,12 @@ def _robot(mod, params: dict, terrain):
 
 
 def _scaled(torque, scale: float):
+    """The torques times the run's scale: a profile stays a profile (the compiled engine runs it)."""
     if torque is None or scale == 1.0:
         return torque
+    if isinstance(torque, TorqueProfile):
+        return torque.scaled(scale)
     return lambda t, q, nu: scale * np.asarray(torque(t, q, nu), float)
-
-
-def _limited(torque, motors: int, limit: float | None, t_end: float):
-    """The torque law (zero when ``None``: the same numbers as no torques) that raises :class:`RunTimeLimit`
-    once the run has taken ``limit`` seconds of wall-clock time."""
-    if limit is None:
-        return torque
-    deadline = time.perf_counter() + limit
-    zero = np.zeros(motors)
-
-    def tau(t, q, nu):
-        if time.perf_counter() > deadline:
-            raise RunTimeLimit(f"the run exceeded its time limit of {limit:g} s at t = {t:.3g} s of {t_end:g} s "
-                               "(a stiff or blown-up run; a longer time_limit allows more)")
-        return zero if torque is None else torque(t, q, nu)
-
-    return tau
 
 
 SCENARIO_LAW = "the scenario's own torque law"
@@ -155,8 +138,8 @@ def simulate_run(ctx: RunContext, run: RunInput):
         return robot, traj, SCENARIO_LAW
     q0, nu0 = scenario.initial_state(robot)  # may set the scenario's torque law (it is a copy)
     torque = _scaled(scenario.torque, run.torque_scale)
-    limited = _limited(torque, len(robot.motors), ctx.time_limit, t_end)
-    traj = simulate(robot, t_end, q0, nu0, limited, n_out=n_out, progress=False, **ctx.tolerances)
+    traj = simulate(robot, t_end, q0, nu0, torque, n_out=n_out, progress=False, time_limit=ctx.time_limit,
+                    **ctx.tolerances)
     return robot, traj, torque
 
 

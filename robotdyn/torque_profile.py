@@ -94,6 +94,10 @@ class TorqueProfile:
             return NotImplemented
         return Sum(self, other)
 
+    def scaled(self, factor: float) -> TorqueProfile:
+        """The profile times a finite scalar ``factor`` (every term's coefficients scaled)."""
+        return Scaled(self, factor)
+
     def __eq__(self, other) -> bool:
         if not isinstance(other, TorqueProfile):
             return NotImplemented
@@ -202,6 +206,23 @@ class Sum(TorqueProfile):
         return " + ".join(repr(p) for p in self.parts)
 
 
+class Scaled(TorqueProfile):
+    """A profile times a scalar (:meth:`TorqueProfile.scaled`)."""
+
+    def __init__(self, part: TorqueProfile, factor: float) -> None:
+        if not isinstance(part, TorqueProfile):
+            raise InputError("only a TorqueProfile can be scaled as a profile")
+        if not math.isfinite(factor):
+            raise InputError(f"torque scale {factor!r}; expected a finite number")
+        self.part, self.factor = part, float(factor)
+
+    def _terms(self):
+        return [(kind, self.factor * coef, par) for kind, coef, par in self.part._terms()]
+
+    def __repr__(self) -> str:
+        return f"{self.factor:g} * ({self.part!r})"
+
+
 def as_profile(torque, motors: int) -> TorqueProfile | None:
     """``torque`` as a profile for a robot with ``motors`` motors: ``None`` (no torque) as zero constants, a
     profile as itself (checked), anything else (a Python callable) as ``None``, meaning "Python only"."""
@@ -214,4 +235,4 @@ def as_profile(torque, motors: int) -> TorqueProfile | None:
     return None
 
 
-__all__ = ["TorqueProfile", "Constant", "Sine", "Table", "Sum", "as_profile"]
+__all__ = ["TorqueProfile", "Constant", "Sine", "Table", "Sum", "Scaled", "as_profile"]

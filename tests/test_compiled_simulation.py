@@ -163,3 +163,22 @@ def test_interrupted_compiled_simulation_keeps_its_samples(sig):
     assert engine == "compiled" and int(samples) >= 2 and float(last) < 1e5 and increasing == "True"
     assert "interrupted at t =" in " ".join(partial)
     assert time.time() - start < 30
+
+
+@pytest.mark.parametrize("engine", ["compiled", "scipy"])
+def test_time_limit_stops_a_crawling_run_on_both_engines(quasimoro, engine):
+    """Torques x 1e6 make the error control crawl (tiny steps): past its wall-clock limit the run raises a named
+    error saying where it was, within a poll interval of the limit; a run inside its limit is untouched."""
+    from robotdyn.errors import TimeLimitError
+
+    q0, nu0 = quasimoro.neutral(), np.zeros(quasimoro.mobility)
+    start = time.perf_counter()
+    with pytest.raises(TimeLimitError, match=r"exceeded its time limit of 0.3 s at t = "):
+        simulate(quasimoro, 0.5, q0, nu0, Sine([1e5, 1e5], np.pi), progress=False, engine=engine, time_limit=0.3)
+    assert 0.3 < time.perf_counter() - start < 1.5
+    free = simulate(quasimoro, 0.5, q0, nu0, Sine([0.1, 0.1], np.pi), progress=False, engine=engine)
+    limited = simulate(quasimoro, 0.5, q0, nu0, Sine([0.1, 0.1], np.pi), progress=False, engine=engine,
+                       time_limit=60.0)
+    assert np.array_equal(free.q, limited.q)
+    with pytest.raises(RobotDynError, match="time_limit = -1 s; expected a positive"):
+        simulate(quasimoro, 0.5, q0, nu0, progress=False, engine=engine, time_limit=-1)

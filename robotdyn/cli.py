@@ -466,7 +466,14 @@ def build_parser() -> argparse.ArgumentParser:
     from .sweep_cli import register as register_sweep  # the command imports Dask only when it runs
 
     register_sweep(sub, [common, robot_args])
+    parser.commands = sub.choices  # name -> subparser (the built-in ones until robot_commands() adds theirs)
+    parser.robot_commands = lambda: _add_robot_commands(sub, [common, robot_args])
+    return parser
 
+
+def _add_robot_commands(sub, parents) -> None:
+    """The commands that robot modules add (``register_cli``): importing every robot module costs start-up time,
+    so :func:`main` adds them only when the command is not a built-in one (or for ``--help``)."""
     from .robots import module, names
 
     for name in names():
@@ -477,8 +484,7 @@ def build_parser() -> argparse.ArgumentParser:
             continue
         hook = getattr(mod, "register_cli", None)
         if hook is not None:
-            hook(sub, [common, robot_args])
-    return parser
+            hook(sub, parents)
 
 
 def _one_line_warnings() -> None:
@@ -505,6 +511,10 @@ def main(argv: list[str] | None = None) -> int:
     _one_line_warnings()
     try:
         parser = build_parser()
+        argv = sys.argv[1:] if argv is None else list(argv)
+        command = next((a for a in argv if not a.startswith("-")), None)
+        if command is None or command not in parser.commands:
+            parser.robot_commands()  # a robot module's command, or --help listing them all
         args = parser.parse_args(argv)
         with np.errstate(all="ignore"):  # non-finite results are refused explicitly (NonFiniteError), in one line
             return int(args.func(args) or 0)

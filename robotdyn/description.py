@@ -87,24 +87,32 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
             ``ROS_PACKAGE_PATH``/``AMENT_PREFIX_PATH``); no ROS installation is needed.
 
     Returns:
-        The URDF XML text.
+        The URDF XML text (from :mod:`robotdyn.description_cache` when none of the files it reads changed).
 
     Raises:
         MissingPackagesError: Packages the description includes were not found (all of them, at once).
         DescriptionError: The file is missing or xacro cannot expand it.
     """
-    import xacro
-
-    from .ros_packages import MISSING_ROOT, MissingPackagesError, PackageIndex, required_packages, xacro_find
+    from . import description_cache
+    from .ros_packages import PackageIndex
 
     path = Path(path)
     if not path.is_file():
         raise DescriptionError(f"description file not found: {path}")
     mappings = {str(k): xacro_value(str(k), v) for k, v in (args or {}).items()}
     index = packages if packages is not None else PackageIndex.create()
+    cached = description_cache.lookup(path, mappings, index)
+    if cached is not None:
+        return cached
+    import xacro
+
+    from .ros_packages import MISSING_ROOT, MissingPackagesError, required_packages, xacro_find
+
     with xacro_find(index) as missing:
         try:
-            doc = xacro.process_file(str(path), mappings=mappings)
+            first = len(xacro.all_includes)
+            doc = xacro.process_file(str(path), mappings=dict(mappings))  # xacro adds the defaults to it
+            read = list(xacro.all_includes[first:])
         except Exception as exc:  # xacro raises a variety of exception types
             msg = " ".join(str(exc).split()) or type(exc).__name__
             needed = {m for m in missing if f"{MISSING_ROOT}/{m}" in msg}
@@ -113,7 +121,9 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
             if needed:
                 raise MissingPackagesError(needed, f"cannot expand xacro {path.name}: ") from None
             raise DescriptionError(f"cannot expand xacro {path.name}: {msg}") from None
-    return doc.toxml()
+    urdf = doc.toxml()
+    description_cache.store(path, mappings, index, read, urdf)
+    return urdf
 
 
 _CHECKS = 1
@@ -121,13 +131,13 @@ _CHECKS = 1
 cache of validated texts does not skip a new check)."""
 
 
-def _validated_cache() -> Path:
-    """The file listing the URDF texts (by SHA-256, with yourdfpy's version) that passed :func:`validate_urdf`:
-    ``$ROBOTDYN_CACHE`` or ``~/.cache/robotdyn``."""
-    import os
+def _validated_cache() -> Path | None:
+    """The file listing the URDF texts (by SHA-256, with yourdfpy's stamp) that passed :func:`validate_urdf`, in
+    :func:`robotdyn.description_cache.cache_dir` (None: caching is off)."""
+    from .description_cache import cache_dir
 
-    root = os.environ.get("ROBOTDYN_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "robotdyn")
-    return Path(root) / "validated-urdf.txt"
+    root = cache_dir()
+    return None if root is None else root / "validated-urdf.txt"
 
 
 def validate_urdf(urdf: str) -> None:
@@ -140,16 +150,20 @@ def validate_urdf(urdf: str) -> None:
         DescriptionError: naming the first problem found.
     """
     import hashlib
-    from importlib.metadata import version
 
-    key = f"{hashlib.sha256(urdf.encode()).hexdigest()} yourdfpy-{version('yourdfpy')} checks-{_CHECKS}"
+    from .description_cache import package_stamp
+
+    stamp = hashlib.sha256(package_stamp("yourdfpy").encode()).hexdigest()[:16]
+    key = f"{hashlib.sha256(urdf.encode()).hexdigest()} yourdfpy-{stamp} checks-{_CHECKS}"
     cache = _validated_cache()
     try:
-        if key in cache.read_text().split("\n"):
+        if cache is not None and key in cache.read_text().split("\n"):
             return
     except OSError:
         pass
     _validate_with_yourdfpy(urdf)
+    if cache is None:
+        return
     try:  # remember it (atomically; a cache that cannot be written only costs time)
         from .output import atomic_output
 

@@ -28,19 +28,19 @@ from functools import partial
 import numpy as np
 import pinocchio as pin
 
-from ..actuation import input_matrix
-from ..comparison import Comparison
-from ..constraint import KinematicState
-from ..errors import ConstraintError, InputError, RobotDynError
-from ..friction import LinearTyre, RegularisedCoulomb
-from ..joint_coupling import CosineLaw, JointCoupling
-from ..robot import MotorSpec, Parameter, Robot, RobotSpec
-from ..rolling_contact import OmniWheel, RollingWheel
-from ..scenario import Scenario
-from ..sliding import SlippingWheel
-from ..statics import solve_contact_forces
-from ..terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
-from ..torque_profile import Constant
+from ...actuation import input_matrix
+from ...comparison import Comparison
+from ...constraint import KinematicState
+from ...errors import ConstraintError, InputError, RobotDynError
+from ...friction import LinearTyre, RegularisedCoulomb
+from ...joint_coupling import CosineLaw, JointCoupling
+from ...robot import MotorSpec, Parameter, Robot, RobotSpec
+from ...rolling_contact import OmniWheel, RollingWheel
+from ...scenario import Scenario
+from ...sliding import SlippingWheel
+from ...statics import solve_contact_forces
+from ...terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
+from ...torque_profile import Constant
 
 WHEELS = ("fr", "fl", "r")
 """Wheel tags: front right, front left, rear (eq 8)."""
@@ -674,7 +674,7 @@ class MissionModel:
 
     def state(self, t: float) -> tuple[Commands, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(commands, IK solution, q, v, a) at time t (natural coordinates of the model)."""
-        from ..reduced_dynamics import reduce
+        from ...reduced_dynamics import reduce
 
         cmd, x = self.ik_at(t)
         q = model_configuration(self.slip, cmd, x)
@@ -790,7 +790,7 @@ def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None =
         params: Parameter overrides (e.g. ``mu``).
         every: Use every n-th step of the run.
     """
-    from ..sliding import inverse
+    from ...sliding import inverse
 
     if lateral not in ("coulomb", "linear"):
         raise InputError(f"lateral = {lateral!r}; expected a friction law: coulomb or linear")
@@ -890,8 +890,8 @@ def cmd_ik(args) -> int:
     """``robotdyn ik adaptable_wheel --commands x_d y_d h_CG q_xd q_yd q_zd``: eqs 4-24 and the static torques."""
     import json
 
-    from ..cli import _jsonable
-    from ..inputs import as_vector, parse_assignments
+    from ...cli import _jsonable
+    from ...inputs import as_vector, parse_assignments
 
     if args.robot != SPEC.name:
         raise InputError(f"ik is implemented for {SPEC.name} only, not {args.robot!r}")

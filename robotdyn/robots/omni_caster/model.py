@@ -23,11 +23,11 @@ import dataclasses
 
 import numpy as np
 
-from ..comparison import Comparison
-from ..errors import InputError, SingularConstraintError
-from ..operational_space import OperationalVelocities
-from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ..scenario import Scenario
+from ...comparison import Comparison
+from ...errors import InputError, SingularConstraintError
+from ...operational_space import OperationalVelocities
+from ...robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from ...scenario import Scenario
 
 CHAINS = (1, 2, 3)
 NU_NAMES = ["v_cx", "v_cy", "omega"]
@@ -213,7 +213,7 @@ def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
     eta_i' is the offset link's absolute yaw rate (its frame Jacobian), theta_i', phi_i' the joint rates; all from
     S of the operational projection (the model's constraint Jacobians).
     """
-    from ..constraint import KinematicState
+    from ...constraint import KinematicState
 
     red = robot.reduced(q, np.zeros(3))
     kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
@@ -444,7 +444,7 @@ class PathScenario(Scenario):
         return torque
 
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
-        from ..simulation import simulate
+        from ...simulation import simulate
 
         t_end, n_out = self.span(t_end, n_out)
         q0, nu0 = self.initial_state(robot)
@@ -476,7 +476,7 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
     Returns:
         {figure: (angles [rad], magnitudes [N s])} for :data:`IMPULSE_CONFIGS`.
     """
-    from ..impulse import impulse_curve
+    from ...impulse import impulse_curve
 
     out = {}
     for name, deg in IMPULSE_CONFIGS.items():
@@ -486,9 +486,9 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
 
 
 def _cmd_impulse(args) -> int:
-    from ..cli import _emit, _load
-    from ..impulse import impact
-    from ..inputs import as_vector
+    from ...cli import _emit, _load
+    from ...impulse import impact
+    from ...inputs import as_vector
 
     _, robot = _load(args)
     q = robot.check_q(args.q)
@@ -615,7 +615,7 @@ def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Com
     fit = fit_printed_matrix(p, starts=20)
     cmp.add("sec 5 printed with-wheel I_uu*: best fit over steering angles (max |residual|)", 0.0, fit["max_abs"],
             5e-4, "phi = (" + ", ".join(f"{np.degrees(x):.1f}" for x in fit["phi"]) + ") deg")
-    from ..impulse import impulse_curve
+    from ...impulse import impulse_curve
 
     for name, deg in IMPULSE_CONFIGS.items():
         Mi = robot.reduced(steering_configuration(robot, np.radians(deg)), np.zeros(3)).M

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..comparison import Comparison, quadratic_coefficients
-from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ..scenario import Scenario
-from ..torque_profile import Sine
+from ...comparison import Comparison, quadratic_coefficients
+from ...robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from ...scenario import Scenario
+from ...torque_profile import Sine
 
 SPEC = RobotSpec(
     name="quasimoro",

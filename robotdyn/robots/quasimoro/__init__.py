@@ -1,0 +1,4 @@
+"""The robot ``quasimoro``: its model and its paper (see the modules of this package)."""
+
+from .model import *  # noqa: F401,F403
+from .model import _pulse  # noqa: F401

@@ -14,7 +14,11 @@ from robotdyn.errors import RobotDynError
 from robotdyn.joint_coupling import JointCoupling
 from robotdyn.projection import project
 from robotdyn.robot import Robot
-from robotdyn.robots import adaptable_wheel as aw
+from robotdyn.robots.adaptable_wheel import model as aw
+from robotdyn.robots.adaptable_wheel import paper as aw_paper
+from robotdyn.robots.adaptable_wheel import missions as aw_missions
+from robotdyn.robots.adaptable_wheel import dynamics as aw_dyn
+from robotdyn.robots.adaptable_wheel import comparison as aw_cmp
 
 
 @pytest.fixture(scope="module")
@@ -29,19 +33,19 @@ def slip_robot():
 
 @pytest.fixture(scope="module")
 def mission1():
-    return aw.run_mission("mission1")
+    return aw_missions.run_mission("mission1")
 
 
 @pytest.fixture(scope="module")
 def mission2():
-    return aw.run_mission("mission2")
+    return aw_missions.run_mission("mission2")
 
 
 def _state(robot, t=0.7, qx=0.04, qy=-0.03, seed=0):
     """A configuration on the constraint manifold (from the IK) and an admissible velocity."""
-    cmd = aw.Commands(np.sin(t), np.cos(t), 0.15, qx, qy, -t)
-    x, err, _ = aw.solve_ik(cmd, robot.params, robot.terrain)
-    q = aw.model_configuration(robot, cmd, x, spins=np.array([0.3, -1.1, 2.0]))
+    cmd = aw_paper.Commands(np.sin(t), np.cos(t), 0.15, qx, qy, -t)
+    x, err, _ = aw_paper.solve_ik(cmd, robot.params, robot.terrain)
+    q = aw_cmp.model_configuration(robot, cmd, x, spins=np.array([0.3, -1.1, 2.0]))
     nu = np.random.default_rng(seed).normal(size=robot.mobility)
     return q, robot.reduced(q, nu).v
 
@@ -65,13 +69,13 @@ def test_wheel_positions_eq8(robot):
     import pinocchio as pin
     pin.forwardKinematics(robot.model, robot.data, q)
     pin.updateFramePlacements(robot.model, robot.data)
-    off = aw.offsets(robot.params)
+    off = aw_paper.offsets(robot.params)
     z = q[robot.coordinate_index("z")]
     for tag in aw.WHEELS:
         c = robot.data.oMf[robot.model.getFrameId(f"wheel_{tag}")].translation
         np.testing.assert_allclose(c, off[tag] + [0, 0, z], atol=1e-14)
     full = Robot(aw.SPEC, {"L_reading": "full"})
-    np.testing.assert_allclose(aw.offsets(full.params)["fr"], [0.3, -0.3, 0.0])
+    np.testing.assert_allclose(aw_paper.offsets(full.params)["fr"], [0.3, -0.3, 0.0])
 
 
 def test_residuals_solvable_and_AS_zero(robot, slip_robot):
@@ -105,9 +109,9 @@ def test_coupling_law_is_eq1_and_eq33(robot):
     w = robot.params["w"]
     c = next(c for c in robot.constraints if c.name == "eq1_fr")
     for q in np.linspace(0.0, np.pi, 7):
-        assert c.law(q) == pytest.approx(aw.radius_law(q, w), abs=1e-15)
-        assert c.dlaw(q) == pytest.approx(aw.radius_law_d(q, w), abs=1e-15)
-        assert c.ddlaw(q) == pytest.approx(aw.radius_law_dd(q, w), abs=1e-15)
+        assert c.law(q) == pytest.approx(aw_paper.radius_law(q, w), abs=1e-15)
+        assert c.dlaw(q) == pytest.approx(aw_paper.radius_law_d(q, w), abs=1e-15)
+        assert c.ddlaw(q) == pytest.approx(aw_paper.radius_law_dd(q, w), abs=1e-15)
         h = 1e-5
         assert c.dlaw(q) == pytest.approx((c.law(q + h) - c.law(q - h)) / (2 * h), abs=1e-9)
         assert c.ddlaw(q) == pytest.approx((c.dlaw(q + h) - c.dlaw(q - h)) / (2 * h), abs=1e-9)
@@ -164,7 +168,7 @@ def test_ik_converges_every_step(name, request, robot):
     r = Robot(aw.SPEC, {"terrain": run.mission.terrain})
     worst = 0.0
     for i in range(0, len(run.t), 5):
-        q = aw.model_configuration(r, run.commands[i], np.concatenate([run.beta[i], run.q[i]]))
+        q = aw_cmp.model_configuration(r, run.commands[i], np.concatenate([run.beta[i], run.q[i]]))
         worst = max(worst, np.max(np.abs(r.constraint_residual(q))))
     assert worst < 1e-10
 
@@ -195,23 +199,23 @@ def test_ik_mission2_constant_on_ramp(mission2):
 @pytest.mark.parametrize(
     "cmd, wheel, limit",
     [
-        (aw.Commands(0, 0, 0.2, 0, 0.15, 0), "wheel r", "q = 0 deg"),
-        (aw.Commands(0, 0, 0.2, 0.3, 0, 0), "wheel fl", "q = 0 deg"),
-        (aw.Commands(0, 0, 0.01), "wheel fr", "q = 180 deg"),
+        (aw_paper.Commands(0, 0, 0.2, 0, 0.15, 0), "wheel r", "q = 0 deg"),
+        (aw_paper.Commands(0, 0, 0.2, 0.3, 0, 0), "wheel fl", "q = 0 deg"),
+        (aw_paper.Commands(0, 0, 0.01), "wheel fr", "q = 180 deg"),
     ],
 )
 def test_ik_out_of_range_names_wheel_and_limit(cmd, wheel, limit, robot):
     from robotdyn.terrain import FlatTerrain
-    with pytest.raises(aw.MechanismRangeError) as exc:
-        aw.solve_ik(cmd, robot.params, FlatTerrain())
+    with pytest.raises(aw_paper.MechanismRangeError) as exc:
+        aw_paper.solve_ik(cmd, robot.params, FlatTerrain())
     msg = str(exc.value)
     assert wheel in msg and limit in msg and "0-180 deg" in msg and "\n" not in msg
     assert isinstance(exc.value, RobotDynError)
 
 
 def test_ik_mission_out_of_range_reports_time():
-    with pytest.raises(aw.MechanismRangeError, match=r"mission1, t = 0.00 s: wheel \w+: .*0-180 deg"):
-        aw.run_mission("mission1", {"w": 0.1})
+    with pytest.raises(aw_paper.MechanismRangeError, match=r"mission1, t = 0.00 s: wheel \w+: .*0-180 deg"):
+        aw_missions.run_mission("mission1", {"w": 0.1})
 
 
 # ------------------------------------------------------------------------------------------------ statics
@@ -220,15 +224,15 @@ def test_statics_flat_lever_rule(robot):
     carries m g / 2 and each front wheel m g / 4 (not the m g / 3 of eq 35); no friction is needed."""
     from robotdyn.terrain import FlatTerrain
     p = robot.params
-    cmd = aw.Commands(0.0, 0.0, 0.15)
-    x, _, _ = aw.solve_ik(cmd, p, FlatTerrain())
-    res = aw.static_torques(cmd, x, p, FlatTerrain())
+    cmd = aw_paper.Commands(0.0, 0.0, 0.15)
+    x, _, _ = aw_paper.solve_ik(cmd, p, FlatTerrain())
+    res = aw_paper.static_torques(cmd, x, p, FlatTerrain())
     mg = 10 * 9.81
     np.testing.assert_allclose(res.normal, [mg / 4, mg / 4, mg / 2], atol=1e-10)
     np.testing.assert_allclose(res.friction, 0.0, atol=1e-10)
     # eq 34 with the equal-share load of eq 35 gives eq 35 exactly
     share = -0.5 * (mg / 3) * 0.3 * np.sin(x[3:] / 2) * np.cos(np.pi / 6)
-    np.testing.assert_allclose(aw.paper_torque_eq35(x[3:], p), share, rtol=1e-14)
+    np.testing.assert_allclose(aw_paper.paper_torque_eq35(x[3:], p), share, rtol=1e-14)
 
 
 @pytest.mark.parametrize("name", ["mission1", "mission2"])
@@ -237,13 +241,13 @@ def test_statics_equilibrium_cone_and_virtual_work(name, request):
     r = Robot(aw.SPEC, {"terrain": run.mission.terrain})
     for i in (0, 77, 250, 500):
         x = np.concatenate([run.beta[i], run.q[i]])
-        res = aw.static_torques(run.commands[i], x, r.params, r.terrain)
+        res = aw_paper.static_torques(run.commands[i], x, r.params, r.terrain)
         assert res.equilibrium < 1e-9
         assert np.all(res.normal > 0) and np.all(res.ratio <= 1 + 1e-9)
         # total force and moment about the CG, recomputed here
         np.testing.assert_allclose(res.forces.sum(0), [0, 0, 98.1], atol=1e-9)
         np.testing.assert_allclose(np.cross(res.contacts - run.cg[i], res.forces).sum(0), 0, atol=1e-9)
-        chk = aw.model_static_check(r, run.commands[i], x, res)
+        chk = aw_cmp.model_static_check(r, run.commands[i], x, res)
         assert chk["residual"] < 1e-9  # the whole model is in equilibrium with these forces and torques
         np.testing.assert_allclose(chk["tau_adjust"], res.torque, atol=1e-9)  # eq 34 = model
         np.testing.assert_allclose(chk["tau_fd"], res.torque, atol=1e-6)  # eq 34 = finite-difference work
@@ -266,7 +270,7 @@ def test_statics_friction_cone_enforced():
 def test_dynamics_rates_match_ik_finite_differences(mission1):
     """The constraint layer's adjustment rates (S nu, rolling + eq-1 coupling rows) equal the time derivative of
     the paper's IK (independent route), and the model's force balance closes."""
-    d = aw.mission_dynamics(mission1, every=50)
+    d = aw_dyn.mission_dynamics(mission1, every=50)
     np.testing.assert_allclose(d.qdot_model, d.qdot_fd, atol=1e-8)
     assert d.residual.max() < 1e-9
     assert np.all(d.ratio_dynamic <= 1 + 1e-9) and np.all(d.normal_dynamic > 0)
@@ -275,7 +279,7 @@ def test_dynamics_rates_match_ik_finite_differences(mission1):
 @pytest.mark.parametrize("params", [{}, {"m_wheel": 0.5, "I_adjust": 0.01}])
 def test_dynamics_energy_balance(mission1, params):
     """dE/dt (finite differences of Pinocchio's energy along the motion) = motor power + contact-force power."""
-    mm = aw.MissionModel(mission1, params)
+    mm = aw_dyn.MissionModel(mission1, params)
     h = 1e-4
     for t in (0.7, 2.3, 4.1):
         r = mm.at(t)
@@ -285,16 +289,16 @@ def test_dynamics_energy_balance(mission1, params):
 
 def test_dynamics_at_rest_equals_statics():
     """With the body at rest (zero path velocity) the kinetostatic route reproduces eqs 25-34."""
-    m = aw.Mission("rest", "", "rough", lambda t: (0.3, -0.2, 0.0, 0.0), t_end=0.05)
-    run = aw.run_mission(m)
-    d = aw.mission_dynamics(run)
+    m = aw_missions.Mission("rest", "", "rough", lambda t: (0.3, -0.2, 0.0, 0.0), t_end=0.05)
+    run = aw_missions.run_mission(m)
+    d = aw_dyn.mission_dynamics(run)
     np.testing.assert_allclose(d.tau_dynamic[:, 3:], d.tau_static, atol=1e-9)
     assert d.lateral_slip.max() < 1e-12
 
 
 def test_mission1_needs_lateral_slip(mission1):
     """Rolling without slipping forbids mission 1: each wheel slides sideways at about |yaw rate| * Lx."""
-    d = aw.mission_dynamics(mission1, every=100)
+    d = aw_dyn.mission_dynamics(mission1, every=100)
     assert d.lateral_slip.min() > 0.5
 
 
@@ -310,7 +314,7 @@ def test_hold_scenario_stays_at_rest(robot):
 
 
 def test_compare_verdicts(robot, mission1, mission2):
-    cmp = aw.compare(robot, {"mission1": mission1, "mission2": mission2})
+    cmp = aw_cmp.compare(robot, {"mission1": mission1, "mission2": mission2})
     rows = {r.quantity: r for r in cmp.rows}
     assert rows["eq 24: max ||C|| over missions 1-2 (criterion 1e-5)"].verdict == "reproduced"
     # eq 35 evaluated at Table 2's own angles does not give Table 2's torques (paper's internal inconsistency)
@@ -349,9 +353,9 @@ def test_energy_balance_forward_simulation(params):
 
     from robotdyn.simulation import power, simulate
     r = Robot(aw.SPEC, {"terrain": "ramp", "ramp_slope": 0.05, **params})
-    cmd = aw.Commands(0.3, -0.2, 0.15)
-    x, _, _ = aw.solve_ik(cmd, r.params, r.terrain)
-    q0 = aw.model_configuration(r, cmd, x)
+    cmd = aw_paper.Commands(0.3, -0.2, 0.15)
+    x, _, _ = aw_paper.solve_ik(cmd, r.params, r.terrain)
+    q0 = aw_cmp.model_configuration(r, cmd, x)
     nu0 = np.random.default_rng(0).normal(size=r.mobility) * 0.3
     free = simulate(r, 0.05, q0, nu0, None, n_out=11, progress=False)
     assert np.ptp(free.energy) < 1e-8 and free.residual.max() < 1e-9
@@ -372,9 +376,9 @@ def test_front_radii_singularity():
     r = Robot(aw.SPEC, {"terrain": "flat"})
     ratios = []
     for roll in (0.0, 0.01, 0.1):
-        cmd = aw.Commands(0, 0, 0.15, roll, 0, 0)
-        x, _, _ = aw.solve_ik(cmd, r.params, FlatTerrain())
-        q = aw.model_configuration(r, cmd, x)
+        cmd = aw_paper.Commands(0, 0, 0.15, roll, 0, 0)
+        x, _, _ = aw_paper.solve_ik(cmd, r.params, FlatTerrain())
+        q = aw_cmp.model_configuration(r, cmd, x)
         s = np.linalg.svd(r.constraint_rows(KinematicState(r.model, r.data, q, np.zeros(15))).A, compute_uv=False)
         ratios.append(s[-1] / s[0])
         if roll == 0.0:
@@ -418,7 +422,7 @@ def test_generic_modules_reject_bad_input(robot):
 def friction_run():
     from dataclasses import replace
 
-    return aw.mission_friction(aw.run_mission(replace(aw.MISSIONS["mission1"], t_end=1.0)))
+    return aw_dyn.mission_friction(aw_missions.run_mission(replace(aw_missions.MISSIONS["mission1"], t_end=1.0)))
 
 
 def test_mission1_lateral_friction_energy_balance(friction_run):
@@ -442,5 +446,6 @@ def test_mission1_impossible_with_lateral_friction(friction_run):
     from dataclasses import replace
 
     assert friction_run.required_mu.min() > 10
-    flat = aw.mission_friction(aw.run_mission(replace(aw.MISSIONS["mission1"], terrain="flat", t_end=0.2)))
+    mission = replace(aw_missions.MISSIONS["mission1"], terrain="flat", t_end=0.2)
+    flat = aw_dyn.mission_friction(aw_missions.run_mission(mission))
     assert np.all(flat.rank == 14) and flat.residual.min() > 1.0

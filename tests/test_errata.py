@@ -24,10 +24,13 @@ from scipy.optimize import brentq, least_squares
 
 import robotdyn
 from robotdyn.robot import Robot
-from robotdyn.robots import adaptable_wheel as aw
-from robotdyn.robots import linkage_suspension as ls
-from robotdyn.robots import mmr12_eod as mm
-from robotdyn.robots import omni_caster as oc
+from robotdyn.robots.adaptable_wheel import model as aw
+from robotdyn.robots.adaptable_wheel import paper as aw_paper
+from robotdyn.robots.linkage_suspension import paper as ls_paper
+from robotdyn.robots.mmr12_eod import model as mm
+from robotdyn.robots.mmr12_eod import paper as mm_paper
+from robotdyn.robots.omni_caster import model as oc
+from robotdyn.robots.omni_caster import paper as oc_paper
 from robotdyn.terrain import RampTerrain
 
 
@@ -41,18 +44,18 @@ def _defaults(spec, **overrides):
 def test_eq35_is_monotonic_and_its_torque_range_contradicts_the_angle_range():
     p = _defaults(aw.SPEC)
     q = np.radians([20.0, 40.0, 140.0, 170.0])
-    t = np.abs(aw.paper_torque_eq35(q, p))
+    t = np.abs(aw_paper.paper_torque_eq35(q, p))
     # eq 32 with F = m g / 3 (the eq-35 load) and dR/dq of eq 1 by central differences
     h = 1e-6
-    dR = (aw.radius_law(q + h, p["w"]) - aw.radius_law(q - h, p["w"])) / (2 * h)
+    dR = (aw_paper.radius_law(q + h, p["w"]) - aw_paper.radius_law(q - h, p["w"])) / (2 * h)
     np.testing.assert_allclose(t, p["m"] * p["g"] / 3 * np.abs(dR), rtol=1e-8)
     np.testing.assert_allclose(t, [0.7376, 1.4529, 3.9917, 4.2317], atol=5e-5)
     # |t| = 4.248 sin(q/2) N m: strictly increasing over the whole adjustment range 0-180 deg
     grid = np.linspace(0.0, np.pi, 1801)
-    assert np.all(np.diff(np.abs(aw.paper_torque_eq35(grid, p))) > 0)
-    assert np.abs(aw.paper_torque_eq35(np.pi, p)) == pytest.approx(4.2479, abs=5e-5)
+    assert np.all(np.diff(np.abs(aw_paper.paper_torque_eq35(grid, p))) > 0)
+    assert np.abs(aw_paper.paper_torque_eq35(np.pi, p)) == pytest.approx(4.2479, abs=5e-5)
     # the angles at which eq 35 gives the paper's 1.4 and 4 N m
-    angle = {T: np.degrees(brentq(lambda x: abs(aw.paper_torque_eq35(x, p)) - T, 0.0, np.pi, xtol=1e-14))
+    angle = {T: np.degrees(brentq(lambda x: abs(aw_paper.paper_torque_eq35(x, p)) - T, 0.0, np.pi, xtol=1e-14))
              for T in (1.4, 4.0)}
     assert angle[1.4] == pytest.approx(38.49, abs=0.01) and angle[4.0] == pytest.approx(140.66, abs=0.01)
     # so 20-170 deg (sec 7) gives 0.74-4.23 N m, not 1.4-4: the torque keeps rising above 140 deg
@@ -66,21 +69,21 @@ def _level_body_angles(p, headings, slope=0.2, h=0.15):
     the plane, so R = n.(c - p0) / |u-component| = (h + n.offset) / sqrt(1 - n_y^2). Returns (angles, feasible)."""
     a = np.asarray(headings, float)
     n = np.stack([-slope * np.cos(a), -slope * np.sin(a), np.ones_like(a)], -1) / np.hypot(1.0, slope)
-    off = np.array([aw.offsets(p)[t] for t in aw.WHEELS])
+    off = np.array([aw_paper.offsets(p)[t] for t in aw.WHEELS])
     R = (h + n @ off.T) / np.sqrt(1.0 - n[:, 1:2] ** 2)
     c = (R - p["R_ru"]) / (p["w"] * aw.COS30)  # eq 1: cos(q/2)
     feasible = np.all((c >= 0.0) & (c <= 1.0), axis=1)
     return np.degrees(2.0 * np.arccos(np.clip(c, 0.0, 1.0))), feasible
 
 
-TABLE2_ANGLES = np.array([aw.TABLE2[t][1] for t in aw.WHEELS])
+TABLE2_ANGLES = np.array([aw_paper.TABLE2[t][1] for t in aw.WHEELS])
 
 
 @pytest.mark.parametrize("reading, heading", [("half", 270.0), ("half", 0.0), ("half", 273.31), ("full", 261.08),
                                               ("full", 95.0)])
 def test_level_body_closed_form_equals_the_transcribed_ik(reading, heading):
     p = _defaults(aw.SPEC, L_reading=reading)
-    x, err, _ = aw.solve_ik(aw.Commands(0.0, 0.0, 0.15), p, RampTerrain(0.2, np.radians(heading)))
+    x, err, _ = aw_paper.solve_ik(aw_paper.Commands(0.0, 0.0, 0.15), p, RampTerrain(0.2, np.radians(heading)))
     closed, ok = _level_body_angles(p, [np.radians(heading)])
     assert ok[0] and err < 1e-10
     np.testing.assert_allclose(np.degrees(x[3:]), closed[0], atol=1e-8)
@@ -135,7 +138,7 @@ def test_eq28_wheel_angles_through_eq14(radius, turns_of_pi):
     for psi in (0.0, 1.3):  # the heading rate does not depend on the configuration: psi(1 s) = psi' * 1 s
         rate = robot.reduced(mm.state(robot, psi=psi), nu).v[i_psi]
         assert rate == pytest.approx(turns_of_pi * np.pi, abs=1e-12)
-    assert mm.paper_platform_rates(robot.params, 0.0, 2 * np.pi, -2 * np.pi)[2] == pytest.approx(
+    assert mm_paper.paper_platform_rates(robot.params, 0.0, 2 * np.pi, -2 * np.pi)[2] == pytest.approx(
         turns_of_pi * np.pi, abs=1e-12)
 
 
@@ -147,7 +150,7 @@ def _eq31_chain(order):
 
 
 def test_eq31_rotation_is_the_modified_dh_product_of_table2():
-    printed = mm.PRINTED["eq 31"]
+    printed = mm_paper.PRINTED["eq 31"]
     out = {}
     for name, order in (("modified", dh.modified), ("paul", dh.paul)):
         G, (phi, t1, t2, lam) = _eq31_chain(order)
@@ -171,7 +174,7 @@ def test_manipulator_rows_follow_pauls_order_so_the_paper_mixes_conventions():
             (0, sp.Rational(14, 10), 0, -h), (-h, 0, sp.Rational(15, 100), h), (h, 0, 0, 0),
             (0, sp.Rational(38, 100), 0, 0), (0, sp.Rational(1, 4), 0, 0), (0, 0, 0, h)]
     A_C = dh.trans(2, 2, sp.Rational(15, 100)) * dh.rot_z(sp.pi / 4) * dh.trans(0, 0, sp.Rational(37, 100))
-    printed = mm.PRINTED["eq 29"]
+    printed = mm_paper.PRINTED["eq 29"]
     paul = np.array((A_C * dh.chain(rows, dh.paul)).evalf(), dtype=float)
     modified = np.array((A_C * dh.chain(rows, dh.modified)).evalf(), dtype=float)
     diff = np.abs(paul[:3] - printed[:3])
@@ -197,7 +200,7 @@ def _steering_term(p):
 
 
 def test_printed_inertia_needs_a_wheel_term_of_0855(caster):
-    P, p = oc.PRINTED_WITH_WHEELS, caster.params
+    P, p = oc_paper.PRINTED_WITH_WHEELS, caster.params
     wheel = 1.5 * p["m_wheel"] + p["m_link"]  # eq 43's theta entry / r^2 with Table 2: 0.775 kg
     assert wheel == pytest.approx(0.775)
     # the model's largest yy entry (all links along j) is m_pl + 3 * 0.775 = 7.325 < printed 7.5379: no steering
@@ -218,7 +221,7 @@ def test_printed_inertia_needs_a_wheel_term_of_0855(caster):
 def test_printed_inertia_best_steady_turn_is_a_tight_turn_not_the_5m_circle(caster):
     """With the wheel term the trace needs, the printed matrix is closest to the casters' steady alignment for a
     turn of 0.67 m radius about a centre on the platform's -i side; the 5 m circle of section 5 is 8x worse."""
-    P, p = oc.PRINTED_WITH_WHEELS, caster.params
+    P, p = oc_paper.PRINTED_WITH_WHEELS, caster.params
     needed = (P[0, 0] + P[1, 1] - 2 * p["m_pl"]) / 3 - _steering_term(p)
     robot = Robot(oc.SPEC, {"m_wheel": p["m_wheel"] + needed - (1.5 * p["m_wheel"] + p["m_link"])})
     iu = np.triu_indices(3)
@@ -301,12 +304,12 @@ def test_eq10_transcriptions_agree_with_the_symbolic_ones():
                dh.THETA1: th1, dh.BETA1: be1}
         num = {k: np.array(v.subs(sub).evalf(), dtype=float).ravel() for k, v in printed.items()}
         zero = np.zeros(3)
-        np.testing.assert_allclose(ls.paper_eq10_lhs(vals, th1, be1, zero, zero, 1.0, 0.0), num["theta1'"],
+        np.testing.assert_allclose(ls_paper.paper_eq10_lhs(vals, th1, be1, zero, zero, 1.0, 0.0), num["theta1'"],
                                    atol=1e-14)
-        np.testing.assert_allclose(ls.paper_eq10_lhs(vals, th1, be1, zero, zero, 0.0, 1.0), num["beta1'"],
+        np.testing.assert_allclose(ls_paper.paper_eq10_lhs(vals, th1, be1, zero, zero, 0.0, 1.0), num["beta1'"],
                                    atol=1e-14)
         # the exact derivative is what compare() finds the Pinocchio model to reproduce ("eq 5 with Table 1 axes")
-        corr = ls.corrected_eq10_joint_terms(vals, th1, be1)
+        corr = ls_paper.corrected_eq10_joint_terms(vals, th1, be1)
         np.testing.assert_allclose(corr[0], np.array(exact["theta1'"].subs(sub).evalf(), float).ravel(), atol=1e-14)
         np.testing.assert_allclose(corr[1], np.array(exact["beta1'"].subs(sub).evalf(), float).ravel(), atol=1e-14)
 

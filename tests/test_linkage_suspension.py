@@ -17,7 +17,8 @@ from robotdyn.errors import ConstraintError, RobotDynError
 from robotdyn.posture import set_terrain, solve_posture
 from robotdyn.projection import project
 from robotdyn.robot import Robot
-from robotdyn.robots import linkage_suspension as ls
+from robotdyn.robots.linkage_suspension import model as ls
+from robotdyn.robots.linkage_suspension import comparison as ls_cmp
 from robotdyn.terrain import BumpTerrain, FlatTerrain, FunctionTerrain, RampTerrain, SineTerrain
 
 
@@ -188,7 +189,7 @@ def test_posture_bad_input_is_one_line_error(robot):
 # ------------------------------------------------------------------------------------------ priority 3, 4
 @pytest.fixture(scope="module")
 def comparison(robot):
-    return {r.quantity: r for r in ls.compare(robot).rows}
+    return {r.quantity: r for r in ls_cmp.compare(robot).rows}
 
 
 def _verdicts(comparison, prefix):

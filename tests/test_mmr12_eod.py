@@ -13,7 +13,9 @@ import pytest
 
 import robotdyn
 from robotdyn.errors import InputError, RobotDynError
-from robotdyn.robots import mmr12_eod as mm
+from robotdyn.robots.mmr12_eod import model as mm
+from robotdyn.robots.mmr12_eod import paper as mm_paper
+from robotdyn.robots.mmr12_eod import comparison as mm_cmp
 from robotdyn.simulation import power, simulate
 
 
@@ -56,7 +58,7 @@ def test_AS_zero_and_S_matches_eqs_12_to_14(robot):
         nu = rng.normal(size=robot.mobility)
         red = robot.reduced(q, nu)
         assert np.max(np.abs(red.rows.A @ red.S)) < 1e-13
-        ref = mm.paper_platform_rates(robot.params, q[ipsi], nu[iR], nu[iL])
+        ref = mm_paper.paper_platform_rates(robot.params, q[ipsi], nu[iR], nu[iL])
         assert red.v[[ix, iy, ipsi]] == pytest.approx(ref, abs=1e-12)
         assert red.v[robot.coordinate_index("lambda_C")] == pytest.approx(0.0, abs=1e-13)
         # eq 12: no lateral velocity; eq 13 with the right wheel at -b
@@ -176,8 +178,8 @@ def test_fk_matches_htg_chain_and_eq2_except_the_R22_typo(robot):
         vals = _fk_values(rng)
         args = [vals[k] for k in _FK_NAMES]
         T = frame_pose(robot, mm.state(robot, theta_mu=0.0, **vals), "X")
-        assert T == pytest.approx(mm.paper_htg_chain(robot.params, *args), abs=1e-12)
-        P = mm.paper_X_M(robot.params, *args)
+        assert T == pytest.approx(mm_paper.paper_htg_chain(robot.params, *args), abs=1e-12)
+        P = mm_paper.paper_X_M(robot.params, *args)
         mask = np.ones((4, 4), bool)
         mask[1, 1] = False
         assert T[mask] == pytest.approx(P[mask], abs=1e-12)
@@ -187,7 +189,7 @@ def test_fk_matches_htg_chain_and_eq2_except_the_R22_typo(robot):
 
 
 def test_printed_eq2_is_not_a_rotation_in_general(robot):
-    P = mm.paper_X_M(robot.params, 0, 0, 0.7, 0.0, 1.0, 0.5, -0.4, 0.3, 0.1)
+    P = mm_paper.paper_X_M(robot.params, 0, 0, 0.7, 0.0, 1.0, 0.5, -0.4, 0.3, 0.1)
     assert not is_rotation(P[:3, :3], 1e-3)
 
 
@@ -209,15 +211,15 @@ def test_every_library_pose_is_a_proper_rotation(robot):
 
 def test_check_pose_rejects_the_printed_eq29():
     with pytest.raises(RobotDynError, match="not a proper rotation"):
-        check_pose(mm.PRINTED["eq 29"])
-    check_pose(mm.PRINTED["eq 28"], tol=2e-4)  # 4-decimal rounding of a rotation
+        check_pose(mm_paper.PRINTED["eq 29"])
+    check_pose(mm_paper.PRINTED["eq 28"], tol=2e-4)  # 4-decimal rounding of a rotation
 
 
-@pytest.mark.parametrize("key", sorted(mm.PRINTED))
+@pytest.mark.parametrize("key", sorted(mm_paper.PRINTED))
 def test_printed_transforms_entry_by_entry(robot, key):
     """Eqs 27-31 with the parameters printed beside them: which entries the model reproduces."""
-    paper = mm.PRINTED[key]
-    model = mm.model_printed(robot, key)
+    paper = mm_paper.PRINTED[key]
+    model = mm_cmp.model_printed(robot, key)
     assert is_rotation(model[:3, :3], 1e-12)
     differs = {(i, j) for i in range(3) for j in range(4)
                if abs(paper[i, j] - model[i, j]) > (5e-20 if 0 < abs(paper[i, j]) < 1e-10 else 5e-5)}
@@ -233,8 +235,8 @@ def test_printed_transforms_entry_by_entry(robot, key):
 
 def test_eq26_lift_matches_the_model_over_the_range(robot):
     for th in np.linspace(-0.5, np.pi / 2, 25):
-        assert mm.model_lift(robot, th) == pytest.approx(mm.paper_delta_lambda(robot.params, th), abs=1e-12)
-    assert mm.model_lift(robot, np.pi / 2) + robot.params["lambda_C0"] == pytest.approx(0.52, abs=1e-12)  # eq 30
+        assert mm_cmp.model_lift(robot, th) == pytest.approx(mm_paper.paper_delta_lambda(robot.params, th), abs=1e-12)
+    assert mm_cmp.model_lift(robot, np.pi / 2) + robot.params["lambda_C0"] == pytest.approx(0.52, abs=1e-12)  # eq 30
 
 
 def test_cli_fk_prints_a_proper_pose(capsys):
@@ -263,7 +265,7 @@ def test_cli_fk_prints_a_proper_pose(capsys):
 # ------------------------------------------------------------------------------------- inverse kinematics
 @pytest.fixture(scope="module")
 def ik_cases(robot):
-    return mm.ik_cases(robot, n=4, seed=3)
+    return mm_cmp.ik_cases(robot, n=4, seed=3)
 
 
 def test_numerical_ik_reaches_targets_in_the_manipulation_range(robot, ik_cases):
@@ -280,7 +282,7 @@ def test_eqs_3_10_11_reproduce_the_numerical_ik(robot, ik_cases):
     p = robot.params
     for case in ik_cases:
         q = case["platform"].q
-        ik = mm.paper_ik(p, case["target"], case["arm"]["lambda2"], case["arm"]["theta1"], case["arm"]["theta3"])
+        ik = mm_paper.paper_ik(p, case["target"], case["arm"]["lambda2"], case["arm"]["theta1"], case["arm"]["theta3"])
         assert ik["phi"] == pytest.approx(q[robot.coordinate_index("psi")], abs=1e-12)  # eq 3 (imposed)
         assert ik["x_C"] == pytest.approx(q[robot.coordinate_index("x")], abs=1e-9)
         assert ik["y_C"] == pytest.approx(q[robot.coordinate_index("y")], abs=1e-9)
@@ -297,25 +299,25 @@ def test_eqs_10_11_omit_the_load_offset_lambda6(robot, ik_cases):
     q[robot.coordinate_index("lambda6")] = 0.25
     target_X = frame_pose(robot, q, "X")[:3, 3]
     arm = case["arm"]
-    ik = mm.paper_ik(robot.params, target_X, arm["lambda2"], arm["theta1"], arm["theta3"])
+    ik = mm_paper.paper_ik(robot.params, target_X, arm["lambda2"], arm["theta1"], arm["theta3"])
     miss = np.hypot(ik["x_C"] - q[robot.coordinate_index("x")], ik["y_C"] - q[robot.coordinate_index("y")])
     assert miss == pytest.approx(0.25 * abs(np.sin(arm["theta1"] + arm["theta3"])), abs=1e-9)
 
 
 def test_eq4_is_the_interior_angle_only_without_l3(ik_cases):
     r0 = robotdyn.load("mmr12_eod", {"l3": 0.0})
-    for case in mm.ik_cases(r0, n=3, seed=4):
+    for case in mm_cmp.ik_cases(r0, n=3, seed=4):
         q = case["free"].q
         rel = case["target"] - frame_pose(r0, q, "frame0")[:3, 3]
         th1, lam2, th3 = (q[r0.coordinate_index(c)] for c in ("theta1", "lambda2", "theta3"))
-        assert mm.paper_ik(r0.params, rel, lam2, th1, th3)["theta3"] == pytest.approx(np.pi - abs(th3), abs=1e-8)
+        assert mm_paper.paper_ik(r0.params, rel, lam2, th1, th3)["theta3"] == pytest.approx(np.pi - abs(th3), abs=1e-8)
     # with the paper's l3 = 0.15 it misses (documented in the errata)
     r = robotdyn.load("mmr12_eod")
     case = ik_cases[0]
     q = case["free"].q
     rel = case["target"] - frame_pose(r, q, "frame0")[:3, 3]
     th1, lam2, th3 = (q[r.coordinate_index(c)] for c in ("theta1", "lambda2", "theta3"))
-    assert abs(mm.paper_ik(r.params, rel, lam2, th1, th3)["theta3"] - (np.pi - abs(th3))) > 0.05
+    assert abs(mm_paper.paper_ik(r.params, rel, lam2, th1, th3)["theta3"] - (np.pi - abs(th3))) > 0.05
 
 
 def test_eq5_does_not_invert_the_model(robot, ik_cases):
@@ -327,7 +329,7 @@ def test_eq5_does_not_invert_the_model(robot, ik_cases):
         z0 = frame_pose(robot, q, "frame0")[2, 3]
         zC = frame_pose(robot, q, "C")[2, 3]
         for k, dz in enumerate((case["target"][2] - z0, case["target"][2] - zC, case["target"][2])):
-            worst[k] = max(worst[k], abs(mm.paper_ik(robot.params, [0, 0, dz], lam2, th1, th3)["lambda2"] - lam2))
+            worst[k] = max(worst[k], abs(mm_paper.paper_ik(robot.params, [0, 0, dz], lam2, th1, th3)["lambda2"] - lam2))
     assert np.all(worst > 0.1)
 
 
@@ -347,7 +349,7 @@ def test_lifting_follows_eq26_and_reaches_052(lifting_run):
     rob = traj.stats["robot"]
     lam = traj.column("lambda_C")
     th = traj.q[:, [rob.coordinate_index(f"theta_C{i}") for i in mm._ARMS]]
-    ref = np.array([mm.paper_delta_lambda(rob.params, a) for a in th[:, 0]])
+    ref = np.array([mm_paper.paper_delta_lambda(rob.params, a) for a in th[:, 0]])
     assert np.max(np.abs(lam - ref)) < 1e-7  # eq 1 / 26 along the whole lift (model's contact constraints)
     assert np.max(np.abs(th - th[:, :1])) < 1e-7  # the four arms move together
     assert lam[0] + rob.params["lambda_C0"] == pytest.approx(0.15, abs=1e-12)

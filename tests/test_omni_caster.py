@@ -1,6 +1,6 @@
 """Omni caster robot (Chung, Yi, Kim, Han): model from the URDF vs independent references.
 
-References: the paper's closed forms transcribed in robotdyn.robots.omni_caster (eqs 12-17, 43, 48-51, 60), a
+References: the paper's closed forms transcribed in robotdyn.robots.omni_caster.paper (eqs 12-17, 43, 48-51, 60), a
 derivation of the offset link's missing velocity terms, A S = 0, finite differences and energy balance.
 """
 
@@ -11,7 +11,9 @@ import pytest
 
 from robotdyn.errors import InputError, RobotDynError, SingularConstraintError
 from robotdyn.robot import Robot
-from robotdyn.robots import omni_caster as oc
+from robotdyn.robots.omni_caster import model as oc
+from robotdyn.robots.omni_caster import paper as oc_paper
+from robotdyn.robots.omni_caster import comparison as oc_cmp
 
 TOL = 1e-10
 
@@ -73,7 +75,7 @@ def test_inertia_matches_eq48_at_200_configurations(robot):
     worst = 0.0
     for phi, pose, _ in _states(200, 2):
         M = robot.reduced(_q(robot, phi, pose), np.zeros(3)).M
-        worst = max(worst, np.abs(M - oc.paper_inertia(robot.params, phi)).max())
+        worst = max(worst, np.abs(M - oc_paper.paper_inertia(robot.params, phi)).max())
     assert worst < TOL
 
 
@@ -106,11 +108,11 @@ def test_kinematic_matrices_eq12_to_17(robot):
     p = robot.params
     worst_inv, worst_fwd, printed16 = 0.0, 0.0, []
     for phi, pose, _ in _states(50, 5):
-        G = oc.model_chain_jacobians(robot, _q(robot, phi, pose))
+        G = oc_cmp.model_chain_jacobians(robot, _q(robot, phi, pose))
         for i in oc.CHAINS:
-            worst_inv = max(worst_inv, np.abs(G[i] - oc.paper_inverse(p, i, phi[i - 1])).max())
-            worst_fwd = max(worst_fwd, np.abs(np.linalg.inv(G[i]) - oc.paper_forward(p, i, phi[i - 1])).max())
-        diff = np.abs(G[2] - oc.paper_inverse(p, 2, phi[1], corrected=False))
+            worst_inv = max(worst_inv, np.abs(G[i] - oc_paper.paper_inverse(p, i, phi[i - 1])).max())
+            worst_fwd = max(worst_fwd, np.abs(np.linalg.inv(G[i]) - oc_paper.paper_forward(p, i, phi[i - 1])).max())
+        diff = np.abs(G[2] - oc_paper.paper_inverse(p, 2, phi[1], corrected=False))
         printed16.append(diff)
     assert worst_inv < 1e-9  # entries are O(1/r) = 40: relative 1e-11
     assert worst_fwd < TOL
@@ -126,7 +128,7 @@ def test_bias_matches_eq49_plus_offset_link_terms(robot):
     worst = 0.0
     for phi, pose, nu in _states(100, 6):
         h = robot.reduced(_q(robot, phi, pose), nu).h
-        ref = oc.paper_bias(robot.params, phi, nu) + oc.offset_link_correction(robot.params, phi, nu)
+        ref = oc_paper.paper_bias(robot.params, phi, nu) + oc_cmp.offset_link_correction(robot.params, phi, nu)
         worst = max(worst, np.abs(h - ref).max())
     assert worst < TOL
 
@@ -135,12 +137,12 @@ def test_bias_matches_eq49_exactly_when_link_mass_centre_on_wheel_axis():
     robot = Robot(oc.SPEC, {"p": 0.0})
     for phi, pose, nu in _states(50, 7):
         h = robot.reduced(_q(robot, phi, pose), nu).h
-        assert np.abs(h - oc.paper_bias(robot.params, phi, nu)).max() < TOL
+        assert np.abs(h - oc_paper.paper_bias(robot.params, phi, nu)).max() < TOL
     # and with the default p the omitted terms are not negligible
     robot = Robot(oc.SPEC)
     phi, pose, nu = next(_states(1, 8))
     h = robot.reduced(_q(robot, phi, pose), nu).h
-    assert np.abs(h - oc.paper_bias(robot.params, phi, nu)).max() > 1e-4
+    assert np.abs(h - oc_paper.paper_bias(robot.params, phi, nu)).max() > 1e-4
 
 
 def test_reduced_coriolis_consistent(robot):
@@ -165,14 +167,14 @@ def noc():
 
 def test_noc_singular_at_fig16_configuration(robot, noc):
     phi = [0.0, 0.0, 0.0]  # Fig. 16: theta1' and theta2' rows coincide (both links along i, A1 and A2 at y = -a)
-    assert abs(np.linalg.det(oc.paper_noc_jacobians(robot.params, phi)[0])) < 1e-15
+    assert abs(np.linalg.det(oc_paper.paper_noc_jacobians(robot.params, phi)[0])) < 1e-15
     with pytest.raises(SingularConstraintError) as err:
         noc.reduced(oc.steering_configuration(noc, phi), np.zeros(3))
     assert "singular" in str(err.value) and "\n" not in str(err.value)
     rep = oc.noc_report(robot, noc, phi)
     assert rep["noc_M"] is None and rep["noc_error"]
     assert np.all(np.isfinite(rep["op_M"])) and rep["op_condition"] < 1e3
-    np.testing.assert_allclose(rep["op_M"], oc.paper_inertia(robot.params, phi), atol=TOL)
+    np.testing.assert_allclose(rep["op_M"], oc_paper.paper_inertia(robot.params, phi), atol=TOL)
 
 
 def test_noc_inertia_blows_up_near_singularity_operational_stays_finite(robot, noc):
@@ -180,7 +182,7 @@ def test_noc_inertia_blows_up_near_singularity_operational_stays_finite(robot, n
     prev = None
     for eps in (1e-1, 1e-2, 1e-3, 1e-4):
         rep = oc.noc_report(robot, noc, [eps, 0.0, 0.0])
-        K = oc.paper_noc_map(p, [eps, 0.0, 0.0])
+        K = oc_paper.paper_noc_map(p, [eps, 0.0, 0.0])
         Kinv = np.linalg.inv(K)
         ref = Kinv.T @ rep["op_M"] @ Kinv  # same kinetic energy in the NOC velocities
         assert np.abs(rep["noc_M"] - ref).max() < 1e-9 * np.abs(ref).max()
@@ -199,14 +201,14 @@ def test_noc_singular_set_matches_paper_det_Jp(robot, noc):
     found = 0
     while found < 5:
         phi12 = rng.uniform(-np.pi, np.pi, 2)
-        f = lambda t: np.linalg.det(oc.paper_noc_map(p, [*phi12, t]))
+        f = lambda t: np.linalg.det(oc_paper.paper_noc_map(p, [*phi12, t]))
         grid = np.linspace(-np.pi, np.pi, 73)
         vals = [f(t) for t in grid]
         for t0, t1, f0, f1 in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
             if f0 * f1 < 0:
                 t = brentq(f, t0, t1, xtol=1e-15)
                 phi = [*phi12, t]
-                assert abs(np.linalg.det(oc.paper_noc_jacobians(p, phi)[0])) < 1e-12
+                assert abs(np.linalg.det(oc_paper.paper_noc_jacobians(p, phi)[0])) < 1e-12
                 with pytest.raises(SingularConstraintError):
                     noc.reduced(oc.steering_configuration(noc, phi), np.zeros(3))
                 rep = oc.noc_report(robot, noc, [*phi12, t + 0.2])  # away from it: both fine
@@ -218,8 +220,8 @@ def test_noc_singular_set_matches_paper_det_Jp(robot, noc):
 def test_noc_dependent_rates_satisfy_eq_A7(robot):
     p = robot.params
     for phi, pose, nu in _states(20, 12):
-        Jp, Ja = oc.paper_noc_jacobians(p, phi)
-        G = oc.model_chain_jacobians(robot, _q(robot, phi, pose))
+        Jp, Ja = oc_paper.paper_noc_jacobians(p, phi)
+        G = oc_cmp.model_chain_jacobians(robot, _q(robot, phi, pose))
         rates = {i: G[i] @ nu for i in oc.CHAINS}
         dep = np.array([rates[1][0], rates[1][2], rates[2][0], rates[2][2], rates[3][0], rates[3][1]])
         ind = np.array([rates[1][1], rates[2][1], rates[3][2]])
@@ -306,7 +308,7 @@ def test_impact_matches_eq60_and_restitution(robot):
             nu = -nu
         e = rng.uniform(0, 1)
         res = impact(M, n, nu, e)
-        assert abs(res.magnitude - oc.paper_impulse(M, n, nu, e)) < 1e-12 * abs(res.magnitude)
+        assert abs(res.magnitude - oc_paper.paper_impulse(M, n, nu, e)) < 1e-12 * abs(res.magnitude)
         assert abs(res.normal_after + e * res.normal_before) < 1e-12  # Newton's law on the normal velocity
         # momentum: M (nu+ - nu-) = F n; tangential (M-orthogonal) part unchanged: kinetic energy loss >= 0
         np.testing.assert_allclose(M @ res.delta_nu, res.magnitude * n, atol=1e-12)
@@ -350,7 +352,7 @@ def test_cli_impulse(capsys):
     out = json.loads(capsys.readouterr().out)
     robot = Robot(oc.SPEC)
     M = robot.reduced(robot.neutral(), np.zeros(3)).M
-    assert abs(out["impulse"] - oc.paper_impulse(M, [-1, 0, 0], [1, 0, 0], 0.8)) < 1e-12
+    assert abs(out["impulse"] - oc_paper.paper_impulse(M, [-1, 0, 0], [1, 0, 0], 0.8)) < 1e-12
     assert main(["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "1", "0"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("robotdyn: error:") and err.count("\n") == 1
@@ -369,7 +371,7 @@ def test_cli_dump_and_compare(capsys):
 
 
 def test_compare_verdicts(robot):
-    cmp = oc.compare(robot, states=20)
+    cmp = oc_cmp.compare(robot, states=20)
     verdict = {r.quantity.split(":")[0]: r.verdict for r in cmp.rows}
     assert verdict["eq 48"] == "reproduced"
     assert verdict["eq 16 as printed"] == "differs"

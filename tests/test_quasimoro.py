@@ -8,7 +8,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from oracles.quasimoro_sympy import quasimoro_reduced
-from robotdyn.robots import quasimoro as qm
+from robotdyn.robots.quasimoro import model as qm
+from robotdyn.robots.quasimoro import comparison as qm_cmp
 from robotdyn.simulation import power, simulate
 
 ORACLE_ORDER = ["x", "y", "psi", "theta1", "theta2", "theta3"]
@@ -116,7 +117,7 @@ def test_trajectory_matches_oracle_integration(quasimoro):
 # ------------------------------------------------------------------------------------------------ paper
 def test_paper_equations_reproduced_under_axle_reading(quasimoro):
     """Eqs 23-31 as printed equal the model when diag(J1, J2, J2) is about C2 (the default)."""
-    cmp = qm.compare(quasimoro, trajectory=_short_rectilinear(quasimoro))
+    cmp = qm_cmp.compare(quasimoro, trajectory=_short_rectilinear(quasimoro))
     closed_forms = [r for r in cmp.rows if not r.quantity.startswith("sec 3")]
     assert len(closed_forms) == 3 * (3 + 6 + 1) + 2
     assert all(r.verdict == "reproduced" for r in closed_forms), [r.quantity for r in closed_forms if r.verdict != "reproduced"]
@@ -125,7 +126,7 @@ def test_paper_equations_reproduced_under_axle_reading(quasimoro):
 def test_com_reading_breaks_exactly_the_J2_terms(quasimoro_com):
     """Under the other reading (about G) the rows involving J2 differ by M d^2 terms: the paper is not consistent
     with it (errata). Which rows differ is computed, and each differs by the parallel-axis amount."""
-    cmp = qm.compare(quasimoro_com, trajectory=_short_rectilinear(quasimoro_com))
+    cmp = qm_cmp.compare(quasimoro_com, trajectory=_short_rectilinear(quasimoro_com))
     differ = {r.quantity for r in cmp.rows if r.verdict == "differs" and not r.quantity.startswith("sec 3")}
     expected = {
         "row 1 (eq 23-24): theta1''", "row 1 (eq 23-24): theta2''", "row 2 (eq 25-26): theta1''",

@@ -1,5 +1,11 @@
-"""The registry of robots: one module per robot in this package, each exposing ``SPEC`` (a
-:class:`~robotdyn.robot.RobotSpec`) and optionally ``SCENARIOS`` and ``compare``."""
+"""The registry of robots: one module or package per robot in this package, each exposing ``SPEC`` (a
+:class:`~robotdyn.robot.RobotSpec`) and optionally ``SCENARIOS`` and ``compare``.
+
+The five robots of the papers are packages that keep the model and the paper apart: ``<name>/model.py`` (the spec,
+parameters, scenarios), ``<name>/paper.py`` (the paper's closed forms and printed values, transcribed) and
+``<name>/comparison.py`` (``compare``, the model against the paper); their ``__init__`` re-exports all names, so
+:func:`module` returns the package. :func:`names` lists packages and plain modules alike (``pkgutil.iter_modules``).
+"""
 
 from __future__ import annotations
 

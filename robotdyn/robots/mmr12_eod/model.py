@@ -1,4 +1,4 @@
-"""MMR12-EOD: a differential-drive mobile manipulator with four lifting arms (Zuniga-Aviles et al., 2014).
+"""MMR12-EOD: a differential-drive mobile manipulator with four lifting arms (Zuniga-Aviles et al., 2014): the model side.
 
 Paper: L. A. Zuniga-Aviles, J. C. Pedraza-Ortega et al., "HTG-Based Kinematic Modeling for Positioning of a
 Multi-Articulated Wheeled Mobile Manipulator", J. Intell. Robot. Syst. (2014)
@@ -13,9 +13,10 @@ theta1 is the DH angle, i.e. theta'_1 + 90 deg) and the load joints ``lambda6`` 
 Independent velocities: every actuated joint (wheels, arms, manipulator, load); (x, y, psi, lambda_C) are
 dependent through the rolling constraints of Table 3 (eqs 12-14) and the wheels' ground contact.
 
-This module holds the parameters (Table 2, section 3), the paper's closed forms transcribed separately from the
-model (eqs 1-2, 3-11, 12-14, 26, printed transforms 27-31), the scenarios (Table 4 tracking, lifting, climbing)
-and the comparison.
+This module holds ``SPEC`` (Table 2, section 3; masses assumed), the CLI hook, the control scenarios (eqs 23-25 on
+the model: Table 4 tracking, the Fig. 9 manipulation, the sec 2.11 d lifting) and the climbing balance of
+sec 2.11 e. The paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31) are in
+:mod:`.paper`, the comparison in :mod:`.comparison`.
 """
 
 from __future__ import annotations
@@ -25,9 +26,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..comparison import Comparison
-from ..errors import InputError
-from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from ...errors import InputError
+from ...robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
+
 
 _ARMS = (1, 2, 3, 4)
 MANIPULATOR = ("theta1", "lambda2", "theta3", "theta4")
@@ -93,112 +94,7 @@ SPEC = RobotSpec(
 )
 
 
-# ------------------------------------------------------------------------------------ paper transcription
-def dh(theta: float, lam: float, l: float, alpha: float) -> np.ndarray:
-    """Paul's link transform A = Rot(z, theta) Trans(0, 0, lambda) Trans(l, 0, 0) Rot(x, alpha) (Table 2)."""
-    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, l * ct], [st, ct * ca, -ct * sa, l * st], [0.0, sa, ca, lam],
-                     [0.0, 0.0, 0.0, 1.0]])
-
-
-def _trans(x: float, y: float, z: float) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, 3] = (x, y, z)
-    return T
-
-
-def paper_delta_lambda(p: dict, theta_C1: float, r: float | None = None) -> float:
-    """Eqs (1)/(26): Delta lambda_C = l_CS1 sin(theta_C1) - lambda_C0 + r when >= 0, else 0 [m]."""
-    r = p["r"] if r is None else r
-    value = p["l_cs1"] * np.sin(theta_C1) - p["lambda_C0"] + r
-    return float(value) if value >= 0 else 0.0
-
-
-def paper_A_C(p: dict, x: float, y: float, phi: float, dlam: float) -> np.ndarray:
-    """Sec 2.7.1 a): A_C = Trans(x_C0, y_C0, z_C0) Rot(z, phi) Trans(0, 0, Delta lambda_C), z_C0 = lambda_C0."""
-    return _trans(x, y, p["lambda_C0"]) @ dh(phi, 0.0, 0.0, 0.0) @ _trans(0.0, 0.0, dlam)
-
-
-def paper_htg_chain(p: dict, x, y, phi, dlam, theta1, lambda2, theta3, theta4, lambda6, theta_mu=0.0) -> np.ndarray:
-    """The HTG product X_M = A_C A_0 A_1 A_2 A_3 A_4 E E_muP E_muR of sec 2.7.1 with Table 2's rows.
-
-    Rows: 0 (alpha pi/2, l = -l0, lambda0, theta 0), 1 (alpha pi/2, theta1), 2 (alpha -pi/2, lambda2),
-    3 (alpha pi/2, l3, theta3), 4 (theta4), E (lambda5), E_muP (lambda6), E_muR (alpha pi/2, theta_mu).
-    """
-    h = np.pi / 2
-    chain = [dh(0.0, p["lambda0"], -p["l0"], h), dh(theta1, 0.0, 0.0, h), dh(0.0, lambda2, 0.0, -h),
-             dh(theta3, 0.0, p["l3"], h), dh(theta4, 0.0, 0.0, 0.0), dh(0.0, p["lambda5"], 0.0, 0.0),
-             dh(0.0, lambda6, 0.0, 0.0), dh(theta_mu, 0.0, 0.0, h)]
-    T = paper_A_C(p, x, y, phi, dlam)
-    for A in chain:
-        T = T @ A
-    return T
-
-
-def paper_X_M(p: dict, x, y, phi, dlam, theta1, lambda2, theta3, theta4, lambda6) -> np.ndarray:
-    """Eq (2) exactly as printed: X_M = GT_4 E E_mu (load frame in global coordinates)."""
-    SC, CC = np.sin(phi), np.cos(phi)
-    S1, C1 = np.sin(theta1), np.cos(theta1)
-    S13, C13 = np.sin(theta1 + theta3), np.cos(theta1 + theta3)
-    S4, C4 = np.sin(theta4), np.cos(theta4)
-    l0, l3, lam0, lam5, lam6 = p["l0"], p["l3"], p["lambda0"], p["lambda5"], lambda6
-    reach = S1 * lambda2 + l3 * C13 - l0
-    return np.array([
-        [S4 * SC + CC * C13 * C4, CC * S13, CC * C13 * S4 - C4 * SC, x + CC * reach + CC * lam5 * S13 + CC * lam6 * S13],
-        [SC * C13 * C4 - CC * S4, SC * C13, SC * C13 * S4 + C4 * CC, y + SC * reach + SC * lam5 * S13 + SC * lam6 * S13],
-        [S13 * C4, -C13, S13 * S4, p["lambda_C0"] + dlam + lam0 - lam5 * C13 - C1 * lambda2 + l3 * S13 - lam6 * C13],
-        [0.0, 0.0, 0.0, 1.0],
-    ])
-
-
-def paper_platform_rates(p: dict, phi: float, thR_dot: float, thL_dot: float) -> np.ndarray:
-    """Eqs (12)-(14) solved for (x', y', phi') given the wheel rates (r of eqs 13-14 = the drive-wheel radius)."""
-    R, b = p["lambda_C0"], p["b"]
-    phidot = R / (2 * b) * (thR_dot - thL_dot)  # eq 14
-    v = thR_dot * R - phidot * b  # eq 13: x' cos + y' sin = theta_r' r - phi' b
-    return np.array([v * np.cos(phi), v * np.sin(phi), phidot])  # eq 12: no lateral velocity
-
-
-def paper_ik(p: dict, target, lambda2: float, theta1: float, theta3: float) -> dict[str, float]:
-    """The evaluable inverse-kinematics equations (3), (4), (5), (10), (11).
-
-    Args:
-        p: Parameters.
-        target: (d_x, d_y, d_z): the end-effector target; for eq 3 and eqs 10-11 in global coordinates, for eqs 4-5
-            relative to the manipulator base (frame 0) as Fig. 8 suggests.
-        lambda2, theta1, theta3: Arm values used on the right-hand sides.
-
-    Returns:
-        ``phi`` (eq 3), ``theta3`` (eq 4, NaN if the arccos argument leaves [-1, 1]), ``lambda2`` (eq 5),
-        ``x_C`` (eq 10), ``y_C`` (eq 11). Eqs 6-9 use symbols (d_0, d_1, d_2, d_C, E1, P1) that the text never
-        defines, so they are not transcribed.
-    """
-    dx, dy, dz = (float(t) for t in target)
-    l0, l3, lam0, lam5 = p["l0"], p["l3"], p["lambda0"], p["lambda5"]
-    c = (dx**2 + dy**2 + dz**2 - lambda2**2 - lam5**2) / (-2 * lambda2 * lam5)
-    th3 = float(np.arccos(c)) if abs(c) <= 1 else float("nan")
-    C3, S3 = np.cos(theta3), np.sin(theta3)
-    lam2 = (dz + lam0 - lam5 * C3 + l3 * S3) / C3 if abs(C3) > 1e-12 else float("nan")
-    phi = float(np.arctan2(dy, dx))
-    S1, S13, C13 = np.sin(theta1), np.sin(theta1 + theta3), np.cos(theta1 + theta3)
-    reach = lambda2 * S1 - l0 + l3 * C13 + lam5 * S13
-    return {"phi": phi, "theta3": th3, "lambda2": float(lam2), "x_C": dx - np.cos(phi) * reach,
-            "y_C": dy - np.sin(phi) * reach}
-
-
-# printed numeric transforms, eqs (27)-(31), with the parameters printed beside each (sec 3)
-PRINTED = {
-    "eq 27": np.array([[1, 2.4493e-15, 0, 0], [-2.4493e-15, 1, 0, 0], [0, 0, 1, 0.15], [0, 0, 0, 1]]),
-    "eq 28": np.array([[0.7071, -0.7071, 0, 2], [0.7071, 0.7071, 0, 2], [0, 0, 1, 0.15], [0, 0, 0, 1]]),
-    "eq 29": np.array([[0.7071, 0.5, 0.5, 2.8567], [-0.7071, 0.5, 0.5, 2.8567], [0, -0.7071, -0.7071, 1.3305],
-                       [0, 0, 0, 1]]),
-    "eq 30": np.array([[0.7071, -0.7071, 0, 0], [0.7071, 0.7071, 0, 0], [0, 0, 1, 0.52], [0, 0, 0, 1]]),
-    "eq 31": np.array([[0.7071, 0, -0.7071, 0], [0.7071, 0, 0.7071, 0], [0, -1, 0, 0.47], [0, 0, 0, 1]]),
-}
-"""The 4x4 matrices of eqs (27)-(31) as printed (4 decimals, except eq 27's 2.4493e-15)."""
-
-
-# ------------------------------------------------------------------------------------------ model side
+# ------------------------------------------------------------------------------------------- configurations
 def state(robot: Robot, **values: float) -> np.ndarray:
     """Natural coordinates: the robot's neutral configuration with the given coordinates overridden."""
     q = robot.neutral()
@@ -207,182 +103,10 @@ def state(robot: Robot, **values: float) -> np.ndarray:
     return q
 
 
-def model_lift(robot: Robot, theta_C: float, arm: int = 1) -> float:
-    """Delta lambda_C from the model: how far the platform must rise for arm ``arm``'s tip wheel (radius r) at
-    angle theta_C to touch the ground, i.e. max(0, r - z_tip) with z_tip the tip-frame height at lambda_C = 0."""
-    from ..kinematics import frame_pose
-
-    q = state(robot, lambda_C=0.0, **{f"theta_C{arm}": theta_C})
-    z_tip = frame_pose(robot, q, f"CS{arm}")[2, 3]
-    return max(0.0, robot.params["r"] - z_tip)
-
-
-def printed_states(p: dict) -> dict[str, tuple[dict, dict, str, str]]:
-    """For each printed transform (eqs 27-31): parameter overrides, coordinate values, model frame, reading.
-
-    The coordinate values are the ones printed beside each equation (sec 3); Delta lambda_C comes from eq 26.
-    """
-    h = np.pi / 2
-    lift = paper_delta_lambda(p, h)  # eq 26 at theta_C1 = pi/2, r = 0.08: 0.37
-    arms_down = {f"theta_C{i}": h for i in _ARMS}
-    return {
-        "eq 27": ({}, dict(x=0.0, y=0.0, psi=20 * np.pi, lambda_C=0.0), "C",
-                  "platform turning about its axis: phi = 20 pi (10 turns), x = y = 0, no lift (the list's "
-                  "x_C0 = y_C0 = 2 and theta_C1 = pi/2 are not what the matrix shows)"),
-        "eq 28": ({}, dict(x=2.0, y=2.0, psi=np.pi / 4, lambda_C=0.0), "C", "x_C = y_C = 2, phi = pi/4, no lift"),
-        "eq 29": ({}, dict(x=2.0, y=2.0, psi=np.pi / 4, lambda_C=lift, theta1=3 * np.pi / 4, lambda2=1.4,
-                           theta3=-h, theta4=h, lambda6=0.25, theta_mu=0.0, **arms_down), "X",
-                  f"load frame X; Delta lambda_C = {lift:.2f} from eq 26 (theta_C1 = pi/2, r = 0.08)"),
-        "eq 30": ({}, dict(x=0.0, y=0.0, psi=np.pi / 4, lambda_C=lift, **arms_down), "C",
-                  f"lifted platform, Delta lambda_C = {lift:.2f} (eq 26), phi = pi/4 from sec 3's list"),
-        "eq 31": ({"r": 0.10}, dict(x=0.0, y=0.0, psi=np.pi / 4,
-                                    lambda_C=paper_delta_lambda(dict(p, r=0.10), h), theta_C1=0.0), "C1",
-                  "arm 1 link frame at the pivot; arm angle theta_C1 + theta_CS1 = pi/2 - pi/2 = 0; "
-                  "Delta lambda_C from eq 26 with eq 31's r = 0.10"),
-    }
-
-
-def model_printed(robot: Robot, key: str) -> np.ndarray:
-    """The model's pose for printed equation ``key`` (see :func:`printed_states`)."""
-    from ..kinematics import frame_pose
-
-    overrides, values, frame, _ = printed_states(robot.params)[key]
-    rob = robot if not overrides else Robot(robot.spec, {**robot.params, **overrides})
-    return frame_pose(rob, state(rob, **values), frame)
-
-
-def _printed_entries(key: str, paper: np.ndarray, model: np.ndarray) -> list[tuple[str, float, float, float]]:
-    out = []
-    for i in range(3):
-        for j in range(4):
-            val = paper[i, j]
-            tol = 5e-20 if 0 < abs(val) < 1e-10 else 5e-5  # half a unit of the last printed digit
-            out.append((f"{key} [{i + 1},{j + 1}]", val, model[i, j], tol))
-    return out
-
-
-def ik_cases(robot: Robot, n: int = 5, seed: int = 0) -> list[dict]:
-    """Targets in the manipulation range (sec 2.11 c: x, y <= 2.5 m, z <= 1.5 m), solved numerically on the model.
-
-    For each target the platform heading is eq 3's phi = atan2(d_y, d_x) and the arm values (theta1, lambda2,
-    theta3) are drawn at random; the numerical IK (scipy, bounded least squares) then finds the platform position
-    (x, y) putting the end effector E on the target. A second, fully numerical IK solves (x, y, psi, theta1,
-    lambda2, theta3) from the neutral posture with minimum change.
-    """
-    from ..kinematics import position_ik
-
-    rng = np.random.default_rng(seed)
-    out = []
-    while len(out) < n:
-        target = np.array([rng.uniform(0.5, 2.5), rng.uniform(0.5, 2.5), rng.uniform(0.5, 1.5)])
-        phi = float(np.arctan2(target[1], target[0]))
-        arm = dict(theta1=rng.uniform(1.2, 2.6), lambda2=rng.uniform(0.3, 1.2), theta3=rng.uniform(-2.0, -0.6))
-        q0 = state(robot, psi=phi, **arm)
-        platform = position_ik(robot, "E", target, q0, ["x", "y", "lambda_C"])
-        if not platform.success:
-            continue
-        free = position_ik(robot, "E", target, state(robot, psi=phi), ["x", "y", "psi", "theta1", "lambda2", "theta3"],
-                           regularisation=1e-3)
-        out.append(dict(target=target, arm=arm, phi=phi, platform=platform, free=free))
-    return out
-
-
-def compare(robot: Robot | None = None, states: int = 50, seed: int = 0) -> Comparison:
-    """The paper's kinematics (eqs 1-2, 3-5, 10-14, 26-31) against the model.
-
-    Closed forms are compared at ``states`` random configurations (worst deviation reported, tolerance 1e-9);
-    printed numbers with half a unit of their last printed digit.
-    """
-    robot = robot or Robot(SPEC)
-    p = robot.params
-    cmp = Comparison("MMR12-EOD (Zuniga-Aviles et al. 2014): paper vs model")
-    rng = np.random.default_rng(seed)
-    names = ["x", "y", "psi", "lambda_C", "theta1", "lambda2", "theta3", "theta4", "lambda6"]
-    dev_printed = np.zeros((4, 4))
-    dev_chain = np.zeros((4, 4))
-    first = None
-    from ..kinematics import frame_pose
-
-    for _ in range(states):
-        vals = dict(x=rng.uniform(-3, 3), y=rng.uniform(-3, 3), psi=rng.uniform(-np.pi, np.pi),
-                    lambda_C=rng.uniform(0, 0.37), theta1=rng.uniform(0, np.pi), lambda2=rng.uniform(0, 1.5),
-                    theta3=rng.uniform(-np.pi, np.pi), theta4=rng.uniform(-np.pi, np.pi), lambda6=rng.uniform(0, 0.3))
-        args = [vals[k] for k in names]
-        T = frame_pose(robot, state(robot, theta_mu=0.0, **vals), "X")
-        P = paper_X_M(p, *args)
-        H = paper_htg_chain(p, *args)
-        if first is None:
-            first = (P, T)
-        dev_printed = np.maximum(dev_printed, np.abs(P - T))
-        dev_chain = np.maximum(dev_chain, np.abs(H - T))
-    for i in range(3):
-        for j in range(4):
-            row = cmp.add(f"eq 2 X_M[{i + 1},{j + 1}] (as printed)", first[0][i, j], first[1][i, j], 1e-9,
-                          note=f"max |diff| over {states} random states: {dev_printed[i, j]:.3g}")
-            if dev_printed[i, j] > row.tol and row.deviation <= row.tol:
-                row.model = row.paper + dev_printed[i, j]
-    cmp.add("eq 2: HTG chain of Table 2 (numeric product), max entry diff", 0.0, float(dev_chain.max()), 1e-12,
-            note=f"over {states} random states")
-    # eqs 1 / 26: lift from the arm angle
-    for th in (np.pi / 6, np.pi / 4, np.pi / 3, np.pi / 2):
-        cmp.add(f"eq 26: Delta lambda_C at theta_C1 = {np.degrees(th):.0f} deg [m]", paper_delta_lambda(p, th),
-                model_lift(robot, th), 1e-12, note="model: tip wheel of arm 1 touching the ground")
-    # eqs 12-14
-    worst = 0.0
-    iR, iL = robot.velocity_names.index("theta_R_dot"), robot.velocity_names.index("theta_L_dot")
-    idx = [robot.coordinate_index(c) for c in ("x", "y", "psi")]
-    for _ in range(10):
-        psi = rng.uniform(-np.pi, np.pi)
-        nu = rng.normal(size=robot.mobility)
-        v = robot.reduced(state(robot, psi=psi), nu).v
-        worst = max(worst, float(np.max(np.abs(v[idx] - paper_platform_rates(p, psi, nu[iR], nu[iL])))))
-    cmp.add("eqs 12-14: platform rates from wheel rates, max |diff|", 0.0, worst, 1e-12, note="10 random states")
-    # printed transforms (27)-(31)
-    for key, paper in PRINTED.items():
-        model = model_printed(robot, key)
-        for label, a, b, tol in _printed_entries(key, paper, model):
-            cmp.add(label, a, b, tol)
-        ortho, det = _defects(paper[:3, :3])
-        cmp.add(f"{key}: det R of the printed matrix", det + 1.0, 1.0, 1e-3,
-                note=f"max|R^T R - I| of the printed matrix = {ortho:.3g}")
-    # climbing (sec 2.11 e): the gravity part of F_climb from the model on a 20 degree slope
-    bal = climbing_balance(robot, np.radians(20.0))
-    cmp.add("sec 2.11 e: m g sin(psi) at psi = 20 deg [N]", bal["F_gravity_paper"], bal["F_gravity_model"], 1e-9,
-            note=f"model: wheel forces holding the robot, tilted gravity; m = {bal['mass']:.4g} kg (assumed masses)")
-    # inverse kinematics
-    for k, case in enumerate(ik_cases(robot)):
-        target, arm = case["target"], case["arm"]
-        num = case["platform"].q
-        ik = paper_ik(p, target, arm["lambda2"], arm["theta1"], arm["theta3"])
-        cmp.add(f"IK case {k + 1}: eq 10 x_C [m]", ik["x_C"], num[robot.coordinate_index("x")], 1e-9,
-                note=f"target {np.round(target, 3).tolist()} for E; numerical IK error {case['platform'].error:.1e}")
-        cmp.add(f"IK case {k + 1}: eq 11 y_C [m]", ik["y_C"], num[robot.coordinate_index("y")], 1e-9)
-        qf = case["free"].q
-        C = frame_pose(robot, qf, "C")[:3, 3]
-        rel = target - frame_pose(robot, qf, "frame0")[:3, 3]
-        th3, lam2, th1 = (qf[robot.coordinate_index(c)] for c in ("theta3", "lambda2", "theta1"))
-        cmp.add(f"IK case {k + 1}: eq 3 phi = atan(dy/dx) of the target seen from C [rad]",
-                float(np.arctan2(target[1] - C[1], target[0] - C[0])), qf[robot.coordinate_index("psi")], 1e-6,
-                note=f"free numerical IK (x, y, psi, theta1, lambda2, theta3), error {case['free'].error:.1e}")
-        e4 = paper_ik(p, rel, lam2, th1, th3)
-        cmp.add(f"IK case {k + 1}: eq 4 theta3 vs model pi - |theta3| [rad]", e4["theta3"], np.pi - abs(th3), 1e-6,
-                note="target relative to frame 0; eq 4 is the law of cosines for the interior angle, l3 neglected")
-        e5 = paper_ik(p, rel, lam2, th1, th3)
-        cmp.add(f"IK case {k + 1}: eq 5 lambda2 [m]", e5["lambda2"], lam2, 1e-6,
-                note="d_z relative to frame 0, with the model's theta3")
-    return cmp
-
-
-def _defects(R: np.ndarray) -> tuple[float, float]:
-    from ..kinematics import rotation_defects
-
-    return rotation_defects(R)
-
-
 # ------------------------------------------------------------------------------------------------- CLI
 def register_cli(subparsers, parents) -> None:
     """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.kinematics`)."""
-    from ..kinematics import register_fk_cli
+    from ...kinematics import register_fk_cli
 
     register_fk_cli(subparsers, parents)
 
@@ -427,14 +151,14 @@ def table4_reference(name: str, omega: float = 0.5) -> Callable:
 
 
 def _hold_task(robot: Robot, labels, q0):
-    from ..control import CoordinateTask, hold
+    from ...control import CoordinateTask, hold
 
     return CoordinateTask(list(labels), hold([q0[robot.coordinate_index(c)] for c in labels]))
 
 
 def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
     """Eqs 23-25 for a Table 4 trajectory: P tracks the reference, every other actuated joint holds its value."""
-    from ..control import LinearisingController, PointTask
+    from ...control import LinearisingController, PointTask
 
     q0 = robot.neutral() if q0 is None else q0
     others = [c for c in ACTUATED if c not in ("theta_R", "theta_L")]
@@ -465,7 +189,7 @@ MANIPULATION_TARGET = np.array([2.0, 2.0, 1.5])
 def manipulation_goal(robot: Robot, q0: np.ndarray | None = None):
     """A final configuration putting E on MANIPULATION_TARGET: numerical IK over (x, y, theta3) with the heading
     kept and the boom raised to theta1 = 2.7 rad, lambda2 = 1.1 m (inside the joint ranges)."""
-    from ..kinematics import position_ik
+    from ...kinematics import position_ik
 
     q0 = manipulation_initial(robot)[0] if q0 is None else q0
     guess = q0.copy()
@@ -478,8 +202,8 @@ def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float
     """End effector E to MANIPULATION_TARGET along a rest-to-rest quintic over T s (primary output, eq 25); arms,
     theta4 and the load hold; in the null space, (theta1, lambda2, theta3) follow quintics to the IK goal posture
     so that the joints stay in range and the platform drives the rest."""
-    from ..control import CoordinateTask, LinearisingController, PointTask
-    from ..kinematics import frame_pose
+    from ...control import CoordinateTask, LinearisingController, PointTask
+    from ...kinematics import frame_pose
 
     q0 = manipulation_initial(robot)[0] if q0 is None else q0
     start = frame_pose(robot, q0, "E")[:3, 3]
@@ -537,7 +261,7 @@ def lifting_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
 def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
     """Arm 1 (the others follow through the contacts) along a quintic from the contact angle to ``end`` in T s,
     the manipulator, load and wheels hold; x, y, psi are unactuated (free on frictionless tips)."""
-    from ..control import CoordinateTask, LinearisingController
+    from ...control import CoordinateTask, LinearisingController
 
     q0 = lifting_initial(robot)[0]
     th0 = contact_angle(robot.params)
@@ -582,7 +306,7 @@ def climbing_balance(robot: Robot, slope: float, mu: float | None = None) -> dic
 
 # ------------------------------------------------------------------------------------------- scenarios
 def _scenarios() -> dict:
-    from ..control import ControlledScenario
+    from ...control import ControlledScenario
 
     out = {}
     for name, desc in (

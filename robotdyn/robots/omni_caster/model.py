@@ -1,8 +1,9 @@
-"""Omnidirectional mobile robot on three active caster wheels (Chung, Yi, Kim, Han).
+"""Omnidirectional platform on three active caster wheels (Chung, Yi, Kim, Han): the model side.
 
-Paper: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free dynamic modeling including wheel dynamics
-for an omni-directional mobile robot with three caster wheels" (``shared/papers/chung_yi_omni_caster_dynamics.txt``).
-Description: ``urdf/omni_caster.urdf.xacro`` (Fig. 2, Tables 1-2).
+Description: ``urdf/omni_caster.urdf.xacro`` (Fig. 2, Tables 1-2); Pinocchio derives the dynamics from it.
+Paper the parameters and manoeuvres come from: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free
+dynamic modeling including wheel dynamics for an omni-directional mobile robot with three caster wheels"
+(``shared/papers/chung_yi_omni_caster_dynamics.txt``).
 
 Coordinates: (x, y, psi) of the platform centre C and heading (world, m and rad), the steering angles phi_i
 (platform relative to offset link i, eq 9-11: omega = eta_i' + phi_i') and the wheel angles theta_i.
@@ -12,9 +13,10 @@ paper's operational-space inertia I_uu* (eq 48) and the reduced bias its u'^T P_
 Each wheel rolls without slipping (both tangential rows) and touches the floor; the 9 rows have rank 6 (the normal
 rows vanish on the plane) and the mobility is 3 (Grubler count of section 2).
 
-This module holds the parameters, a transcription of the paper's closed forms (eqs 12-17, 43, 48-52, 60, 61),
-kept apart from the model (which Pinocchio derives from the description), the trajectories of section 5 and the
-paper comparison.
+This module holds ``SPEC`` (Tables 1-2), the paper's NOC coordinates as a second spec (eq A9), the section-5
+trajectories (eq 61) and their feed-forward scenarios, the impulse study of Figs. 16-19 on the model (eq 60 is
+:func:`robotdyn.impulse.impact`) and the ``impulse`` CLI subcommand. The paper's closed forms (eqs 12-19, 43,
+48-51, 60, A7-A9) are in :mod:`.paper`, the comparison in :mod:`.comparison`.
 """
 
 from __future__ import annotations
@@ -23,11 +25,11 @@ import dataclasses
 
 import numpy as np
 
-from ..comparison import Comparison
-from ..errors import InputError, SingularConstraintError
-from ..operational_space import OperationalVelocities
-from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ..scenario import Scenario
+from ...errors import InputError, SingularConstraintError
+from ...operational_space import OperationalVelocities
+from ...robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from ...scenario import Scenario
+
 
 CHAINS = (1, 2, 3)
 NU_NAMES = ["v_cx", "v_cy", "omega"]
@@ -87,165 +89,9 @@ def steering_configuration(robot: Robot, phi, psi: float = 0.0, x: float = 0.0, 
     return q
 
 
-# ------------------------------------------------------------------------------------ paper transcription
 def _anchor(p: dict, i: int) -> tuple[float, float]:
     """(x, y) components of the vector A_iC (eq 6-8) in platform axes."""
     return {1: (p["l"] / 2, p["a"]), 2: (-p["l"] / 2, p["a"]), 3: (0.0, -p["b"])}[i]
-
-
-def paper_forward(p: dict, i: int, phi: float) -> np.ndarray:
-    """[iG_phi^u] of eq (12)-(14) as printed: u' = G (eta_i', theta_i', phi_i')."""
-    d, r, a, l, b = p["d"], p["r"], p["a"], p["l"], p["b"]
-    s, c = np.sin(phi), np.cos(phi)
-    if i == 1:
-        return np.array([[-d * s - a, r * c, -a], [-d * c + l / 2, -r * s, l / 2], [1.0, 0.0, 1.0]])
-    if i == 2:
-        return np.array([[-d * s - a, r * c, -a], [-d * c - l / 2, -r * s, -l / 2], [1.0, 0.0, 1.0]])
-    return np.array([[-d * s + b, r * c, b], [-d * c, -r * s, 0.0], [1.0, 0.0, 1.0]])
-
-
-def paper_inverse(p: dict, i: int, phi: float, corrected: bool = True) -> np.ndarray:
-    """[iG_u^phi] of eq (15)-(17): (eta_i', theta_i', phi_i') = G u'.
-
-    Args:
-        corrected: Apply the erratum of eq (16), entry (1, 3): the paper prints ``l/2 r cos phi2 - a r sin phi2``;
-            the inverse of eq (13) (and the model) give ``-l/2 r cos phi2 - a r sin phi2`` (the chain-2 mirror of
-            eq 15, l -> -l). ``False`` returns the matrix as printed.
-    """
-    d, r, a, l, b = p["d"], p["r"], p["a"], p["l"], p["b"]
-    s, c = np.sin(phi), np.cos(phi)
-    if i == 1:
-        G = [[-r * s, -r * c, l / 2 * r * c - a * r * s],
-             [d * c, -d * s, l / 2 * d * s + a * d * c],
-             [r * s, r * c, d * r + a * r * s - l / 2 * r * c]]
-    elif i == 2:
-        e13 = (-l / 2 * r * c - a * r * s) if corrected else (l / 2 * r * c - a * r * s)
-        G = [[-r * s, -r * c, e13],
-             [d * c, -d * s, -l / 2 * d * s + a * d * c],
-             [r * s, r * c, d * r + a * r * s + l / 2 * r * c]]
-    else:
-        G = [[-r * s, -r * c, b * r * s],
-             [d * c, -d * s, -b * d * c],
-             [r * s, r * c, d * r - b * r * s]]
-    return np.array(G) / (d * r)
-
-
-def paper_chain_inertia(p: dict) -> np.ndarray:
-    """[iI_phi_phi*] of eq (43): diag(m2 p^2 + I_z1 + I_z2, 3/2 m1 r^2 + m2 r^2, 0), (eta, theta, phi) order.
-
-    As printed, 3/2 m1 r^2 assumes the wheel's axle inertia is m1 r^2 / 2 (true of Table 2's values).
-    """
-    m1, m2, r = p["m_wheel"], p["m_link"], p["r"]
-    return np.diag([m2 * p["p"] ** 2 + p["I_wheel_diam"] + p["I_link_z"], 1.5 * m1 * r**2 + m2 * r**2, 0.0])
-
-
-def paper_platform_inertia(p: dict) -> np.ndarray:
-    """[pl I_uu*] of eq (50): diag(m_pl, m_pl, m_pl b^2 / 2)."""
-    return np.diag([p["m_pl"], p["m_pl"], 0.5 * p["m_pl"] * p["b"] ** 2])
-
-
-def paper_inertia(p: dict, phi) -> np.ndarray:
-    """I_uu* of eq (48) with (51): sum_i G_i^T I_phiphi G_i + pl I_uu*, G_i of eq (15)-(17) (corrected (16))."""
-    I = paper_chain_inertia(p)
-    out = paper_platform_inertia(p).copy()
-    for i in CHAINS:
-        G = paper_inverse(p, i, phi[i - 1])
-        out += G.T @ I @ G
-    return out
-
-
-def _dforward_dphi(p: dict, i: int, phi: float) -> np.ndarray:
-    """d[iG_phi^u]/d phi_i (the only non-zero plane of the Hessian [iH_phiphi^u], eq 18 and A.1)."""
-    d, r = p["d"], p["r"]
-    s, c = np.sin(phi), np.cos(phi)
-    return np.array([[-d * c, -r * s, 0.0], [d * s, -r * c, 0.0], [0.0, 0.0, 0.0]])
-
-
-def paper_bias(p: dict, phi, nu, platform_terms: bool = True) -> np.ndarray:
-    """u'^T P_uuu* u' of eq (49) with P_phiphiphi* = 0 (eq 43 is constant), [iH_uu^phi] of eq (19).
-
-    The paper does not print the platform's [pl P_uuu*]; with ``platform_terms`` it is taken as the Newton-Euler
-    terms of a rigid body in body axes, m_pl (-omega v_cy, omega v_cx, 0) (our reading, see the errata).
-    """
-    phi = np.asarray(phi, float)
-    nu = np.asarray(nu, float)
-    I = paper_chain_inertia(p)
-    out = np.zeros(3)
-    for i in CHAINS:
-        Gu = paper_inverse(p, i, phi[i - 1])
-        H = np.zeros((3, 3, 3))  # H[m, j, k] = d G_phi^u[m, j] / d phi_k, joint order (eta, theta, phi)
-        H[:, :, 2] = _dforward_dphi(p, i, phi[i - 1])
-        Hphi = -np.einsum("nm,mjk,ja,kb->nab", Gu, H, Gu, Gu)  # eq (19)
-        phidd = np.einsum("nab,a,b->n", Hphi, nu, nu)  # joint accelerations at u'' = 0
-        out += Gu.T @ I @ phidd
-    if platform_terms:
-        vx, vy, w = nu
-        out += p["m_pl"] * np.array([-w * vy, w * vx, 0.0])
-    return out
-
-
-def offset_link_correction(p: dict, phi, nu) -> np.ndarray:
-    """What eq (43)'s "P_phiphiphi* = 0" leaves out when the link's mass centre is off the wheel axis (p != 0).
-
-    Derived here (see the errata): with e the unit vector A_i -> O_i, the link's mass centre moves at
-    v = r theta' e - p eta' (k x e), so its inertia forces on (eta, theta) are m2 (p^2 eta'' - p r theta' eta',
-    r^2 theta'' + r p eta'^2); the velocity products are missing from eq (43)-(49). Returns sum_i G_i^T of them.
-    """
-    out = np.zeros(3)
-    m2, pp, r = p["m_link"], p["p"], p["r"]
-    for i in CHAINS:
-        Gu = paper_inverse(p, i, phi[i - 1])
-        eta_d, theta_d, _ = Gu @ np.asarray(nu, float)
-        out += Gu.T @ np.array([-m2 * pp * r * theta_d * eta_d, m2 * r * pp * eta_d**2, 0.0])
-    return out
-
-
-def paper_impulse(I_uu: np.ndarray, n, u_dot, e: float) -> float:
-    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.impulse)."""
-    n = np.asarray(n, float)
-    return float(-(1 + e) * np.dot(u_dot, n) / (n @ np.linalg.inv(I_uu) @ n))
-
-
-# ------------------------------------------------------------------------------------------ the model side
-def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
-    """[iG_u^phi] from the model: (eta_i', theta_i', phi_i') per unit platform twist, columns (v_cx, v_cy, omega).
-
-    eta_i' is the offset link's absolute yaw rate (its frame Jacobian), theta_i', phi_i' the joint rates; all from
-    S of the operational projection (the model's constraint Jacobians).
-    """
-    from ..constraint import KinematicState
-
-    red = robot.reduced(q, np.zeros(3))
-    kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
-    out = {}
-    for i in CHAINS:
-        _, jac, _ = kin.frame(robot.description.frame_id(f"link_{i}"))
-        eta = jac[5] @ red.S
-        out[i] = np.vstack([eta, red.S[robot.coordinate_index(f"theta{i}")], red.S[robot.coordinate_index(f"phi{i}")]])
-    return out
-
-
-# ------------------------------------------------------------------------------- NOC singularity (sec 3.1)
-def paper_noc_jacobians(p: dict, phi) -> tuple[np.ndarray, np.ndarray]:
-    """J_p (6x6) and J_a (6x3) of eq (A7)-(A8) from the columns ig_j of eq (12)-(14).
-
-    Dependent rates (eta1', phi1', eta2', phi2', eta3', theta3'), independent (theta1', theta2', phi3'), eq (A9).
-    """
-    g = {i: paper_forward(p, i, phi[i - 1]) for i in CHAINS}
-    z = np.zeros(3)
-    Jp = np.block([[g[1][:, [0]], g[1][:, [2]], -g[2][:, [0]], -g[2][:, [2]], z[:, None], z[:, None]],
-                   [g[1][:, [0]], g[1][:, [2]], z[:, None], z[:, None], -g[3][:, [0]], -g[3][:, [1]]]])
-    Ja = np.block([[-g[1][:, [1]], g[2][:, [1]], z[:, None]], [-g[1][:, [1]], z[:, None], g[3][:, [2]]]])
-    return Jp, Ja
-
-
-def paper_noc_map(p: dict, phi) -> np.ndarray:
-    """K with (theta1', theta2', phi3') = K u': rows theta of eq (15), theta of eq (16), phi of eq (17).
-
-    The NOC model exists iff K is invertible (equivalently det J_p != 0); then its inertia is
-    K^-T I_uu* K^-1 (the same kinetic energy in other velocities).
-    """
-    return np.vstack([paper_inverse(p, 1, phi[0])[1], paper_inverse(p, 2, phi[1])[1], paper_inverse(p, 3, phi[2])[2]])
 
 
 def noc_report(robot: Robot, noc: Robot, phi) -> dict:
@@ -444,7 +290,7 @@ class PathScenario(Scenario):
         return torque
 
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
-        from ..simulation import simulate
+        from ...simulation import simulate
 
         t_end, n_out = self.span(t_end, n_out)
         q0, nu0 = self.initial_state(robot)
@@ -476,7 +322,7 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
     Returns:
         {figure: (angles [rad], magnitudes [N s])} for :data:`IMPULSE_CONFIGS`.
     """
-    from ..impulse import impulse_curve
+    from ...impulse import impulse_curve
 
     out = {}
     for name, deg in IMPULSE_CONFIGS.items():
@@ -486,9 +332,9 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
 
 
 def _cmd_impulse(args) -> int:
-    from ..cli import _emit, _load
-    from ..impulse import impact
-    from ..inputs import as_vector
+    from ...cli import _emit, _load
+    from ...impulse import impact
+    from ...inputs import as_vector
 
     _, robot = _load(args)
     q = robot.check_q(args.q)
@@ -528,110 +374,3 @@ def register_cli(subparsers, parents) -> None:
     p.add_argument("--speed", type=float, default=1.0, help="head-on approach speed along -n (default 1)")
     p.add_argument("--v", nargs="+", help="velocity before impact in the minimal coordinates (instead of --speed)")
     p.set_defaults(func=_cmd_impulse)
-
-
-# ------------------------------------------------------------------------------------------ comparison
-PRINTED_WITH_WHEELS = np.array([[5.4329, 0.0537, -0.00078], [0.0537, 7.5379, 0.0107], [-0.00078, 0.0107, 0.0397]])
-"""The with-wheel I_uu* printed in section 5 "at a configuration" (no configuration given)."""
-PRINTED_NO_WHEELS = np.diag([5.0, 5.0, 0.025])
-"""The no-wheel I_uu* printed in section 5."""
-
-
-def fit_printed_matrix(p: dict, free: tuple[str, ...] = (), starts: int = 60, seed: int = 0) -> dict:
-    """Least-squares search for steering angles (and optionally parameters ``free``) reproducing the printed
-    with-wheel I_uu* (6 independent entries) through the eq-48 transcription.
-
-    Returns:
-        dict with ``phi`` [rad], ``params`` (the fitted free ones), ``residual`` (entries, printed - fit) and
-        ``max_abs`` (the largest absolute residual).
-    """
-    from scipy.optimize import least_squares
-
-    iu = np.triu_indices(3)
-
-    def res(x):
-        pp = dict(p)
-        pp.update(zip(free, x[3:]))
-        return (paper_inertia(pp, x[:3]) - PRINTED_WITH_WHEELS)[iu]
-
-    rng = np.random.default_rng(seed)
-    best = None
-    for _ in range(starts):
-        x0 = np.r_[rng.uniform(-np.pi, np.pi, 3), [p[k] * rng.uniform(0.2, 4.0) for k in free]]
-        lb = np.r_[[-np.inf] * 3, [0.0] * len(free)]
-        s = least_squares(res, x0, bounds=(lb, np.inf))
-        if best is None or s.cost < best.cost:
-            best = s
-    r = res(best.x)
-    return {"phi": np.angle(np.exp(1j * best.x[:3])), "params": dict(zip(free, best.x[3:])), "residual": r,
-            "max_abs": float(np.abs(r).max())}
-
-
-def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Comparison:
-    """The paper's closed forms and printed numbers against the model (see ``docs/errata/omni_caster.md``).
-
-    Closed forms are compared at ``states`` random steering configurations (random pose too); each such row shows
-    the worst entry and uses a tolerance of 1e-10 (relative to the entries' scale for eq 15-17, whose entries
-    are O(1/r)).
-    """
-    robot = robot or Robot(SPEC)
-    p = robot.params
-    rng = np.random.default_rng(seed)
-    cmp = Comparison("Omni caster platform (Chung, Yi, Kim, Han): paper vs model")
-    worst = {k: 0.0 for k in ("I48", "G15", "G12", "G16p", "P49", "P49c")}
-    scale = 1.0 / min(p["d"], p["r"])
-    for _ in range(states):
-        phi = rng.uniform(-np.pi, np.pi, 3)
-        nu = rng.normal(size=3)
-        q = steering_configuration(robot, phi, *rng.uniform(-5, 5, 3))
-        red = robot.reduced(q, nu)
-        worst["I48"] = max(worst["I48"], np.abs(red.M - paper_inertia(p, phi)).max())
-        G = model_chain_jacobians(robot, q)
-        for i in CHAINS:
-            worst["G15"] = max(worst["G15"], np.abs(G[i] - paper_inverse(p, i, phi[i - 1])).max() / scale)
-            worst["G12"] = max(worst["G12"], np.abs(np.linalg.inv(G[i]) - paper_forward(p, i, phi[i - 1])).max())
-        worst["G16p"] = max(worst["G16p"], np.abs(G[2] - paper_inverse(p, 2, phi[1], corrected=False)).max() / scale)
-        worst["P49"] = max(worst["P49"], np.abs(red.h - paper_bias(p, phi, nu)).max())
-        worst["P49c"] = max(worst["P49c"], np.abs(red.h - paper_bias(p, phi, nu)
-                                                   - offset_link_correction(p, phi, nu)).max())
-    n = f"max over {states} random configurations"
-    cmp.add("eq 48: I_uu* (worst entry deviation)", 0.0, worst["I48"], 1e-10, n)
-    cmp.add("eq 12-14: G_phi^u (worst entry deviation)", 0.0, worst["G12"], 1e-10, n)
-    cmp.add("eq 15-17 (eq 16 corrected): G_u^phi (worst deviation x min(d, r))", 0.0, worst["G15"], 1e-10, n)
-    cmp.add("eq 16 as printed: G_u^phi of chain 2 (worst deviation x min(d, r))", 0.0, worst["G16p"], 1e-10,
-            "entry (1,3): printed +l/2 r cos(phi2), should be -l/2 r cos(phi2) (errata)")
-    cmp.add("eq 49 with P_phiphiphi* = 0: u'^T P_uuu* u' (worst deviation, |u'| ~ 1)", 0.0, worst["P49"], 1e-10,
-            "eq 43's constant inertia omits the offset link's velocity products when p != 0 (errata)")
-    cmp.add("eq 49 + derived offset-link terms (worst deviation)", 0.0, worst["P49c"], 1e-10, n)
-    bare = Robot(SPEC, {**robot.params, **NO_WHEELS})
-    Mb = bare.reduced(steering_configuration(bare, rng.uniform(-np.pi, np.pi, 3)), np.zeros(3)).M
-    for k, lab in enumerate(("xx", "yy", "omega omega")):
-        cmp.add(f"sec 5 printed no-wheel I_uu* {lab}", PRINTED_NO_WHEELS[k, k], Mb[k, k], 5e-4,
-                "printed to 3 decimals; eq 50 with m_pl = 5 kg, b = 0.1 m")
-    M = robot.reduced(robot.neutral(), np.zeros(3)).M
-    cmp.add("sec 5 printed with-wheel I_uu*: trace of xy block (steering-invariant)",
-            PRINTED_WITH_WHEELS[0, 0] + PRINTED_WITH_WHEELS[1, 1], M[0, 0] + M[1, 1], 5e-4,
-            "invariant under steering: no configuration reproduces the printed matrix with Table 1-2 values")
-    fit = fit_printed_matrix(p, starts=20)
-    cmp.add("sec 5 printed with-wheel I_uu*: best fit over steering angles (max |residual|)", 0.0, fit["max_abs"],
-            5e-4, "phi = (" + ", ".join(f"{np.degrees(x):.1f}" for x in fit["phi"]) + ") deg")
-    from ..impulse import impulse_curve
-
-    for name, deg in IMPULSE_CONFIGS.items():
-        Mi = robot.reduced(steering_configuration(robot, np.radians(deg)), np.zeros(3)).M
-        ang, mag = impulse_curve(Mi, RESTITUTION, 1.0, (0, 1), 721)
-        if name == "fig18":
-            cmp.add("Fig. 18 (240, 120, 0) deg: impulse curve max/min (paper: uniform)", 1.0, mag.max() / mag.min(),
-                    1e-7, "links tangential, 120-degree symmetry; 1 to 1e-15 with l = b sqrt(3), Table 1's "
-                    "rounded l = 0.173 breaks it at 1e-8")
-        elif name in ("fig16", "fig17"):
-            roll = (-np.radians(deg[0])) % np.pi  # the wheels' rolling direction (all links parallel)
-            peak = ang[np.argmax(mag)] % np.pi
-            cmp.add(f"Fig. {name[3:]} {deg} deg: direction of largest impulse [deg] (paper: moving direction)",
-                    np.degrees(roll), np.degrees(peak), 0.5, "rolling direction of the (parallel) wheels")
-    noc = Robot(noc_spec(), robot.params)
-    rep = noc_report(robot, noc, np.radians(IMPULSE_CONFIGS["fig16"]))
-    Jp, _ = paper_noc_jacobians(p, np.zeros(3))
-    cmp.add("sec 3.1: det J_p at Fig. 16 configuration (0,0,0) vs model NOC 1/condition", abs(np.linalg.det(Jp)),
-            1.0 / rep["noc_condition"], 1e-12, "NOC singular (SingularConstraintError); I_uu* finite")
-    return cmp

@@ -1,0 +1,15 @@
+"""The MMR12-EOD mobile manipulator (Zuniga-Aviles et al. 2014): the model and the paper, kept apart.
+
+- :mod:`.model`: what robotdyn derives from ``urdf/mmr12_eod.urdf.xacro`` -- ``SPEC``, the control ``SCENARIOS``
+  (Table 4 tracking, manipulation, lifting), the climbing balance, the ``fk`` CLI hook.
+- :mod:`.paper`: the paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31), transcribed
+  (``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``).
+- :mod:`.comparison`: ``compare``, the model against the paper (``docs/errata/mmr12_eod.md``).
+
+The names of all three are re-exported here (``robotdyn.robots.module("mmr12_eod")``).
+"""
+
+from .comparison import *  # noqa: F401,F403
+from .model import *  # noqa: F401,F403
+from .model import _ARMS  # noqa: F401
+from .paper import *  # noqa: F401,F403

@@ -1,0 +1,15 @@
+"""The Quasimoro (Staicu, virtual powers): the model and the paper, kept apart.
+
+- :mod:`.model`: what robotdyn derives from ``urdf/quasimoro.urdf.xacro`` -- ``SPEC`` (parameters of section 3,
+  wheels, motors), the torque pulse of eq 19 and the two section-3 manoeuvres (``SCENARIOS``), ``drift``.
+- :mod:`.paper`: the paper's closed forms (eqs 23-31) and printed values, transcribed
+  (``shared/papers/staicu_quasimoro_virtual_powers.txt``).
+- :mod:`.comparison`: ``compare``, the model against the paper (``docs/errata/quasimoro.md``).
+
+The names of all three are re-exported here (``robotdyn.robots.module("quasimoro")``).
+"""
+
+from .comparison import *  # noqa: F401,F403
+from .model import *  # noqa: F401,F403
+from .model import _pulse  # noqa: F401
+from .paper import *  # noqa: F401,F403

@@ -14,8 +14,8 @@ Independent velocities: every actuated joint (wheels, arms, manipulator, load); 
 dependent through the rolling constraints of Table 3 (eqs 12-14) and the wheels' ground contact.
 
 This module holds ``SPEC`` (Table 2, section 3; masses assumed), the CLI hook, the control scenarios (eqs 23-25 on
-the model: Table 4 tracking, the Fig. 9 manipulation, the sec 2.11 d lifting) and the climbing balance of
-sec 2.11 e. The paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31) are in
+the model: Table 4 tracking, the Fig. 9 manipulation, the sec 2.11 d lifting), the climbing balance of
+sec 2.11 e and the climbing posture's contact forces on a ramp (:func:`climbing_forces`). The paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31) are in
 :mod:`.paper`, the comparison in :mod:`.comparison`.
 """
 
@@ -302,6 +302,45 @@ def climbing_balance(robot: Robot, slope: float, mu: float | None = None) -> dic
     F = m * g * (np.sin(slope) + mu * np.cos(slope))
     return {"mass": m, "F_paper": F, "F_gravity_paper": m * g * np.sin(slope),
             "F_gravity_model": float((red.g[iR] + red.g[iL]) / R), "wheel_torque": F * R / 2}
+
+
+# ------------------------------------------------------------------------------------------- climbing on forces
+CLIMB_ARMS_UP = 0.6
+"""How far [rad] the front arms (1, 2) are raised above the contact angle in :func:`climbing_robot`."""
+
+
+def climbing_robot(slope: float, robot: Robot | None = None) -> Robot:
+    """The robot holding itself on a ramp of ``slope`` [rad] (rising along world x): floating root, the two drive
+    wheels rolling without slipping and the rear arms' tip wheels (3, 4) as frictionless supports, the front arms
+    raised (sec 2.11 e's climbing with the arms as outriggers; the real robot's tracks are not in the
+    description)."""
+    from ...terrain import RampTerrain
+
+    if not np.isfinite(slope) or abs(slope) >= np.pi / 2:
+        raise InputError(f"slope = {slope} rad; expected |slope| < pi/2")
+    spec = dataclasses.replace(
+        robot.spec if robot is not None else SPEC, name=f"{SPEC.name}_climbing", root="floating", independent=None,
+        wheels=[*SPEC.wheels, *(Wheel(f"CS{i}", "r", axis=(0.0, 0.0, 1.0), kind="support", name=f"tip{i}")
+                                for i in (3, 4))])
+    return Robot(spec, robot.params if robot is not None else None, RampTerrain(float(np.tan(slope))))
+
+
+def climbing_state(robot: Robot, slope: float) -> np.ndarray:
+    """The climbing posture on the ramp of :func:`climbing_robot`: facing uphill (pitch = -slope about the ramp
+    line through the origin), rear arms at the contact angle (their tips and the drive wheels on the ramp), front
+    arms :data:`CLIMB_ARMS_UP` higher, manipulator neutral."""
+    th = contact_angle(robot.params)
+    return state(robot, pitch=-slope, theta_C1=th - CLIMB_ARMS_UP, theta_C2=th - CLIMB_ARMS_UP, theta_C3=th,
+                 theta_C4=th)
+
+
+def climbing_forces(slope: float, robot: Robot | None = None):
+    """Contact forces holding the robot at rest on a ramp of ``slope`` [rad] (:func:`climbing_robot`, every motor
+    holding its coordinate): the :class:`~robotdyn.contact_forces.ConstraintForces` (drive-wheel traction and
+    loads, tip loads, ``minimum_mu``: the smallest friction coefficient that holds the robot there)."""
+    climber = climbing_robot(slope, robot)
+    zero = np.zeros(climber.mobility)
+    return climber.contact_forces(climbing_state(climber, slope), zero, nudot=zero)
 
 
 # ------------------------------------------------------------------------------------------- scenarios

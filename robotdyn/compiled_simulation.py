@@ -18,6 +18,14 @@ check for signals (Ctrl-C keeps the samples so far, as on the scipy path) and to
 Where the compiled model's row choice stops working (:class:`robotdyn.compiled.Fallback`) the C++ side asks the
 Python path for a new one at that state (:func:`rechooser`), or gets its usual error, as the scipy path does.
 
+Robots with slipping wheels (:mod:`robotdyn.sliding`, laws :class:`~robotdyn.friction.RegularisedCoulomb` and
+:class:`~robotdyn.friction.LinearTyre`, encoded by :meth:`~robotdyn.friction.FrictionLaw.encode`) run here too: the
+accelerations and normal loads come from the same coupled linear system as :func:`robotdyn.sliding.forward`
+(``Evaluator.slip_rhs``), the friction work is an extra state, a singular system raises the Python path's
+Painleve error, and the terminal lift-off event (the smallest normal load of a slipping wheel crossing zero
+downwards) is located on the stepper's dense output, or for Adams on a Dormand-Prince re-integration of the step,
+with the Python path's ``stats["event"]`` (and ``stats["t_event"]``). Exact stick-slip stays on the Python path.
+
 The scipy path (DOP853) stays the reference; ``tests/test_compiled_simulation.py`` checks the compiled trajectories
 against it to 1e-8 on every compiled robot.
 """

@@ -135,7 +135,8 @@ def simulate(
     Two engines integrate the same ODE: the compiled one (:mod:`robotdyn.compiled_simulation`: the whole run in
     C++, Boost.Odeint's adaptive Adams-Bashforth-Moulton by default) and scipy's (``solve_ivp``'s DOP853 loop, the
     reference, with a Python call per evaluation). Both restart at the breakpoints of a torque profile. ``engine="auto"`` takes the compiled one where the robot has a compiled
-    model (:func:`robotdyn.compiled.why_not`), no slipping wheels, and the torques are ``None`` or a
+    model (:func:`robotdyn.compiled.why_not`; slipping wheels with a compiled friction law included, exact
+    stick-slip not), and the torques are ``None`` or a
     :class:`~robotdyn.torque_profile.TorqueProfile` (a Python callable needs the scipy engine); ``stats["engine"]``
     says which ran.
 

@@ -33,6 +33,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -65,6 +66,29 @@ struct Wheel {
   double radius;   // m (plus q[radius_index] when radius_index >= 0)
   int radius_index;
   Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3> D;  // (nd, 3) rows as coefficients of (t1, t2, n)
+};
+
+// A wheel whose tangential force follows a friction law (robotdyn/sliding.py, robotdyn/friction.py): F_t = -f_n c(s)
+// on its free directions (t1, t2), with the law
+//   0 RegularisedCoulomb   c = p0 s / sqrt(|s|^2 + p1^2)          (p0 = mu, p1 = slip velocity [m/s])
+//   1 LinearTyre           c = p0 s if p0 |s| <= p1, else p1 s/|s|  (p0 = stiffness [s/m], p1 = mu, inf allowed)
+struct Slip {
+  int wheel;       // index into Evaluator::wheels_
+  int normal_row;  // its normal row (index into the stacked rows)
+  int law;
+  double p0, p1;
+  Eigen::Vector2d free;  // 1: the direction follows the law, 0: it rolls (its no-slip row stays a constraint)
+};
+
+// The slipping wheels' contact problem cannot be solved here: kind 0 singular (Painleve; value: its 2-norm
+// condition number), kind 1 a slipping wheel's normal row is not among the projection's rows (value: the slip's
+// index). The Python side raises the reference path's error from it (robotdyn/compiled_simulation.py).
+struct SlipError : std::runtime_error {
+  SlipError(int kind_, double value_)
+      : std::runtime_error(kind_ == 0 ? "singular slipping contact problem" : "slipping wheel's normal row redundant"),
+        kind(kind_), value(value_) {}
+  int kind;
+  double value;
 };
 
 struct Coupling {  // q[i] = amplitude cos(rate q[j] + phase) + offset
@@ -212,6 +236,14 @@ class Evaluator {
     holonomic_.push_back(true);
   }
   void add_motor(int index, int joint, int reaction) { motors_.push_back(Motor{index, joint, reaction}); }
+  // A slipping wheel: wheel index, its normal row, law code and parameters (see Slip), free directions (t1, t2).
+  void add_slipping(int wheel, int normal_row, int law, double p0, double p1, const Eigen::Vector2d& free) {
+    if (wheel < 0 || wheel >= static_cast<int>(wheels_.size())) throw std::invalid_argument("no such wheel");
+    if (normal_row < 0 || normal_row >= nrows()) throw std::invalid_argument("no such row");
+    if (law < 0 || law > 1) throw std::invalid_argument("unknown friction law code");
+    slips_.push_back(Slip{wheel, normal_row, law, p0, p1, free});
+  }
+  int slipping() const { return static_cast<int>(slips_.size()); }
   // The rows used and the independent velocity indices (a selection of v).
   void set_selection(const std::vector<int>& rows, const std::vector<int>& independent,
                      const std::vector<int>& dependent) {
@@ -389,6 +421,101 @@ class Evaluator {
     out.tail(k) = force_;
   }
 
+  // ------------------------------------------------------------------------------------------ slipping wheels
+  // c(s) of a slipping wheel's law on its free directions (FrictionLaw.coefficient, SlippingWheel.
+  // friction_coefficient), in the Python formulas' order of operations.
+  static Eigen::Vector2d coefficient(const Slip& sl, const Eigen::Vector2d& slip) {
+    const Eigen::Vector2d s = slip.cwiseProduct(sl.free);
+    Eigen::Vector2d c;
+    if (sl.law == 0) {
+      c = sl.p0 * s / std::sqrt(s.dot(s) + sl.p1 * sl.p1);
+    } else {
+      const double speed = std::sqrt(s.dot(s));
+      c = speed * sl.p0 <= sl.p1 ? Eigen::Vector2d(sl.p0 * s) : Eigen::Vector2d(sl.p1 * s / speed);
+    }
+    return c.cwiseProduct(sl.free);
+  }
+
+  // d/dt of (q, nu, W) with slipping wheels (robotdyn/sliding.py forward): the accelerations and the normal loads
+  // from one linear system
+  //   [M S,  -(A_R^T - sum_i J_t,i^T c_i e_i^T)] [nudot; lambda] = B tau - RNEA(q, v, w),
+  // A_R the projection's rows, J_t,i = (t1, t2)^T A_w,i the tangential rows of slipping wheel i, s_i = J_t,i v its
+  // slip velocity, c_i = c(s_i), e_i selecting its normal load; W-dot = sum_i F_i . s_i, F_i = -f_n,i c_i (the
+  // friction power). The system's 2-norm condition number above 1e12 is the Painleve case (SlipError 0), decided
+  // as numpy.linalg.cond would: the exact 1-norm number kappa_1 (from the inverse) bounds it, kappa_2 <= n kappa_1,
+  // and only where n kappa_1 exceeds 1e12 are the singular values computed. Leaves the normal loads in
+  // slip_normal_ and their minimum (the lift-off event's value) in slip_min_.
+  void slip_rhs_into(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+                     const Eigen::Ref<const VectorXd>& tau, double alpha, Eigen::Ref<VectorXd> out) {
+    configure(q);
+    dynamics(nu);
+    const int k = static_cast<int>(S_.cols());
+    const int nr = static_cast<int>(rows_.size());
+    const int nw = static_cast<int>(slips_.size());
+    if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
+    if (out.size() != nv_ + k + 1) throw std::invalid_argument("state has the wrong length");
+    if (k + nr != nv_) throw Fallback("rows and independent velocities do not make a square system");
+    Ks_.resize(nv_, nv_);
+    Ks_.leftCols(k) = SM_;  // M S (dynamics)
+    for (int r = 0; r < nr; ++r) Ks_.col(k + r) = -A_.row(rows_[r]).transpose();
+    slip_pos_.resize(nw);
+    slip_s_.resize(nw, 2);
+    slip_c_.resize(nw, 2);
+    Jt_.resize(2, nv_);
+    for (int i = 0; i < nw; ++i) {
+      const Slip& sl = slips_[i];
+      const auto hit = std::find(rows_.begin(), rows_.end(), sl.normal_row);
+      if (hit == rows_.end()) throw SlipError(1, i);
+      slip_pos_[i] = static_cast<int>(hit - rows_.begin());
+      const Geometry& g = geo_[sl.wheel];
+      Jt_.row(0).noalias() = g.t1.transpose() * Aw_[sl.wheel];
+      Jt_.row(1).noalias() = g.t2.transpose() * Aw_[sl.wheel];
+      const Eigen::Vector2d s = Jt_ * v_;
+      const Eigen::Vector2d c = coefficient(sl, s);
+      slip_s_.row(i) = s.transpose();
+      slip_c_.row(i) = c.transpose();
+      Ks_.col(k + slip_pos_[i]).noalias() += Jt_.transpose() * c;
+    }
+    bs_.noalias() = B_ * tau;
+    bs_ -= data_.tau;  // C v + g (dynamics)
+    bs_.noalias() -= data_.M * w_;
+    slip_lu_.compute(Ks_);
+    Ksinv_ = slip_lu_.inverse();
+    const double kappa1 = Ks_.cwiseAbs().colwise().sum().maxCoeff() * Ksinv_.cwiseAbs().colwise().sum().maxCoeff();
+    if (!(std::isfinite(kappa1) && nv_ * kappa1 <= 1e12)) {
+      slip_svd_.compute(Ks_);
+      const VectorXd& sv = slip_svd_.singularValues();
+      const double cond = sv[0] / sv[sv.size() - 1];
+      if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, std::isnan(cond) ? HUGE_VAL : cond);
+    }
+    xs_ = slip_lu_.solve(bs_);
+    out.head(nv_) = v_;
+    if (alpha != 0.0) pull_back(alpha, out);
+    out.segment(nv_, k) = xs_.head(k);
+    slip_normal_.resize(nw);
+    double power = 0.0;
+    slip_min_ = HUGE_VAL;
+    for (int i = 0; i < nw; ++i) {
+      const double fn = xs_[k + slip_pos_[i]];
+      slip_normal_[i] = fn;
+      slip_min_ = std::min(slip_min_, fn);
+      power += -fn * slip_c_(i, 0) * slip_s_(i, 0) + -fn * slip_c_(i, 1) * slip_s_(i, 1);
+    }
+    out[nv_ + k] = power;
+  }
+
+  // (d/dt (q, nu, W), normal loads (W,), slip velocities (W, 2), friction forces (W, 2)) at one state: the compiled
+  // sliding.forward (tests compare it with the Python path).
+  py::tuple slip_rhs(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+                     const Eigen::Ref<const VectorXd>& tau, double alpha) {
+    if (slips_.empty()) throw std::invalid_argument("no slipping wheels");
+    VectorXd out(nv_ + nu.size() + 1);
+    slip_rhs_into(q, nu, tau, alpha, out);
+    RowMat force(slips_.size(), 2);
+    for (size_t i = 0; i < slips_.size(); ++i) force.row(i) = -slip_normal_[i] * slip_c_.row(i);
+    return py::make_tuple(out, slip_normal_, RowMat(slip_s_), force);
+  }
+
   // ------------------------------------------------------------------------------------------ simulation
   // Where the row choice stops working (Fallback), `rechoose(q, nu)` (Python, with the GIL) returns the Python
   // path's new (rows, independent, dependent), or raises the Python path's error: as the scipy path, which
@@ -421,10 +548,37 @@ class Evaluator {
     tau_.resize(profile.motors());
     profile.eval(t, tau_);
     dy.resize(y.size());
-    with_rechoice(y.data(), rechoose, [&] {
-      rhs_into(Eigen::Map<const VectorXd>(y.data(), nv_), Eigen::Map<const VectorXd>(y.data() + nv_, k), tau_,
-               alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k));
-    });
+    if (slips_.empty()) {
+      with_rechoice(y.data(), rechoose, [&] {
+        rhs_into(Eigen::Map<const VectorXd>(y.data(), nv_), Eigen::Map<const VectorXd>(y.data() + nv_, k), tau_,
+                 alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k));
+      });
+      return;
+    }
+    try {  // y = (q, nu, friction work)
+      with_rechoice(y.data(), rechoose, [&] {
+        slip_rhs_into(Eigen::Map<const VectorXd>(y.data(), nv_), Eigen::Map<const VectorXd>(y.data() + nv_, k),
+                      tau_, alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k + 1));
+      });
+    } catch (const SlipError&) {
+      slip_error_t_ = t;
+      slip_error_y_ = y;
+      throw;
+    }
+    event_t_ = t;  // the lift-off event's value at this state (lift_off reuses it)
+    event_y_ = y;
+    event_g_ = slip_min_;
+  }
+
+  // The lift-off event: the smallest normal load of the slipping wheels at (t, y) [N] (from the last evaluation
+  // when it was at this very state).
+  double lift_off(double t, const std::vector<double>& y, double alpha, const robotdyn::TorqueProfile& profile,
+                  const py::object& rechoose) {
+    if (!(t == event_t_ && y == event_y_)) {
+      event_dy_.resize(y.size());
+      deriv(t, y, event_dy_, alpha, profile, rechoose);
+    }
+    return event_g_;
   }
 
   // Total mechanical energy [J] (kinetic 1/2 v^T M v, potential -sum m_i g . c_i as Pinocchio's
@@ -630,6 +784,7 @@ class Evaluator {
                          const std::vector<std::vector<double>>& breaks, double t_end,
                          const std::vector<double>& samples, double rtol, double atol, double alpha,
                          const std::string& method, int threads, py::object progress, py::object rechoose) {
+    if (!slips_.empty()) throw std::invalid_argument("simulate_many does not run robots with slipping wheels");
     const long N = static_cast<long>(Q0.rows());
     const int k = mobility(), dim = nv_ + k;
     const long S = static_cast<long>(samples.size());
@@ -774,8 +929,9 @@ class Evaluator {
     if (q0.size() != nv_ || nu0.size() != k) throw std::invalid_argument("q0 or nu0 has the wrong length");
     if (profile.motors() != static_cast<int>(motors_.size()))
       throw std::invalid_argument("the torque profile is for another number of motors");
-    const int dim = nv_ + k;
-    robotdyn::State y0(dim);
+    const bool slipping = !slips_.empty();
+    const int dim = nv_ + k + (slipping ? 1 : 0);  // slipping wheels: the friction work as the last component
+    robotdyn::State y0(dim, 0.0);
     Eigen::Map<VectorXd>(y0.data(), nv_) = q0;
     Eigen::Map<VectorXd>(y0.data() + nv_, k) = nu0;
     std::vector<double> ts, ys, energy, residual;
@@ -815,9 +971,30 @@ class Evaluator {
     size_t next = 0;
     while (next < samples.size() && samples[next] < t0) ++next;
     robotdyn::Outcome out;
+    struct LiftOff {  // the terminal event of slipping wheels: their smallest normal load crossing zero downwards
+      Evaluator* ev;
+      double alpha;
+      const robotdyn::TorqueProfile* profile;
+      const py::object* rechoose;
+      bool on;
+      bool active() const { return on; }
+      double operator()(double t, const robotdyn::State& y) { return ev->lift_off(t, y, alpha, *profile, *rechoose); }
+    } lift_off{this, alpha, &profile, &rechoose, slipping};
+    int slip_error = -1;
+    double slip_value = 0.0;
     {
       py::gil_scoped_release release;
-      out = robotdyn::integrate(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol, observer, poll);
+      try {
+        out = robotdyn::integrate(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol, observer, poll,
+                                  lift_off);
+      } catch (const SlipError& e) {
+        slip_error = e.kind;
+        slip_value = e.value;
+        out.status = robotdyn::FAILED;
+        out.t = slip_error_t_;
+        out.y = slip_error_y_;
+        out.message = e.what();
+      }
       energy.resize(ts.size());
       residual.resize(ts.size());
       for (size_t i = 0; i < ts.size(); ++i) observe(ys.data() + i * dim, energy[i], residual[i], rechoose);
@@ -836,6 +1013,9 @@ class Evaluator {
     result["message"] = out.message;
     result["nfev"] = nfev;
     result["steps"] = out.steps;
+    result["event"] = out.event;
+    result["slip_error"] = slip_error;
+    result["slip_value"] = slip_value;
     return result;
   }
 
@@ -1223,6 +1403,7 @@ class Evaluator {
   std::vector<Coupling> couplings_;
   std::vector<std::pair<int, int>> order_;  // (0: wheel, 1: closure, 2: coupling; index), in row order
   std::vector<Motor> motors_;
+  std::vector<Slip> slips_;
   std::vector<bool> holonomic_;
   Terrain terrain_;
   pin::Motion gravity_;  // the model's gravity (the Pinocchio model itself has none, see the constructor)
@@ -1242,6 +1423,16 @@ class Evaluator {
   Eigen::LLT<MatrixXd> llt_;
   Eigen::JacobiSVD<MatrixXd> svd_;
   double cond_ = 1.0;
+  // slipping wheels' work buffers (slip_rhs_into), the lift-off event's cache and the state of a SlipError
+  MatrixXd Ks_, Ksinv_, Jt_;
+  VectorXd bs_, xs_, slip_normal_;
+  Eigen::Matrix<double, Eigen::Dynamic, 2> slip_s_, slip_c_;
+  std::vector<int> slip_pos_;
+  Eigen::PartialPivLU<MatrixXd> slip_lu_;
+  Eigen::JacobiSVD<MatrixXd> slip_svd_;
+  double slip_min_ = HUGE_VAL, event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
+  double slip_error_t_ = 0.0;
+  std::vector<double> event_y_, event_dy_, slip_error_y_;
   std::vector<Geometry> geo_;
   std::vector<Matrix6x> Jf_;
   std::vector<MatrixXd> Aw_;
@@ -1274,6 +1465,9 @@ PYBIND11_MODULE(_compiled, m) {
       .def("add_wheel", &Evaluator::add_wheel)
       .def("add_closure", &Evaluator::add_closure)
       .def("add_motor", &Evaluator::add_motor)
+      .def("add_slipping", &Evaluator::add_slipping)
+      .def_property_readonly("slipping", &Evaluator::slipping)
+      .def("slip_rhs", &Evaluator::slip_rhs)
       .def("set_selection", &Evaluator::set_selection)
       .def("set_operational", &Evaluator::set_operational)
       .def("full", &Evaluator::full)

@@ -11,6 +11,12 @@
 //    sampling); the stepper is restarted at breakpoints too.
 // Both call `poll` every ~50 ms of wall time (progress, Ctrl-C, a stop flag), refuse a vanishing step size and a
 // non-finite state (FAILED), and let an exception of the right-hand side propagate.
+//
+// A terminal event (optional, as solve_ivp's with direction -1): a function g(t, y) checked at every accepted step;
+// where it goes from >= 0 to <= 0 across a step, its root is located (Illinois regula falsi safeguarded by
+// bisection, to 4 eps relative in t) on the dense output (run_dense) or, for Adams (no dense output), on a
+// Dormand-Prince re-integration from the step's start at the run's tolerances; the run stops there, with the
+// samples up to the root and Outcome::event set.
 #pragma once
 
 #include <boost/numeric/odeint/stepper/bulirsch_stoer_dense_out.hpp>
@@ -20,6 +26,7 @@
 #include <boost/numeric/odeint/stepper/adaptive_adams_bashforth_moulton.hpp>
 #include <boost/numeric/odeint/stepper/controlled_adams_bashforth_moulton.hpp>
 #include <boost/numeric/odeint/util/odeint_error.hpp>
+#include <boost/numeric/odeint/integrate/integrate_adaptive.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -43,15 +50,52 @@ struct Outcome {
   State y;         // state there
   std::string message;
   long steps = 0;
+  bool event = false;  // stopped at a root of the terminal event (t, y: there)
 };
+
+// No event (the default of integrate).
+struct NoEvent {
+  bool active() const { return false; }
+  double operator()(double, const State&) { return 0.0; }
+};
+
+// The root of g in [a, b] with g(a) = ga >= 0 >= gb = g(b): Illinois regula falsi, every third iterate a bisection,
+// until the bracket is 4 eps (relative) wide; returns its right end (g <= 0 there: the crossing has happened).
+template <class G>
+double locate_root(G&& g, double a, double ga, double b, double gb) {
+  if (ga == 0.0) return a;
+  if (gb == 0.0) return b;
+  const double eps = std::numeric_limits<double>::epsilon();
+  int side = 0;
+  for (int it = 0; it < 300; ++it) {
+    if (b - a <= 4.0 * eps * std::max(std::fabs(a), std::fabs(b))) break;
+    double c = it % 3 == 2 ? 0.5 * (a + b) : (a * gb - b * ga) / (gb - ga);
+    if (!(c > a && c < b)) c = 0.5 * (a + b);
+    if (!(c > a && c < b)) break;  // no double strictly inside
+    const double gc = g(c);
+    if (gc == 0.0) return c;
+    if (gc > 0.0) {
+      a = c;
+      ga = gc;
+      if (side == 1) gb *= 0.5;
+      side = 1;
+    } else {
+      b = c;
+      gb = gc;
+      if (side == -1) ga *= 0.5;
+      side = -1;
+    }
+  }
+  return b;
+}
 
 // One error-controlled run from (t0, y0) to t_end. `samples` are the requested output times (sorted), `next`
 // the index of the first one still to emit (updated); observer(t, y) receives them in order. `breaks`: sorted
 // times never stepped across.
-template <class Stepper, class System, class Observer, class Poll>
+template <class Stepper, class System, class Observer, class Poll, class Event = NoEvent>
 Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, double t_end,
                   const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
-                  double dt0, Observer&& observer, Poll&& poll) {
+                  double dt0, Observer&& observer, Poll&& poll, Event&& event = Event()) {
   Outcome out;
   out.t = t0;
   out.y = y0;
@@ -65,6 +109,7 @@ Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, 
   double limit = std::min(b < breaks.size() ? breaks[b] : t_end, t_end);
   stepper.initialize(y0, t0, std::min(dt0, limit - t0));
   State y(y0.size());
+  double g_prev = event.active() ? event(t0, y0) : 0.0;
   auto clock = std::chrono::steady_clock::now();
   while (!reached(stepper.current_time(), t_end)) {
     const double tc = stepper.current_time();
@@ -98,6 +143,30 @@ Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, 
         return out;
       }
     ++out.steps;
+    if (event.active()) {
+      const double g1 = event(t1, x1);
+      if (g_prev >= 0.0 && g1 <= 0.0) {  // a root inside the step: on the dense output
+        const double t0s = stepper.previous_time();
+        const double te = locate_root(
+            [&](double tc) {
+              stepper.calc_state(tc, y);
+              return event(tc, y);
+            },
+            t0s, g_prev, t1, g1);
+        while (next < samples.size() && samples[next] <= te) {
+          const double ts = samples[next++];
+          stepper.calc_state(ts, y);
+          observer(ts, y);
+        }
+        if (te >= t1) y = x1;
+        else stepper.calc_state(te, y);
+        out.t = te;
+        out.y = y;
+        out.event = true;
+        return out;
+      }
+      g_prev = g1;
+    }
     while (next < samples.size() && (samples[next] <= t1 || (samples[next] <= t_end && reached(t1, t_end)))) {
       const double ts = samples[next++];
       if (ts >= t1) {
@@ -125,10 +194,11 @@ Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, 
 
 // A controlled multistep stepper (Adams) stepping exactly onto every sample (no interpolation) and breakpoint, and
 // restarted (reset) at breakpoints. A step that would end within 1 % of a target is stretched onto it.
-template <class Stepper, class System, class Observer, class Poll>
+template <class Stepper, class System, class Observer, class Poll, class Event = NoEvent>
 Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0, double t_end,
                     const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
-                    double dt0, Observer&& observer, Poll&& poll) {
+                    double dt0, Observer&& observer, Poll&& poll, Event&& event = Event(), double rtol = 0.0,
+                    double atol = 0.0) {
   Outcome out;
   const double eps = std::numeric_limits<double>::epsilon();
   auto reached = [&](double t, double target) { return target - t <= 8.0 * eps * std::max(1.0, std::fabs(target)); };
@@ -136,8 +206,9 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
   while (b < breaks.size() && breaks[b] <= t0) ++b;
   while (next < samples.size() && samples[next] <= t0) observer(samples[next++], y0);
   auto sys = [&system](const State& x, State& dxdt, double t) { system(x, dxdt, t); };
-  State x = y0;
+  State x = y0, x_prev;
   double t = t0, dt_nat = dt0;
+  double g_prev = event.active() ? event(t0, y0) : 0.0;
   int rejected = 0;
   auto clock = std::chrono::steady_clock::now();
   while (!reached(t, t_end)) {
@@ -151,6 +222,8 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
       out.message = "Required step size is less than spacing between numbers.";
       break;
     }
+    const double t_prev = t;
+    if (event.active()) x_prev = x;
     if (stepper.try_step(sys, x, t, dt) != odeint::success) {
       dt_nat = dt;
       if (++rejected > 1000) {
@@ -168,6 +241,34 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
       while (b < breaks.size() && reached(t, breaks[b])) ++b;
       stepper.reset();
       dt_nat = std::min(dt_nat, dt0);
+    }
+    if (event.active()) {
+      const double g1 = event(t, x);
+      if (g_prev >= 0.0 && g1 <= 0.0) {  // a root inside the step: re-integrate from its start (Dormand-Prince)
+        State y;
+        auto state_at = [&](double tc) {
+          y = x_prev;
+          auto rk = odeint::make_controlled(atol, rtol, odeint::runge_kutta_dopri5<State>());
+          odeint::integrate_adaptive(rk, sys, y, t_prev, tc, std::min(dt, tc - t_prev));
+        };
+        const double te = locate_root(
+            [&](double tc) {
+              state_at(tc);
+              return event(tc, y);
+            },
+            t_prev, g_prev, t, g1);
+        if (reached(te, t)) {  // the root is the step's end
+          while (next < samples.size() && reached(t, samples[next])) observer(samples[next++], x);
+          y = x;
+        } else {
+          state_at(te);
+        }
+        out.t = te;
+        out.y = y;
+        out.event = true;
+        return out;
+      }
+      g_prev = g1;
     }
     while (next < samples.size() && reached(t, samples[next])) observer(samples[next++], x);
     if ((out.steps & 15) == 0) {
@@ -189,23 +290,24 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
 // Adams (default), Bulirsch-Stoer or Dormand-Prince 5(4) at tolerances rtol, atol on every component (odeint's
 // error checkers, max norm: |err_i| <= atol + rtol (|y_i| + dt |dy_i/dt|) for adams and dopri5,
 // atol + rtol |y_i| for bulirsch_stoer).
-template <class System, class Observer, class Poll>
+template <class System, class Observer, class Poll, class Event = NoEvent>
 Outcome integrate(const std::string& method, System& system, const State& y0, double t0, double t_end,
                   const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks, double rtol,
-                  double atol, Observer&& observer, Poll&& poll) {
+                  double atol, Observer&& observer, Poll&& poll, Event&& event = Event()) {
   const double dt0 = std::min(1e-3, 1e-3 * (t_end - t0));
   if (method == "bulirsch_stoer") {
     odeint::bulirsch_stoer_dense_out<State> stepper(atol, rtol, 1.0, 0.0);
-    return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll);
+    return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, event);
   }
   if (method == "dopri5") {
     auto stepper = odeint::make_dense_output(atol, rtol, odeint::runge_kutta_dopri5<State>());
-    return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll);
+    return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, event);
   }
   if (method == "adams") {
     using Adams = odeint::controlled_adams_bashforth_moulton<odeint::adaptive_adams_bashforth_moulton<8, State>>;
     Adams stepper(typename Adams::step_adjuster_type(atol, rtol, 1.0));
-    return run_sampled(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll);
+    return run_sampled(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, event, rtol,
+                       atol);
   }
   throw std::invalid_argument("unknown compiled integrator " + method + "; expected adams, bulirsch_stoer or dopri5");
 }

@@ -201,6 +201,7 @@ class CompiledModel:
                 ev.add_closure(frame(c.f1), frame(c.f2), [int(s) for s in c._sel])
         for m in robot.motors:
             ev.add_motor(int(m.index), int(m.jid), -1 if m.rid is None else frame(m.rid))
+        self.slip_refusal = self._add_slipping(ev, robot)
         self.operational = getattr(robot, "operational", None)
         if self.operational is not None:
             tw = self.operational.twist
@@ -212,6 +213,28 @@ class CompiledModel:
         self._check_model()
         self._hint = None
         self._compute, self._generation, self._views = ev.compute, -1, None
+
+    def _add_slipping(self, ev, robot) -> str | None:
+        """Give the evaluator the slipping wheels' friction laws (:mod:`robotdyn.sliding`): returns why their
+        friction is not compiled (``None``: it is, or there are none). Their rows are compiled either way."""
+        from .sliding import SlippingWheel, sliding_now
+
+        sliding = sliding_now(robot)
+        if not sliding:
+            return None
+        labels = robot.rows_at(robot.neutral()).labels
+        laws = []
+        for c in sliding:
+            if not (isinstance(c, SlippingWheel) and type(c).friction_coefficient is SlippingWheel.friction_coefficient
+                    and type(c).slip is SlippingWheel.slip):
+                return f"wheel {c.name!r} ({type(c).__name__}) is simulated on the Python path"
+            code = c.law.encode()
+            if code is None:
+                return f"wheel {c.name!r} has the friction law {c.law!r}, whose formula is not compiled"
+            laws.append((self.wheels.index(c), labels.index(f"{c.name}.normal"), code, np.asarray(c._free, float)))
+        for wheel, row, (law, p0, p1), free in laws:
+            ev.add_slipping(wheel, row, law, float(p0), float(p1), free)
+        return None
 
     def __repr__(self) -> str:
         return f"CompiledModel({self.robot.spec.name!r}, nv={self.ev.nv}, rows={self.ev.nrows})"
@@ -367,7 +390,7 @@ class CompiledModel:
 
 def compiled_model(robot) -> CompiledModel | None:
     """The robot's :class:`CompiledModel` for the calling thread (built once per thread; rebuilt when its
-    constraints, their terrain or radius, or the model's gravity change), or ``None`` when the fast path is off or
+    constraints, their terrain, radius or friction law, or the model's gravity change), or ``None`` when the fast path is off or
     :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated from several
     threads at once."""
     if not enabled():
@@ -378,12 +401,13 @@ def compiled_model(robot) -> CompiledModel | None:
     cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
     gravity = robot.model.gravity.linear
     if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
-        getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r
-        for c, (t, r) in zip(robot.constraints, cached[2])
+        getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r and getattr(c, "law", None) is law
+        for c, (t, r, law) in zip(robot.constraints, cached[2])
     ):
         return cached[3]
     fast = CompiledModel(robot) if why_not(robot) is None else None
-    state = [(getattr(c, "terrain", None), getattr(c, "radius", None)) for c in robot.constraints]
+    state = [(getattr(c, "terrain", None), getattr(c, "radius", None), getattr(c, "law", None))
+             for c in robot.constraints]
     entry = (list(robot.constraints), gravity.copy(), state, fast)
     if local is not None:
         local.compiled = entry

@@ -18,12 +18,21 @@ check for signals (Ctrl-C keeps the samples so far, as on the scipy path) and to
 Where the compiled model's row choice stops working (:class:`robotdyn.compiled.Fallback`) the C++ side asks the
 Python path for a new one at that state (:func:`rechooser`), or gets its usual error, as the scipy path does.
 
+Robots with slipping wheels (:mod:`robotdyn.sliding`, laws :class:`~robotdyn.friction.RegularisedCoulomb` and
+:class:`~robotdyn.friction.LinearTyre`, encoded by :meth:`~robotdyn.friction.FrictionLaw.encode`) run here too: the
+accelerations and normal loads come from the same coupled linear system as :func:`robotdyn.sliding.forward`
+(``Evaluator.slip_rhs``), the friction work is an extra state, a singular system raises the Python path's
+Painleve error, and the terminal lift-off event (the smallest normal load of a slipping wheel crossing zero
+downwards) is located on the stepper's dense output, or for Adams on a Dormand-Prince re-integration of the step,
+with the Python path's ``stats["event"]`` (and ``stats["t_event"]``). Exact stick-slip stays on the Python path.
+
 The scipy path (DOP853) stays the reference; ``tests/test_compiled_simulation.py`` checks the compiled trajectories
 against it to 1e-8 on every compiled robot.
 """
 
 from __future__ import annotations
 
+import sys
 import time
 from typing import TYPE_CHECKING
 
@@ -86,6 +95,13 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     out = fast.ev.simulate(q0, nu0, 0.0, float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
                            native, breaks, method, progress, rechooser(robot, fast))
     status, t_stop = out["status"], float(out["t_stop"])
+    if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's errors
+        from .sliding import painleve_error, redundant_load_error
+
+        wheels = slipping_wheels(robot)
+        if out["slip_error"] == 0:
+            raise painleve_error(wheels, float(out["slip_value"]))
+        raise redundant_load_error(wheels[int(out["slip_value"])])
     interrupted = None
     if status == INTERRUPTED:
         reached = float(out["t"][-1]) if len(out["t"]) else 0.0
@@ -98,7 +114,8 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
         raise RobotDynError(f"integration failed at t = {t_stop:.4g} s: {message}"
                             + failure_note(robot, np.asarray(out["y_stop"])[:n], stabilisation))
     return {"t": out["t"], "y": out["y"], "energy": out["energy"], "residual": out["residual"],
-            "nfev": int(out["nfev"]), "steps": int(out["steps"]), "interrupted": interrupted}
+            "nfev": int(out["nfev"]), "steps": int(out["steps"]), "interrupted": interrupted,
+            "event": (t_stop, np.asarray(out["y_stop"])) if out["event"] else None}
 
 
 def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
@@ -117,12 +134,14 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     if engine == "scipy" or (method is not None and engine == "auto"):
         return False
     reason = None
-    if slipping_wheels(robot) or any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):
-        reason = "slipping wheels are simulated on the Python path"
+    if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):
+        reason = "stick-slip wheels (exact switching) are simulated on the Python path"
     elif compiled_model(robot) is None:
         from .compiled import enabled, why_not
 
         reason = why_not(robot) if enabled() else "the compiled fast path is turned off (ROBOTDYN_COMPILED=0)"
+    elif compiled_model(robot).slip_refusal is not None:
+        reason = compiled_model(robot).slip_refusal
     elif torque is not None and not isinstance(torque, TorqueProfile):
         reason = ("the torques are a Python function; give a robotdyn.torque_profile.TorqueProfile (constant, sine, "
                   "table) to run them compiled")
@@ -150,11 +169,20 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
              "engine": f"compiled ({method})"}
     if out["interrupted"]:
         stats["partial"] = out["interrupted"]
+    k = robot.mobility
+    if out["event"] is not None:  # a slipping wheel's load reached zero: the contact model ends there
+        from .sliding import lift_off_message
+
+        t_ev, y_ev = out["event"]
+        stats["event"] = lift_off_message(robot, t_ev, y_ev[:n], y_ev[n:n + k], profile(t_ev))
+        stats["t_event"] = t_ev
+        print(f"simulate: {stats['event']}", file=sys.stderr, flush=True)
     if offsets:
         stats["offsets"] = offsets
-    y = out["y"]
-    return Trajectory(out["t"], y[:, :n], y[:, n:], out["energy"], out["residual"], list(robot.coordinates),
-                      list(robot.velocity_names), stats, robot.units)
+    y = out["y"].reshape(len(out["t"]), -1)
+    work = y[:, n + k] if slipping_wheels(robot) else None  # the friction work, the extra state
+    return Trajectory(out["t"], y[:, :n], y[:, n:n + k], out["energy"], out["residual"], list(robot.coordinates),
+                      list(robot.velocity_names), stats, robot.units, work)
 
 
 def rechooser(robot, fast=None):

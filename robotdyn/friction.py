@@ -34,6 +34,11 @@ class FrictionLaw:
         """Tangential force on the wheel :math:`F_t = -f_n c(s)` (2,) [N]."""
         return -float(normal) * self.coefficient(np.asarray(s, float))
 
+    def encode(self) -> tuple[int, float, float] | None:
+        """The law as data for the compiled engine (``robotdyn/_compiled.cpp``, ``Slip``): ``(code, p0, p1)``, or
+        ``None`` where its formula is not compiled (the robot then runs on the Python path)."""
+        return None
+
 
 class RegularisedCoulomb(FrictionLaw):
     """Coulomb friction smoothed near zero slip:
@@ -57,6 +62,10 @@ class RegularisedCoulomb(FrictionLaw):
 
     def coefficient(self, s: np.ndarray) -> np.ndarray:
         return self.mu * s / math.sqrt(float(s @ s) + self.slip_velocity**2)
+
+    def encode(self) -> tuple[int, float, float] | None:
+        """``(0, mu, slip_velocity)`` (:meth:`FrictionLaw.encode`; a subclass with its own formula: ``None``)."""
+        return (0, self.mu, self.slip_velocity) if type(self).coefficient is RegularisedCoulomb.coefficient else None
 
     def __repr__(self) -> str:
         return f"RegularisedCoulomb(mu={self.mu}, slip_velocity={self.slip_velocity} m/s)"
@@ -86,6 +95,10 @@ class LinearTyre(FrictionLaw):
         if speed * self.stiffness <= self.mu:
             return self.stiffness * s
         return self.mu * s / speed
+
+    def encode(self) -> tuple[int, float, float] | None:
+        """``(1, stiffness, mu)`` (:meth:`FrictionLaw.encode`; a subclass with its own formula: ``None``)."""
+        return (1, self.stiffness, self.mu) if type(self).coefficient is LinearTyre.coefficient else None
 
     def __repr__(self) -> str:
         return f"LinearTyre(stiffness={self.stiffness} s/m, mu={self.mu})"

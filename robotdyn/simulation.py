@@ -28,7 +28,7 @@ from .projection import solve
 from .pull_back import correction, failure_note, start_offsets
 from .reduced_dynamics import velocity
 from .sliding import forward as forward_sliding
-from .sliding import slipping_wheels
+from .sliding import lift_off_message, slipping_wheels
 from .torque_profile import TorqueProfile, as_profile
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
@@ -135,7 +135,8 @@ def simulate(
     Two engines integrate the same ODE: the compiled one (:mod:`robotdyn.compiled_simulation`: the whole run in
     C++, Boost.Odeint's adaptive Adams-Bashforth-Moulton by default) and scipy's (``solve_ivp``'s DOP853 loop, the
     reference, with a Python call per evaluation). Both restart at the breakpoints of a torque profile. ``engine="auto"`` takes the compiled one where the robot has a compiled
-    model (:func:`robotdyn.compiled.why_not`), no slipping wheels, and the torques are ``None`` or a
+    model (:func:`robotdyn.compiled.why_not`; slipping wheels with a compiled friction law included, exact
+    stick-slip not), and the torques are ``None`` or a
     :class:`~robotdyn.torque_profile.TorqueProfile` (a Python callable needs the scipy engine); ``stats["engine"]``
     says which ran.
 
@@ -245,11 +246,8 @@ def simulate(
     stats_event = None
     if slipping and sol.status == 1:  # a slipping wheel's load reached zero: the contact model ends there
         t_ev, y_ev = sol.t_events[0][0], sol.y_events[0][0]
-        st = forward_sliding(robot, y_ev[:n], y_ev[n:n + k], zero_tau if torque is None else
-                             np.asarray(torque(t_ev, y_ev[:n], y_ev[n:n + k]), float))
-        wheel = slipping[int(np.argmin(st.normal))].name
-        stats_event = (f"lift-off of wheel {wheel} at t = {t_ev:.6g} s (normal load {np.min(st.normal):.3g} N): "
-                       "the run stops there (a wheel in flight is not modelled)")
+        stats_event = lift_off_message(robot, t_ev, y_ev[:n], y_ev[n:n + k], zero_tau if torque is None else
+                                       np.asarray(torque(t_ev, y_ev[:n], y_ev[n:n + k]), float))
         print(f"simulate: {stats_event}", file=sys.stderr, flush=True)
     q, nu = sol.y[:n].T, sol.y[n:n + k].T
     energy = np.empty(len(sol.t))
@@ -270,6 +268,7 @@ def simulate(
         stats["partial"] = interrupted
     if stats_event:
         stats["event"] = stats_event
+        stats["t_event"] = float(sol.t_events[0][0])
     if offsets:
         stats["offsets"] = offsets
     return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,

@@ -144,8 +144,7 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
         row = rows.labels.index(f"{wheel.name}.normal")
         hit = np.flatnonzero(kept == row)
         if not hit.size:
-            raise ConstraintError(f"slipping wheel {wheel.name!r}: its normal row is redundant here, so its load "
-                                  "(and its friction) is not determined by rigid-body dynamics")
+            raise redundant_load_error(wheel)
         Jt, slip[i] = tangential(wheel, kin)
         coef[i] = wheel.friction_coefficient(slip[i])
         position[i] = hit[0]
@@ -155,15 +154,37 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
     cond = np.linalg.cond(K)
     if not np.isfinite(cond) or cond > PAINLEVE_CONDITION:
-        raise SingularConstraintError(
-            f"the friction of slipping wheels {', '.join(w.name for w in wheels)} makes the contact problem "
-            f"singular (condition {cond:.3g}; Painleve paradox: the accelerations and loads have no or many "
-            "solutions); expected a smaller mu or another friction law", cond)
+        raise painleve_error(wheels, cond)
     sol = np.linalg.solve(K, rhs)
     k = red.S.shape[1]
     normal = sol[k + position]
     force = -normal[:, None] * coef
     return SlidingState(sol[:k], red, normal, slip, force, float(np.sum(force * slip)))
+
+
+def painleve_error(wheels, cond: float) -> SingularConstraintError:
+    """The error of a singular contact problem of slipping ``wheels`` (condition number ``cond`` of the coupled
+    system), the same on every engine."""
+    return SingularConstraintError(
+        f"the friction of slipping wheels {', '.join(w.name for w in wheels)} makes the contact problem "
+        f"singular (condition {cond:.3g}; Painleve paradox: the accelerations and loads have no or many "
+        "solutions); expected a smaller mu or another friction law", cond)
+
+
+def redundant_load_error(wheel) -> ConstraintError:
+    """The error of a slipping wheel whose normal row is redundant (its load is not determined)."""
+    return ConstraintError(f"slipping wheel {wheel.name!r}: its normal row is redundant here, so its load "
+                           "(and its friction) is not determined by rigid-body dynamics")
+
+
+def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> str:
+    """``stats["event"]`` of a run stopped where a slipping wheel's normal load reached zero at time t [s] and
+    state (q, nu), with torques tau there (the same on every engine)."""
+    wheels = sliding_now(robot)
+    st = forward(robot, q, nu, tau)
+    wheel = wheels[int(np.argmin(st.normal))].name
+    return (f"lift-off of wheel {wheel} at t = {t:.6g} s (normal load {np.min(st.normal):.3g} N): "
+            "the run stops there (a wheel in flight is not modelled)")
 
 
 @dataclass

@@ -1,0 +1,237 @@
+"""Slipping wheels on the compiled engine (robotdyn/_compiled.cpp: Evaluator.slip_rhs, robotdyn/_integrator.hpp: the
+lift-off event) against the Python reference path (robotdyn.sliding.forward, scipy's solve_ivp with its event) and
+closed forms: one state at a time, whole trajectories of the skid-steer rover (both directions and lateral slip,
+linear and Coulomb laws), a disc sliding down an incline (g (sin a - mu cos a) when tan a > 3 mu), the energy
+balance with the friction work, and a disc lifting off over a bump."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from robotdyn.compiled import compiled_model
+from robotdyn.compiled_simulation import choose_engine
+from robotdyn.constraint_file import read
+from robotdyn.errors import RobotDynError
+from robotdyn.friction import RegularisedCoulomb
+from robotdyn.posture import set_terrain
+from robotdyn.robot import Robot
+from robotdyn.simulation import simulate
+from robotdyn.sliding import forward, slipping_wheels
+from robotdyn.terrain import BumpTerrain
+from robotdyn.torque_profile import Constant
+
+sys.path.insert(0, str(Path(__file__).parent))
+from test_sliding import G, disc  # noqa: E402
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skid_steer.toml"
+
+
+def _rover(**wheel) -> Robot:
+    mod = read(EXAMPLE)
+    if not wheel:
+        return mod.robot()
+    independent = ["x", "y", "yaw"] if wheel.get("slip") == "lateral" else mod.SPEC.independent
+    return Robot(replace(mod.SPEC, wheels=[replace(w, **wheel) for w in mod.SPEC.wheels], independent=independent))
+
+
+ROVERS = {
+    "linear": dict(),
+    "coulomb": dict(friction="coulomb", mu=0.6, slip_velocity=0.01, stiffness=None),
+    "lateral linear": dict(slip="lateral"),
+    "lateral coulomb": dict(slip="lateral", friction="coulomb", mu=0.6, slip_velocity=0.01, stiffness=None),
+}
+
+
+@pytest.mark.parametrize("kind", ROVERS)
+def test_one_state_equals_the_python_path(kind):
+    """Accelerations, normal loads, slip velocities, friction forces and power of Evaluator.slip_rhs equal
+    robotdyn.sliding.forward at random states (tilted chassis, random velocities and torques)."""
+    robot = _rover(**ROVERS[kind])
+    fast = compiled_model(robot)
+    assert fast.slip_refusal is None and fast.ev.slipping == 4
+    rng = np.random.default_rng(3)
+    n, k = robot.nq, robot.mobility
+    for _ in range(5):
+        q = robot.neutral()
+        q[robot.coordinate_index("roll")] = rng.uniform(-0.05, 0.05)
+        q[robot.coordinate_index("yaw")] = rng.uniform(-np.pi, np.pi)
+        nu, tau = rng.uniform(-1.0, 1.0, k), rng.uniform(-1.0, 1.0, 4)
+        ref = forward(robot, q, nu, tau)
+        fast.select(ref.reduced.projection)
+        out, normal, slip, force = fast.ev.slip_rhs(q, nu, tau, 0.0)
+        np.testing.assert_allclose(out[:n], ref.reduced.v, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(out[n:n + k], ref.nudot, rtol=1e-10, atol=1e-10 * np.max(np.abs(ref.nudot)))
+        np.testing.assert_allclose(normal, ref.normal, rtol=1e-10)
+        np.testing.assert_allclose(slip, ref.slip, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(force, ref.force, rtol=1e-10, atol=1e-12)
+        assert out[-1] == pytest.approx(ref.power, rel=1e-10, abs=1e-12)
+
+
+def _both(robot, t_end, q0, nu0, torque, **kw):
+    a = simulate(robot, t_end, q0, nu0, torque, progress=False, **kw)
+    b = simulate(robot, t_end, q0, nu0, torque, progress=False, engine="scipy", **kw)
+    assert a.stats["engine"].startswith("compiled") and b.stats["engine"].startswith("scipy")
+    return a, b
+
+
+@pytest.mark.parametrize("scenario", ["turn_in_place", "straight"])
+def test_skid_steer_trajectories_agree(scenario):
+    """The rover's scenarios (linear law, both directions slip) on both engines: q to 1e-8, nu and the friction
+    work to 1e-7; the work is never positive."""
+    mod = read(EXAMPLE)
+    robot = mod.robot()
+    sc = mod.SCENARIOS[scenario]
+    q0, nu0 = sc.initial_state(robot)
+    a, b = _both(robot, 0.5, q0, nu0, sc.torque, n_out=51)
+    np.testing.assert_array_equal(a.t, b.t)
+    assert np.max(np.abs(a.q - b.q)) < 1e-8
+    assert np.max(np.abs(a.nu - b.nu)) < 1e-7
+    assert np.max(np.abs(a.friction_work - b.friction_work)) < 1e-7
+    assert np.all(np.diff(a.friction_work) <= 1e-12) and a.friction_work[-1] < -1e-3
+
+
+@pytest.mark.parametrize("law", ["lateral linear", "lateral coulomb"])
+def test_lateral_slip_turn_agrees(law):
+    """Lateral slip (longitudinal no-slip rows kept), turning in place under constant torques: both engines agree
+    to 1e-8 on q, and the yaw rate follows the closed form of tests/test_lateral_slip.py for the linear law
+    (omega* (1 - exp(-t/T)), checked on the compiled trajectory against the scipy one's closed-form error)."""
+    robot = _rover(**ROVERS[law])
+    tau = 0.3
+    torque = Constant([-tau, tau, -tau, tau])
+    a, b = _both(robot, 0.3, robot.neutral(), np.zeros(3), torque, n_out=31)
+    assert np.max(np.abs(a.q - b.q)) < 1e-8
+    assert np.max(np.abs(a.nu - b.nu)) < 1e-7
+    assert np.max(np.abs(a.friction_work - b.friction_work)) < 1e-8
+    if law == "lateral linear":
+        from test_lateral_slip import A, B, R, _yaw_inertia
+
+        mass = sum(robot.model.inertias[i].mass for i in range(robot.model.njoints))
+        fn, stiffness = mass * G / 4, 5.0
+        omega_star = tau * B / (R * fn * stiffness * A**2)
+        T = _yaw_inertia(robot) / (4 * fn * stiffness * A**2)
+        closed = omega_star * (1 - np.exp(-a.t / T))
+        assert np.max(np.abs(a.column("yaw_dot") - closed)) < 1e-6 * omega_star
+
+
+def test_linkage_slip_energy_balance():
+    """The six-wheel linkage robot on a sine terrain with its middle wheels slipping (Coulomb), torque-free: both
+    engines agree to 1e-8 on q, and on each E(t) - E(0) equals the friction work to 1e-6 of the loss."""
+    from test_linkage_slip import _robot
+
+    robot, q0 = _robot(slipping=True)
+    nu0 = np.zeros(robot.mobility)
+    nu0[robot.velocity_names.index("phi2_dot")] = nu0[robot.velocity_names.index("phi5_dot")] = 3.0
+    a, b = _both(robot, 0.3, q0, nu0, None, n_out=31)
+    assert np.max(np.abs(a.q - b.q)) < 1e-8
+    for traj in (a, b):
+        scale = abs(traj.friction_work[-1])
+        assert scale > 1e-4
+        np.testing.assert_allclose(traj.energy - traj.energy[0], traj.friction_work, atol=1e-6 * max(scale, 1.0))
+
+
+@pytest.mark.parametrize("engine", ["compiled", "scipy"])
+def test_disc_slides_down_incline_at_the_closed_form(engine):
+    """A disc sliding down a slope tan a = 2 > 3 mu (mu = 0.3, Coulomb, v_s = 1e-6 m/s), launched at 1 m/s without
+    spin, keeps sliding: along the slope d(t) = v0 t + g (sin a - mu cos a) t^2 / 2, the spin rate
+    mu g cos(a) R m / I t, the energy lost equals the friction work."""
+    from test_sliding import I, M, R
+
+    slope, mu = 2.0, 0.3
+    robot, q0 = disc(slope, friction="coulomb", mu=mu, slip_velocity=1e-6)
+    alpha = np.arctan(slope)
+    nu0 = np.array([-np.cos(alpha), 0.0, 0.0, 0.0, 0.0])
+    traj = simulate(robot, 0.5, q0, nu0, n_out=51, progress=False, engine=engine)
+    assert traj.stats["engine"].startswith(engine)
+    t = traj.t
+    d = t + G * (np.sin(alpha) - mu * np.cos(alpha)) * t**2 / 2
+    np.testing.assert_allclose(-(traj.column("x") - q0[0]) / np.cos(alpha), d, rtol=1e-9, atol=1e-11)
+    spin = mu * G * np.cos(alpha) * R * M / I * t
+    np.testing.assert_allclose(np.abs(traj.column("spin_dot")), spin, rtol=1e-8, atol=1e-10)
+    loss = traj.energy - traj.energy[0]
+    np.testing.assert_allclose(loss, traj.friction_work, atol=1e-8 * abs(traj.friction_work[-1]))
+
+
+@pytest.fixture(scope="module")
+def over_the_bump():
+    """A disc sliding and spinning at 6 m/s towards a smooth step (0.1 m high, 0.3 m wide): its normal load reaches
+    zero on the step's convex edge (lift-off), on both engines."""
+    robot, q = disc(0.0, friction="coulomb", mu=0.5, slip_velocity=1e-2)
+    set_terrain(robot, BumpTerrain(0.1, 1.0, 0.3))
+    iz = robot.coordinate_index("z")
+
+    def gap(z):
+        qq = q.copy()
+        qq[iz] = z
+        return robot.constraint_residual(qq)[0]
+
+    q[iz] = brentq(gap, -2.0, 2.0, xtol=1e-15)
+    return robot, _both(robot, 0.3, q, [6.0, 0, 0, 0, 10.0], None, n_out=301)
+
+
+def test_lift_off_time_equals_the_python_path(over_the_bump):
+    """The terminal event: the same lift-off time to 1e-8 s, the same message, the load zero there (to the event
+    location), the samples up to it and equal to 1e-8 on q."""
+    robot, (a, b) = over_the_bump
+    assert "event" in a.stats and "event" in b.stats
+    assert abs(a.stats["t_event"] - b.stats["t_event"]) < 1e-8
+    assert 0.1 < a.stats["t_event"] < 0.3
+    for traj in (a, b):
+        assert traj.stats["event"].startswith(f"lift-off of wheel disc at t = {traj.stats['t_event']:.6g} s")
+        assert traj.t[-1] <= traj.stats["t_event"] < traj.t[-1] + 1e-3
+    assert a.stats["event"].split("(")[0] == b.stats["event"].split("(")[0]
+    np.testing.assert_array_equal(a.t, b.t)
+    assert np.max(np.abs(a.q - b.q)) < 1e-8
+    # the load just before the event is positive and falling to zero at it
+    last = forward(robot, a.q[-1], a.nu[-1], np.zeros(0)).normal[0]
+    assert 0 < last < 0.05 * M_G(robot)
+
+
+def M_G(robot) -> float:
+    return G * sum(robot.model.inertias[i].mass for i in range(robot.model.njoints))
+
+
+@pytest.mark.parametrize("method", ["bulirsch_stoer", "dopri5"])
+def test_lift_off_on_the_dense_output_steppers(over_the_bump, method):
+    """The event located on the dense output of the other compiled integrators: the same time to 1e-8 s."""
+    robot, (_, ref) = over_the_bump
+    traj = simulate(robot, 0.3, ref.q[0], ref.nu[0], None, n_out=301, progress=False, method=method)
+    assert abs(traj.stats["t_event"] - ref.stats["t_event"]) < 1e-8
+
+
+def test_engine_choice():
+    """engine="auto" takes the compiled engine for slipping wheels with compiled laws, the scipy engine when asked;
+    a law without a compiled formula or exact stick-slip keeps the robot on the Python path, with the reason."""
+    robot = _rover()
+    assert choose_engine(robot, None, None, "auto") is True
+    assert choose_engine(robot, None, None, "scipy") is False
+
+    class Cubic(RegularisedCoulomb):
+        def coefficient(self, s):
+            return self.mu * s * float(s @ s)
+
+    other = _rover()
+    wheel = slipping_wheels(other)[0]
+    wheel.law = Cubic(0.5)
+    assert compiled_model(other).slip_refusal is not None  # another law: the compiled model is rebuilt
+    assert choose_engine(other, None, None, "auto") is False
+    with pytest.raises(RobotDynError, match="whose formula is not compiled") as exc:
+        choose_engine(other, None, None, "compiled")
+    assert "\n" not in str(exc.value)
+    stick, _ = disc(0.0, friction="stick_slip", mu=0.3)
+    with pytest.raises(RobotDynError, match="stick-slip wheels"):
+        choose_engine(stick, None, None, "compiled")
+
+
+def test_simulate_many_refuses_slipping_wheels():
+    from robotdyn.many_runs import simulate_many
+
+    robot = _rover()
+    with pytest.raises(RobotDynError, match="slipping wheels") as exc:
+        simulate_many(robot, 0.1, robot.neutral(), np.zeros(robot.mobility))
+    assert "\n" not in str(exc.value)

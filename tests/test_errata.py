@@ -28,7 +28,7 @@ from robotdyn.robots import adaptable_wheel as aw
 from robotdyn.robots import linkage_suspension as ls
 from robotdyn.robots import mmr12_eod as mm
 from robotdyn.robots import omni_caster as oc
-from robotdyn.terrain import RampTerrain
+from robotdyn.constraints.terrain import RampTerrain
 
 
 def _defaults(spec, **overrides):

@@ -12,13 +12,13 @@ import pinocchio as pin
 import pytest
 from scipy.optimize import minimize_scalar
 
-from robotdyn.constraint import KinematicState
+from robotdyn.constraints.constraint import KinematicState
 from robotdyn.errors import ConstraintError, RobotDynError
-from robotdyn.posture import set_terrain, solve_posture
-from robotdyn.projection import project
+from robotdyn.constraints.posture import set_terrain, solve_posture
+from robotdyn.reduction.projection import project
 from robotdyn.robot import Robot
 from robotdyn.robots import linkage_suspension as ls
-from robotdyn.terrain import BumpTerrain, FlatTerrain, FunctionTerrain, RampTerrain, SineTerrain
+from robotdyn.constraints.terrain import BumpTerrain, FlatTerrain, FunctionTerrain, RampTerrain, SineTerrain
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +52,7 @@ def _rim_gap(robot, q, terrain, frame, radius):
 
 
 def _closure_errors(robot, q):
-    """Loop-closure errors straight from the frame placements (independent of robotdyn.loop_closure)."""
+    """Loop-closure errors straight from the frame placements (independent of robotdyn.constraints.loop_closure)."""
     pin.forwardKinematics(robot.model, robot.data, q)
     pin.updateFramePlacements(robot.model, robot.data)
     oMf = robot.data.oMf
@@ -277,7 +277,7 @@ def test_reduced_dynamics_on_the_bump(bump_robot):
 
 
 def test_energy_conserved_torque_free_on_a_ramp():
-    from robotdyn.simulation import simulate
+    from robotdyn.simulation.engine import simulate
 
     rob = Robot(ls.SPEC)
     set_terrain(rob, RampTerrain(0.15, 0.6))  # slope across the robot's heading: it turns downhill
@@ -291,7 +291,7 @@ def test_energy_conserved_torque_free_on_a_ramp():
 def test_drift_term_matches_finite_differences_along_a_bump_run(bump_robot):
     """A a + Adot v = 0 with a from central differences of v = S nu along a simulated torque-free run:
     the error must fall as h^2 (ratio 4 per halving), i.e. vanish in the limit."""
-    from robotdyn.simulation import simulate
+    from robotdyn.simulation.engine import simulate
 
     rob = bump_robot
     q0 = solve_posture(rob, {"x": -0.1, "y": 0.0, "yaw": 0.0}).q
@@ -315,7 +315,7 @@ def test_drift_term_matches_finite_differences_along_a_bump_run(bump_robot):
 
 
 def test_wheel_torques_over_the_bump_energy_balance(bump_robot):
-    from robotdyn.simulation import power, simulate
+    from robotdyn.simulation.engine import power, simulate
 
     rob = bump_robot
     q0 = solve_posture(rob, {"x": -0.1, "y": 0.0, "yaw": 0.0}).q
@@ -335,7 +335,7 @@ def test_wheel_torques_over_the_bump_energy_balance(bump_robot):
 def test_cli_posture_dump_and_errors(capsys):
     import json
 
-    from robotdyn.cli import main
+    from robotdyn.cli.commands import main
 
     assert main(["linkage-posture", "--terrain", "bump", "--x", "0.1", "--v", "2", "2", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

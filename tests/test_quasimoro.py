@@ -9,7 +9,7 @@ from scipy.integrate import solve_ivp
 
 from oracles.quasimoro_sympy import quasimoro_reduced
 from robotdyn.robots import quasimoro as qm
-from robotdyn.simulation import power, simulate
+from robotdyn.simulation.engine import power, simulate
 
 ORACLE_ORDER = ["x", "y", "psi", "theta1", "theta2", "theta3"]
 

@@ -8,15 +8,15 @@ Model (derived by Pinocchio from the description): floating body (x, y, z, yaw, 
 three wheels fr, fl, r at the eq-8 positions, each with a spin joint ``theta_<i>`` (wheel motor), an adjustment
 angle ``q_<i>`` (adjustment motor, 0-180 deg) and a prismatic radius ``Rch_<i>`` (the close-loop pattern radius).
 The wheel radius is :math:`R_T = R_{ru} + R_{ch}` and the mechanism law of eq 1,
-:math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)`, is a holonomic :class:`~robotdyn.joint_coupling.JointCoupling`, so
+:math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)`, is a holonomic :class:`~robotdyn.constraints.joint_coupling.JointCoupling`, so
 the radius follows the configuration through the constraint layer. Each wheel rolls on the terrain
-(:class:`~robotdyn.rolling_contact.RollingWheel` with ``radius_joint``); ``lateral=slip`` drops the lateral
+(:class:`~robotdyn.constraints.rolling_contact.RollingWheel` with ``radius_joint``); ``lateral=slip`` drops the lateral
 no-slip row (the paper's kinematic missions turn the robot about a vertical axis away from its wheel axles,
 which rolling without lateral slip forbids: see ``docs/errata/adaptable_wheel.md``).
 
 Paper transcription, kept apart from the model: the inverse kinematics of eqs 4-24 (:func:`solve_ik`,
 :func:`run_mission`), the static torque estimate of eq 35 (:func:`paper_torque_eq35`) and the fuller route of
-eqs 25-34 (:func:`static_torques`), with the contact forces from :func:`robotdyn.statics.solve_contact_forces`.
+eqs 25-34 (:func:`static_torques`), with the contact forces from :func:`robotdyn.contact.statics.solve_contact_forces`.
 """
 
 from __future__ import annotations
@@ -28,19 +28,19 @@ from functools import partial
 import numpy as np
 import pinocchio as pin
 
-from ..actuation import input_matrix
-from ..comparison import Comparison
-from ..constraint import KinematicState
+from ..reduction.actuation import input_matrix
+from ..interfaces.comparison import Comparison
+from ..constraints.constraint import KinematicState
 from ..errors import ConstraintError, InputError, RobotDynError
-from ..friction import LinearTyre, RegularisedCoulomb
-from ..joint_coupling import CosineLaw, JointCoupling
+from ..contact.friction import LinearTyre, RegularisedCoulomb
+from ..constraints.joint_coupling import CosineLaw, JointCoupling
 from ..robot import MotorSpec, Parameter, Robot, RobotSpec
-from ..rolling_contact import OmniWheel, RollingWheel
-from ..scenario import Scenario
-from ..sliding import SlippingWheel
-from ..statics import solve_contact_forces
-from ..terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
-from ..torque_profile import Constant
+from ..constraints.rolling_contact import OmniWheel, RollingWheel
+from ..simulation.scenario import Scenario
+from ..contact.sliding import SlippingWheel
+from ..contact.statics import solve_contact_forces
+from ..constraints.terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
+from ..simulation.torque_profile import Constant
 
 WHEELS = ("fr", "fl", "r")
 """Wheel tags: front right, front left, rear (eq 8)."""
@@ -642,7 +642,7 @@ class MissionModel:
     velocities nu (five-point differences of the commanded pose); Pinocchio's RNEA gives the generalised forces
     :math:`\\tau_{RNEA}(q, v, a)`. Its six root rows are the wrench the contacts must supply (weight plus inertial
     forces: eq 25 with inertia); the contact forces are chosen as in eqs 28-30
-    (:func:`robotdyn.statics.solve_contact_forces`); the remaining rows give the six motor torques and the three
+    (:func:`robotdyn.contact.statics.solve_contact_forces`); the remaining rows give the six motor torques and the three
     coupling forces by least squares (residual reported).
 
     Args:
@@ -674,7 +674,7 @@ class MissionModel:
 
     def state(self, t: float) -> tuple[Commands, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(commands, IK solution, q, v, a) at time t (natural coordinates of the model)."""
-        from ..reduced_dynamics import reduce
+        from ..reduction.reduced_dynamics import reduce
 
         cmd, x = self.ik_at(t)
         q = model_configuration(self.slip, cmd, x)
@@ -752,7 +752,7 @@ class FrictionRun:
     The wheels roll along their rolling direction and slide sideways under the law of ``lateral`` (Coulomb with the
     robot's mu, Table 1: 1.0), so each lateral force is :math:`-\\mu f_n` times the slip direction: known once the
     normal loads are. Torques, normal loads and traction then follow from one square linear system per state
-    (:func:`robotdyn.sliding.inverse`).
+    (:func:`robotdyn.contact.sliding.inverse`).
 
     Attributes:
         t: (N,) times [s].
@@ -790,7 +790,7 @@ def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None =
         params: Parameter overrides (e.g. ``mu``).
         every: Use every n-th step of the run.
     """
-    from ..sliding import inverse
+    from ..contact.sliding import inverse
 
     if lateral not in ("coulomb", "linear"):
         raise InputError(f"lateral = {lateral!r}; expected a friction law: coulomb or linear")
@@ -890,7 +890,7 @@ def cmd_ik(args) -> int:
     """``robotdyn ik adaptable_wheel --commands x_d y_d h_CG q_xd q_yd q_zd``: eqs 4-24 and the static torques."""
     import json
 
-    from ..cli import _jsonable
+    from ..cli.commands import _jsonable
     from ..inputs import as_vector, parse_assignments
 
     if args.robot != SPEC.name:

@@ -27,11 +27,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..comparison import Comparison
-from ..constraint import KinematicState
+from ..interfaces.comparison import Comparison
+from ..constraints.constraint import KinematicState
 from ..robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ..scenario import Scenario
-from ..terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
+from ..simulation.scenario import Scenario
+from ..constraints.terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
 
 THETA0 = np.pi / 3
 """Default nominal rocker angle theta0 [rad] (xacro default)."""
@@ -338,7 +338,7 @@ def rolling_comparison(cmp: Comparison, robot: Robot, states: int = 12, seed: in
     Rows compare the printed eq (9) (phi' = the wheel's spin relative to its carrier) and the same formula with
     the wheel's absolute rate about its axle; then a straight run on flat ground with rollers at rho = 0.4 rad.
     """
-    from ..posture import set_terrain, solve_posture
+    from ..constraints.posture import set_terrain, solve_posture
 
     rng = np.random.default_rng(seed)
     rec = _Worst()
@@ -427,7 +427,7 @@ def kinematic_run(robot: Robot, direction: tuple[float, float], q0: np.ndarray |
     """
     from scipy.integrate import solve_ivp
 
-    from ..posture import solve_posture
+    from ..constraints.posture import solve_posture
 
     sgn = np.asarray(direction, float)
     if q0 is None:
@@ -459,7 +459,7 @@ def centroid_circle_radius(run: dict[str, np.ndarray]) -> float:
 def section3_comparison(cmp: Comparison, robot: Robot) -> dict[str, dict]:
     """Section 3: straight line and pivot steering under the wheel-speed profile (Figs. 6-12), on flat ground
     (the paper's XOZ plane)."""
-    from ..posture import set_terrain
+    from ..constraints.posture import set_terrain
 
     old = robot.terrain
     set_terrain(robot, FlatTerrain())
@@ -514,7 +514,7 @@ class TerrainScenario(Scenario):
     start: dict[str, float] = field(default_factory=lambda: {"x": 0.0, "y": 0.0, "yaw": 0.0})
 
     def initial_state(self, robot) -> tuple[np.ndarray, np.ndarray]:
-        from ..posture import set_terrain, solve_posture
+        from ..constraints.posture import set_terrain, solve_posture
 
         set_terrain(robot, TERRAINS[self.terrain]())
         q0 = solve_posture(robot, self.start).q
@@ -559,10 +559,10 @@ SCENARIOS = {
 def _cmd_posture(args) -> int:
     import json
 
-    from ..cli import _jsonable
+    from ..cli.commands import _jsonable
     from ..errors import InputError
     from ..inputs import parse_assignments
-    from ..posture import set_terrain, solve_posture
+    from ..constraints.posture import set_terrain, solve_posture
 
     if args.terrain not in TERRAINS:
         raise InputError(f"unknown terrain {args.terrain!r}; expected one of {', '.join(TERRAINS)}")
@@ -603,7 +603,7 @@ def side_bump(height: float = 0.06, x0: float = 0.0, length: float = 0.5, width:
               side_width: float = 0.04) -> Terrain:
     """A smooth plateau of ``height`` [m] for x in [x0, x0 + length] under the right-hand wheels only (y < 0):
     :math:`z = h\\,s(x)\\,\\tfrac12(1 - \\tanh(y / w_y))`, s a tanh plateau of ramp width ``width``."""
-    from ..terrain import FunctionTerrain
+    from ..constraints.terrain import FunctionTerrain
 
     bx = BumpTerrain(height, x0, width, length)
 

@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..comparison import Comparison
+from ..interfaces.comparison import Comparison
 from ..errors import InputError
 from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
 
@@ -210,7 +210,7 @@ def state(robot: Robot, **values: float) -> np.ndarray:
 def model_lift(robot: Robot, theta_C: float, arm: int = 1) -> float:
     """Delta lambda_C from the model: how far the platform must rise for arm ``arm``'s tip wheel (radius r) at
     angle theta_C to touch the ground, i.e. max(0, r - z_tip) with z_tip the tip-frame height at lambda_C = 0."""
-    from ..kinematics import frame_pose
+    from ..description.kinematics import frame_pose
 
     q = state(robot, lambda_C=0.0, **{f"theta_C{arm}": theta_C})
     z_tip = frame_pose(robot, q, f"CS{arm}")[2, 3]
@@ -244,7 +244,7 @@ def printed_states(p: dict) -> dict[str, tuple[dict, dict, str, str]]:
 
 def model_printed(robot: Robot, key: str) -> np.ndarray:
     """The model's pose for printed equation ``key`` (see :func:`printed_states`)."""
-    from ..kinematics import frame_pose
+    from ..description.kinematics import frame_pose
 
     overrides, values, frame, _ = printed_states(robot.params)[key]
     rob = robot if not overrides else Robot(robot.spec, {**robot.params, **overrides})
@@ -269,7 +269,7 @@ def ik_cases(robot: Robot, n: int = 5, seed: int = 0) -> list[dict]:
     (x, y) putting the end effector E on the target. A second, fully numerical IK solves (x, y, psi, theta1,
     lambda2, theta3) from the neutral posture with minimum change.
     """
-    from ..kinematics import position_ik
+    from ..description.kinematics import position_ik
 
     rng = np.random.default_rng(seed)
     out = []
@@ -301,7 +301,7 @@ def compare(robot: Robot | None = None, states: int = 50, seed: int = 0) -> Comp
     dev_printed = np.zeros((4, 4))
     dev_chain = np.zeros((4, 4))
     first = None
-    from ..kinematics import frame_pose
+    from ..description.kinematics import frame_pose
 
     for _ in range(states):
         vals = dict(x=rng.uniform(-3, 3), y=rng.uniform(-3, 3), psi=rng.uniform(-np.pi, np.pi),
@@ -374,15 +374,15 @@ def compare(robot: Robot | None = None, states: int = 50, seed: int = 0) -> Comp
 
 
 def _defects(R: np.ndarray) -> tuple[float, float]:
-    from ..kinematics import rotation_defects
+    from ..description.kinematics import rotation_defects
 
     return rotation_defects(R)
 
 
 # ------------------------------------------------------------------------------------------------- CLI
 def register_cli(subparsers, parents) -> None:
-    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.kinematics`)."""
-    from ..kinematics import register_fk_cli
+    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.description.kinematics`)."""
+    from ..description.kinematics import register_fk_cli
 
     register_fk_cli(subparsers, parents)
 
@@ -427,14 +427,14 @@ def table4_reference(name: str, omega: float = 0.5) -> Callable:
 
 
 def _hold_task(robot: Robot, labels, q0):
-    from ..control import CoordinateTask, hold
+    from ..simulation.control import CoordinateTask, hold
 
     return CoordinateTask(list(labels), hold([q0[robot.coordinate_index(c)] for c in labels]))
 
 
 def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
     """Eqs 23-25 for a Table 4 trajectory: P tracks the reference, every other actuated joint holds its value."""
-    from ..control import LinearisingController, PointTask
+    from ..simulation.control import LinearisingController, PointTask
 
     q0 = robot.neutral() if q0 is None else q0
     others = [c for c in ACTUATED if c not in ("theta_R", "theta_L")]
@@ -465,7 +465,7 @@ MANIPULATION_TARGET = np.array([2.0, 2.0, 1.5])
 def manipulation_goal(robot: Robot, q0: np.ndarray | None = None):
     """A final configuration putting E on MANIPULATION_TARGET: numerical IK over (x, y, theta3) with the heading
     kept and the boom raised to theta1 = 2.7 rad, lambda2 = 1.1 m (inside the joint ranges)."""
-    from ..kinematics import position_ik
+    from ..description.kinematics import position_ik
 
     q0 = manipulation_initial(robot)[0] if q0 is None else q0
     guess = q0.copy()
@@ -478,8 +478,8 @@ def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float
     """End effector E to MANIPULATION_TARGET along a rest-to-rest quintic over T s (primary output, eq 25); arms,
     theta4 and the load hold; in the null space, (theta1, lambda2, theta3) follow quintics to the IK goal posture
     so that the joints stay in range and the platform drives the rest."""
-    from ..control import CoordinateTask, LinearisingController, PointTask
-    from ..kinematics import frame_pose
+    from ..simulation.control import CoordinateTask, LinearisingController, PointTask
+    from ..description.kinematics import frame_pose
 
     q0 = manipulation_initial(robot)[0] if q0 is None else q0
     start = frame_pose(robot, q0, "E")[:3, 3]
@@ -537,7 +537,7 @@ def lifting_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
 def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
     """Arm 1 (the others follow through the contacts) along a quintic from the contact angle to ``end`` in T s,
     the manipulator, load and wheels hold; x, y, psi are unactuated (free on frictionless tips)."""
-    from ..control import CoordinateTask, LinearisingController
+    from ..simulation.control import CoordinateTask, LinearisingController
 
     q0 = lifting_initial(robot)[0]
     th0 = contact_angle(robot.params)
@@ -582,7 +582,7 @@ def climbing_balance(robot: Robot, slope: float, mu: float | None = None) -> dic
 
 # ------------------------------------------------------------------------------------------- scenarios
 def _scenarios() -> dict:
-    from ..control import ControlledScenario
+    from ..simulation.control import ControlledScenario
 
     out = {}
     for name, desc in (

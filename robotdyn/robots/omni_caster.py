@@ -7,7 +7,7 @@ Description: ``urdf/omni_caster.urdf.xacro`` (Fig. 2, Tables 1-2).
 Coordinates: (x, y, psi) of the platform centre C and heading (world, m and rad), the steering angles phi_i
 (platform relative to offset link i, eq 9-11: omega = eta_i' + phi_i') and the wheel angles theta_i.
 Minimal velocities: the platform twist in BODY axes, u' = (v_cx, v_cy, omega) of eq (2) -- eq (6)-(8) write v_c in
-the platform's unit vectors i, j -- through :mod:`robotdyn.operational_space`, so that the reduced inertia is the
+the platform's unit vectors i, j -- through :mod:`robotdyn.reduction.operational_space`, so that the reduced inertia is the
 paper's operational-space inertia I_uu* (eq 48) and the reduced bias its u'^T P_uuu* u' (eq 49).
 Each wheel rolls without slipping (both tangential rows) and touches the floor; the 9 rows have rank 6 (the normal
 rows vanish on the plane) and the mobility is 3 (Grubler count of section 2).
@@ -23,11 +23,11 @@ import dataclasses
 
 import numpy as np
 
-from ..comparison import Comparison
+from ..interfaces.comparison import Comparison
 from ..errors import InputError, SingularConstraintError
-from ..operational_space import OperationalVelocities
+from ..reduction.operational_space import OperationalVelocities
 from ..robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ..scenario import Scenario
+from ..simulation.scenario import Scenario
 
 CHAINS = (1, 2, 3)
 NU_NAMES = ["v_cx", "v_cy", "omega"]
@@ -201,7 +201,7 @@ def offset_link_correction(p: dict, phi, nu) -> np.ndarray:
 
 
 def paper_impulse(I_uu: np.ndarray, n, u_dot, e: float) -> float:
-    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.impulse)."""
+    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.contact.impulse)."""
     n = np.asarray(n, float)
     return float(-(1 + e) * np.dot(u_dot, n) / (n @ np.linalg.inv(I_uu) @ n))
 
@@ -213,7 +213,7 @@ def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
     eta_i' is the offset link's absolute yaw rate (its frame Jacobian), theta_i', phi_i' the joint rates; all from
     S of the operational projection (the model's constraint Jacobians).
     """
-    from ..constraint import KinematicState
+    from ..constraints.constraint import KinematicState
 
     red = robot.reduced(q, np.zeros(3))
     kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
@@ -444,7 +444,7 @@ class PathScenario(Scenario):
         return torque
 
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
-        from ..simulation import simulate
+        from ..simulation.engine import simulate
 
         t_end, n_out = self.span(t_end, n_out)
         q0, nu0 = self.initial_state(robot)
@@ -476,7 +476,7 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
     Returns:
         {figure: (angles [rad], magnitudes [N s])} for :data:`IMPULSE_CONFIGS`.
     """
-    from ..impulse import impulse_curve
+    from ..contact.impulse import impulse_curve
 
     out = {}
     for name, deg in IMPULSE_CONFIGS.items():
@@ -486,8 +486,8 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
 
 
 def _cmd_impulse(args) -> int:
-    from ..cli import _emit, _load
-    from ..impulse import impact
+    from ..cli.commands import _emit, _load
+    from ..contact.impulse import impact
     from ..inputs import as_vector
 
     _, robot = _load(args)
@@ -615,7 +615,7 @@ def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Com
     fit = fit_printed_matrix(p, starts=20)
     cmp.add("sec 5 printed with-wheel I_uu*: best fit over steering angles (max |residual|)", 0.0, fit["max_abs"],
             5e-4, "phi = (" + ", ".join(f"{np.degrees(x):.1f}" for x in fit["phi"]) + ") deg")
-    from ..impulse import impulse_curve
+    from ..contact.impulse import impulse_curve
 
     for name, deg in IMPULSE_CONFIGS.items():
         Mi = robot.reduced(steering_configuration(robot, np.radians(deg)), np.zeros(3)).M

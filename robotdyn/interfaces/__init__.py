@@ -1,0 +1,1 @@
+"""robotdyn.interfaces: see robotdyn/interfaces/__init__.py (placeholder written by relayout.py)."""

@@ -1,0 +1,79 @@
+"""Plots of trajectories and comparisons (matplotlib: the Agg backend, files and no window, unless ``MPLBACKEND``
+names one, as a Jupyter kernel does for its inline figures)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+
+import matplotlib
+
+if not os.environ.get("MPLBACKEND"):  # keep a backend chosen by the user or a notebook kernel (inline figures)
+    matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+def _unit(traj, name: str) -> str:
+    """The column's unit as the trajectory records it (from the joint types), else a guess from the name."""
+    if name in getattr(traj, "units", {}):
+        return traj.units[name]
+    base = name[:-4] if name.endswith("_dot") else name
+    unit = "m" if base in ("x", "y", "z") else "rad"
+    return unit + ("/s" if name.endswith("_dot") else "")
+
+
+def plot_trajectory(
+    traj,
+    columns: Sequence[str],
+    path=None,
+    title: str = "",
+    zoom: float | None = None,
+    references: dict[str, list[tuple[float, str]]] | None = None,
+):
+    """Plot columns of a :class:`~robotdyn.simulation.engine.Trajectory` against time.
+
+    Args:
+        traj: The trajectory.
+        columns: Coordinate or velocity names, one row of axes each.
+        path: Where to save the figure (PNG/PDF/SVG by extension); ``None`` to only return it.
+        title: Figure title.
+        zoom: If given, a second column of axes shows only ``0 <= t <= zoom`` (the paper's transient windows).
+        references: Horizontal reference lines per column, e.g. a paper's printed amplitude.
+
+    Returns:
+        The matplotlib figure.
+    """
+    ncol = 2 if zoom else 1
+    fig, axes = plt.subplots(len(columns), ncol, figsize=(5.5 * ncol, 2.3 * len(columns)), squeeze=False)
+    for i, name in enumerate(columns):
+        y = traj.column(name)
+        for j in range(ncol):
+            ax = axes[i, j]
+            mask = slice(None) if j == 0 else traj.t <= zoom
+            ax.plot(traj.t[mask], y[mask], lw=1.2, label="robotdyn")
+            for value, label in (references or {}).get(name, []):
+                ax.axhline(value, color="C3", ls="--", lw=1.0, label=label)
+            ax.set_ylabel(f"{name} [{_unit(traj, name)}]")
+            ax.grid(alpha=0.3)
+            if i == len(columns) - 1:
+                ax.set_xlabel("t [s]")
+            if i == 0:
+                ax.set_title("whole run" if j == 0 else f"first {zoom:g} s")
+            if (references or {}).get(name) and j == ncol - 1:
+                ax.legend(fontsize=7, loc="upper right")
+    return finish(fig, path, title)
+
+
+def finish(fig, path=None, title: str = ""):
+    """Title and lay out a figure, then save it atomically (:func:`robotdyn.output.save_figure`) and close it when
+    ``path`` is given; returns the figure."""
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    if path is not None:
+        from ..output import save_figure
+
+        try:
+            save_figure(fig, path)
+        finally:
+            plt.close(fig)
+    return fig

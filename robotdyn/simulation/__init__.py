@@ -1,0 +1,1 @@
+"""robotdyn.simulation.engine: see robotdyn/simulation/__init__.py (placeholder written by relayout.py)."""

@@ -23,7 +23,8 @@ import pinocchio as pin
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import robotdyn  # noqa: E402
-from robotdyn.fast.compiled import available, compiled_model, use_compiled, why_not  # noqa: E402
+from robotdyn.fast.dispatch import available, compiled_model, use_compiled
+from robotdyn.fast.compiled import why_not  # noqa: E402
 from robotdyn.robots import module, names  # noqa: E402
 
 

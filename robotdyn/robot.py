@@ -27,24 +27,12 @@ from .contact.friction import make_law
 from .inputs import as_vector
 from .constraints.loop_closure import LoopClosure
 from .reduction.projection import auto_independent
-from .reduction.reduced_dynamics import ReducedDynamics, reduce
+from .fast.dispatch import reduce
+from .reduction.reduced_dynamics import ReducedDynamics, checked, solve_mass
 from .constraints.rolling_contact import OmniWheel, RollingWheel, SupportWheel
 from .contact.sliding import SlippingWheel, sliding_now
 from .contact.sliding import forward as forward_sliding
 from .constraints.terrain import FlatTerrain, Terrain
-
-
-def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """:math:`M^{-1} b` for a reduced mass matrix, which must be positive definite (Cholesky); else a one-line
-    :class:`~robotdyn.errors.InputError` naming the likely cause."""
-    try:
-        L = np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        eig = np.linalg.eigvalsh(M) if np.all(np.isfinite(M)) else np.array([np.nan])
-        raise InputError(f"the reduced mass matrix is not positive definite (smallest eigenvalue {eig.min():.3g}): "
-                         "massless or zero-inertia bodies move freely; expected positive masses and inertias"
-                         ) from None
-    return np.linalg.solve(L.T, np.linalg.solve(L, b))
 
 
 @dataclass
@@ -437,16 +425,10 @@ class Robot:
 
     # ------------------------------------------------------------------------------------------- dynamics
     def reduced(self, q, nu, coriolis: bool = False) -> ReducedDynamics:
-        """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduction.reduced_dynamics`."""
-        if self.operational is not None:
-            out = self.operational.reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
-        else:
-            out = reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
-        if not (np.isfinite(out.M).all() and np.isfinite(out.h).all() and np.isfinite(out.w).all()):
-            raise NonFiniteError(f"the reduced model at this state is not finite (|q| up to "
-                                 f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g}): the "
-                                 "state is beyond what double precision holds")
-        return out
+        """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduction.reduced_dynamics` (compiled where
+        the robot allows it: :func:`robotdyn.fast.dispatch.reduce`)."""
+        q, nu = np.asarray(q, float), np.asarray(nu, float)
+        return checked(reduce(self, q, nu, coriolis), q, nu)
 
     def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Full-coordinate M(q), C(q, v), g(q) of the unconstrained tree (Pinocchio)."""

@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.fast import compiled
-from robotdyn.fast.compiled import Fallback, LazyProjection, compiled_model, use_compiled, why_not
+from robotdyn.fast import compiled, dispatch
+from robotdyn.fast.compiled import Fallback, LazyProjection, why_not
+from robotdyn.fast.dispatch import compiled_model, use_compiled
 from robotdyn.errors import SingularConstraintError
 from robotdyn.robots import names
 
@@ -23,7 +24,7 @@ from robotdyn.robots import names
 @pytest.fixture(autouse=True)
 def _needs_compiled(request):
     """Every test but test_available needs the fast path on (test_available reports why it is not)."""
-    if request.node.name != "test_available" and not compiled.enabled():
+    if request.node.name != "test_available" and not dispatch.enabled():
         pytest.skip("the compiled fast path is off (ROBOTDYN_COMPILED=0 or the extension was not built)")
 
 
@@ -161,10 +162,10 @@ def test_available():
     if os.environ.get("ROBOTDYN_COMPILED") == "0":
         pytest.skip("ROBOTDYN_COMPILED=0 in the environment")
     assert compiled.available()
-    assert compiled.enabled()
+    assert dispatch.enabled()
     with use_compiled(False):
-        assert not compiled.enabled()
-    assert compiled.enabled()
+        assert not dispatch.enabled()
+    assert dispatch.enabled()
 
 
 def test_every_robot_but_radius_joints_is_served():

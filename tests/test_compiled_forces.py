@@ -9,7 +9,7 @@ import pytest
 from test_contact_forces import ROBOTS, _pinocchio_kkt
 
 import robotdyn
-from robotdyn.fast.compiled import available, compiled_model, use_compiled
+from robotdyn.fast.dispatch import available, compiled_model, use_compiled
 
 pytestmark = pytest.mark.skipif(not available(), reason="compiled extension not built")
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.fast.compiled import available
+from robotdyn.fast.dispatch import available
 from robotdyn.simulation.compiled_engine import native_profile, rechooser
 from robotdyn.errors import RobotDynError
 from robotdyn.robots import module
@@ -105,7 +105,7 @@ def test_a_failing_row_choice_is_rechosen_by_the_python_path():
     q0, nu0 = robot.neutral(), np.array([0.3, -0.2, 0.4])
     torque = Sine(np.full(len(robot.motors), 0.5), 2.0)
     good = simulate(robot, 1.0, q0, nu0, torque, n_out=11, progress=False)
-    fast = robotdyn.fast.compiled.compiled_model(robot)
+    fast = robotdyn.fast.dispatch.compiled_model(robot)
     hint = fast._hint
     calls = []
     choose = rechooser(robot, fast)

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotdyn.fast.compiled import use_compiled
+from robotdyn.fast.dispatch import use_compiled
 from robotdyn.errors import ConstraintError
 from robotdyn.reduction.pull_back import RANK_TOL, correction, offsets
 from robotdyn.robot import MotorSpec, Robot, RobotSpec, Wheel

@@ -22,7 +22,7 @@ import pytest
 
 from oracles.wheeled_bases_sympy import Body, Wheel, mecanum, synchro, unicycle
 from robotdyn.cli.commands import main
-from robotdyn.fast.compiled import use_compiled
+from robotdyn.fast.dispatch import use_compiled
 from robotdyn.interfaces.constraint_file import ConstraintFileError, load_robot, read
 from robotdyn.description.urdf import expand_xacro
 from robotdyn.errors import ConstraintError, RobotDynWarning

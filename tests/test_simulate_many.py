@@ -16,7 +16,7 @@ import pytest
 
 import robotdyn
 from robotdyn.simulation.batch import simulate_many
-from robotdyn.fast.compiled import available
+from robotdyn.fast.dispatch import available
 from robotdyn.errors import InputError, RobotDynError
 from robotdyn.simulation.model_variants import ParameterModel, model_vector, variant
 from robotdyn.robots import module

@@ -9,7 +9,7 @@ import pickle
 import numpy as np
 import pytest
 
-from robotdyn.fast.compiled import available
+from robotdyn.fast.dispatch import available
 from robotdyn.errors import InputError
 from robotdyn.robots import quasimoro
 from robotdyn.simulation.torque_profile import Constant, Sine, Sum, Table, as_profile

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import RobotDynError
 from ..inputs import as_vector, parse_assignments
-from ..robot import solve_mass
+from ..reduction.reduced_dynamics import solve_mass
 from ..constraints.rolling_contact import RollingWheel
 
 
@@ -257,7 +257,8 @@ def cmd_simulate(args) -> int:
             raise RobotDynError("--mu/--traction-plot: this robot's wheels switch between sticking and sliding "
                                 "(friction = 'stick_slip'); their phases are reported instead")
     elif any(isinstance(c, RollingWheel) for c in robot.constraints):
-        from ..contact.traction import plot_traction, traction
+        from ..interfaces.plotting import plot_traction
+        from ..contact.traction import traction
 
         try:
             tr = traction(robot, traj, sc.torque, args.mu)

@@ -36,7 +36,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..reduction.actuation import input_matrix
-from ..fast.compiled import compiled_model
+from ..fast.dispatch import compiled_model
 from ..constraints.constraint import ConstraintRows, KinematicState
 from ..errors import InputError, NonFiniteError
 from ..constraints.loop_closure import LoopClosure
@@ -276,7 +276,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
             friction[wheel.name] = (tangential(wheel, kin_v)[0], st.force[i])
     elif nudot is None:
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
-        from ..robot import solve_mass
+        from ..reduction.reduced_dynamics import solve_mass
 
         nudot = solve_mass(red.M, red.B @ tau - red.h)
     else:
@@ -365,10 +365,8 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
 
     twin = getattr(robot, "_floating_twin", None)
     if twin is None or twin.terrain is not robot.terrain:  # (re)built for the robot's current terrain
-        from ..robot import Robot
-
         spec = replace(robot.spec, root="floating", independent=None, operational=None)
-        twin = Robot(spec, robot.params, robot.terrain)
+        twin = type(robot)(spec, robot.params, robot.terrain)  # a Robot (robotdyn.robot, the layer above)
         robot._floating_twin = twin
     names = twin.description.joint_names
     index = [names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]

@@ -18,7 +18,8 @@ a plane, a sine or a bump terrain of :mod:`robotdyn.constraints.terrain`, loop c
 the Python path. The row choice of the projection is the Python path's (its last projection); where that choice
 stops working (a singular block, rows that no longer span, a wheel lying flat) the evaluation falls back to the
 Python path, which re-chooses or raises its usual error. ``ROBOTDYN_COMPILED=0`` in the environment, or
-:func:`use_compiled` ``(False)``, turns the fast path off. The same C++ object also runs whole simulations
+:func:`robotdyn.fast.dispatch.use_compiled` ``(False)``, turns the fast path off (:mod:`robotdyn.fast.dispatch` is where
+every caller asks for it). The same C++ object also runs whole simulations
 (:mod:`robotdyn.simulation.compiled_engine`, :mod:`robotdyn.simulation.many_runs`) and gives the constraint forces
 (:meth:`CompiledModel.forces`). ``tests/test_compiled.py`` checks every output against
 the Python path on every robot.
@@ -26,16 +27,15 @@ the Python path on every robot.
 
 from __future__ import annotations
 
-import os
-from contextlib import contextmanager
-
 import numpy as np
 
 from ..constraints.constraint import ConstraintRows, KinematicState
 from ..constraints.joint_coupling import CosineLaw, JointCoupling
 from ..constraints.loop_closure import LoopClosure
 from ..constraints.loop_closure import groupable as groupable_loop
+from ..reduction.operational_space import OperationalProjection
 from ..reduction.projection import Projection, inverse_and_condition
+from ..reduction.reduced_dynamics import ReducedDynamics, checked, reference
 from ..constraints.rolling_contact import RollingWheel
 from ..constraints.terrain import BumpTerrain, RampTerrain, SineTerrain
 from ..constraints.wheel_group import groupable as groupable_wheel
@@ -49,7 +49,6 @@ except ImportError:  # built without a C++ compiler: the Python path serves ever
     class Fallback(RuntimeError):
         """The compiled path cannot decide here (never raised without the extension)."""
 
-_ENABLED = os.environ.get("ROBOTDYN_COMPILED", "1") != "0"
 _KINDS = {"RX": "RX", "RY": "RY", "RZ": "RZ", "PX": "PX", "PY": "PY", "PZ": "PZ",
           "RevoluteUnaligned": "RU", "PrismaticUnaligned": "PU"}
 SELF_CHECK_TOL = 1e-9
@@ -59,22 +58,6 @@ SELF_CHECK_TOL = 1e-9
 def available() -> bool:
     """Whether the compiled extension was built (it needs a C++ compiler at install time)."""
     return _compiled is not None
-
-
-def enabled() -> bool:
-    """Whether :func:`robotdyn.reduction.reduced_dynamics.reduce` uses the fast path when a robot allows it."""
-    return _ENABLED and _compiled is not None
-
-
-@contextmanager
-def use_compiled(flag: bool):
-    """Turn the fast path on or off inside a ``with`` block (e.g. to compare it with the Python path)."""
-    global _ENABLED
-    old, _ENABLED = _ENABLED, bool(flag)
-    try:
-        yield
-    finally:
-        _ENABLED = old
 
 
 def _terrain_code(terrain) -> tuple[int, list[float]] | None:
@@ -242,9 +225,7 @@ class CompiledModel:
 
     def _choose(self, q: np.ndarray, nu: np.ndarray) -> None:
         """Let the Python path choose the projection's rows at (q, nu) (it raises its usual errors there)."""
-        with use_compiled(False):
-            out = self.robot.reduced(q, nu)
-        self.select(out.projection)
+        self.select(checked(reference(self.robot, q, nu), q, nu).projection)
 
     def select(self, proj) -> None:
         """Use the row choice (and independent velocities) of a Python projection from now on."""
@@ -298,11 +279,7 @@ class CompiledModel:
             M, h, g, B, S, w, v, A, residual, cond, inv = self.ev.evaluate(q, nu)
         except Fallback:
             return None
-        from ..reduction.reduced_dynamics import ReducedDynamics
-
         if self.operational is not None:
-            from ..reduction.operational_space import OperationalProjection
-
             proj = OperationalProjection(S, hint.rows, cond, inv)
         else:
             proj = LazyProjection(S, hint, A)
@@ -365,32 +342,4 @@ class CompiledModel:
         return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
 
 
-def compiled_model(robot) -> CompiledModel | None:
-    """The robot's :class:`CompiledModel` for the calling thread (built once per thread; rebuilt when its
-    constraints, their terrain or radius, or the model's gravity change), or ``None`` when the fast path is off or
-    :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated from several
-    threads at once."""
-    if not enabled():
-        return None
-    # one compiled model per thread: compute() returns views of its buffers, which another thread's call would
-    # overwrite (the robot's Pinocchio data is per thread as well, see Robot.data)
-    local = getattr(robot, "_local", None)
-    cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
-    gravity = robot.model.gravity.linear
-    if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
-        getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r
-        for c, (t, r) in zip(robot.constraints, cached[2])
-    ):
-        return cached[3]
-    fast = CompiledModel(robot) if why_not(robot) is None else None
-    state = [(getattr(c, "terrain", None), getattr(c, "radius", None)) for c in robot.constraints]
-    entry = (list(robot.constraints), gravity.copy(), state, fast)
-    if local is not None:
-        local.compiled = entry
-    else:
-        robot._compiled_model = entry
-    return fast
-
-
-__all__ = ["Fallback", "CompiledModel", "LazyProjection", "compiled_model", "why_not", "available", "enabled",
-           "use_compiled"]
+__all__ = ["Fallback", "CompiledModel", "LazyProjection", "why_not", "available"]

@@ -7,6 +7,7 @@ import os
 from collections.abc import Sequence
 
 import matplotlib
+import numpy as np
 
 if not os.environ.get("MPLBACKEND"):  # keep a backend chosen by the user or a notebook kernel (inline figures)
     matplotlib.use("Agg")
@@ -77,3 +78,34 @@ def finish(fig, path=None, title: str = ""):
         finally:
             plt.close(fig)
     return fig
+
+
+def plot_traction(tr, path=None, title: str = ""):
+    """A :class:`~robotdyn.contact.traction.Traction`: normal loads and required friction per wheel against time, shaded where the no-slip assumption is broken
+    (load <= 0, or required friction above the wheel's mu, drawn dashed)."""
+    fig, (ax_n, ax_mu) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
+    broken = tr.broken().any(axis=1) if tr.wheels else np.zeros(len(tr.t), bool)
+    for j, name in enumerate(tr.wheels):
+        ax_n.plot(tr.t, tr.normal[:, j], lw=1.2, label=name)
+        if not tr.friction_determined[j]:
+            ax_mu.plot([], [], lw=1.2, label=f"{name}: friction not determined")
+            continue
+        mu = np.where(np.isfinite(tr.required_mu[:, j]), tr.required_mu[:, j], np.nan)
+        (line,) = ax_mu.plot(tr.t, mu, lw=1.2, label=name)
+        if np.isfinite(tr.mu[j]):
+            ax_mu.axhline(tr.mu[j], color=line.get_color(), ls="--", lw=1.0)
+    for ax in (ax_n, ax_mu):
+        if broken.any():
+            ax.fill_between(tr.t, 0, 1, where=broken, transform=ax.get_xaxis_transform(), color="C3", alpha=0.15,
+                            label="no-slip broken" if ax is ax_n else None)
+        ax.grid(alpha=0.3)
+    ax_n.axhline(0.0, color="k", lw=0.8)
+    ax_n.set_ylabel("normal load [N]")
+    ax_mu.set_ylabel("required friction |f_t|/f_n")
+    ax_mu.set_xlabel("t [s]")
+    if tr.wheels:
+        ax_n.legend(fontsize=7, loc="upper right")
+        ax_mu.legend(fontsize=7, loc="upper right")
+    if tr.undetermined:
+        ax_n.set_title(f"loads of {', '.join(tr.undetermined)} not determined", fontsize=8)
+    return finish(fig, path, title)

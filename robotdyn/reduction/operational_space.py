@@ -28,7 +28,6 @@ import numpy as np
 import pinocchio as pin
 
 from .actuation import input_matrix
-from ..fast.compiled import compiled_model
 from ..constraints.constraint import KinematicState
 from ..errors import DescriptionError, InputError, SingularConstraintError
 from .projection import MAX_CONDITION, independent_rows, inverse_and_condition
@@ -154,24 +153,18 @@ def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
                        coriolis: bool = False) -> ReducedDynamics:
     """The reduced model of ``robot`` in operational velocities ``nu = J_o v`` at (q, nu).
 
-    Same content as :func:`robotdyn.reduction.reduced_dynamics.reduce` (``M`` = operational-space inertia,
+    The Python reference (the compiled path: :func:`robotdyn.fast.dispatch.reduce`). Same content as
+    :func:`robotdyn.reduction.reduced_dynamics.reduce` (``M`` = operational-space inertia,
     ``h`` = :math:`C_r\\nu + g_r`, ``B`` = :math:`S^T B`, ...), with ``projection`` an
     :class:`OperationalProjection`.
     """
     model, data = robot.model, robot.data
     q = np.asarray(q, float)
     nu = np.asarray(nu, float)
-    fast = None if coriolis else compiled_model(robot)
-    if fast is not None:
-        out = fast.reduced(q, nu)
-        if out is not None:
-            return out
     kin0 = KinematicState(model, data, q, np.zeros(model.nv))
     rows0 = constraint_set(robot).jacobian(kin0)
     J = twist.jacobian(kin0)
     proj = project_operational(rows0.A, J, twist.names)
-    if fast is not None:
-        fast.select(proj)
     S = proj.S
     v = S @ nu
     kin = kin0.with_velocity(v)
@@ -216,11 +209,16 @@ class OperationalModel:
         """S(q) only (cheaper than :meth:`reduce` when no dynamics is needed, e.g. kinematic integration)."""
         return operational_projection(robot, self.twist, q)
 
-    def reduce(self, robot, q, nu, coriolis: bool = False) -> ReducedDynamics:
+    def check(self, nu) -> None:
+        """Raises InputError unless ``nu`` has one value per operational velocity."""
         nu = np.asarray(nu, float)
         if nu.shape != (len(self.names),):
             raise InputError(f"nu has shape {nu.shape}; expected {len(self.names)} values ({', '.join(self.names)})")
-        return reduce_operational(robot, self.twist, q, nu, coriolis)
+
+    def reduce(self, robot, q, nu, coriolis: bool = False) -> ReducedDynamics:
+        """The Python reference (:func:`reduce_operational`); the compiled path: :func:`robotdyn.fast.dispatch.reduce`."""
+        self.check(nu)
+        return reduce_operational(robot, self.twist, q, np.asarray(nu, float), coriolis)
 
 
 __all__ = ["FrameTwist", "OperationalProjection", "project_operational", "operational_projection", "reduce_operational",

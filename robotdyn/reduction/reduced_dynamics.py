@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ..errors import InputError, NonFiniteError
 from .actuation import input_matrix
-from ..fast.compiled import compiled_model
 from ..constraints.constraint import ConstraintRows, KinematicState
 from .projection import Projection, project
 from ..constraints.loop_closure import LoopGroup
@@ -198,27 +198,55 @@ def assemble(robot, q: np.ndarray, proj, rows0: ConstraintRows, v: np.ndarray, w
 
 
 def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
-    """Evaluate the reduced model of ``robot`` at (q, nu): by the robot's compiled model
-    (:mod:`robotdyn.fast.compiled`) where it serves the robot, else (and to choose the projection's rows) in Python.
+    """Evaluate the reduced model of ``robot`` at (q, nu) in Python: the reference of the compiled fast path
+    (:mod:`robotdyn.fast`; :func:`robotdyn.fast.dispatch.reduce` chooses between the two).
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot`.
         q: Natural coordinates (n,), already validated.
         nu: Independent velocities (k,).
-        coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`; the Python path).
+        coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`).
         independent: Override of the independent velocity indices.
     """
     ind = robot.independent_indices if independent is None else independent
-    fast = None if coriolis else compiled_model(robot)
-    if fast is not None:
-        out = fast.reduced(q, nu, ind)
-        if out is not None:
-            return out
     kin0, rows0, proj = _project_at(robot, q, ind)
-    if fast is not None:
-        fast.select(proj)
     v = proj.S @ nu
     kin = kin0.with_velocity(v)
     drift = constraint_set(robot).drift(kin)
     B = input_matrix(robot.motors, kin)
     return assemble(robot, q, proj, rows0, v, proj.offset(drift), B, coriolis, proj.Sdot)
+
+
+def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:math:`M^{-1} b` for a reduced mass matrix, which must be positive definite (Cholesky); else a one-line
+    :class:`~robotdyn.errors.InputError` naming the likely cause."""
+    try:
+        L = np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        eig = np.linalg.eigvalsh(M) if np.all(np.isfinite(M)) else np.array([np.nan])
+        raise InputError(f"the reduced mass matrix is not positive definite (smallest eigenvalue {eig.min():.3g}): "
+                         "massless or zero-inertia bodies move freely; expected positive masses and inertias"
+                         ) from None
+    return np.linalg.solve(L.T, np.linalg.solve(L, b))
+
+
+def reference(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
+    """The Python reference of the robot's reduced model: :func:`reduce`, or the robot's operational reduction
+    (``robot.operational.reduce``) where its independent velocities are a frame twist."""
+    op = getattr(robot, "operational", None)
+    if op is not None:
+        return op.reduce(robot, q, nu, coriolis)
+    return reduce(robot, q, nu, coriolis, independent)
+
+
+def checked(out: ReducedDynamics, q, nu) -> ReducedDynamics:
+    """``out``, after checking that its M, h and w are finite.
+
+    Raises:
+        NonFiniteError: They are not (a state beyond what double precision holds).
+    """
+    if not (np.isfinite(out.M).all() and np.isfinite(out.h).all() and np.isfinite(out.w).all()):
+        raise NonFiniteError(f"the reduced model at this state is not finite (|q| up to "
+                             f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g}): the "
+                             "state is beyond what double precision holds")
+    return out

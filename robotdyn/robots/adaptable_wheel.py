@@ -674,7 +674,7 @@ class MissionModel:
 
     def state(self, t: float) -> tuple[Commands, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(commands, IK solution, q, v, a) at time t (natural coordinates of the model)."""
-        from ..reduction.reduced_dynamics import reduce
+        from ..fast.dispatch import reduce
 
         cmd, x = self.ik_at(t)
         q = model_configuration(self.slip, cmd, x)

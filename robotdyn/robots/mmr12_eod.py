@@ -382,7 +382,7 @@ def _defects(R: np.ndarray) -> tuple[float, float]:
 # ------------------------------------------------------------------------------------------------- CLI
 def register_cli(subparsers, parents) -> None:
     """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.description.kinematics`)."""
-    from ..description.kinematics import register_fk_cli
+    from ..cli.fk import register_fk_cli
 
     register_fk_cli(subparsers, parents)
 

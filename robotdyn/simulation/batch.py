@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fast.compiled import compiled_model
+from ..fast.dispatch import compiled_model
 from ..errors import RobotDynError, SingularConstraintError
 
 _WORKER_ROBOT = None

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..fast.compiled import compiled_model
+from ..fast.dispatch import compiled_model
 from ..errors import NonFiniteError, RobotDynError
 from ..reduction.pull_back import failure_note
 from ..contact.sliding import slipping_wheels
@@ -120,7 +120,8 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     if slipping_wheels(robot) or any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):
         reason = "slipping wheels are simulated on the Python path"
     elif compiled_model(robot) is None:
-        from ..fast.compiled import enabled, why_not
+        from ..fast.dispatch import enabled
+        from ..fast.compiled import why_not
 
         reason = why_not(robot) if enabled() else "the compiled fast path is turned off (ROBOTDYN_COMPILED=0)"
     elif torque is not None and not isinstance(torque, TorqueProfile):
@@ -161,7 +162,7 @@ def rechooser(robot, fast=None):
     """The callback with which the C++ integrator asks the Python path for a new row choice at (q, nu), where the
     compiled one stops working: returns ``(rows, independent, dependent)`` of the Python projection there (and
     makes ``fast``, if given, use it), or raises the Python path's error (e.g. a singular configuration)."""
-    from ..fast.compiled import use_compiled
+    from ..fast.dispatch import use_compiled
 
     def rechoose(q: np.ndarray, nu: np.ndarray) -> tuple[list[int], list[int], list[int]]:
         with use_compiled(False):

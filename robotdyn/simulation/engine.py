@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fast.compiled import Fallback, compiled_model
+from ..fast.compiled import Fallback
+from ..fast.dispatch import compiled_model
 from .compiled_engine import METHODS, choose_engine, simulate_compiled
 from ..errors import NonFiniteError, RobotDynError, TimeLimitError
 from ..reduction.projection import solve
@@ -191,7 +192,7 @@ def simulate(
     fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path
     k = robot.mobility
 
-    # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.robot.solve_mass)
+    # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.reduction.reduced_dynamics.solve_mass)
     robot.forward_dynamics(q0, nu0, zero_tau if torque is None else np.asarray(torque(0.0, q0, nu0), float))
 
     def finite(t: float, y: np.ndarray) -> None:  # on the Python paths only: the compiled one stays lean

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fast.compiled import compiled_model
+from ..fast.dispatch import compiled_model
 from ..errors import InputError, RobotDynError
 
 

@@ -28,7 +28,8 @@ import threading
 import numpy as np
 import pinocchio as pin
 
-from ..fast.compiled import compiled_model, why_not
+from ..fast.dispatch import compiled_model
+from ..fast.compiled import why_not
 from ..errors import DescriptionError, InputError
 
 JOINT, FRAME, WHEEL, COUPLING, GRAVITY = 22, 12, 4, 4, 3

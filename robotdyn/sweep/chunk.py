@@ -214,7 +214,7 @@ def _one(ctx: RunContext, run: RunInput) -> tuple[dict, dict | None]:
 def run_chunk(ctx: RunContext, runs: list[RunInput]) -> list[tuple[dict, dict | None]]:
     """Compute a chunk of runs, one after the other: for each, its summary row (``status`` ok, stopped or
     error, with the message) and its trajectory columns (``None`` unless ``ctx.trajectories``)."""
-    from ..fast.compiled import use_compiled
+    from ..fast.dispatch import use_compiled
 
     with use_compiled(ctx.compiled), np.errstate(all="ignore"):
         return [_one(ctx, run) for run in runs]

@@ -112,7 +112,7 @@ def _terrain(mod, item, scenarios) -> tuple[str, tuple]:
 
 def plan(spec: SweepSpec) -> Plan:
     """Check ``spec`` against its robot and list its runs (see the module docstring)."""
-    from ..fast.compiled import enabled
+    from ..fast.dispatch import enabled
 
     import robotdyn
 

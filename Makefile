@@ -11,7 +11,7 @@ $(STAMP): pyproject.toml setup.py robotdyn/_compiled.cpp robotdyn/_integrator.hp
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet "setuptools>=77" wheel "pybind11>=2.12" "pin>=4.1,<5" "cmeel-eigen>=3.4"  # build requirements (pyproject.toml)
 	$(PY) -m pip install --quiet --no-build-isolation -e ".[test]"  # compiles robotdyn._compiled (~2 min)
-	$(PY) -c "import robotdyn.compiled as c; print('robotdyn: compiled fast path', 'built' if c.available() else 'NOT built (no C++ compiler?): Python path only')"
+	$(PY) -c "import robotdyn.fast.compiled as c; print('robotdyn: compiled fast path', 'built' if c.available() else 'NOT built (no C++ compiler?): Python path only')"
 	touch $(STAMP)
 
 venv: $(STAMP)

@@ -1,7 +1,7 @@
 """make bench: speed of robotdyn's reduced model next to raw Pinocchio, for every registered robot, in one run.
 
 For each robot: the median time of one reduced-model evaluation (M_r, C_r nu + g_r, g_r, S, w = Sdot nu) -- by
-the compiled model (robotdyn.compiled, views of its buffers), by robot.reduced (the full ReducedDynamics object) and
+the compiled model (robotdyn.fast.compiled, views of its buffers), by robot.reduced (the full ReducedDynamics object) and
 by the Python path -- next to Pinocchio's CRBA + RNEA on the same model, their ratios; for Quasimoro also the sympy-derived model lambdified
 with numpy (tests/oracles); and simulated seconds per wall-clock second of the robot's first scenario with the
 constraint drift at the end (for Quasimoro also DOP853 at rtol 1e-8 and LSODA at rtol 1e-10, each with its
@@ -23,7 +23,8 @@ import pinocchio as pin
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import robotdyn  # noqa: E402
-from robotdyn.compiled import available, compiled_model, use_compiled, why_not  # noqa: E402
+from robotdyn.fast.dispatch import available, compiled_model, use_compiled
+from robotdyn.fast.compiled import why_not  # noqa: E402
 from robotdyn.robots import module, names  # noqa: E402
 
 
@@ -87,7 +88,7 @@ def main() -> None:
     print(f"\nquasimoro: sympy-lambdified model {t_sym * 1e6:.1f} us; robotdyn compiled {t_fast * 1e6:.2f} us "
           f"({t_sym / t_fast:.1f}x faster), robot.reduced {t_red * 1e6:.1f} us ({t_sym / t_red:.1f}x faster)")
 
-    from robotdyn.batch import evaluate
+    from robotdyn.simulation.batch import evaluate
 
     rng = np.random.default_rng(1)
     N = 2000
@@ -173,7 +174,7 @@ def forces_bench() -> None:
     """Contact forces against a compiled evaluation, and a slipping against a rolling simulation (issue 13)."""
     from dataclasses import replace
 
-    from robotdyn.constraint_file import read
+    from robotdyn.interfaces.constraint_file import read
     from robotdyn.robot import Robot
 
     print(f"\n{'robot':<20} {'compiled [us]':>14} {'forces [us]':>12} {'forces / compiled':>18}")
@@ -214,7 +215,7 @@ def forces_bench() -> None:
 
 # ------------------------------------------------------------------ compiled simulation engine (issue 17, items 1, 2)
 def compiled_engine_bench() -> None:
-    """The whole simulation in C++ (robotdyn.compiled_simulation) against the scipy path on Quasimoro's rectilinear
+    """The whole simulation in C++ (robotdyn.simulation.compiled_engine) against the scipy path on Quasimoro's rectilinear
     manoeuvre (90 s, default tolerances rtol 1e-10, atol 1e-12): cost per simulated second (best of 5 whole
     simulate() calls, 2 for scipy, after a warm-up), evaluations, deviation from the scipy trajectory, energy drift
     after the pulse."""
@@ -263,9 +264,9 @@ def compiled_forces_bench() -> None:
 
 
 def simulate_many_bench(runs: int = 10_000) -> None:
-    """robotdyn.batch.simulate_many: ten-second Quasimoro runs (the eq 19 pulse) with six parameters varied per run
+    """robotdyn.simulation.batch.simulate_many: ten-second Quasimoro runs (the eq 19 pulse) with six parameters varied per run
     (M, m, d, r, J1, J2, uniform in physical ranges), 201 samples each, on 1 thread (a tenth of the runs) and 2."""
-    from robotdyn.batch import simulate_many
+    from robotdyn.simulation.batch import simulate_many
 
     robot = robotdyn.load("quasimoro")
     pulse = module("quasimoro").SCENARIOS["rectilinear"].torque

@@ -1,5 +1,5 @@
 """make bench, side by side in one run (issue 17): Quasimoro's 'rectilinear' manoeuvre by robotdyn's scipy path,
-by the compiled simulation (where ``robotdyn.simulation.simulate`` offers it) and by MuJoCo, with the cost per
+by the compiled simulation (where ``robotdyn.simulation.engine.simulate`` offers it) and by MuJoCo, with the cost per
 simulated second and the accuracy against robotdyn's exact trajectory; then the throughput of a 2,000-run sweep
 on 1 and 2 Dask workers, with the identity of their results. Ratios matter here, not absolute times: the machine
 has 2 cores and may be shared. This is a benchmark, not a test: it asserts nothing.
@@ -19,7 +19,7 @@ import numpy as np
 import mujoco_quasimoro as mq
 import robotdyn
 from robotdyn.robots import module
-from robotdyn.simulation import simulate
+from robotdyn.simulation.engine import simulate
 
 SAMPLE = 0.05  # [s] output spacing: the scenario's own (1801 samples over 90 s)
 REPEAT = 3  # each timed run is repeated; the fastest counts (the machine may be shared)
@@ -95,15 +95,15 @@ def manoeuvre(t_ends=(20.0, 90.0)) -> None:
 
 def sweep_throughput(n: int | None = None, t_end: float = 2.0) -> None:
     """A Latin-hypercube sweep of n Quasimoro runs (M, d, J1, torque scale) on 1 and 2 Dask workers: runs per
-    second of the whole ``robotdyn.sweep.run`` call (cluster start included) and whether the results agree."""
-    from robotdyn import sweep
-    from robotdyn.sweep_spec import SweepSpec, parse_axis
+    second of the whole ``robotdyn.sweep.runner.run`` call (cluster start included) and whether the results agree."""
+    from robotdyn.sweep import runner as sweep
+    from robotdyn.sweep.spec import SweepSpec, parse_axis
 
     n = n or int(os.environ.get("ROBOTDYN_BENCH_SWEEP_RUNS", 2000))
     spec = SweepSpec(robot="quasimoro", sample="lhs", n=n, seed=0, t_end=t_end, columns=["theta3"],
                      axes=[parse_axis(a) for a in ("M=4:6", "d=0.1:0.2", "J1=0.15:0.25", "torque_scale=0.5:2")])
     print(f"\nsweep throughput: {n} Quasimoro runs of {t_end:g} s (LHS over M, d, J1, torque scale), "
-          f"robotdyn.sweep.run on a local Dask cluster (cluster start included)")
+          f"robotdyn.sweep.runner.run on a local Dask cluster (cluster start included)")
     tables, rates = {}, {}
     for workers in (1, 2):
         before = os.times()

@@ -18,33 +18,21 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .actuation import Motor
-from .constraint import ConstraintRows, KinematicState
-from .description import _ROOT_CHAINS, URDF_DIR, Description, build_description, expand_xacro
-from .dynamics import energy
+from .reduction.actuation import Motor
+from .constraints.constraint import ConstraintRows, KinematicState
+from .description.urdf import _ROOT_CHAINS, URDF_DIR, Description, build_description, expand_xacro
+from .reduction.dynamics import energy
 from .errors import ConstraintError, InputError, NonFiniteError, RobotDynWarning
-from .friction import make_law
+from .contact.friction import make_law
 from .inputs import as_vector
-from .loop_closure import LoopClosure
-from .projection import auto_independent
-from .reduced_dynamics import ReducedDynamics, reduce
-from .rolling_contact import OmniWheel, RollingWheel, SupportWheel
-from .sliding import SlippingWheel, sliding_now
-from .sliding import forward as forward_sliding
-from .terrain import FlatTerrain, Terrain
-
-
-def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """:math:`M^{-1} b` for a reduced mass matrix, which must be positive definite (Cholesky); else a one-line
-    :class:`~robotdyn.errors.InputError` naming the likely cause."""
-    try:
-        L = np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        eig = np.linalg.eigvalsh(M) if np.all(np.isfinite(M)) else np.array([np.nan])
-        raise InputError(f"the reduced mass matrix is not positive definite (smallest eigenvalue {eig.min():.3g}): "
-                         "massless or zero-inertia bodies move freely; expected positive masses and inertias"
-                         ) from None
-    return np.linalg.solve(L.T, np.linalg.solve(L, b))
+from .constraints.loop_closure import LoopClosure
+from .reduction.projection import auto_independent
+from .fast.dispatch import reduce
+from .reduction.reduced_dynamics import ReducedDynamics, checked, solve_mass
+from .constraints.rolling_contact import OmniWheel, RollingWheel, SupportWheel
+from .contact.sliding import SlippingWheel, sliding_now
+from .contact.sliding import forward as forward_sliding
+from .constraints.terrain import FlatTerrain, Terrain
 
 
 @dataclass
@@ -90,7 +78,7 @@ class Wheel:
     radius_joint: str | None = None
     name: str | None = None
     mu: float | None = None  # friction coefficient (traction checks, friction laws); None: not given
-    friction: str = "rolling"  # rolling (no slip) | coulomb | linear (robotdyn.friction)
+    friction: str = "rolling"  # rolling (no slip) | coulomb | linear (robotdyn.contact.friction)
     slip_velocity: float | None = None  # coulomb law's regularisation scale [m/s]
     stiffness: float | None = None  # linear law's slip stiffness [s/m]
     slip: str = "both"  # with a friction law: both tangential directions slip, or only the lateral one
@@ -140,9 +128,9 @@ class RobotSpec:
             construction (description, params and terrain are set).
         operational: Minimal velocities that are not a subset of v (e.g. a platform twist in body axes): an object
             with ``build(description)`` returning a model with ``names`` and ``reduce(robot, q, nu, coriolis)``,
-            such as :class:`robotdyn.operational_space.OperationalVelocities`; ``None``: ``independent`` is used.
+            such as :class:`robotdyn.reduction.operational_space.OperationalVelocities`; ``None``: ``independent`` is used.
         packages: ROS packages by name (name -> directory) for ``$(find NAME)`` and ``package://NAME/`` (see
-            :mod:`robotdyn.ros_packages`; ``package_dirs``, ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH`` are
+            :mod:`robotdyn.description.ros_packages`; ``package_dirs``, ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH`` are
             searched for the others).
         root_height: Height [m] of the plane in which a planar root moves its link (the root link's height above
             the ground, z = 0), or of the reference of a floating root's z; ``None``: found from the wheels for a
@@ -206,7 +194,7 @@ class Robot:
         if not path.is_absolute():
             path = URDF_DIR / path
         xacro_args = {**spec.xacro_args, **{p.name: values[p.name] for p in spec.parameters if p.xacro}}
-        from .ros_packages import PackageIndex
+        from .description.ros_packages import PackageIndex
 
         dirs = [str(d) for d in spec.package_dirs]
         self.packages = PackageIndex.create(spec.packages, dirs)
@@ -287,7 +275,7 @@ class Robot:
                                  "standard wheel (support wheels are frictionless, omni wheels roll on rollers)")
             law = make_law(w.friction, w.mu, w.slip_velocity, w.stiffness, wheel=name)
             if w.friction == "stick_slip":
-                from .stick_slip import StickSlipWheel
+                from .simulation.stick_slip import StickSlipWheel
 
                 if w.slip != "both":
                     raise InputError(f"wheel {name!r}: slip = {w.slip!r} with friction = 'stick_slip'; exact "
@@ -397,8 +385,8 @@ class Robot:
                 f"every wheel is {abs(values[0]):.6g} m {where} the ground at this configuration: the root link sits "
                 f"at the wrong height ({self.spec.root} root at {self.description.root_height:.6g} m); {fix}")
         what = ("the wheels must touch the ground: check the radii and joint values, or solve the posture "
-                "(robotdyn.posture)" if rows.labels[i].rsplit(".", 1)[0] in heights else
-                "solve the closures first (robotdyn.posture solves the holonomic constraints for the free coordinates)")
+                "(robotdyn.constraints.posture)" if rows.labels[i].rsplit(".", 1)[0] in heights else
+                "solve the closures first (robotdyn.constraints.posture solves the holonomic constraints for the free coordinates)")
         raise ConstraintError(
             f"q violates constraint {rows.labels[i]} by {rows.residual[i]:.3g}; expected |residual| <= {tol:g}; {what}"
         )
@@ -437,16 +425,10 @@ class Robot:
 
     # ------------------------------------------------------------------------------------------- dynamics
     def reduced(self, q, nu, coriolis: bool = False) -> ReducedDynamics:
-        """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduced_dynamics`."""
-        if self.operational is not None:
-            out = self.operational.reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
-        else:
-            out = reduce(self, np.asarray(q, float), np.asarray(nu, float), coriolis)
-        if not (np.isfinite(out.M).all() and np.isfinite(out.h).all() and np.isfinite(out.w).all()):
-            raise NonFiniteError(f"the reduced model at this state is not finite (|q| up to "
-                                 f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g}): the "
-                                 "state is beyond what double precision holds")
-        return out
+        """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduction.reduced_dynamics` (compiled where
+        the robot allows it: :func:`robotdyn.fast.dispatch.reduce`)."""
+        q, nu = np.asarray(q, float), np.asarray(nu, float)
+        return checked(reduce(self, q, nu, coriolis), q, nu)
 
     def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Full-coordinate M(q), C(q, v), g(q) of the unconstrained tree (Pinocchio)."""
@@ -458,10 +440,10 @@ class Robot:
 
     def forward_dynamics(self, q, nu, tau, check: bool = True) -> np.ndarray:
         """Independent accelerations :math:`\\dot\\nu = M_r^{-1}(B_r\\tau - C_r\\nu - g_r)` (with slipping
-        wheels, together with their normal loads and friction: :func:`robotdyn.sliding.forward`).
+        wheels, together with their normal loads and friction: :func:`robotdyn.contact.sliding.forward`).
 
         With ``check``, rows the projection dropped as redundant are checked at the velocity and acceleration
-        level (:mod:`robotdyn.redundancy`): where the mobility changes (e.g. steerable wheels all parallel) these
+        level (:mod:`robotdyn.constraints.redundancy`): where the mobility changes (e.g. steerable wheels all parallel) these
         accelerations can violate them, and a :class:`~robotdyn.errors.RobotDynWarning` names each row and by
         how much."""
         if sliding_now(self):
@@ -477,14 +459,14 @@ class Robot:
 
     def redundant_row_violations(self, q, nu, nudot=None) -> list:
         """The constraint rows dropped as redundant at q that the velocities ``nu`` (and the accelerations
-        ``nudot``, if given) violate: a list of :class:`~robotdyn.redundancy.RowViolation` (empty where the state is
-        consistent). See :mod:`robotdyn.redundancy`."""
-        from .redundancy import violations
+        ``nudot``, if given) violate: a list of :class:`~robotdyn.constraints.redundancy.RowViolation` (empty where the state is
+        consistent). See :mod:`robotdyn.constraints.redundancy`."""
+        from .constraints.redundancy import violations
 
         return violations(self.reduced(q, nu), nudot)
 
     def _warn_dropped(self, red, nudot) -> None:
-        from .redundancy import message, violations
+        from .constraints.redundancy import message, violations
 
         found = violations(red, nudot)
         if found:
@@ -509,8 +491,8 @@ class Robot:
     def contact_forces(self, q, nu, tau=None, nudot=None, twin: bool = True):
         """Wheel-ground contact forces and loop-closure forces at (q, nu) for motor torques ``tau`` (forward
         dynamics) or independent accelerations ``nudot`` (inverse dynamics); see
-        :func:`robotdyn.contact_forces.constraint_forces`."""
-        from .contact_forces import constraint_forces
+        :func:`robotdyn.contact.contact_forces.constraint_forces`."""
+        from .contact.contact_forces import constraint_forces
 
         return constraint_forces(self, q, nu, tau=tau, nudot=nudot, twin=twin)
 

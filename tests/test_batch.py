@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robotdyn.batch import evaluate
+from robotdyn.simulation.batch import evaluate
 from robotdyn.errors import RobotDynError
 
 

@@ -25,8 +25,8 @@ from PIL import Image
 import robotdyn
 from oracles.urdf_fk import UrdfVisuals
 from robotdyn.robots import names
-from robotdyn.terrain import SineTerrain
-from robotdyn.viewer import Viewer, find_chromium, screenshot
+from robotdyn.constraints.terrain import SineTerrain
+from robotdyn.interfaces.viewer import Viewer, find_chromium, screenshot
 
 TILE = (400, 300)  # each export is shown in an iframe of this size [px]
 FOV_DEG = 75.0  # meshcat 0.3.2's default PerspectiveCamera

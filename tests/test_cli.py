@@ -61,7 +61,7 @@ def test_simulate_writes_csv_and_plot(tmp_path):
     header = csv.read_text().splitlines()[0].split(",")
     robot = robotdyn.load("quasimoro")
     # then the traction columns: normal loads (from the floating twin) and the smallest mu that admits a split of
-    # the two wheels' lateral forces in both cones (robotdyn.traction)
+    # the two wheels' lateral forces in both cones (robotdyn.contact.traction)
     assert header == ["t", *robot.coordinates, "theta1_dot", "theta2_dot", "theta3_dot", "wheel_A.normal",
                       "wheel_B.normal", "mu_required_min"]
     data = np.loadtxt(csv, delimiter=",", skiprows=1)

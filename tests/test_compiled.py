@@ -1,4 +1,4 @@
-"""The compiled fast path (:mod:`robotdyn.compiled`, ``robotdyn/_compiled.cpp``) against the Python reference path.
+"""The compiled fast path (:mod:`robotdyn.fast.compiled`, ``robotdyn/_compiled.cpp``) against the Python reference path.
 
 Every output of the compiled evaluation (M_r, h, g_r, B_r, S, w, v, the constraint rows A and their residuals, the
 projection's condition number, the simulation right-hand side) is compared with the Python path
@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn import compiled
-from robotdyn.compiled import Fallback, LazyProjection, compiled_model, use_compiled, why_not
+from robotdyn.fast import compiled, dispatch
+from robotdyn.fast.compiled import Fallback, LazyProjection, why_not
+from robotdyn.fast.dispatch import compiled_model, use_compiled
 from robotdyn.errors import SingularConstraintError
 from robotdyn.robots import names
 
@@ -23,7 +24,7 @@ from robotdyn.robots import names
 @pytest.fixture(autouse=True)
 def _needs_compiled(request):
     """Every test but test_available needs the fast path on (test_available reports why it is not)."""
-    if request.node.name != "test_available" and not compiled.enabled():
+    if request.node.name != "test_available" and not dispatch.enabled():
         pytest.skip("the compiled fast path is off (ROBOTDYN_COMPILED=0 or the extension was not built)")
 
 
@@ -161,10 +162,10 @@ def test_available():
     if os.environ.get("ROBOTDYN_COMPILED") == "0":
         pytest.skip("ROBOTDYN_COMPILED=0 in the environment")
     assert compiled.available()
-    assert compiled.enabled()
+    assert dispatch.enabled()
     with use_compiled(False):
-        assert not compiled.enabled()
-    assert compiled.enabled()
+        assert not dispatch.enabled()
+    assert dispatch.enabled()
 
 
 def test_every_robot_but_radius_joints_is_served():
@@ -243,7 +244,7 @@ def test_linkage_singular_states_raise_like_python(linkage):
 def test_ramp_terrain():
     """Wheels on a sloped plane (the linkage's floating base follows it) and on a raised plane: nonzero residuals
     and slope-dependent drift; the planar bases cannot follow a slope, so both paths find them singular there."""
-    from robotdyn.terrain import RampTerrain
+    from robotdyn.constraints.terrain import RampTerrain
 
     rng = np.random.default_rng(8)
     cases = [("linkage_suspension", RampTerrain(0.2, 0.7, 0.01), True),
@@ -271,7 +272,7 @@ def test_ramp_terrain():
 
 # ---------------------------------------------------------------------------------------------------- why_not
 def _user_terrain():
-    from robotdyn.terrain import FunctionTerrain
+    from robotdyn.constraints.terrain import FunctionTerrain
 
     return FunctionTerrain(lambda x, y: 0.01 * x * y, lambda x, y: np.array([0.01 * y, 0.01 * x]),
                            lambda x, y: np.array([[0.0, 0.01], [0.01, 0.0]]))
@@ -289,7 +290,7 @@ def test_why_not_names_a_terrain_without_compiled_formulas():
 def test_curved_terrain_named_or_equal(kind):
     """Wheels on a curved terrain (sine, bump): either why_not names the terrain, or (once compiled) the fast path
     equals the Python path (the linkage is regular there only at neutral; adaptable_wheel's floating wheels are)."""
-    from robotdyn.terrain import BumpTerrain, SineTerrain
+    from robotdyn.constraints.terrain import BumpTerrain, SineTerrain
 
     make = {"sine": lambda: SineTerrain(0.02, 0.3), "bump": lambda: BumpTerrain(0.05, 0.1, 0.2, 0.5)}[kind]
     rng = np.random.default_rng(12)
@@ -312,7 +313,7 @@ def test_curved_terrain_named_or_equal(kind):
 
 
 def test_why_not_different_terrains():
-    from robotdyn.terrain import RampTerrain
+    from robotdyn.constraints.terrain import RampTerrain
 
     rob = robotdyn.load("linkage_suspension")
     wheels = [c for c in rob.constraints if hasattr(c, "terrain")]
@@ -323,9 +324,9 @@ def test_why_not_different_terrains():
 
 
 def test_why_not_unsupported_constraint_and_rebuild():
-    from robotdyn.constraint import Constraint
-    from robotdyn.posture import set_terrain
-    from robotdyn.terrain import RampTerrain
+    from robotdyn.constraints.constraint import Constraint
+    from robotdyn.constraints.posture import set_terrain
+    from robotdyn.constraints.terrain import RampTerrain
 
     rob = robotdyn.load("quasimoro")
     fast = compiled_model(rob)
@@ -360,7 +361,7 @@ def test_why_not_unsupported_constraint_and_rebuild():
 
 def test_why_not_joint_coupling_with_a_user_law():
     """A JointCoupling whose law is a plain callable (no compiled formula) keeps the robot on the Python path."""
-    from robotdyn.joint_coupling import JointCoupling
+    from robotdyn.constraints.joint_coupling import JointCoupling
 
     rob = robotdyn.load("mmr12_eod")
     assert why_not(rob) is None
@@ -546,7 +547,7 @@ def test_simulate_rectilinear_equals_python(quasimoro_m):
 ])
 def test_simulate_energy_conserved(name, coordinate, value, nu0):
     """A torque-free run with the compiled rhs conserves energy and really moves."""
-    from robotdyn.simulation import simulate
+    from robotdyn.simulation.engine import simulate
 
     rob = robotdyn.load(name)
     q0 = rob.neutral()
@@ -588,7 +589,7 @@ def test_fallback_at_singular_linkage_state(linkage):
 def test_fallback_bad_row_choice(robot):
     """A row choice that is singular at the state (chosen where another configuration made those rows regular):
     evaluate/rhs raise Fallback, robot.reduced gives the Python path's result, re-selects and is fast again."""
-    from robotdyn.projection import _build
+    from robotdyn.reduction.projection import _build
 
     rng = np.random.default_rng(43)
     for _ in range(10):
@@ -621,7 +622,7 @@ def test_fallback_bad_row_choice(robot):
     if bad is None:
         pytest.skip(f"no singular row choice of this size at this state of {robot.spec.name} (e.g. every row is used)")
     if operational:
-        from robotdyn.operational_space import OperationalProjection
+        from robotdyn.reduction.operational_space import OperationalProjection
 
         other = OperationalProjection(proj.S, bad, proj.condition, proj._inv)
     else:
@@ -682,9 +683,9 @@ def test_compute_views(robot):
 # ------------------------------------------------------------------------------------------ later changes, more
 def test_cosine_coupling_named_or_equal():
     """A JointCoupling with a CosineLaw on mmr12 (one velocity less): named by why_not, or compiled and equal."""
-    jc = pytest.importorskip("robotdyn.joint_coupling")
+    jc = pytest.importorskip("robotdyn.constraints.joint_coupling")
     if not hasattr(jc, "CosineLaw"):
-        pytest.skip("no CosineLaw in robotdyn.joint_coupling")
+        pytest.skip("no CosineLaw in robotdyn.constraints.joint_coupling")
     rob = robotdyn.load("mmr12_eod")
     coupling = jc.JointCoupling(rob.description, "theta3_joint", "theta1_joint", jc.CosineLaw(0.3, 1.5, 0.2, -0.1))
     rob.constraints.append(coupling)

@@ -1,6 +1,6 @@
 """Constraint forces in the compiled fast path (CompiledModel.forces, and robot.contact_forces where it serves):
 against Pinocchio's own KKT solve of the constrained dynamics, and against the Python path of
-robotdyn.contact_forces, on every robot."""
+robotdyn.contact.contact_forces, on every robot."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from test_contact_forces import ROBOTS, _pinocchio_kkt
 
 import robotdyn
-from robotdyn.compiled import available, compiled_model, use_compiled
+from robotdyn.fast.dispatch import available, compiled_model, use_compiled
 
 pytestmark = pytest.mark.skipif(not available(), reason="compiled extension not built")
 
@@ -37,8 +37,8 @@ def test_compiled_forces_match_pinocchio_kkt(robots, name):
         nudot, lam, e, local, world, frames, points = (np.array(x) for x in fast.forces(q, nu, tau))
         red = robot.reduced(q, nu)
         np.testing.assert_allclose(nudot, robot.forward_dynamics(q, nu, tau), rtol=1e-10, atol=1e-10)
-        kin = robotdyn.constraint.KinematicState(robot.model, robot.data, q, red.v)
-        B = robotdyn.actuation.input_matrix(robot.motors, kin)
+        kin = robotdyn.constraints.constraint.KinematicState(robot.model, robot.data, q, red.v)
+        B = robotdyn.reduction.actuation.input_matrix(robot.motors, kin)
         a_pin, A, sel, lam_pin = _pinocchio_kkt(robot, q, red.v, B @ tau)
         scale = 1.0 + np.abs(e).max()
         np.testing.assert_allclose(A.T @ lam, e, atol=1e-9 * scale)

@@ -1,4 +1,4 @@
-"""The compiled simulation engine (robotdyn.compiled_simulation) against the scipy reference (DOP853, rtol 1e-10,
+"""The compiled simulation engine (robotdyn.simulation.compiled_engine) against the scipy reference (DOP853, rtol 1e-10,
 atol 1e-12), and the drift it leaves: holonomic residuals and, where no torque acts, the energy."""
 
 from __future__ import annotations
@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.compiled import available
-from robotdyn.compiled_simulation import native_profile, rechooser
+from robotdyn.fast.dispatch import available
+from robotdyn.simulation.compiled_engine import native_profile, rechooser
 from robotdyn.errors import RobotDynError
 from robotdyn.robots import module
-from robotdyn.simulation import simulate
-from robotdyn.torque_profile import Constant, Sine
+from robotdyn.simulation.engine import simulate
+from robotdyn.simulation.torque_profile import Constant, Sine
 
 pytestmark = pytest.mark.skipif(not available(), reason="compiled extension not built")
 
@@ -105,14 +105,14 @@ def test_a_failing_row_choice_is_rechosen_by_the_python_path():
     q0, nu0 = robot.neutral(), np.array([0.3, -0.2, 0.4])
     torque = Sine(np.full(len(robot.motors), 0.5), 2.0)
     good = simulate(robot, 1.0, q0, nu0, torque, n_out=11, progress=False)
-    fast = robotdyn.compiled.compiled_model(robot)
+    fast = robotdyn.fast.dispatch.compiled_model(robot)
     hint = fast._hint
     calls = []
     choose = rechooser(robot, fast)
     bad = [int(hint.rows[0])] * len(hint.rows)  # one row repeated: a singular block
     fast.ev.set_operational(bad, *fast._op)  # (this robot's velocities are a platform twist)
     fast._hint = None  # the Python side must not rely on the old choice either
-    with pytest.raises(robotdyn.compiled.Fallback):
+    with pytest.raises(robotdyn.fast.compiled.Fallback):
         fast.ev.evaluate(q0, nu0)  # the wrong choice fails here
 
     def counting(q, nu):

@@ -1,4 +1,4 @@
-"""Constraint files (robotdyn.constraint_file): equivalence with a robot module's RobotSpec, generic options
+"""Constraint files (robotdyn.interfaces.constraint_file): equivalence with a robot module's RobotSpec, generic options
 (locked joints, massless links), and one clear line for each mistake."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import pinocchio as pin
 import pytest
 
 import robotdyn
-from robotdyn.cli import main
-from robotdyn.constraint_file import ConstraintFileError, load_robot, read
+from robotdyn.cli.commands import main
+from robotdyn.interfaces.constraint_file import ConstraintFileError, load_robot, read
 from robotdyn.errors import RobotDynError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -264,8 +264,8 @@ def test_xacro_args_reach_the_description(tmp_path, capsys):
 
 
 def test_terrain_and_wheel_kinds(tmp_path):
-    from robotdyn.rolling_contact import OmniWheel, RollingWheel
-    from robotdyn.terrain import RampTerrain
+    from robotdyn.constraints.rolling_contact import OmniWheel, RollingWheel
+    from robotdyn.constraints.terrain import RampTerrain
 
     text = BASE.replace('name = "B"', 'name = "B"\nkind = "omni"\nroller_angle = 0.7').replace(
         'name = "A"', 'name = "A"\nkind = "caster"') + '\n[terrain]\nkind = "ramp"\nslope = 0.1\n'

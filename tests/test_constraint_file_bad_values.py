@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 import tomli_w
 
-from robotdyn.cli import main
+from robotdyn.cli.commands import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skid_steer.toml"
 WRONG = {"list": [1, 2], "table": {"a": 1}, "nested": {"a": {"b": {"c": [[1]]}}}, "bool": True, "text": "x(",
@@ -86,7 +86,7 @@ def _omni(tmp_path, angle):
 
 def test_angles_with_units(tmp_path, capsys):
     """roller_angle = "45 deg" is pi/4 rad; a bare 45 (degrees without their unit) is refused, not taken as rad."""
-    from robotdyn.constraint_file import read
+    from robotdyn.interfaces.constraint_file import read
 
     rows = {}
     for label, angle in (("deg", "45 deg"), ("rad", 0.7853981633974483), ("rad-string", "0.7853981633974483 rad")):

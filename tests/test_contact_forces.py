@@ -1,4 +1,4 @@
-"""Constraint forces (robotdyn.contact_forces) against independent references: Pinocchio's own KKT solve of the
+"""Constraint forces (robotdyn.contact.contact_forces) against independent references: Pinocchio's own KKT solve of the
 constrained dynamics, the static force and moment balance of the whole robot, and the closed form of a disc
 rolling down an incline."""
 
@@ -24,7 +24,7 @@ def robots():
 
 def _pinocchio_kkt(robot, q, v, tau_full):
     """Pinocchio's forwardDynamics with the independent constraint rows: accelerations and A^T lambda."""
-    rows = robot.constraint_rows(robotdyn.constraint.KinematicState(robot.model, robot.data, q, v))
+    rows = robot.constraint_rows(robotdyn.constraints.constraint.KinematicState(robot.model, robot.data, q, v))
     A, gamma = rows.A, rows.Adot @ v
     r = np.linalg.matrix_rank(A)
     sel = np.sort(qr(A.T, pivoting=True)[2][:r])  # a maximal independent subset of the rows
@@ -54,8 +54,8 @@ def test_forces_match_pinocchio_kkt(robots, name):
         tau = rng.normal(size=len(robot.motors))
         f = robot.contact_forces(q, nu, tau=tau, twin=False)  # the model's own multipliers
         red = robot.reduced(q, nu)
-        kin = robotdyn.constraint.KinematicState(robot.model, robot.data, q, red.v)
-        B = robotdyn.actuation.input_matrix(robot.motors, kin)
+        kin = robotdyn.constraints.constraint.KinematicState(robot.model, robot.data, q, red.v)
+        B = robotdyn.reduction.actuation.input_matrix(robot.motors, kin)
         a_pin, A, sel, lam_pin = _pinocchio_kkt(robot, q, red.v, B @ tau)
         scale = 1.0 + np.abs(A.T @ f.lam).max()
         np.testing.assert_allclose(red.S @ f.nudot + red.w, a_pin, atol=1e-9 * (1 + np.abs(a_pin).max()))
@@ -133,8 +133,8 @@ def test_planar_loads_from_the_floating_twin_match_pinocchio(robots):
     idx = [twin.description.joint_names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]
     qt, vt = np.zeros(twin.nq), np.zeros(twin.nq)
     qt[idx], vt[idx] = q, red.v
-    kin = robotdyn.constraint.KinematicState(twin.model, twin.data, qt, vt)
-    B = robotdyn.actuation.input_matrix(twin.motors, kin)
+    kin = robotdyn.constraints.constraint.KinematicState(twin.model, twin.data, qt, vt)
+    B = robotdyn.reduction.actuation.input_matrix(twin.motors, kin)
     a_pin, A, sel, lam_pin = _pinocchio_kkt(twin, qt, vt, B @ tau)
     out_of_plane = [twin.coordinate_index(c) for c in ("z", "pitch", "roll")]
     np.testing.assert_allclose(a_pin[out_of_plane], 0.0, atol=1e-9)

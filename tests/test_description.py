@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 import yourdfpy
 
-from robotdyn.description import URDF_DIR, build_description, expand_xacro
+from robotdyn.description.urdf import URDF_DIR, build_description, expand_xacro
 from robotdyn.errors import DescriptionError
 
 
@@ -80,7 +80,7 @@ def test_units_follow_joint_types():
 
 def test_every_placeholder_inertia_is_named_at_once(tmp_path):
     """Two links with impossible inertials: both are named in one line, with the hint to declare them massless."""
-    from robotdyn.description import validate_urdf
+    from robotdyn.description.urdf import validate_urdf
     from robotdyn.errors import DescriptionError
 
     bad = ('<inertial><mass value="1e-6"/><inertia ixx="-1e-8" iyy="1e-9" izz="1e-9" ixy="0" ixz="0" iyz="0"/>'

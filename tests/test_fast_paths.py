@@ -1,6 +1,6 @@
 """The vectorised evaluation paths against the per-constraint rows they replace, on every registered robot.
 
-:class:`robotdyn.reduced_dynamics.ConstraintSet` (rolling wheels in one :class:`~robotdyn.wheel_group.WheelGroup`
+:class:`robotdyn.reduction.reduced_dynamics.ConstraintSet` (rolling wheels in one :class:`~robotdyn.constraints.wheel_group.WheelGroup`
 pass, loop closures through their vector drift) must give the same Jacobian rows, residuals and drift terms as
 stacking each constraint's full :meth:`rows` (whose ``Adot`` is checked against finite differences in the core
 tests), at states off the constraint manifold too (the formulas do not assume A v = 0).
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.constraint import ConstraintRows, KinematicState
-from robotdyn.reduced_dynamics import constraint_set, velocity
+from robotdyn.constraints.constraint import ConstraintRows, KinematicState
+from robotdyn.reduction.reduced_dynamics import constraint_set, velocity
 from robotdyn.robots import names
 
 
@@ -59,7 +59,7 @@ def test_velocity_matches_reduce(robot):
 
 
 def test_batch_vectorised_equals_one_by_one(robot):
-    from robotdyn.batch import _evaluate_loop, evaluate
+    from robotdyn.simulation.batch import _evaluate_loop, evaluate
 
     rng = np.random.default_rng(5)
     N = 12
@@ -75,7 +75,7 @@ def test_batch_vectorised_equals_one_by_one(robot):
 
 
 def test_batch_singular_state_is_named():
-    from robotdyn.batch import evaluate
+    from robotdyn.simulation.batch import evaluate
     from robotdyn.errors import SingularConstraintError
 
     rob = robotdyn.load("quasimoro")
@@ -86,8 +86,8 @@ def test_batch_singular_state_is_named():
 
 
 def test_terrain_changed_in_place_is_seen():
-    from robotdyn.posture import set_terrain
-    from robotdyn.terrain import RampTerrain
+    from robotdyn.constraints.posture import set_terrain
+    from robotdyn.constraints.terrain import RampTerrain
 
     rob = robotdyn.load("mmr12_eod")
     q = rob.neutral()

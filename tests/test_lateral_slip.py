@@ -25,12 +25,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from robotdyn.constraint_file import ConstraintFileError, read
+from robotdyn.interfaces.constraint_file import ConstraintFileError, read
 from robotdyn.errors import InputError
 from robotdyn.robot import Robot
-from robotdyn.simulation import simulate
-from robotdyn.sliding import forward as forward_sliding
-from robotdyn.sliding import inverse
+from robotdyn.simulation.engine import simulate
+from robotdyn.contact.sliding import forward as forward_sliding
+from robotdyn.contact.sliding import inverse
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skid_steer.toml"
 A, B, R, G = 0.25, 0.22, 0.1, 9.81
@@ -163,8 +163,8 @@ def test_lateral_slip_from_toml(tmp_path):
 
 @pytest.mark.parametrize("slip", ["lateral", "both"])
 def test_inverse_reproduces_forward(slip):
-    """robotdyn.sliding.inverse (torques and loads from the accelerations, least squares) against
-    robotdyn.sliding.forward (accelerations and loads from the torques, the coupled solve): at a turning state the
+    """robotdyn.contact.sliding.inverse (torques and loads from the accelerations, least squares) against
+    robotdyn.contact.sliding.forward (accelerations and loads from the torques, the coupled solve): at a turning state the
     accelerations of forward give back the same loads and the same generalised motor forces. With lateral slip the
     four torques are not all determined (each side's wheels roll on one line, so shifting torque between a side's
     front and rear wheel only changes their traction split: two free combinations), with free slip they are."""

@@ -1,7 +1,7 @@
 """The six-wheel linkage robot on asymmetric terrain: with rigid no-slip middle wheels it is locked wherever the
 terrain makes beta1 != beta2 (SingularConstraintError, docs/errata/linkage_suspension.md); with its two middle
 (standard) wheels slipping under regularised Coulomb friction it moves, and its energy balance holds: torque-free,
-E(t) - E(0) equals the friction work (robotdyn.sliding)."""
+E(t) - E(0) equals the friction work (robotdyn.contact.sliding)."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ import pytest
 
 import robotdyn
 from robotdyn.errors import SingularConstraintError
-from robotdyn.posture import set_terrain, solve_posture
+from robotdyn.constraints.posture import set_terrain, solve_posture
 from robotdyn.robot import Robot
-from robotdyn.simulation import simulate
-from robotdyn.terrain import SineTerrain
+from robotdyn.simulation.engine import simulate
+from robotdyn.constraints.terrain import SineTerrain
 
 TERRAIN = dict(amplitude=0.03, kx=2.0, ky=3.0)
 

@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotdyn.constraint import KinematicState
+from robotdyn.constraints.constraint import KinematicState
 from robotdyn.errors import DescriptionError, SingularConstraintError
-from robotdyn.loop_closure import LoopClosure
-from robotdyn.projection import project
+from robotdyn.constraints.loop_closure import LoopClosure
+from robotdyn.reduction.projection import project
 from robotdyn.robot import Closure, Robot, RobotSpec
-from robotdyn.simulation import simulate
+from robotdyn.simulation.engine import simulate
 
 FOURBAR = Path(__file__).parent / "data" / "fourbar.urdf"
 

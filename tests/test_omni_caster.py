@@ -285,7 +285,7 @@ def test_inverse_dynamics_power_balance(robot, kind, t_end, par):
 
 
 def test_circle_scenario_feedforward_follows_plan(robot):
-    from robotdyn.simulation import power
+    from robotdyn.simulation.engine import power
 
     sc = oc.SCENARIOS["circle"]
     tr = sc.run(robot, t_end=4.0, n_out=9, progress=False)
@@ -297,7 +297,7 @@ def test_circle_scenario_feedforward_follows_plan(robot):
 
 # ------------------------------------------------------------------------------------------ priority 5-6
 def test_impact_matches_eq60_and_restitution(robot):
-    from robotdyn.impulse import impact
+    from robotdyn.contact.impulse import impact
 
     rng = np.random.default_rng(21)
     for phi, pose, nu in _states(20, 22):
@@ -316,7 +316,7 @@ def test_impact_matches_eq60_and_restitution(robot):
 
 
 def test_impact_bad_input():
-    from robotdyn.impulse import impact
+    from robotdyn.contact.impulse import impact
 
     M = np.eye(3)
     for args in [(M, [0, 0, 0], [-1, 0, 0], 0.8), (M, [1, 0, 0], [-1, 0, 0], 1.5), (M, [1, 0], [-1, 0, 0], 0.5),
@@ -346,7 +346,7 @@ def test_impulse_ellipses(robot, bare):
 def test_cli_impulse(capsys):
     import json
 
-    from robotdyn.cli import main
+    from robotdyn.cli.commands import main
 
     assert main(["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "-1", "0", "0", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
@@ -361,7 +361,7 @@ def test_cli_impulse(capsys):
 
 
 def test_cli_dump_and_compare(capsys):
-    from robotdyn.cli import main
+    from robotdyn.cli.commands import main
 
     assert main(["dump", "omni_caster", "--q", *["0.3"] * 9, "--v", "0.1", "0.2", "0.3"]) == 0
     assert "v_cx" in capsys.readouterr().out

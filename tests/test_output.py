@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.cli import main
+from robotdyn.cli.commands import main
 from robotdyn.errors import OutputError
 from robotdyn.output import atomic_output, check_target
 

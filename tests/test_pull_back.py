@@ -1,4 +1,4 @@
-"""The holonomic pull-back (robotdyn.pull_back) on rows a planar root cannot move (issue 14, item 1).
+"""The holonomic pull-back (robotdyn.reduction.pull_back) on rows a planar root cannot move (issue 14, item 1).
 
 Fixture: tests/data/tilted_axles.urdf, a differential drive whose wheel joints use ROS's rounded rpy="-1.57 0 0",
 so each axle is tilted by eps = pi/2 - 1.57 = 7.96e-4 rad and the lowest rim point lies
@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotdyn.compiled import use_compiled
+from robotdyn.fast.dispatch import use_compiled
 from robotdyn.errors import ConstraintError
-from robotdyn.pull_back import RANK_TOL, correction, offsets
+from robotdyn.reduction.pull_back import RANK_TOL, correction, offsets
 from robotdyn.robot import MotorSpec, Robot, RobotSpec, Wheel
-from robotdyn.simulation import simulate
-from robotdyn.terrain import RampTerrain
+from robotdyn.simulation.engine import simulate
+from robotdyn.constraints.terrain import RampTerrain
 
 TILTED = Path(__file__).parent / "data" / "tilted_axles.urdf"
 R = 0.1

@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from robotdyn.constraint import KinematicState
+from robotdyn.constraints.constraint import KinematicState
 from robotdyn.errors import ConstraintError, DescriptionError
 from robotdyn.robot import Robot, RobotSpec, Wheel
-from robotdyn.rolling_contact import OmniWheel, RollingWheel
-from robotdyn.simulation import simulate
-from robotdyn.terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain
+from robotdyn.constraints.rolling_contact import OmniWheel, RollingWheel
+from robotdyn.simulation.engine import simulate
+from robotdyn.constraints.terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain
 
 DISC = Path(__file__).parent / "data" / "disc.urdf"
 R = 0.3

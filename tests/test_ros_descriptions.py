@@ -21,16 +21,16 @@ import numpy as np
 import pytest
 
 from oracles.wheeled_bases_sympy import Body, Wheel, mecanum, synchro, unicycle
-from robotdyn.cli import main
-from robotdyn.compiled import use_compiled
-from robotdyn.constraint_file import ConstraintFileError, load_robot, read
-from robotdyn.description import expand_xacro
+from robotdyn.cli.commands import main
+from robotdyn.fast.dispatch import use_compiled
+from robotdyn.interfaces.constraint_file import ConstraintFileError, load_robot, read
+from robotdyn.description.urdf import expand_xacro
 from robotdyn.errors import ConstraintError, RobotDynWarning
-from robotdyn.joint_coupling import JointCoupling
+from robotdyn.constraints.joint_coupling import JointCoupling
 from robotdyn.robot import Robot
-from robotdyn.ros_packages import MissingPackagesError, PackageIndex, required_packages
-from robotdyn.scene_page import pack_scene, page_commands, unpack_scene
-from robotdyn.viewer import Viewer
+from robotdyn.description.ros_packages import MissingPackagesError, PackageIndex, required_packages
+from robotdyn.interfaces.scene_page import pack_scene, page_commands, unpack_scene
+from robotdyn.interfaces.viewer import Viewer
 
 WS = Path(__file__).resolve().parent.parent / "examples" / "ros_ws"
 SRC = WS / "src"
@@ -203,7 +203,7 @@ def test_page_unpacker_script_gives_the_same_commands(diff_drive, tmp_path):
     import json
     import zlib
 
-    from robotdyn.scene_page import _UNPACK_JS
+    from robotdyn.interfaces.scene_page import _UNPACK_JS
 
     page = Viewer(diff_drive).static_html()
     scene = re.search(r'var robotdyn_scene = "[^"]*";', page).group(0)

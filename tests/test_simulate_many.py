@@ -1,5 +1,5 @@
-"""Many simulations in one call (robotdyn.batch.simulate_many) and the model variants behind per-run parameters
-(robotdyn.model_variants): every run equals the same run alone through the compiled simulate, bit for bit, on
+"""Many simulations in one call (robotdyn.simulation.batch.simulate_many) and the model variants behind per-run parameters
+(robotdyn.simulation.model_variants): every run equals the same run alone through the compiled simulate, bit for bit, on
 1 or 2 threads; a parameter variant's model equals the robot rebuilt from its description (Xacro) with those
 values; what cannot vary without a rebuild is refused in one line."""
 
@@ -15,13 +15,13 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.batch import simulate_many
-from robotdyn.compiled import available
+from robotdyn.simulation.batch import simulate_many
+from robotdyn.fast.dispatch import available
 from robotdyn.errors import InputError, RobotDynError
-from robotdyn.model_variants import ParameterModel, model_vector, variant
+from robotdyn.simulation.model_variants import ParameterModel, model_vector, variant
 from robotdyn.robots import module
-from robotdyn.simulation import simulate
-from robotdyn.torque_profile import Constant, Sine
+from robotdyn.simulation.engine import simulate
+from robotdyn.simulation.torque_profile import Constant, Sine
 
 pytestmark = pytest.mark.skipif(not available(), reason="compiled extension not built")
 
@@ -129,7 +129,7 @@ def test_a_run_violating_its_constraints_fails_alone():
 
 INTERRUPTED = """
 import numpy as np, robotdyn
-from robotdyn.batch import simulate_many
+from robotdyn.simulation.batch import simulate_many
 from robotdyn.robots import module
 robot = robotdyn.load("quasimoro")
 print("ready", flush=True)

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotdyn.constraint_file import read
+from robotdyn.interfaces.constraint_file import read
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skid_steer.toml"
 A, B, R, K, TAU, G = 0.25, 0.22, 0.1, 5.0, 0.3, 9.81
@@ -82,7 +82,7 @@ def test_without_slip_the_rover_cannot_turn(rover):
 def test_info_explains_a_locked_base(tmp_path, capsys):
     """robotdyn info on the rover with wheels that roll without slipping: mobility 1 (n - rank A), and the note
     that turning requires slip; with its slipping wheels, mobility 7 and no such note."""
-    from robotdyn.cli import main
+    from robotdyn.cli.commands import main
 
     text = EXAMPLE.read_text().replace('friction = "linear"', 'friction = "rolling"').replace("stiffness = 5.0", "")
     text = text.replace("mu = 0.8", "").replace('urdf = "skid_steer.urdf.xacro"',

@@ -1,4 +1,4 @@
-"""Wheels that slip (robotdyn.sliding, robotdyn.friction) against closed forms: a disc sliding down an incline
+"""Wheels that slip (robotdyn.contact.sliding, robotdyn.contact.friction) against closed forms: a disc sliding down an incline
 under Coulomb friction, a disc launched sliding on flat ground reaching pure rolling, the energy balance with the
 friction work, the linear tyre law, and the one-line errors of the interfaces."""
 
@@ -12,8 +12,8 @@ from scipy.optimize import brentq
 
 from robotdyn.errors import InputError
 from robotdyn.robot import Robot, RobotSpec, Wheel
-from robotdyn.simulation import simulate
-from robotdyn.terrain import RampTerrain
+from robotdyn.simulation.engine import simulate
+from robotdyn.constraints.terrain import RampTerrain
 
 DISC = Path(__file__).parent / "data" / "disc.urdf"
 M, I, R, G = 2.0, 0.04, 0.3, 9.81  # tests/data/disc.urdf: mass, axle inertia; wheel radius; gravity

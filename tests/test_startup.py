@@ -1,5 +1,5 @@
 """Start-up of the CLI (issue 17): `robotdyn info` imports neither scipy nor yourdfpy once the description was
-validated before (robotdyn.description keeps a cache of validated URDF texts), the cache never lets an invalid
+validated before (robotdyn.description.urdf keeps a cache of validated URDF texts), the cache never lets an invalid
 description through, and `make bench` reports the wall time."""
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ import sys
 
 import pytest
 
-from robotdyn.description import validate_urdf
+from robotdyn.description.urdf import validate_urdf
 from robotdyn.errors import DescriptionError
 
-PROBE = ("import sys, io, contextlib, robotdyn.cli as c\n"
+PROBE = ("import sys, io, contextlib, robotdyn.cli.commands as c\n"
          "with contextlib.redirect_stdout(io.StringIO()): rc = c.main(['info', 'quasimoro'])\n"
          "print(rc, 'scipy' in sys.modules, 'yourdfpy' in sys.modules, 'matplotlib' in sys.modules)")
 

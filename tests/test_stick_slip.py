@@ -1,4 +1,4 @@
-"""Exact stick-slip switching (robotdyn.stick_slip) against the closed forms of a disc: launched sliding on flat
+"""Exact stick-slip switching (robotdyn.simulation.stick_slip) against the closed forms of a disc: launched sliding on flat
 ground it sticks at t* = v0 k / (mu g (1 + k)) with v* = v0 / (1 + k) and loses m v0^2 k / (2 (1 + k)) (for a solid
 disc k = 1/2: t* = v0 / (3 mu g), v* = 2 v0 / 3, m v0^2 / 6); on an incline it rolls iff
 tan(alpha) <= mu (1 + k) / k (3 mu for a solid disc), else it slides at g (sin a - mu cos a) along the slope."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robotdyn.simulation import simulate
+from robotdyn.simulation.engine import simulate
 
 from test_sliding import G, K, M, disc
 
@@ -17,7 +17,7 @@ def _launch(mu=0.3, v0=2.0, t_end=0.3):
     robot, q0 = disc(0.0, friction="stick_slip", mu=mu)
     v = np.zeros(robot.nq)
     v[robot.coordinate_index("x")] = v0
-    from robotdyn.stick_slip import simulate as hybrid
+    from robotdyn.simulation.stick_slip import simulate as hybrid
 
     return robot, hybrid(robot, t_end, q0, v, n_out=31, progress=False)
 

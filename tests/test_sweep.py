@@ -14,11 +14,11 @@ import psutil
 import pytest
 
 import robotdyn
-from robotdyn import sweep, sweep_chunk
-from robotdyn.cli import main
+from robotdyn.sweep import runner as sweep, chunk as sweep_chunk
+from robotdyn.cli.commands import main
 from robotdyn.robots import module
-from robotdyn.sweep_plan import plan
-from robotdyn.sweep_spec import Axis, SweepSpec, SweepSpecError, from_toml, parse_axis, parse_value, points
+from robotdyn.sweep.plan import plan
+from robotdyn.sweep.spec import Axis, SweepSpec, SweepSpecError, from_toml, parse_axis, parse_value, points
 
 QUASIMORO = module("quasimoro")
 T_END = 1.5
@@ -278,7 +278,7 @@ def test_cli_end_to_end(tmp_path):
     assert (out / "results.parquet").is_file() and (out / "summary.png").is_file()
     again = json.loads(subprocess.run(argv, capture_output=True, text=True, timeout=300).stdout)
     assert (again["computed"], again["resumed"]) == (0, 2)
-    probe = ("import sys, io, contextlib, robotdyn.cli as c\n"
+    probe = ("import sys, io, contextlib, robotdyn.cli.commands as c\n"
              "with contextlib.redirect_stdout(io.StringIO()): c.main(['info', 'quasimoro'])\n"
              "print('dask' in sys.modules, 'pyarrow' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True).stdout.split() == [

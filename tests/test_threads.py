@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.compiled import compiled_model
+from robotdyn.fast.dispatch import compiled_model
 
 
 @pytest.mark.parametrize("name", ["quasimoro", "linkage_suspension"])

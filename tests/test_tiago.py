@@ -20,9 +20,9 @@ import pinocchio as pin
 import pytest
 from oracles import diff_drive_sympy as oracle
 
-from robotdyn.constraint_file import read
+from robotdyn.interfaces.constraint_file import read
 from robotdyn.errors import RobotDynError
-from robotdyn.simulation import simulate
+from robotdyn.simulation.engine import simulate
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 R_WHEEL = 0.0985  # examples/tiago.toml

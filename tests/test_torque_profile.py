@@ -1,4 +1,4 @@
-"""Torque profiles (robotdyn.torque_profile): their values against closed forms, and the C++ evaluation
+"""Torque profiles (robotdyn.simulation.torque_profile): their values against closed forms, and the C++ evaluation
 (robotdyn._compiled.TorqueProfile) bit for bit equal to the Python one at many times."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import pickle
 import numpy as np
 import pytest
 
-from robotdyn.compiled import available
+from robotdyn.fast.dispatch import available
 from robotdyn.errors import InputError
 from robotdyn.robots import quasimoro
-from robotdyn.torque_profile import Constant, Sine, Sum, Table, as_profile
+from robotdyn.simulation.torque_profile import Constant, Sine, Sum, Table, as_profile
 
 
 def profiles():
@@ -50,7 +50,7 @@ def test_quasimoro_pulse_is_eq_19():
 @pytest.mark.skipif(not available(), reason="compiled extension not built")
 @pytest.mark.parametrize("name", list(profiles()))
 def test_cpp_evaluation_is_bitwise_the_python_one(name):
-    from robotdyn.compiled_simulation import native_profile
+    from robotdyn.simulation.compiled_engine import native_profile
 
     prof = profiles()[name]
     native = native_profile(prof)

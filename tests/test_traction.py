@@ -1,4 +1,4 @@
-"""Traction along simulations (robotdyn.traction): loads and required friction of a disc rolling down an incline
+"""Traction along simulations (robotdyn.contact.traction): loads and required friction of a disc rolling down an incline
 against the closed form, event times, the CSV columns and the summary line of ``robotdyn simulate``."""
 
 from __future__ import annotations
@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robotdyn.cli import main
+from robotdyn.cli.commands import main
 from robotdyn.errors import InputError
-from robotdyn.simulation import simulate
-from robotdyn.traction import Traction, _events, traction
+from robotdyn.simulation.engine import simulate
+from robotdyn.contact.traction import Traction, _events, traction
 
 from test_contact_forces import _disc_on_ramp
 

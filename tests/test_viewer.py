@@ -18,12 +18,12 @@ import umsgpack
 
 import robotdyn
 from oracles.urdf_fk import UrdfVisuals
-from robotdyn.cli import main
+from robotdyn.cli.commands import main
 from robotdyn.errors import InputError
 from robotdyn.robots import names
-from robotdyn.terrain import FlatTerrain, SineTerrain
-from robotdyn.scene_page import page_commands
-from robotdyn.viewer import Viewer
+from robotdyn.constraints.terrain import FlatTerrain, SineTerrain
+from robotdyn.interfaces.scene_page import page_commands
+from robotdyn.interfaces.viewer import Viewer
 
 ROBOTS = names()
 

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from robotdyn.cli import main
-from robotdyn.description import expand_xacro, xacro_value
+from robotdyn.cli.commands import main
+from robotdyn.description.urdf import expand_xacro, xacro_value
 from robotdyn.errors import InputError
 
 PAYLOADS = [

@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parent.parent
 CELLS = [
     new_markdown_cell(
         "# The 3-D viewer in a notebook\n\n"
-        "`robotdyn.viewer.Viewer` draws a robot's URDF visuals (placed by Pinocchio), the terrain, the wheels' "
+        "`robotdyn.interfaces.viewer.Viewer` draws a robot's URDF visuals (placed by Pinocchio), the terrain, the wheels' "
         "contact points with their contact frames, and the link frames. A viewer as the last expression of a cell "
         "renders inline: the standalone HTML export (meshcat's JavaScript inlined, no server, works offline) in an "
         "iframe. Drag to orbit, scroll to zoom; *Open Controls* toggles layers and plays animations. "
@@ -28,7 +28,7 @@ CELLS = [
         "from IPython.display import HTML, display\n\n"
         "import robotdyn\n"
         "from robotdyn.robots import module\n"
-        "from robotdyn.viewer import Viewer\n\n"
+        "from robotdyn.interfaces.viewer import Viewer\n\n"
         "robot = robotdyn.load(\"quasimoro\")\n"
         "viewer = Viewer(robot)\n"
         "viewer"

@@ -2,7 +2,7 @@
 
 For every registered robot (robotdyn.robots.names(), so new robots appear automatically): the meshcat viewer at
 the robot's neutral configuration (or, if that violates its constraints, a scenario's initial state) is exported to standalone HTML and rendered by headless Chromium with its
-network switched off (robotdyn.viewer.screenshot). The gallery section between the markers in docs/viewer.md
+network switched off (robotdyn.interfaces.viewer.screenshot). The gallery section between the markers in docs/viewer.md
 lists each robot's title, paper, scenarios, screenshot and what its notebook shows (its section headings).
 
 Usage::
@@ -48,7 +48,7 @@ def pose(robot, scenarios: dict):
 def shoot(name: str, out: Path) -> None:
     import robotdyn
     from robotdyn.robots import module
-    from robotdyn.viewer import Viewer, screenshot
+    from robotdyn.interfaces.viewer import Viewer, screenshot
 
     robot = robotdyn.load(name)
     viewer = Viewer(robot)

@@ -1,0 +1,534 @@
+"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep`` plus robot-specific commands
+(every command has ``--json``).
+
+Robot modules may add their own subcommands by defining ``register_cli(subparsers, parents)``; each such
+subcommand sets ``func(args) -> int``.
+
+Bad input gives one line ``robotdyn: error: ...`` on stderr and exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+
+import numpy as np
+
+from ..errors import RobotDynError
+from ..inputs import as_vector, parse_assignments
+from ..reduction.reduced_dynamics import solve_mass
+from ..constraints.rolling_contact import RollingWheel
+
+
+def _load(args):
+    from ..robot import Robot
+    from ..robots import module
+
+    urdf, constraints = getattr(args, "urdf", None), getattr(args, "constraints", None)
+    if urdf is not None or constraints is not None:
+        if args.robot is not None:
+            raise RobotDynError(f"give either ROBOT ({args.robot!r}) or --urdf FILE --constraints FILE, not both")
+        if constraints is None:
+            raise RobotDynError("--urdf needs --constraints FILE (the wheels, closures and motors of the robot)")
+        from ..interfaces.constraint_file import read
+
+        named, dirs = _packages(getattr(args, "package", []))
+        mod = read(constraints, urdf, parse_assignments(args.xacro_arg, "--xacro-arg"), dirs, named,
+                   getattr(args, "twist", None))
+        robot = mod.robot(parse_assignments(args.param))
+        args.robot = robot.spec.name
+        return mod, robot
+    if args.robot is None:
+        raise RobotDynError("no robot given: expected ROBOT (robotdyn list) or --urdf FILE --constraints FILE")
+    if getattr(args, "package", []):
+        raise RobotDynError("--package is for your own robot (--constraints FILE); the built-in robots need none")
+    mod = module(args.robot)
+    spec = mod.SPEC
+    if getattr(args, "twist", None):
+        from dataclasses import replace
+
+        from ..reduction.operational_space import OperationalVelocities
+
+        frame, _, comps = args.twist.partition(":")
+        comps = tuple(comps.replace(",", " ").split()) or ("vx", "vy", "wz")
+        spec = replace(spec, independent=None, operational=OperationalVelocities(frame, comps, "local", list(comps)))
+    return mod, Robot(spec, parse_assignments(args.param))
+
+
+def _packages(items) -> tuple[dict[str, str], list[str]]:
+    """``--package NAME=DIR`` (a package by name) and ``--package DIR`` (a directory searched for packages)."""
+    named, dirs = {}, []
+    for item in items or []:
+        if "=" in item:
+            named.update(parse_assignments([item], "--package"))
+        else:
+            dirs.append(item)
+    return named, dirs
+
+
+def _emit(args, data: dict, text: str) -> None:
+    if args.json:
+        print(json.dumps(data, indent=2, default=_jsonable))
+    else:
+        print(text)
+
+
+def _jsonable(x):
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    raise TypeError(f"not JSON serialisable: {type(x).__name__}")
+
+
+def _matrix_text(name: str, rows: list[str], cols: list[str], A: np.ndarray) -> str:
+    w = max(14, *(len(c) + 2 for c in cols))  # a '-1.23457e-05' (12 characters) keeps a space on its left
+    left = max(14, *(len(r) for r in rows)) if rows else 14  # long row names keep the columns aligned
+    lines = [f"{name}:", " " * left + "".join(f"{c:>{w}}" for c in cols)]
+    for r, row in zip(rows, np.atleast_2d(A)):
+        lines.append(f"{r:>{left}}" + "".join(f"{x:>{w}.6g}" for x in row))
+    return "\n".join(lines)
+
+
+def _vector_text(name: str, rows: list[str], x: np.ndarray) -> str:
+    left = max(14, *(len(r) for r in rows)) if rows else 14
+    return f"{name}:\n" + "\n".join(f"{r:>{left}}  {v:.10g}" for r, v in zip(rows, x))
+
+
+# --------------------------------------------------------------------------------------------- commands
+def cmd_list(args) -> int:
+    from ..robots import module, names
+
+    data = {n: module(n).SPEC.title for n in names()}
+    _emit(args, {"robots": data}, "\n".join(f"{n:<20} {t}" for n, t in data.items()))
+    return 0
+
+
+def cmd_info(args) -> int:
+    mod, robot = _load(args)
+    info = robot.info()
+    info["scenarios"] = {k: s.description for k, s in getattr(mod, "SCENARIOS", {}).items()}
+    lines = [
+        f"{info['robot']}: {info['title']}",
+        *([f"paper: shared/papers/{info['paper']}"] if info["paper"] else []),
+        f"coordinates q ({len(info['coordinates'])}): {', '.join(info['coordinates'])}   [m, rad]",
+        f"independent velocities ({info['mobility']}): {', '.join(info['independent_velocities'])}",
+        f"mobility at the neutral configuration: {info['mobility_at_neutral']} (n - rank A)"
+        + ("" if info["mobility_at_neutral"] == info["mobility"] else
+           f"; the independent velocities listed are {info['mobility']}: expected as many as the mobility"),
+        *(f"note: {n}" for n in info["mobility_notes"]),
+        *([f"root: {info['root']}, its link at {info['root_height']:.6g} m above the ground "
+           f"({info['root_height_source']}; root_height in the constraint file)"]
+          if info["root"] == "planar" and info["root_height"] else []),
+        "parameters:",
+        *(f"  {k:<14} = {v['value']!s:<10} {v['unit']:<8} {v['description']}" for k, v in info["parameters"].items()),
+        "actuators:",
+        *(f"  {a['name']}: on {a['joint']}" + (f", reacting on {a['reaction']}" if a["reaction"] else "")
+          for a in info["actuators"]),
+        "constraints:",
+        *(f"  {c}" for c in info["constraints"]),
+        f"terrain: {info['terrain']}",
+        "scenarios:",
+        *(f"  {k}: {d}" for k, d in info["scenarios"].items()),
+    ]
+    _emit(args, info, "\n".join(lines))
+    return 0
+
+
+def cmd_dump(args) -> int:
+    _, robot = _load(args)
+    q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates)
+    for name, x in _numbers(args.set, "--set", "a value in m or rad").items():
+        q[robot.coordinate_index(name)] = x
+    q = robot.check_q(q)
+    if args.full:
+        v = as_vector(args.v, robot.nq, "v", robot.velocity_labels)
+        M, C, g = robot.full(q, v)
+        out = {"coordinates": robot.coordinates, "velocities": robot.velocity_labels, "M": M, "C": C, "g": g}
+        text = [_matrix_text("M (full)", robot.coordinates, robot.coordinates, M),
+                _matrix_text("C (full)", robot.coordinates, robot.coordinates, C),
+                _vector_text("g (full)", robot.coordinates, g)]
+        if args.a is not None:
+            a = as_vector(args.a, robot.nq, "a", robot.velocity_labels)
+            out["tau"] = M @ a + C @ v + g
+            text.append(_vector_text("tau (full, M a + C v + g)", robot.coordinates, out["tau"]))
+        elif args.tau is not None:
+            tau = as_vector(args.tau, robot.nq, "tau", robot.coordinates)
+            out["a"] = np.linalg.solve(M, tau - C @ v - g)
+            text.append(_vector_text("a (full)", robot.velocity_labels, out["a"]))
+        _emit(args, out, "\n".join(text))
+        return 0
+    robot.check_constraints(q)
+    nu = robot.check_nu(args.v, "v")
+    red = robot.reduced(q, nu, coriolis=True)
+    names = robot.velocity_names
+    motors = [m.name for m in robot.motors]
+    out = {"coordinates": names, "q": q, "q_names": robot.coordinates, "M": red.M, "C": red.C, "g": red.g,
+           "B": red.B, "motors": motors, "S": red.S, "condition": red.projection.condition}
+    text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g})",
+            _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
+            _vector_text("g", names, red.g), _matrix_text("B", names, motors, red.B)]
+    if args.a is not None:
+        nudot = robot.check_nu(args.a, "a")
+        Q, tau, resid = robot.inverse_dynamics(q, nu, nudot)
+        out.update(tau=Q, motor_torques=dict(zip(motors, tau)), motor_residual=resid)
+        text += [_vector_text("tau (generalised forces M a + C v + g)", names, Q),
+                 _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
+    elif args.tau is not None or args.tau_set:
+        tau = _torques(robot, args.tau, args.tau_set)
+        nudot = solve_mass(red.M, red.B @ tau - red.h)
+        out["a"] = nudot
+        text.append(_vector_text("a (independent accelerations)", names, nudot))
+    from ..constraints.redundancy import message, violations
+
+    found = violations(red, nudot if (args.a is not None or args.tau is not None or args.tau_set) else None)
+    out["dropped_row_violations"] = [vars(f) for f in found]
+    if found and args.a is None:  # (inverse dynamics warns by itself)
+        import warnings
+
+        from ..errors import RobotDynWarning
+
+        warnings.warn(message(found), RobotDynWarning, stacklevel=1)
+    if args.forces:
+        if args.a is None and args.tau is None and not args.tau_set:
+            raise RobotDynError("--forces needs --tau (forward dynamics) or --a (inverse dynamics)")
+        forces = robot.contact_forces(q, nu, tau=tau, nudot=nudot)
+        out["forces"] = forces.as_dict()
+        text.append(forces.table())
+    _emit(args, out, "\n".join(text))
+    return 0
+
+
+def _torques(robot, tau, assignments) -> np.ndarray:
+    """Motor torques from ``--tau`` (all, in motor order; default zeros) and ``--tau-set MOTOR=VALUE`` by name."""
+    motors = [m.name for m in robot.motors]
+    out = robot.check_tau(tau) if tau is not None else np.zeros(len(motors))
+    for name, x in _numbers(assignments, "--tau-set", "a torque in N m (or N)").items():
+        if name not in motors:
+            raise RobotDynError(f"--tau-set {name}: no motor named {name!r}; motors are {', '.join(motors) or '(none)'}")
+        out[motors.index(name)] = x
+    return out
+
+
+def _numbers(items, option: str, expected: str) -> dict[str, float]:
+    """``NAME=VALUE`` options as finite numbers by name (one line naming the option otherwise)."""
+    out = {}
+    for name, value in parse_assignments(items, option).items():
+        try:
+            x = float(value)
+        except ValueError:
+            raise RobotDynError(f"{option} {name}={value!r}: not a number; expected {expected}") from None
+        if not np.isfinite(x):
+            raise RobotDynError(f"{option} {name}={value!r}: not finite; expected {expected}")
+        out[name] = x
+    return out
+
+
+def cmd_simulate(args) -> int:
+    from ..output import IMAGE_FORMATS, check_target
+
+    # output paths checked before the run, so that a typo does not cost a simulation
+    if args.csv:
+        check_target(args.csv, "CSV file")
+    for path in (args.plot, args.traction_plot):
+        if path:
+            check_target(path, "plot", IMAGE_FORMATS)
+    mod, robot = _load(args)
+    scenarios = getattr(mod, "SCENARIOS", {})
+    if args.scenario not in scenarios:
+        raise RobotDynError(
+            f"unknown scenario {args.scenario!r} for {args.robot}; expected one of {', '.join(scenarios) or '(none)'}"
+        )
+    sc = scenarios[args.scenario]
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():  # SIGTERM stops the run like Ctrl-C: results kept
+        signal.signal(signal.SIGTERM, _interrupt)
+    extra = {} if args.stabilisation is None else {"stabilisation": args.stabilisation}
+    traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
+    partial = traj.stats.get("partial")
+    tr = None
+    switches = traj.stats.get("switches")
+    if switches is not None:  # exact stick-slip: the phases' switches stand for the traction summary
+        if args.mu is not None or args.traction_plot:
+            raise RobotDynError("--mu/--traction-plot: this robot's wheels switch between sticking and sliding "
+                                "(friction = 'stick_slip'); their phases are reported instead")
+    elif any(isinstance(c, RollingWheel) for c in robot.constraints):
+        from ..interfaces.plotting import plot_traction
+        from ..contact.traction import traction
+
+        try:
+            tr = traction(robot, traj, sc.torque, args.mu)
+        except KeyboardInterrupt:  # the trajectory is kept; only its traction columns are lost
+            partial = traj.stats["partial"] = (partial + "; " if partial else "") + "traction not computed (interrupted)"
+            tr = None
+        if tr is not None and args.traction_plot:
+            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction")
+    elif args.mu is not None or args.traction_plot:
+        raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
+    if args.csv:
+        traj.to_csv(args.csv, tr.columns() if tr is not None else None)
+    if args.plot:
+        from ..interfaces.plotting import plot_trajectory
+
+        plot_trajectory(traj, sc.plot or traj.velocity_names, args.plot, f"{args.robot}: {sc.name}", sc.zoom,
+                        sc.references)
+    drift = float(np.max(traj.residual)) if traj.residual.size else 0.0
+    final = dict(zip(traj.coordinates + traj.velocity_names, np.concatenate([traj.q[-1], traj.nu[-1]])))
+    out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,
+           "energy_start": float(traj.energy[0]), "energy_end": float(traj.energy[-1]),
+           "max_holonomic_residual": drift, "wall_time_s": traj.stats["wall"], "csv": args.csv, "plot": args.plot,
+           "engine": traj.stats.get("engine")}
+    if tr is not None:
+        out["traction"] = {"summary": tr.summary(), "wheels": tr.wheels, "undetermined": list(tr.undetermined),
+                           "events": [vars(e) for e in tr.events],
+                           "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)},
+                           "min_normal_load": {w: float(np.min(tr.normal[:, j])) for j, w in enumerate(tr.wheels)}}
+    text = [f"{args.robot} / {sc.name}: {sc.description}",
+            f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations, "
+            f"{traj.stats.get('engine', 'scipy')} engine)",
+            "final state:", *(f"  {k:<14} {v: .8g}" for k, v in final.items()),
+            f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
+    if tr is not None:
+        text.append(tr.summary())
+    if switches is not None:
+        out["switches"] = switches
+        text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
+            f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
+            + ("; ..." if len(switches) > 10 else ""))
+    if "offsets" in traj.stats:  # holonomic residuals no coordinate can change (robotdyn.reduction.pull_back)
+        out["constant_offsets"] = traj.stats["offsets"]
+    if "event" in traj.stats:
+        out["stopped"] = traj.stats["event"]
+        text.append(f"stopped early: {traj.stats['event']}")
+    if args.csv:
+        text.append(f"wrote {args.csv}")
+    if args.plot:
+        text.append(f"wrote {args.plot}")
+    if args.traction_plot:
+        text.append(f"wrote {args.traction_plot}")
+    if partial:
+        out["partial"] = partial
+        text.append(f"partial: {partial}")
+    _emit(args, out, "\n".join(text))
+    if partial:
+        written = ", ".join(p for p in (args.csv, args.plot, args.traction_plot) if p) or "nothing"
+        print(f"robotdyn: {partial}; wrote the partial results: {written}", file=sys.stderr)
+        return 130
+    return 0
+
+
+def _nonnegative(text: str) -> float:
+    value = float(text)
+    if not (np.isfinite(value) and value >= 0):
+        raise ValueError(text)
+    return value
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def cmd_compare(args) -> int:
+    mod, robot = _load(args)
+    if not hasattr(mod, "compare"):
+        raise RobotDynError(f"robot {args.robot!r} has no paper comparison")
+    cmp = mod.compare(robot)
+    _emit(args, {"title": cmp.title, "rows": cmp.as_dicts()}, cmp.table())
+    return 0
+
+
+def cmd_view(args) -> int:
+    """The meshcat viewer: the robot (and a scenario's animation); a standalone HTML file or a live server."""
+    from ..interfaces.viewer import Viewer
+
+    mod, robot = _load(args)
+    traj = None
+    if args.scenario is not None:
+        scenarios = getattr(mod, "SCENARIOS", {})
+        if args.scenario not in scenarios:
+            raise RobotDynError(f"unknown scenario {args.scenario!r} for {args.robot}; "
+                                f"expected one of {', '.join(scenarios) or '(none)'}")
+        if args.t_end is not None and not (np.isfinite(args.t_end) and args.t_end > 0):
+            raise RobotDynError(f"--t-end {args.t_end:g}; expected a positive duration in s")
+        traj = scenarios[args.scenario].run(robot, t_end=args.t_end, progress=not args.quiet)
+    viewer = Viewer(robot, live=args.html is None, frames=args.frames)
+    viewer.display(robot.neutral() if traj is None else traj.q[0])
+    if traj is not None:
+        viewer.animate(traj)
+    out = {"robot": args.robot, "scenario": args.scenario, "html": args.html, "url": viewer.url,
+           "duration_s": None if traj is None else float(traj.t[-1] - traj.t[0])}
+    if args.html:
+        viewer.save(args.html)
+        viewer.close()
+        _emit(args, out, f"wrote {args.html}" + ("" if traj is None else f" ({out['duration_s']:g} s animation)"))
+        return 0
+    try:  # from the first line printed on, Ctrl-C stops the server cleanly
+        _emit(args, out, f"meshcat viewer of {args.robot} at {viewer.url}  (Ctrl-C to stop)")
+        if args.open:
+            import webbrowser
+
+            webbrowser.open(viewer.url)
+        import time
+
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        viewer.close()
+    return 0
+
+
+# ------------------------------------------------------------------------------------------------ parser
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors as robotdyn's one line (``robotdyn: error: ...``, exit status 2), no usage block,
+    and negative numbers in scientific notation (``--v 1e-5 -2e-5``) read as values, not options."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$|^-(inf|nan)$", re.I)
+
+    def error(self, message: str):
+        raise RobotDynError(f"{message} (see robotdyn {self.prog.split(' ', 1)[-1] + ' ' if ' ' in self.prog else ''}"
+                            "--help)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="robotdyn", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    common = _Parser(add_help=False)
+    common.add_argument("--json", action="store_true", help="machine-readable output")
+    robot_args = _Parser(add_help=False)
+    robot_args.add_argument("robot", metavar="ROBOT", nargs="?", default=None,
+                            help="robot name (robotdyn list); or describe your own with --urdf/--constraints")
+    robot_args.add_argument("--urdf", metavar="FILE",
+                            help="your robot's URDF/Xacro (a path or package://PKG/...; default: the file's urdf)")
+    robot_args.add_argument("--xacro-arg", action="append", default=[], metavar="NAME=VALUE",
+                            help="a xacro argument of --urdf (repeatable)")
+    robot_args.add_argument("--constraints", metavar="FILE",
+                            help="TOML constraint file: root, wheels, closures, motors (see examples/*.toml)")
+    robot_args.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                            help="override a parameter (repeatable; robotdyn info ROBOT lists them)")
+    robot_args.add_argument("--package", action="append", default=[], metavar="NAME=DIR|DIR",
+                            help="a ROS package for $(find NAME) and package://NAME (NAME=DIR), or a directory "
+                                 "searched for packages (DIR) (repeatable; ROS_PACKAGE_PATH is searched too)")
+    robot_args.add_argument("--twist", metavar="FRAME[:vx,vy,wz]",
+                            help="independent velocities that are FRAME's twist in its own axes (default components "
+                                 "vx vy wz: a base's body twist) instead of joint velocities")
+
+    p = sub.add_parser("list", parents=[common], help="list the robots")
+    p.set_defaults(func=cmd_list)
+    p = sub.add_parser("info", parents=[common, robot_args], help="coordinates, parameters, actuators")
+    p.set_defaults(func=cmd_info)
+    p = sub.add_parser("dump", parents=[common, robot_args],
+                       help="minimal-coordinate M, C, g and torques (or accelerations) at a state")
+    p.add_argument("--q", nargs="+", help="natural coordinates, in the order info lists them (default: the neutral "
+                                          "configuration)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="set one coordinate by name, e.g. --set theta3=0.3 (repeatable; applied after --q)")
+    p.add_argument("--v", nargs="+", required=True, help="independent velocities (with --full: all velocities)")
+    group = p.add_mutually_exclusive_group()
+    group.add_argument("--a", nargs="+", help="accelerations -> torques (inverse dynamics)")
+    group.add_argument("--tau", nargs="+", help="motor torques -> accelerations (forward dynamics)")
+    p.add_argument("--tau-set", action="append", default=[], metavar="MOTOR=VALUE",
+                   help="one motor torque by name, e.g. --tau-set tau_R=0.5 (repeatable; the others from --tau or 0)")
+    p.add_argument("--full", action="store_true", help="the unconstrained tree's M, C, g instead")
+    p.add_argument("--forces", action="store_true",
+                   help="also the wheel-ground contact forces and loop-closure forces (needs --tau or --a)")
+    p.set_defaults(func=cmd_dump)
+    p = sub.add_parser("simulate", parents=[common, robot_args], help="run a scenario")
+    p.add_argument("--scenario", required=True, help="scenario name (robotdyn info ROBOT lists them)")
+    p.add_argument("--t-end", type=float, default=None, help="duration [s] (default: the scenario's)")
+    p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file")
+    p.add_argument("--plot", help="save the paper's figures reproduced to this image file")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--stabilisation", type=_nonnegative, default=None, metavar="ALPHA",
+                   help="gain [1/s] pulling holonomic residuals back (default 10; 0 turns the pull-back off)")
+    p.add_argument("--mu", type=float, default=None,
+                   help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
+    p.add_argument("--traction-plot", metavar="FILE",
+                   help="save the wheel loads and required friction against time to this image file")
+    p.set_defaults(func=cmd_simulate)
+    p = sub.add_parser("compare", parents=[common, robot_args], help="the paper comparison table")
+    p.set_defaults(func=cmd_compare)
+    p = sub.add_parser("view", parents=[common, robot_args],
+                       help="meshcat viewer (live on localhost, or a standalone HTML file with --html)")
+    p.add_argument("--scenario", help="animate this scenario (robotdyn info ROBOT lists them)")
+    p.add_argument("--t-end", type=float, default=None, help="duration [s] of the scenario (default: the scenario's)")
+    p.add_argument("--html", help="write a standalone HTML file (opens offline) instead of starting a server")
+    p.add_argument("--frames", action="store_true", help="show the link frames initially")
+    p.add_argument("--open", action="store_true", help="open the live viewer in the default web browser")
+    p.add_argument("--quiet", action="store_true", help="no simulation progress on stderr")
+    p.set_defaults(func=cmd_view)
+    from .sweep import register as register_sweep  # the command imports Dask only when it runs
+
+    register_sweep(sub, [common, robot_args])
+    parser.commands = sub.choices  # name -> subparser (the built-in ones until robot_commands() adds theirs)
+    parser.robot_commands = lambda: _add_robot_commands(sub, [common, robot_args])
+    return parser
+
+
+def _add_robot_commands(sub, parents) -> None:
+    """The commands that robot modules add (``register_cli``): importing every robot module costs start-up time,
+    so :func:`main` adds them only when the command is not a built-in one (or for ``--help``)."""
+    from ..robots import module, names
+
+    for name in names():
+        try:
+            mod = module(name)
+        except Exception as exc:  # a broken robot module must not take the whole CLI down
+            print(f"robotdyn: warning: robot module {name!r} failed to import: {exc}", file=sys.stderr)
+            continue
+        hook = getattr(mod, "register_cli", None)
+        if hook is not None:
+            hook(sub, parents)
+
+
+def _one_line_warnings() -> None:
+    """robotdyn's warnings (:class:`~robotdyn.errors.RobotDynWarning`) as ``robotdyn: warning: ...`` on stderr, each
+    message once per run."""
+    import warnings
+
+    from ..errors import RobotDynWarning
+
+    default = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, RobotDynWarning):
+            print(f"robotdyn: warning: {message}", file=sys.stderr)
+        else:
+            default(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    warnings.simplefilter("default", RobotDynWarning)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``robotdyn`` console script."""
+    _one_line_warnings()
+    try:
+        parser = build_parser()
+        argv = sys.argv[1:] if argv is None else list(argv)
+        command = next((a for a in argv if not a.startswith("-")), None)
+        if command is None or command not in parser.commands:
+            parser.robot_commands()  # a robot module's command, or --help listing them all
+        args = parser.parse_args(argv)
+        with np.errstate(all="ignore"):  # non-finite results are refused explicitly (NonFiniteError), in one line
+            return int(args.func(args) or 0)
+    except RobotDynError as exc:
+        print(f"robotdyn: error: {exc}", file=sys.stderr)
+        return 2
+    except np.linalg.LinAlgError as exc:  # a solve the checks above did not foresee: still one line
+        print(f"robotdyn: error: a linear solve failed ({exc}): the model is singular at this state (massless "
+              "bodies, or redundant constraints)", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("robotdyn: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
+        sys.stderr.close()
+        return 0

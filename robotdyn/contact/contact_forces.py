@@ -1,0 +1,479 @@
+"""Constraint forces at a state: wheel-ground contact loads and loop-closure forces.
+
+With the constraint rows :math:`A(q)v = 0` (m rows, rank r) the full equations of motion read
+
+.. math:: M a + h = B\\tau + A^T\\lambda,\\qquad a = S\\dot\\nu + w,
+
+so once :math:`\\dot\\nu` is known (forward dynamics from motor torques) or given (inverse dynamics), the residual
+:math:`e = M a + h - B\\tau = \\mathrm{RNEA}(q, v, a) - B\\tau` lies in the range of :math:`A^T` and
+:math:`A^T\\lambda = e` gives the constraint forces (``shared/notes/contact-forces-and-friction.md``).
+
+Units and frames. Each row's multiplier is the force along that row:
+
+- a rolling wheel's rows are the velocity of its material point at the contact along (t1, t2, n) of the contact
+  frame (t1 = rolling direction, t2 = n x t1, n = terrain normal, upward), so its multipliers are the force
+  *the ground exerts on the wheel* at the contact point, in N, split into longitudinal (t1), lateral (t2) and
+  normal (n) components; a positive normal component presses the wheel up (a load);
+- an omni wheel has a driving row (along its rollers' constrained direction) and a normal row; a support wheel
+  only the normal row;
+- a loop closure's rows are the relative motion of its frame 2 with respect to frame 1 in frame 1's axes, so its
+  multipliers are the force [N] (x, y, z) and moment [N m] (rx, ry, rz) that the closure exerts on the body of
+  frame 2, at frame 2's origin, in frame 1's axes (the body of frame 1 receives the opposite).
+
+Redundant rows (r < m). :math:`\\lambda` is then determined only up to the null space N of :math:`A^T`: a rigid
+four-wheel chassis on flat ground is statically indeterminate, and under a planar root the wheels' normal rows do
+not act on any coordinate at all (the model has no vertical motion), so the normal loads are not determined by that
+model. The result reports, per row and per wheel component, whether rigid-body dynamics determine it, and the
+undetermined combinations (the columns of N); the values shown for undetermined rows are the minimum-norm choice,
+one arbitrary member of the family :math:`\\lambda + N z`, and are flagged as such, never presented as the answer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from ..reduction.actuation import input_matrix
+from ..fast.dispatch import compiled_model
+from ..constraints.constraint import ConstraintRows, KinematicState
+from ..errors import InputError, NonFiniteError
+from ..constraints.loop_closure import LoopClosure
+from ..constraints.rolling_contact import RollingWheel
+from .sliding import forward as forward_sliding
+from .sliding import sliding_now, tangential
+
+ILL_DETERMINED = 1e3
+"""Condition number of the rows above which the forces are flagged as ill-determined (a note, not an error)."""
+
+DETERMINED_TOL = 1e-8
+"""A row (or force component) is determined when its weight in every null-space direction is below this."""
+
+
+@dataclass
+class WheelForce:
+    """The ground's force on one wheel at its contact point.
+
+    Attributes:
+        name: The wheel's name.
+        kind: ``standard``, ``omni`` or ``support``.
+        force: (3,) components along (t1 longitudinal, t2 lateral, n normal) of the contact frame [N].
+        determined: (3,) whether rigid-body dynamics determine each component.
+        world: (3,) the same force in world axes [N].
+        point: (3,) the contact point in world coordinates [m].
+    """
+
+    name: str
+    kind: str
+    force: np.ndarray
+    determined: np.ndarray
+    world: np.ndarray
+    point: np.ndarray
+
+    @property
+    def normal(self) -> float:
+        """Normal load f_n [N] (positive: the ground pushes the wheel up)."""
+        return float(self.force[2])
+
+    @property
+    def tangential(self) -> float:
+        """Magnitude of the tangential (friction) force :math:`\\|(f_{t1}, f_{t2})\\|` [N]."""
+        return float(np.hypot(self.force[0], self.force[1]))
+
+    @property
+    def required_mu(self) -> float:
+        """Friction coefficient the motion requires, :math:`|f_t| / f_n` (``inf`` if the wheel is not pressed
+        on the ground, :math:`f_n \\le 0`)."""
+        return self.tangential / self.normal if self.normal > 0 else float("inf")
+
+    @property
+    def load_determined(self) -> bool:
+        """Whether the normal load and the friction force are all determined."""
+        return bool(self.determined.all())
+
+    def __repr__(self) -> str:
+        flag = "" if self.load_determined else ", NOT all determined"
+        return (f"WheelForce({self.name!r}, long={self.force[0]:.6g} N, lat={self.force[1]:.6g} N, "
+                f"normal={self.force[2]:.6g} N{flag})")
+
+
+@dataclass
+class ConstraintForces:
+    """Constraint forces of a robot at one state.
+
+    Attributes:
+        labels: Row names (constraint name and component), in row order.
+        lam: (m,) multipliers :math:`\\lambda` [N or N m] (minimum-norm where not determined).
+        determined: (m,) whether rigid-body dynamics determine each row's multiplier.
+        null_space: (m, m - r) orthonormal basis of the undetermined combinations (zero columns: none).
+        rank: Rank r of the constraint Jacobian.
+        residual: :math:`\\|A^T\\lambda - e\\|` relative to :math:`\\|e\\|` (0 for a consistent motion; large when
+            the given accelerations are not reachable with the motors).
+        nudot: (k,) independent accelerations used.
+        tau: Motor torques used [N m or N].
+        wheels: One :class:`WheelForce` per rolling, omni or support wheel.
+        closures: Loop-closure forces/moments by closure name, then component (x, y, z [N]; rx, ry, rz [N m]).
+        condition: Condition number of the rows' rank-r part (large: nearly redundant rows, ill-determined forces).
+        undetermined_reason: Why rows are undetermined (empty when all are determined).
+        notes: How the forces were obtained where that is not the model itself (e.g. a planar model's loads from
+            its floating twin).
+    """
+
+    labels: list[str]
+    lam: np.ndarray
+    determined: np.ndarray
+    null_space: np.ndarray
+    rank: int
+    residual: float
+    nudot: np.ndarray
+    tau: np.ndarray
+    wheels: list[WheelForce] = field(default_factory=list)
+    closures: dict[str, dict[str, float]] = field(default_factory=dict)
+    undetermined_reason: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    condition: float = 1.0
+    _tangential: list = field(default_factory=list, repr=False)  # per wheel: (row indices, D, friction or None)
+
+    @property
+    def all_determined(self) -> bool:
+        """Whether every multiplier is determined by rigid-body dynamics."""
+        return bool(self.determined.all())
+
+    def minimum_mu(self) -> float | None:
+        """The smallest friction coefficient with which some force distribution that rigid-body dynamics allow
+        (:math:`\\lambda + N z`) lies inside every wheel's friction cone:
+        :math:`\\min_z \\max_i \\|f_{t,i}(z)\\| / f_{n,i}` (a convex problem, solved by SLSQP in epigraph form).
+
+        Equal to the largest per-wheel required mu when every friction force is determined; ``None`` when a
+        normal load is undetermined; ``inf`` when a wheel is not pressed on the ground."""
+        if not self.wheels or not all(w.determined[2] for w in self.wheels):
+            return None
+        fn = np.array([w.normal for w in self.wheels])
+        if np.any(fn <= 0):
+            return float("inf")
+        maps = []  # f_t,i(z) = base_i + T_i z
+        for (idx, D, friction), w in zip(self._tangential, self.wheels):
+            if friction is not None:
+                maps.append((np.asarray(friction, float), np.zeros((2, self.null_space.shape[1]))))
+            else:
+                maps.append((D.T[:2] @ self.lam[idx], D.T[:2] @ self.null_space[idx]))
+        ratio = lambda z: max(float(np.linalg.norm(b + T @ z)) / f for (b, T), f in zip(maps, fn))  # noqa: E731
+        d = self.null_space.shape[1]
+        if d == 0 or all(not np.any(T) for _, T in maps):
+            return ratio(np.zeros(d))
+        if d == 1:  # one undetermined combination (two wheels on one axle, ...): a bounded scalar search
+            from scipy.optimize import minimize_scalar
+
+            scale = 10.0 * (1.0 + max(float(np.linalg.norm(b)) for b, _ in maps))
+            res = minimize_scalar(lambda z: ratio(np.array([z])), bounds=(-scale, scale), method="bounded",
+                                  options={"xatol": 1e-12 * scale})
+            return min(float(res.fun), ratio(np.zeros(1)))
+        from scipy.optimize import minimize
+
+        cons = [{"type": "ineq", "fun": (lambda x, b=b, T=T, f=f: (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2))}
+                for (b, T), f in zip(maps, fn)]
+        x0 = np.append(np.zeros(d), ratio(np.zeros(d)))
+        res = minimize(lambda x: x[-1], x0, constraints=cons, bounds=[(None, None)] * d + [(0, None)],
+                       method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
+        return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
+
+    def wheel(self, name: str) -> WheelForce:
+        """The force on the wheel called ``name``."""
+        for w in self.wheels:
+            if w.name == name:
+                return w
+        raise InputError(f"unknown wheel {name!r}; expected one of {', '.join(w.name for w in self.wheels)}")
+
+    def as_dict(self) -> dict:
+        """Plain data (for JSON): rows, wheels, closures and what is undetermined."""
+        return {
+            "rows": {lab: float(x) for lab, x in zip(self.labels, self.lam)},
+            "determined": {lab: bool(d) for lab, d in zip(self.labels, self.determined)},
+            "wheels": {
+                w.name: {"longitudinal": float(w.force[0]), "lateral": float(w.force[1]), "normal": w.normal,
+                         "determined": {"longitudinal": bool(w.determined[0]), "lateral": bool(w.determined[1]),
+                                        "normal": bool(w.determined[2])},
+                         "required_mu": w.required_mu if w.load_determined and w.normal > 0 else None,
+                         "world": w.world.tolist(), "contact_point": w.point.tolist()}
+                for w in self.wheels
+            },
+            "closures": self.closures,
+            "rank": self.rank,
+            "condition": self.condition,
+            "rows_count": len(self.labels),
+            "undetermined_combinations": [
+                {lab: float(c) for lab, c in zip(self.labels, col) if abs(c) > DETERMINED_TOL}
+                for col in self.null_space.T
+            ],
+            "undetermined_reason": self.undetermined_reason,
+            "notes": self.notes,
+            "minimum_mu": self.minimum_mu(),
+            "residual": self.residual,
+        }
+
+    def table(self) -> str:
+        """A readable text table of the wheel and closure forces."""
+        lines = []
+        if self.wheels:
+            lines.append("contact forces (ground on wheel, contact frame) [N]:")
+            lines.append(f"{'wheel':>16} {'longitudinal':>14} {'lateral':>14} {'normal':>14} {'required mu':>12}")
+            for w in self.wheels:
+                cells = [f"{x:>14.6g}" if d else f"{'undetermined':>14}" for x, d in zip(w.force, w.determined)]
+                mu = w.required_mu if w.load_determined else None
+                mu_text = "-" if mu is None else ("lift-off" if w.normal <= 0 else f"{mu:.4g}")
+                lines.append(f"{w.name:>16} " + " ".join(cells) + f" {mu_text:>12}")
+        for name, comps in self.closures.items():
+            det = {c: d for c, d in zip(self.labels, self.determined)}
+            parts = [f"{c}={v:.6g}" if det[f"{name}.{c}"] else f"{c}=undetermined" for c, v in comps.items()]
+            lines.append(f"closure {name} (on frame 2's body, frame 1's axes; N, N m): " + ", ".join(parts))
+        for reason in self.undetermined_reason:
+            lines.append(f"not determined by rigid-body dynamics: {reason}")
+        if self.wheels and not all(w.load_determined for w in self.wheels):
+            mu = self.minimum_mu()
+            if mu is not None:
+                lines.append(f"smallest mu with which some admissible split of the undetermined forces lies in every "
+                             f"friction cone: {mu:.6g}")
+        for note in self.notes:
+            lines.append(f"note: {note}")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        und = int((~self.determined).sum())
+        return (f"ConstraintForces(rows={len(self.labels)}, rank={self.rank}, undetermined={und}, "
+                f"wheels={[w.name for w in self.wheels]}, closures={list(self.closures)})")
+
+
+def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> ConstraintForces:
+    """Constraint forces at (q, nu) for given motor torques (forward dynamics) or accelerations (inverse dynamics).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad].
+        nu: Independent velocities (k,).
+        tau: Motor torques [N m or N]; with ``nudot`` None the accelerations follow from forward dynamics
+            (default: zero torques).
+        nudot: Independent accelerations (k,); the motor torques then follow by least squares (``tau`` given
+            too: those torques are used as given, and ``residual`` says whether they produce ``nudot``).
+        twin: For a planar-root robot whose normal loads the planar model leaves undetermined, take them from its
+            floating twin (:func:`_from_floating_twin`); False keeps the planar model's own answer.
+
+    Returns:
+        The :class:`ConstraintForces`.
+    """
+    q = robot.check_q(q)
+    nu = robot.check_nu(nu, "v")
+    red = robot.reduced(q, nu)
+    friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
+    if sliding_now(robot):
+        if nudot is not None:
+            raise InputError("with slipping wheels the forces follow from motor torques: give tau, not nudot")
+        tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
+        st = forward_sliding(robot, q, nu, tau)
+        nudot = st.nudot
+        kin_v = KinematicState(robot.model, robot.data, q, red.v)
+        for i, wheel in enumerate(sliding_now(robot)):
+            friction[wheel.name] = (tangential(wheel, kin_v)[0], st.force[i])
+    elif nudot is None:
+        tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
+        from ..reduction.reduced_dynamics import solve_mass
+
+        nudot = solve_mass(red.M, red.B @ tau - red.h)
+    else:
+        nudot = robot.check_nu(nudot, "a")
+        if tau is None:
+            tau = robot.inverse_dynamics(q, nu, nudot)[1]
+        else:
+            tau = robot.check_tau(tau)
+    a = red.S @ nudot + red.w
+    out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
+    if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
+        out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
+    return out
+
+
+def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
+    """:math:`A^T\\lambda = \\mathrm{RNEA}(q, v, a) - B\\tau - \\sum J_t^T F_t` and the per-wheel and per-closure
+    forces, at a state whose accelerations are known (``rows``: the constraint rows there, ``None``: computed here).
+    Without friction forces and where the robot's compiled model serves, e, :math:`\\lambda` on the projection's
+    rows and the wheels' contact frames come from one compiled call (:meth:`robotdyn.fast.compiled.CompiledModel.
+    forces_at`) and :math:`\\lambda` is made minimum-norm with the null space of :math:`A^T` (:func:`_from_basic`),
+    the Python path's choice on undetermined rows; else all of it in Python."""
+    served = None if friction else _compiled_forces(robot, q, v, a, tau)
+    if rows is None:  # the rows at (q, v): the compiled evaluation's, else the Python path's
+        if served is not None:
+            fast = compiled_model(robot)
+            rows = ConstraintRows(served[3], None, np.zeros(len(fast.labels)), fast.holonomic, list(fast.labels))
+        else:
+            rows = robot.constraint_rows(KinematicState(robot.model, robot.data, q, v))
+    A = rows.A
+    if served is not None:  # lambda on the projection's rows and the wheels' contact frames, in C++
+        lam_basic, e, (_, _, frames, points), _ = served
+        geometry = {id(w): (f.reshape(3, 3).T, p) for w, f, p in zip(compiled_model(robot).wheels, frames, points)}
+        with np.errstate(all="ignore"):
+            lam, N, rank, residual, condition = _from_basic(A, e, lam_basic)
+    else:
+        model, data = robot.model, robot.data
+        kin = KinematicState(model, data, q, v)
+        B = input_matrix(robot.motors, kin)
+        e = pin.rnea(model, data, q, v, a) - B @ tau
+        for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
+            e -= Jt.T @ force
+        with np.errstate(all="ignore"):  # an overflow is refused below as a NonFiniteError, in one line
+            lam, N, rank, residual, condition = _solve_transpose(A, e)
+    determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
+    out = ConstraintForces(list(rows.labels), lam, determined, N, rank, residual, nudot, tau)
+    out.condition = condition
+    if condition > ILL_DETERMINED:
+        out.notes.append(f"the rows' condition number is {condition:.3g}: nearly redundant rows, so the determined "
+                         "forces (e.g. an internal squeeze between two wheels) hinge on small geometric differences "
+                         "and a little compliance would redistribute them")
+    index = {lab: i for i, lab in enumerate(rows.labels)}
+    for c in robot.constraints:
+        if isinstance(c, RollingWheel):
+            fr = friction.get(c.name, (None, None))[1]
+            if served is not None:
+                E, p = geometry[id(c)]
+            else:
+                geo = c._geometry(kin)
+                E, p = geo[9], geo[5]
+            out.wheels.append(_wheel_force(c, E, p, index, lam, N, fr))
+            out._tangential.append(([index[lab] for lab in c._labels()], c._directions, fr))
+        elif isinstance(c, LoopClosure):
+            out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
+                                    if f"{c.name}.{comp}" in index}
+    out.undetermined_reason = _reasons(A, rows.labels, N)
+    if not (np.all(np.isfinite(lam)) and np.isfinite(residual)):
+        raise NonFiniteError(f"constraint forces at this state are not finite (max |e| = {np.max(np.abs(e)):.3g})")
+    return out
+
+
+TWIN_RESIDUAL = 1e-8
+"""Relative residual above which the wheels cannot hold a planar model's out-of-plane equilibrium."""
+
+
+def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) -> ConstraintForces:
+    """The loads of a planar-root model from its floating twin.
+
+    A planar root holds the robot at z = 0, pitch = roll = 0 without saying by what; physically the ground does,
+    through the wheels' normal rows. The same description on a floating root (x, y, z, yaw, pitch, roll), at the
+    same state with zero z, pitch and roll rates and accelerations, has those rows active, and the out-of-plane
+    equations of motion (vertical force, roll and pitch moments of the whole robot) then determine the normal
+    loads. If the wheels cannot hold that equilibrium (e.g. a robot on two wheels with no other support) the
+    residual says so and the planar result is kept, with the reason."""
+    from dataclasses import replace
+
+    twin = getattr(robot, "_floating_twin", None)
+    if twin is None or twin.terrain is not robot.terrain:  # (re)built for the robot's current terrain
+        spec = replace(robot.spec, root="floating", independent=None, operational=None)
+        twin = type(robot)(spec, robot.params, robot.terrain)  # a Robot (robotdyn.robot, the layer above)
+        robot._floating_twin = twin
+    names = twin.description.joint_names
+    index = [names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]
+
+    def lift(x):
+        out = np.zeros(twin.nq)
+        out[index] = x
+        return out
+
+    qt, vt, at = lift(q), lift(v), lift(a)
+    out = _forces(twin, qt, vt, at, tau, None, {}, nudot)  # (the twin's rows: compiled where it serves)
+    if out.residual > TWIN_RESIDUAL:
+        planar.undetermined_reason.append(
+            f"the wheels cannot hold this planar model's out-of-plane equilibrium (relative residual "
+            f"{out.residual:.3g} on its floating twin): the description lacks a support, so its normal loads stay "
+            "undetermined")
+        return planar
+    out.notes.append("normal loads from the out-of-plane equilibrium (vertical force, roll and pitch moments) of the "
+                     "same description on a floating root: the planar root's z, roll and pitch are held by the ground")
+    return out
+
+
+def _compiled_forces(robot, q, v, a, tau):
+    """``(lambda on the projection's rows, e, wheel forces and frames)`` by the robot's compiled model
+    (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`), or ``None`` where it does not serve."""
+    from ..fast.compiled import Fallback
+
+    fast = compiled_model(robot)
+    if fast is None:
+        return None
+    try:
+        return fast.forces_at(np.asarray(q, float), np.asarray(v, float), np.asarray(a, float),
+                              np.asarray(tau, float))
+    except Fallback:
+        return None
+
+
+def _from_basic(A: np.ndarray, e: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float, float]:
+    """As :func:`_solve_transpose`, from a solution ``lam`` of :math:`A^T\\lambda = e` (the compiled one, zero on
+    redundant rows): the same null space, rank and condition number (SVD), and the minimum-norm solution
+    :math:`\\lambda - NN^T\\lambda` (the same values on the determined rows; the Python path's choice on the
+    others)."""
+    m = A.shape[0]
+    if m == 0:
+        return np.zeros(0), np.zeros((0, 0)), 0, float(np.linalg.norm(e) / max(1.0, np.linalg.norm(e))), 1.0
+    _, s, Vt = np.linalg.svd(A.T, full_matrices=True)
+    tol = s.max(initial=0.0) * max(A.shape) * np.finfo(float).eps
+    rank = int(np.sum(s > tol))
+    N = Vt[rank:].T
+    lam = lam - N @ (N.T @ lam)
+    scale = max(np.linalg.norm(e), 1.0)
+    condition = float(s[0] / s[rank - 1]) if rank else 1.0
+    return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale), condition
+
+
+def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, float, float]:
+    """Minimum-norm :math:`\\lambda` of :math:`A^T\\lambda = e`, the null space of :math:`A^T` (orthonormal
+    columns), the rank, the relative residual and the condition number of the rank-r part (largest over smallest
+    nonzero singular value), by SVD (rank tolerance as numpy's ``matrix_rank``)."""
+    m = A.shape[0]
+    if m == 0:
+        return np.zeros(0), np.zeros((0, 0)), 0, float(np.linalg.norm(e) / max(1.0, np.linalg.norm(e))), 1.0
+    U, s, Vt = np.linalg.svd(A.T, full_matrices=True)  # A^T = U diag(s) Vt, n x m
+    tol = s.max(initial=0.0) * max(A.shape) * np.finfo(float).eps
+    rank = int(np.sum(s > tol))
+    lam = Vt[:rank].T @ ((U[:, :rank].T @ e) / s[:rank])
+    N = Vt[rank:].T
+    scale = max(np.linalg.norm(e), 1.0)
+    condition = float(s[0] / s[rank - 1]) if rank else 1.0
+    return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale), condition
+
+
+def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict, lam: np.ndarray,
+                 N: np.ndarray, friction: np.ndarray | None = None) -> WheelForce:
+    """A wheel's force in its contact frame (E: columns t1, t2, n; contact point p), from its rows' multipliers
+    (row i acts along D[i] of (t1, t2, n)); a slipping wheel's tangential part is its friction force (t1, t2)."""
+    labels = wheel._labels()
+    idx = [index[lab] for lab in labels]
+    D = wheel._directions
+    force = D.T @ lam[idx]
+    if N.shape[1]:
+        determined = np.linalg.norm(D.T @ N[idx], axis=1) <= DETERMINED_TOL
+        # a direction with no row at all (e.g. the lateral direction of an omni wheel) carries no force: determined
+    else:
+        determined = np.ones(3, bool)
+    kind = "support" if D.shape[0] == 1 else ("omni" if D.shape[0] == 2 else "standard")
+    if friction is not None:  # the law's force along its free directions (zero along a rolling one)
+        force[:2] += friction
+        kind = "slipping"
+    return WheelForce(wheel.name, kind, force, determined, E @ force, np.array(p, float))
+
+
+def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
+    """Plain-language reasons why rows are undetermined: rows that act on no coordinate of the model (e.g. a
+    wheel's normal row under a planar root), and combinations of rows that the motion cannot tell apart."""
+    if N.shape[1] == 0:
+        return []
+    out = []
+    scale = max(np.abs(A).max(initial=0.0), 1.0)
+    zero = [lab for lab, row in zip(labels, A) if np.abs(row).max(initial=0.0) <= 1e-12 * scale]
+    if zero:
+        out.append(f"rows {', '.join(zero)} act on no coordinate of this model at this configuration (the tree "
+                   "already enforces them; a wheel's normal row does so under a planar root, which has no vertical, "
+                   "roll or pitch motion: a floating root determines normal loads)")
+    others = N.shape[1] - len(zero)
+    if others > 0:
+        mixed = sorted({lab for col in N.T for lab, c in zip(labels, col) if abs(c) > DETERMINED_TOL} - set(zero))
+        out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: the rows are "
+                   "redundant, e.g. more wheels than a rigid body needs; a compliance model would split them)")
+    return out

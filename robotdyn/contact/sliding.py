@@ -1,0 +1,253 @@
+"""Wheels that slip: a normal contact kept as a constraint, the tangential force from a friction law.
+
+A :class:`SlippingWheel` contributes only its holonomic normal row (it stays on the terrain); the no-slip rows
+are replaced by the force of its :class:`~robotdyn.contact.friction.FrictionLaw`, applied at the contact point:
+:math:`J_t^T F_t` with :math:`J_t` the tangential rows of the rolling Jacobian (the slip velocity is
+:math:`s = J_t v`) and :math:`F_t = -f_n c(s)`. The normal load :math:`f_n` is a constraint force, so it depends on
+the accelerations; with the friction direction fixed by the current slip, the system in
+:math:`(\\dot\\nu, \\lambda)` stays linear and is solved exactly at each evaluation (no lagged load,
+``shared/notes/contact-forces-and-friction.md``):
+
+.. math:: M S\\dot\\nu - \\Big(A_R^T - \\sum_i J_{t,i}^T c_i e_{n_i}^T\\Big)\\lambda = B\\tau - \\mathrm{RNEA}(q, v, w),
+
+with :math:`A_R` the independent constraint rows the projection uses and :math:`e_{n_i}` selecting wheel i's
+normal multiplier. A singular system is the Painlevé paradox of Coulomb friction (no or many solutions): it is
+reported, never regularised silently.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ..reduction.actuation import input_matrix
+from ..constraints.constraint import KinematicState
+from ..errors import ConstraintError, InputError, SingularConstraintError
+from .friction import FrictionLaw
+from ..constraints.rolling_contact import SupportWheel
+
+PAINLEVE_CONDITION = 1e12
+"""Condition number of the coupled system above which it counts as singular."""
+
+
+SLIP_DIRECTIONS = ("both", "lateral")
+"""Which tangential directions of a slipping wheel follow its law: ``both`` (the wheel slides freely in its
+tangent plane) or ``lateral`` (it rolls without slipping along t1 and slides sideways along t2: the tyre model
+of vehicle dynamics that neglects longitudinal slip)."""
+
+
+class SlippingWheel(SupportWheel):
+    """A wheel that keeps contact (its normal row) and slips under a friction law.
+
+    With ``slip="lateral"`` it also keeps its longitudinal no-slip row (t1; the rolling constraint force is the
+    traction) and only its lateral force (t2) follows the law, from the lateral slip velocity. The law then sees a
+    purely lateral slip, so the lateral force alone is bounded by :math:`\\mu f_n`; the combined force
+    :math:`\\|(f_{t1}, f_{t2})\\|/f_n` is reported by :mod:`robotdyn.contact.contact_forces` (``required_mu``), and exceeding
+    :math:`\\mu` there means the longitudinal no-slip assumption breaks too.
+
+    Args:
+        law: The :class:`~robotdyn.contact.friction.FrictionLaw` of its tangential force.
+        slip: ``both`` (default) or ``lateral`` (:data:`SLIP_DIRECTIONS`).
+        Other arguments as :class:`~robotdyn.constraints.rolling_contact.RollingWheel`.
+    """
+
+    sliding = True  # its friction force comes from a law (robotdyn.contact.sliding.forward)
+
+    def __init__(self, description, frame: str, radius: float, law: FrictionLaw, slip: str = "both",
+                 **kwargs) -> None:
+        super().__init__(description, frame, radius, **kwargs)
+        if slip not in SLIP_DIRECTIONS:
+            raise InputError(f"wheel {self.name!r}: slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")
+        self.law = law
+        self.slip_directions = slip
+        self._free = np.array([1.0, 1.0]) if slip == "both" else np.array([0.0, 1.0])
+        if slip == "lateral":  # the longitudinal no-slip row stays a constraint
+            self._directions = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+            self._row_names = ("longitudinal", "normal")
+
+    def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
+        """:math:`c(s)` of its law on the free directions: the friction force is :math:`-f_n c(s)` (t1, t2), zero
+        along a direction that rolls without slipping."""
+        return self.law.coefficient(s * self._free) * self._free
+
+    def __repr__(self) -> str:
+        slip = "" if self.slip_directions == "both" else ", slip='lateral'"
+        return (f"SlippingWheel(frame={self.frame!r}, radius={self.radius}, law={self.law!r}{slip}, "
+                f"terrain={self.terrain!r})")
+
+    def slip(self, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
+        """The tangential rows :math:`J_t` (2, nv) and the slip velocity (2,) [m/s]: :func:`tangential`."""
+        return tangential(self, kin)
+
+
+def tangential(wheel, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
+    """A wheel's tangential rows :math:`J_t` (2, nv) (t1 longitudinal, t2 lateral of the contact frame) and its slip
+    velocity :math:`s = J_t v` (2,) [m/s] at the state of ``kin`` (the velocity of its material point at the
+    contact, in the tangent plane)."""
+    Aw, geo = wheel._world_jacobian(kin)
+    Jt = geo[9][:, :2].T @ Aw
+    return Jt, Jt @ kin.v
+
+
+def sliding_now(robot) -> list:
+    """The robot's wheels whose tangential force currently comes from friction (slipping wheels, and stick-slip
+    wheels in their sliding phase)."""
+    return [c for c in robot.constraints if getattr(c, "sliding", False)]
+
+
+def slipping_wheels(robot) -> list[SlippingWheel]:
+    """The robot's slipping wheels (empty: every wheel rolls without slipping)."""
+    return [c for c in robot.constraints if isinstance(c, SlippingWheel)]
+
+
+@dataclass
+class SlidingState:
+    """Forward dynamics with slipping wheels at one state.
+
+    Attributes:
+        nudot: Independent accelerations (k,).
+        reduced: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at the state (S, w, v, rows).
+        normal: Normal load of each slipping wheel (W,) [N].
+        slip: Slip velocity of each slipping wheel (W, 2) [m/s] (t1, t2).
+        force: Friction force on each slipping wheel (W, 2) [N] (t1, t2).
+        power: Power of the friction forces :math:`\\sum F_t\\cdot s` [W] (<= 0 while loads are positive).
+    """
+
+    nudot: np.ndarray
+    reduced: object
+    normal: np.ndarray
+    slip: np.ndarray
+    force: np.ndarray
+    power: float
+
+
+def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingState:
+    """Accelerations and normal loads with the slipping wheels' friction, solved together (see the module).
+
+    Raises:
+        ConstraintError: a slipping wheel's normal row is redundant (its load is not determined).
+        SingularConstraintError: the coupled system is singular (Painlevé).
+    """
+    wheels = sliding_now(robot)
+    red = robot.reduced(q, nu)
+    model, data = robot.model, robot.data
+    kin = KinematicState(model, data, q, red.v)
+    rows = red.jacobian_rows
+    kept = np.asarray(red.projection.rows, int)
+    G = rows.A[kept].T.copy()
+    slip = np.zeros((len(wheels), 2))
+    coef = np.zeros((len(wheels), 2))
+    position = np.zeros(len(wheels), int)
+    for i, wheel in enumerate(wheels):
+        row = rows.labels.index(f"{wheel.name}.normal")
+        hit = np.flatnonzero(kept == row)
+        if not hit.size:
+            raise redundant_load_error(wheel)
+        Jt, slip[i] = tangential(wheel, kin)
+        coef[i] = wheel.friction_coefficient(slip[i])
+        position[i] = hit[0]
+        G[:, hit[0]] -= Jt.T @ coef[i]
+    M = pin.crba(model, data, q)
+    K = np.hstack([M @ red.S, -G])
+    rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
+    cond = np.linalg.cond(K)
+    if not np.isfinite(cond) or cond > PAINLEVE_CONDITION:
+        raise painleve_error(wheels, cond)
+    sol = np.linalg.solve(K, rhs)
+    k = red.S.shape[1]
+    normal = sol[k + position]
+    force = -normal[:, None] * coef
+    return SlidingState(sol[:k], red, normal, slip, force, float(np.sum(force * slip)))
+
+
+def painleve_error(wheels, cond: float) -> SingularConstraintError:
+    """The error of a singular contact problem of slipping ``wheels`` (condition number ``cond`` of the coupled
+    system), the same on every engine."""
+    return SingularConstraintError(
+        f"the friction of slipping wheels {', '.join(w.name for w in wheels)} makes the contact problem "
+        f"singular (condition {cond:.3g}; Painleve paradox: the accelerations and loads have no or many "
+        "solutions); expected a smaller mu or another friction law", cond)
+
+
+def redundant_load_error(wheel) -> ConstraintError:
+    """The error of a slipping wheel whose normal row is redundant (its load is not determined)."""
+    return ConstraintError(f"slipping wheel {wheel.name!r}: its normal row is redundant here, so its load "
+                           "(and its friction) is not determined by rigid-body dynamics")
+
+
+def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> str:
+    """``stats["event"]`` of a run stopped where a slipping wheel's normal load reached zero at time t [s] and
+    state (q, nu), with torques tau there (the same on every engine)."""
+    wheels = sliding_now(robot)
+    st = forward(robot, q, nu, tau)
+    wheel = wheels[int(np.argmin(st.normal))].name
+    return (f"lift-off of wheel {wheel} at t = {t:.6g} s (normal load {np.min(st.normal):.3g} N): "
+            "the run stops there (a wheel in flight is not modelled)")
+
+
+@dataclass
+class SlidingInverse:
+    """Inverse dynamics with slipping wheels at one state (:func:`inverse`).
+
+    Attributes:
+        tau: Motor torques (n_motors,) [N m or N].
+        multipliers: The constraint rows' forces by label (rows of :meth:`Robot.constraint_rows`) [N, N m].
+        normal: Normal load of each sliding wheel (W,) [N].
+        slip: Slip velocity of each sliding wheel (W, 2) [m/s] (t1, t2).
+        force: Friction force of each sliding wheel from its law (W, 2) [N] (t1, t2).
+        residual: :math:`\\|K x - b\\|` of the least-squares solve [N, N m] (0: the motion is exactly realisable by
+            these motors and contacts).
+        rank: Rank of K; below its column count the torques and forces are not all determined.
+    """
+
+    tau: np.ndarray
+    multipliers: dict[str, float]
+    normal: np.ndarray
+    slip: np.ndarray
+    force: np.ndarray
+    residual: float
+    rank: int
+
+
+def inverse(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> SlidingInverse:
+    """Motor torques and contact forces that produce the full accelerations ``a`` at (q, v), with the sliding
+    wheels' friction from their laws.
+
+    The friction forces are linear in the (unknown) normal loads, so torques and constraint forces solve one linear
+    system, by least squares with its residual and rank reported:
+
+    .. math:: \\Big[B \\;\\; A^T - \\sum_i J_{t,i}^T c_i e_{n_i}^T\\Big] \\begin{bmatrix}\\tau\\\\ \\lambda\\end{bmatrix}
+        = \\mathrm{RNEA}(q, v, a).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` (its sliding wheels as :func:`sliding_now` lists them).
+        q, v, a: Natural coordinates, full velocities (consistent with the constraints) and full accelerations.
+    """
+    q, v, a = (np.asarray(x, float) for x in (q, v, a))
+    wheels = sliding_now(robot)
+    model, data = robot.model, robot.data
+    kin = KinematicState(model, data, q, v)
+    from ..reduction.reduced_dynamics import constraint_set
+
+    rows = constraint_set(robot).jacobian(kin)
+    G = rows.A.T.copy()
+    slip = np.zeros((len(wheels), 2))
+    coef = np.zeros((len(wheels), 2))
+    normal_row = np.zeros(len(wheels), int)
+    for i, wheel in enumerate(wheels):
+        normal_row[i] = rows.labels.index(f"{wheel.name}.normal")
+        Jt, slip[i] = tangential(wheel, kin)
+        coef[i] = wheel.friction_coefficient(slip[i])
+        G[:, normal_row[i]] -= Jt.T @ coef[i]
+    B = input_matrix(robot.motors, kin)
+    K = np.hstack([B, G])
+    b = pin.rnea(model, data, q, v, a)
+    x, _, rank, _ = np.linalg.lstsq(K, b, rcond=None)
+    n_tau = B.shape[1]
+    lam = x[n_tau:]
+    normal = lam[normal_row]
+    return SlidingInverse(x[:n_tau], dict(zip(rows.labels, lam.tolist())), normal, slip, -normal[:, None] * coef,
+                          float(np.linalg.norm(K @ x - b)), int(rank))
+

@@ -1,0 +1,211 @@
+"""Traction along a simulated motion: each wheel's normal load, the friction the motion requires, and where the
+no-slip assumption breaks.
+
+The forces come from :func:`robotdyn.contact.contact_forces.constraint_forces` at every output sample of a
+:class:`~robotdyn.simulation.engine.Trajectory` (a post-pass: the integrator is not slowed down). Per wheel:
+
+- the normal load :math:`f_n` [N] (positive: pressed on the ground);
+- the required friction coefficient :math:`\\mu_{req} = \\|f_t\\| / f_n` (``inf`` where :math:`f_n \\le 0`);
+- events: the first time a wheel's load reaches zero (lift-off: rolling without slipping then needs the ground
+  to pull) and, where the wheel's friction coefficient :math:`\\mu` is known, the first time
+  :math:`\\mu_{req} > \\mu` (the wheel would slip). Event times are interpolated linearly between samples.
+
+A wheel whose load rigid-body dynamics do not determine (a planar root, a statically indeterminate wheel set: see
+:mod:`robotdyn.contact.contact_forces`) is reported as such; its columns are left out rather than filled with an arbitrary
+split.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .contact_forces import constraint_forces
+from ..errors import InputError
+
+
+@dataclass
+class TractionEvent:
+    """The first sample where a wheel's no-slip assumption breaks.
+
+    Attributes:
+        kind: ``lift-off`` (normal load <= 0) or ``slip`` (required friction > mu).
+        wheel: The wheel's name.
+        t: Time [s], interpolated between the two samples around the crossing.
+        value: The normal load [N] (lift-off) or the required friction (slip) at the first sample past it.
+    """
+
+    kind: str
+    wheel: str
+    t: float
+    value: float
+
+    def __str__(self) -> str:
+        what = f"load {self.value:.4g} N" if self.kind == "lift-off" else f"required mu {self.value:.4g}"
+        return f"{self.kind} of wheel {self.wheel} at t = {self.t:.4g} s ({what})"
+
+
+@dataclass
+class Traction:
+    """Wheel loads and required friction along a trajectory.
+
+    Attributes:
+        t: Sample times (N,) [s].
+        wheels: Names of the wheels whose normal loads are determined (columns of the arrays).
+        normal: (N, W) normal loads [N].
+        tangential: (N, W) friction force magnitudes [N].
+        required_mu: (N, W) :math:`\\|f_t\\|/f_n` (``inf`` where :math:`f_n \\le 0`; only meaningful where
+            ``friction_determined``).
+        friction_determined: (W,) whether each wheel's friction force (so its required mu) is determined.
+        minimum_mu: (N,) the smallest mu with which some admissible split of undetermined forces lies in every
+            cone (:meth:`robotdyn.contact.contact_forces.ConstraintForces.minimum_mu`); ``None`` when every friction force
+            is determined (then it is the largest per-wheel required mu) or a normal load is not.
+        mu: (W,) the wheels' friction coefficients (``nan``: not given, no slip check).
+        undetermined: Wheels whose loads rigid-body dynamics do not determine, with the reason.
+        events: The first lift-off and slip of each wheel, in time order.
+    """
+
+    t: np.ndarray
+    wheels: list[str]
+    normal: np.ndarray
+    tangential: np.ndarray
+    required_mu: np.ndarray
+    mu: np.ndarray
+    friction_determined: np.ndarray
+    undetermined: dict[str, str] = field(default_factory=dict)
+    minimum_mu: np.ndarray | None = None
+    events: list[TractionEvent] = field(default_factory=list)
+
+    def broken(self) -> np.ndarray:
+        """(N, W) where the no-slip assumption is broken: load <= 0, or required friction above mu."""
+        out = self.normal <= 0
+        known = np.isfinite(self.mu) & self.friction_determined
+        out[:, known] |= self.required_mu[:, known] > self.mu[known]
+        return out
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """CSV columns by name: ``<wheel>.normal`` [N] and ``<wheel>.mu_required`` for each determined wheel."""
+        out = {}
+        for j, name in enumerate(self.wheels):
+            out[f"{name}.normal"] = self.normal[:, j]
+            if self.friction_determined[j]:
+                out[f"{name}.mu_required"] = self.required_mu[:, j]
+        if self.minimum_mu is not None:
+            out["mu_required_min"] = self.minimum_mu
+        return out
+
+    def summary(self) -> str:
+        """One line: the extremes per wheel set and the first event (or that the no-slip assumption holds)."""
+        parts = []
+        if self.wheels:
+            mus = self.required_mu[:, self.friction_determined]
+            finite = mus[np.isfinite(mus)]
+            peak = finite.max() if finite.size else float("inf")
+            parts.append(f"loads {self.normal.min():.4g}..{self.normal.max():.4g} N"
+                         + (f", required mu up to {peak:.3g}" if self.friction_determined.any() else ""))
+            if self.minimum_mu is not None:
+                parts.append(f"with the best split of undetermined forces mu >= {np.max(self.minimum_mu):.3g} suffices")
+        if self.events:
+            parts.append("first: " + str(self.events[0]))
+        elif self.wheels:
+            checked = "within every wheel's mu" if np.isfinite(self.mu).all() else "loads stay positive"
+            if not self.friction_determined.all():
+                checked += ", friction of " + ", ".join(
+                    w for w, d in zip(self.wheels, self.friction_determined) if not d) + " not determined"
+            parts.append(f"no-slip assumption holds ({checked})")
+        if self.undetermined:
+            parts.append(f"loads of {', '.join(self.undetermined)} not determined by rigid-body dynamics")
+        elif not self.wheels:
+            parts.append("no wheel")
+        return "traction: " + "; ".join(parts)
+
+    def __repr__(self) -> str:
+        return f"Traction(wheels={self.wheels}, N={len(self.t)}, events={len(self.events)})"
+
+
+def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, float] | None = None) -> Traction:
+    """Wheel loads, required friction and no-slip events along a trajectory.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` the trajectory was simulated with.
+        traj: The :class:`~robotdyn.simulation.engine.Trajectory`.
+        torque: The motor torques ``tau(t, q, nu)`` it was simulated with (``None``: unactuated).
+        mu: Friction coefficient of every wheel, or by wheel name; default each wheel's own ``mu`` (its spec),
+            else no slip check.
+
+    Returns:
+        The :class:`Traction`.
+    """
+    zero = np.zeros(len(robot.motors))
+    samples, minimum = [], []
+    for i, t in enumerate(traj.t):
+        tau = zero if torque is None else np.asarray(torque(t, traj.q[i], traj.nu[i]), float)
+        forces = constraint_forces(robot, traj.q[i], traj.nu[i], tau=tau)
+        samples.append(forces.wheels)
+        if not all(w.load_determined for w in forces.wheels):
+            minimum.append(forces.minimum_mu())
+    names = [w.name for w in samples[0]] if samples else []
+    undetermined = {}
+    for j, name in enumerate(names):
+        if not all(s[j].determined[2] for s in samples):
+            undetermined[name] = "normal load not determined (see robotdyn.contact.contact_forces)"
+    keep = [j for j, name in enumerate(names) if name not in undetermined]
+    friction_known = np.array([all(s[j].load_determined for s in samples) for j in keep], bool)
+    normal = np.array([[s[j].normal for j in keep] for s in samples]).reshape(len(samples), len(keep))
+    tangential = np.array([[s[j].tangential for j in keep] for s in samples]).reshape(len(samples), len(keep))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        required = np.where(normal > 0, tangential / np.where(normal > 0, normal, 1.0), np.inf)
+    wheels = [names[j] for j in keep]
+    out = Traction(np.asarray(traj.t, float), wheels, normal, tangential, required,
+                   _friction_coefficients(robot, wheels, mu), friction_known, undetermined)
+    if minimum and len(minimum) == len(samples) and all(m is not None for m in minimum):
+        out.minimum_mu = np.array(minimum, float)
+    out.events = _events(out)
+    return out
+
+
+def _friction_coefficients(robot, wheels: list[str], mu) -> np.ndarray:
+    """Each wheel's mu: the argument (a number or a dict by name), else the wheel spec's ``mu``, else nan."""
+    own = {(w.name or w.frame): getattr(w, "mu", None) for w in robot.spec.wheels}
+    out = np.full(len(wheels), np.nan)
+    if isinstance(mu, dict):
+        unknown = set(mu) - set(own)
+        if unknown:
+            raise InputError(f"unknown wheel(s) {', '.join(sorted(unknown))} in mu; expected {', '.join(own)}")
+    for j, name in enumerate(wheels):
+        value = mu.get(name) if isinstance(mu, dict) else mu
+        value = own.get(name) if value is None else value
+        if value is not None:
+            value = float(value)
+            if not np.isfinite(value) or value < 0:
+                raise InputError(f"friction coefficient mu = {value} for wheel {name!r}; expected a number >= 0")
+            out[j] = value
+    return out
+
+
+def _events(tr: Traction) -> list[TractionEvent]:
+    """The first lift-off and the first slip of each wheel, interpolated between samples, in time order."""
+    events = []
+    for j, name in enumerate(tr.wheels):
+        fn = tr.normal[:, j]
+        idx = np.flatnonzero(fn <= 0)
+        if idx.size:
+            events.append(TractionEvent("lift-off", name, _crossing(tr.t, fn, idx[0], 0.0), float(fn[idx[0]])))
+        if np.isfinite(tr.mu[j]) and tr.friction_determined[j]:
+            over = np.flatnonzero((fn > 0) & (tr.required_mu[:, j] > tr.mu[j]))
+            if over.size:
+                k = over[0]
+                events.append(TractionEvent("slip", name, _crossing(tr.t, tr.required_mu[:, j], k, tr.mu[j]),
+                                            float(tr.required_mu[k, j])))
+    return sorted(events, key=lambda e: e.t)
+
+
+def _crossing(t: np.ndarray, y: np.ndarray, k: int, level: float) -> float:
+    """Time where y crosses ``level`` between samples k-1 and k (linear interpolation; t[k] at the first
+    sample or where y jumps to inf)."""
+    if k == 0 or not (np.isfinite(y[k]) and np.isfinite(y[k - 1])) or y[k] == y[k - 1]:
+        return float(t[k])
+    s = (level - y[k - 1]) / (y[k] - y[k - 1])
+    return float(t[k - 1] + min(max(s, 0.0), 1.0) * (t[k] - t[k - 1]))

@@ -1,0 +1,368 @@
+"""The reduced model in one compiled call per state: the fast path of :mod:`robotdyn.reduction.reduced_dynamics`.
+
+:class:`CompiledModel` evaluates :math:`M_r = S^TMS`, :math:`h = C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, S\\nu, w)`,
+:math:`g_r`, :math:`B_r`, :math:`S` and :math:`w = \\dot S\\nu` with the formulas of the Python reference
+(:mod:`robotdyn.constraints.rolling_contact` on a plane, :mod:`robotdyn.constraints.loop_closure`, :mod:`robotdyn.reduction.projection`,
+:mod:`robotdyn.reduction.operational_space`, :mod:`robotdyn.reduction.actuation`) in C++ (``robotdyn/_compiled.cpp``), on a copy of
+the robot's Pinocchio model rebuilt joint by joint and checked against it when built (M, g and RNEA at a random
+state). Pinocchio's own C++ algorithms do the rigid-body work, two passes per state: CRBA in the world convention
+(M, the joint Jacobians and, from its composite inertias, :math:`g_k = -J_k^T (Y_k a_g)`) and RNEA without gravity
+(:math:`C v`, and the zero-acceleration accelerations the drift terms need), so that
+:math:`\\mathrm{RNEA}(q, v, w) = Cv + g + Mw`. The projection solves with the LU factors of :math:`A_d`; its exact
+condition number and inverse (:class:`LazyProjection`) are computed on request.
+
+It serves robots whose constraints are rolling wheels (standard, omni, support; with or without a radius joint) on
+a plane, a sine or a bump terrain of :mod:`robotdyn.constraints.terrain`, loop closures and joint couplings with a
+:class:`~robotdyn.constraints.joint_coupling.CosineLaw`, with independent velocities that are a selection of v or a frame twist
+(:class:`~robotdyn.reduction.operational_space.OperationalVelocities`); :func:`why_not` names what keeps another robot on
+the Python path. The row choice of the projection is the Python path's (its last projection); where that choice
+stops working (a singular block, rows that no longer span, a wheel lying flat) the evaluation falls back to the
+Python path, which re-chooses or raises its usual error. ``ROBOTDYN_COMPILED=0`` in the environment, or
+:func:`robotdyn.fast.dispatch.use_compiled` ``(False)``, turns the fast path off (:mod:`robotdyn.fast.dispatch` is where
+every caller asks for it). The same C++ object also runs whole simulations
+(:mod:`robotdyn.simulation.compiled_engine`, :mod:`robotdyn.simulation.many_runs`) and gives the constraint forces
+(:meth:`CompiledModel.forces`). ``tests/test_compiled.py`` checks every output against
+the Python path on every robot.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..constraints.constraint import ConstraintRows, KinematicState
+from ..constraints.joint_coupling import CosineLaw, JointCoupling
+from ..constraints.loop_closure import LoopClosure
+from ..constraints.loop_closure import groupable as groupable_loop
+from ..reduction.operational_space import OperationalProjection
+from ..reduction.projection import Projection, inverse_and_condition
+from ..reduction.reduced_dynamics import ReducedDynamics, checked, reference
+from ..constraints.rolling_contact import RollingWheel
+from ..constraints.terrain import BumpTerrain, RampTerrain, SineTerrain
+from ..constraints.wheel_group import groupable as groupable_wheel
+
+try:
+    from .. import _compiled
+    from .._compiled import Fallback
+except ImportError:  # built without a C++ compiler: the Python path serves every robot
+    _compiled = None
+
+    class Fallback(RuntimeError):
+        """The compiled path cannot decide here (never raised without the extension)."""
+
+_KINDS = {"RX": "RX", "RY": "RY", "RZ": "RZ", "PX": "PX", "PY": "PY", "PZ": "PZ",
+          "RevoluteUnaligned": "RU", "PrismaticUnaligned": "PU"}
+SELF_CHECK_TOL = 1e-9
+"""Relative tolerance of the check of the rebuilt model against the robot's Pinocchio model."""
+
+
+def available() -> bool:
+    """Whether the compiled extension was built (it needs a C++ compiler at install time)."""
+    return _compiled is not None
+
+
+def _terrain_code(terrain) -> tuple[int, list[float]] | None:
+    """The C++ code of a terrain of :mod:`robotdyn.constraints.terrain` (``None``: not compiled, e.g. a user function)."""
+    if isinstance(terrain, RampTerrain):
+        grad = terrain.gradient(0.0, 0.0)
+        return 0, [terrain.h, float(grad[0]), float(grad[1])]
+    if type(terrain) is SineTerrain:
+        return 1, [terrain.a, terrain.kx, terrain.ky, terrain.phase]
+    if type(terrain) is BumpTerrain:
+        return 2, [terrain.h, terrain.x0, terrain.w, float("nan") if terrain.length is None else terrain.length]
+    return None
+
+
+def why_not(robot) -> str | None:
+    """Why ``robot`` cannot use the compiled path (``None``: it can)."""
+    if _compiled is None:
+        return "the compiled extension robotdyn._compiled was not built"
+    for i in range(1, robot.model.njoints):
+        kind = robot.model.joints[i].shortname().replace("JointModel", "")
+        if kind not in _KINDS:
+            return f"joint {robot.model.names[i]!r} of type {kind} is not compiled"
+    terrains = set()
+    for c in robot.constraints:
+        if isinstance(c, RollingWheel) and groupable_wheel(c):
+            if _terrain_code(c.terrain) is None:
+                return f"wheel {c.name!r} rolls on {c.terrain!r}, whose formulas are not compiled"
+            terrains.add(id(c.terrain))
+        elif isinstance(c, JointCoupling) and type(c).rows is JointCoupling.rows:
+            if not (isinstance(c.law, CosineLaw) and c.dlaw == c.law.d and c.ddlaw == c.law.dd):
+                return f"coupling {c.name!r} has a law other than a CosineLaw"
+        elif not (isinstance(c, LoopClosure) and groupable_loop(c)):
+            return f"constraint {c!r} is not compiled"
+    if len(terrains) > 1:
+        return "the wheels roll on different terrains"
+    op = getattr(robot, "operational", None)
+    if op is not None and not hasattr(op, "twist"):
+        return f"operational velocities {op!r} are not compiled"
+    return None
+
+
+class LazyProjection(Projection):
+    """The :class:`~robotdyn.reduction.projection.Projection` of a compiled evaluation: the same S, independent, dependent
+    velocities and rows, with :math:`A_d^{-1}` and the exact 1-norm condition number computed from A on first
+    access (by the formulas of :func:`robotdyn.reduction.projection.project`). The compiled path itself needs neither: it
+    solves with the LU factors and decides singularity by LAPACK's condition estimate, switching to the exact
+    number from an estimate of 1e8 on (``robotdyn/_compiled.cpp``).
+
+    Args:
+        S: (n, k) with v = S nu.
+        hint: The Python projection whose choice of rows and velocities was used.
+        A: The stacked constraint rows at this configuration (m, n).
+    """
+
+    def __init__(self, S: np.ndarray, hint: Projection, A: np.ndarray) -> None:  # noqa: D107 (no dataclass init)
+        self.S, self.independent, self.dependent, self.rows = S, hint.independent, hint.dependent, hint.rows
+        self._layout, self._A, self._exact = hint._layout, A, None
+
+    def _inverse(self) -> tuple[np.ndarray | None, float]:
+        if self._exact is None:
+            self._exact = inverse_and_condition(self._A[self._layout[1]]) if self.rows.size else (None, 1.0)
+        return self._exact
+
+    @property
+    def Ad_inv(self) -> np.ndarray | None:
+        """:math:`A_d^{-1}` (rows used x dependent), ``None`` without constraints."""
+        return self._inverse()[0]
+
+    @property
+    def condition(self) -> float:
+        """1-norm condition number of the dependent block :math:`A_d` (1 without constraints)."""
+        return self._inverse()[1]
+
+
+def _placement(M) -> np.ndarray:
+    return np.hstack([M.rotation, M.translation[:, None]])
+
+
+class CompiledModel:
+    """A robot's reduced model as one C++ object (build with :func:`compiled_model`).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` for which :func:`why_not` is ``None``.
+
+    Raises:
+        RuntimeError: The rebuilt model differs from the robot's Pinocchio model (a bug, never silent).
+    """
+
+    def __init__(self, robot) -> None:
+        model = robot.model
+        self.robot = robot
+        self.constraints = list(robot.constraints)
+        kinds, parents, placements, axes, inertias = [], [], [], [], []
+        for i in range(1, model.njoints):
+            joint = model.joints[i]
+            kinds.append(_KINDS[joint.shortname().replace("JointModel", "")])
+            parents.append(int(model.parents[i]))
+            placements.append(_placement(model.jointPlacements[i]))
+            extracted = joint.extract()
+            axes.append(np.asarray(getattr(extracted, "axis", np.zeros(3)), float))
+            Y = model.inertias[i]
+            I = Y.inertia
+            inertias.append(np.array([Y.mass, *Y.lever, I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]]))
+        ev = _compiled.Evaluator(kinds, parents, placements, axes, inertias, np.asarray(model.gravity.linear, float))
+        frames: dict[int, int] = {}
+
+        def frame(fid: int) -> int:
+            if fid not in frames:
+                f = model.frames[fid]
+                frames[fid] = ev.add_frame(int(f.parentJoint), _placement(f.placement))
+            return frames[fid]
+
+        self.wheels = [c for c in self.constraints if isinstance(c, RollingWheel)]
+        self.couplings = [c for c in self.constraints if isinstance(c, JointCoupling)]
+        for c in self.constraints:
+            if isinstance(c, RollingWheel):
+                ev.set_terrain(*_terrain_code(c.terrain))
+                ev.add_wheel(frame(c.fid), np.asarray(c.axis, float), float(c.radius),
+                             -1 if c.radius_index is None else int(c.radius_index), np.asarray(c._directions, float))
+            elif isinstance(c, JointCoupling):
+                law = c.law
+                ev.add_coupling(int(c.i), int(c.j), law.amplitude, law.rate, law.phase, law.offset)
+            else:
+                ev.add_closure(frame(c.f1), frame(c.f2), [int(s) for s in c._sel])
+        for m in robot.motors:
+            ev.add_motor(int(m.index), int(m.jid), -1 if m.rid is None else frame(m.rid))
+        self.slip_refusal = self._add_slipping(ev, robot)
+        self.operational = getattr(robot, "operational", None)
+        if self.operational is not None:
+            tw = self.operational.twist
+            self._op = (frame(tw.fid), [int(s) for s in tw.select], tw.axes == "local")
+        self.ev = ev
+        self.frame_ids = sorted(frames, key=frames.get)  # Pinocchio frame ids in the evaluator's order
+        rows = robot.rows_at(robot.neutral())
+        self.labels, self.holonomic = rows.labels, rows.holonomic
+        self._check_model()
+        self._hint = None
+        self._compute, self._generation, self._views = ev.compute, -1, None
+
+    def _add_slipping(self, ev, robot) -> str | None:
+        """Give the evaluator the slipping wheels' friction laws (:mod:`robotdyn.sliding`): returns why their
+        friction is not compiled (``None``: it is, or there are none). Their rows are compiled either way."""
+        from .sliding import SlippingWheel, sliding_now
+
+        sliding = sliding_now(robot)
+        if not sliding:
+            return None
+        labels = robot.rows_at(robot.neutral()).labels
+        laws = []
+        for c in sliding:
+            if not (isinstance(c, SlippingWheel) and type(c).friction_coefficient is SlippingWheel.friction_coefficient
+                    and type(c).slip is SlippingWheel.slip):
+                return f"wheel {c.name!r} ({type(c).__name__}) is simulated on the Python path"
+            code = c.law.encode()
+            if code is None:
+                return f"wheel {c.name!r} has the friction law {c.law!r}, whose formula is not compiled"
+            laws.append((self.wheels.index(c), labels.index(f"{c.name}.normal"), code, np.asarray(c._free, float)))
+        for wheel, row, (law, p0, p1), free in laws:
+            ev.add_slipping(wheel, row, law, float(p0), float(p1), free)
+        return None
+
+    def __repr__(self) -> str:
+        return f"CompiledModel({self.robot.spec.name!r}, nv={self.ev.nv}, rows={self.ev.nrows})"
+
+    def _check_model(self) -> None:
+        """The rebuilt model must give Pinocchio's M, g and RNEA of the robot's model at a random state."""
+        import pinocchio as pin
+
+        model, data = self.robot.model, self.robot.model.createData()
+        rng = np.random.default_rng(0)
+        q, v, a = (rng.uniform(-1.0, 1.0, model.nv) for _ in range(3))
+        M, g, tau = self.ev.full(q, v, a)
+        ref_M = pin.crba(model, data, q)
+        ref_M = np.triu(ref_M) + np.triu(ref_M, 1).T
+        ref_g = pin.computeGeneralizedGravity(model, data, q)
+        ref_tau = pin.rnea(model, data, q, v, a)
+        for name, x, ref in (("M", M, ref_M), ("g", g, ref_g), ("RNEA", tau, ref_tau)):
+            err = float(np.max(np.abs(x - ref))) / max(1.0, float(np.max(np.abs(ref))))
+            if not err <= SELF_CHECK_TOL:
+                raise RuntimeError(
+                    f"compiled model of {self.robot.spec.name}: {name} differs from Pinocchio's by {err:.3g}"
+                )
+
+    @property
+    def ready(self) -> bool:
+        """Whether a projection was chosen (by the Python path's first evaluation), so :meth:`rhs` can run."""
+        return self._hint is not None
+
+    def _choose(self, q: np.ndarray, nu: np.ndarray) -> None:
+        """Let the Python path choose the projection's rows at (q, nu) (it raises its usual errors there)."""
+        self.select(checked(reference(self.robot, q, nu), q, nu).projection)
+
+    def select(self, proj) -> None:
+        """Use the row choice (and independent velocities) of a Python projection from now on."""
+        if proj is self._hint:
+            return
+        if self.operational is not None:
+            frame, select, local = self._op
+            self.ev.set_operational([int(r) for r in proj.rows], frame, select, local)
+        else:
+            self.ev.set_selection([int(r) for r in proj.rows], [int(i) for i in proj.independent],
+                                  [int(i) for i in proj.dependent])
+        self._hint = proj
+
+    def evaluate(self, q: np.ndarray, nu: np.ndarray) -> tuple:
+        """The raw outputs at (q, nu): ``(M_r, h, g_r, B_r, S, w, v, A, residual, condition, inverse)``, with
+        ``condition`` and ``inverse`` :math:`K^{-1}` for operational velocities, ``None`` otherwise (the exact
+        condition number and :math:`A_d^{-1}` then come from :class:`LazyProjection`, on request).
+
+        Raises:
+            robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
+        """
+        if self._hint is None:
+            self._choose(q, nu)
+        return self.ev.evaluate(q, nu)
+
+    def compute(self, q: np.ndarray, nu: np.ndarray) -> tuple:
+        """``(M_r, h, g_r, B_r, S, w, v)`` at (q, nu) without copies: read-only views of the evaluator's buffers,
+        overwritten by the next call (copy what must be kept). The cheapest evaluation, e.g. inside an integrator.
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, nu)
+        generation = self._compute(q, nu)
+        if generation != self._generation:
+            ev = self.ev
+            self._views = (ev.M, ev.h, ev.g, ev.B, ev.S, ev.w, ev.v)
+            self._generation = generation
+        return self._views
+
+    def reduced(self, q: np.ndarray, nu: np.ndarray, independent: np.ndarray | None = None):
+        """The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu), or ``None`` where the Python path
+        must decide (then call :meth:`select` with its projection): no projection chosen yet, other
+        ``independent`` velocity indices than the chosen ones, or a :meth:`evaluate` fallback."""
+        hint = self._hint
+        if hint is None or (independent is not None and independent is not getattr(hint, "independent", None)
+                            and not np.array_equal(independent, hint.independent)):
+            return None
+        try:
+            M, h, g, B, S, w, v, A, residual, cond, inv = self.ev.evaluate(q, nu)
+        except Fallback:
+            return None
+        if self.operational is not None:
+            proj = OperationalProjection(S, hint.rows, cond, inv)
+        else:
+            proj = LazyProjection(S, hint, A)
+        rows0 = ConstraintRows(A, None, residual, self.holonomic, self.labels)
+        robot = self.robot
+        full_rows = lambda: robot.constraint_rows(KinematicState(robot.model, robot.data, q, v))  # noqa: E731
+        return ReducedDynamics(M, h, g, B, S, w, v, proj, rows0, _full_rows=full_rows)
+
+    def rhs(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray, stabilisation: float) -> np.ndarray:
+        """:math:`(\\dot q, \\dot\\nu)` of :func:`robotdyn.simulation.engine.simulate`'s ODE in one call.
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, nu)
+        return self.ev.rhs(q, nu, tau, stabilisation)
+
+    def forces(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tuple:
+        """Forward dynamics and constraint forces in one call, without copies (views overwritten by the next call,
+        as :meth:`compute`): ``(nudot, lambda, e, wheel forces (nw, 3) along (t1, t2, n), the same in world axes,
+        contact frames (nw, 9: rows t1, t2, n), contact points (nw, 3))``, with
+        :math:`A^T\\lambda = e = Ma + Cv + g - B\\tau` solved on the projection's rows by the LU factors of
+        :math:`A_d` (the projection's own factorisation; operational velocities: its :math:`K^{-1}`) and zero on
+        redundant rows (the basic solution: equal to any other on the rows rigid-body dynamics determine;
+        :mod:`robotdyn.contact.contact_forces` reports the others).
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, nu)
+        generation = self.ev.forces(q, nu, tau)
+        if generation != getattr(self, "_fgeneration", None):
+            ev = self.ev
+            self._fviews = (ev.nudot, ev.lam, ev.e, ev.wheel_local, ev.wheel_world, ev.wheel_frames,
+                            ev.contact_points)
+            self._fgeneration = generation
+        return self._fviews
+
+    def forces_at(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau: np.ndarray) -> tuple:
+        """The constraint forces at given full velocities v and accelerations a (inverse dynamics):
+        ``(lambda, e, (wheel forces, world forces, frames, points), A)`` as :meth:`forces` (copies), with the
+        constraint rows A (rows in :attr:`labels`' order).
+
+        Raises:
+            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+        """
+        if self._hint is None:
+            self._choose(q, np.zeros(self.robot.mobility))
+        return self.ev.forces_at(q, v, a, tau)
+
+    def evaluate_many(self, Q: np.ndarray, NU: np.ndarray) -> tuple:
+        """Many states in one call: ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n),
+        B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path."""
+        N, n = Q.shape
+        k = NU.shape[1]
+        Q, NU = np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float)
+        M, h, g, S, w, B, failed = self.ev.evaluate_many(Q, NU)
+        return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
+
+
+__all__ = ["Fallback", "CompiledModel", "LazyProjection", "why_not", "available"]

@@ -1,0 +1,89 @@
+"""The one place that chooses between the compiled fast path and the Python reference.
+
+Every evaluation that has a compiled form asks this module: :func:`reduce` (the reduced model, behind
+:meth:`robotdyn.robot.Robot.reduced`) tries the robot's :class:`~robotdyn.fast.compiled.CompiledModel` and falls
+back to the Python reference of :mod:`robotdyn.reduction` (which also chooses the projection's rows the compiled
+model then uses); the simulation engines, the constraint forces and the many-run/batch evaluators ask
+:func:`compiled_model` for the robot's compiled model (``None``: take the Python path). ``ROBOTDYN_COMPILED=0`` in
+the environment, or :func:`use_compiled` ``(False)`` in a ``with`` block, turns the fast path off everywhere.
+"""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+
+import numpy as np
+
+from ..reduction.reduced_dynamics import ReducedDynamics, reference
+from .compiled import CompiledModel, available, why_not
+
+_ENABLED = os.environ.get("ROBOTDYN_COMPILED", "1") != "0"
+
+
+def enabled() -> bool:
+    """Whether the fast path is used where a robot allows it (built, and not turned off)."""
+    return _ENABLED and available()
+
+
+@contextmanager
+def use_compiled(flag: bool):
+    """Turn the fast path on or off inside a ``with`` block (e.g. to compare it with the Python path)."""
+    global _ENABLED
+    old, _ENABLED = _ENABLED, bool(flag)
+    try:
+        yield
+    finally:
+        _ENABLED = old
+
+
+def compiled_model(robot) -> CompiledModel | None:
+    """The robot's :class:`CompiledModel` for the calling thread (built once per thread; rebuilt when its
+    constraints, their terrain, radius or friction law, or the model's gravity change), or ``None`` when the fast
+    path is off or :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated
+    from several threads at once."""
+    if not enabled():
+        return None
+    # one compiled model per thread: compute() returns views of its buffers, which another thread's call would
+    # overwrite (the robot's Pinocchio data is per thread as well, see Robot.data)
+    local = getattr(robot, "_local", None)
+    cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
+    gravity = robot.model.gravity.linear
+    if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
+        getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r and getattr(c, "law", None) is law
+        for c, (t, r, law) in zip(robot.constraints, cached[2])
+    ):
+        return cached[3]
+    fast = CompiledModel(robot) if why_not(robot) is None else None
+    state = [(getattr(c, "terrain", None), getattr(c, "radius", None), getattr(c, "law", None))
+             for c in robot.constraints]
+    entry = (list(robot.constraints), gravity.copy(), state, fast)
+    if local is not None:
+        local.compiled = entry
+    else:
+        robot._compiled_model = entry
+    return fast
+
+
+def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
+    """The reduced model of ``robot`` at (q, nu) (in its operational velocities if it has them): by the robot's
+    compiled model where it serves, else (and to choose the projection's rows) by the Python reference
+    (:func:`robotdyn.reduction.reduced_dynamics.reference`). ``coriolis`` (the matrix :math:`C_r`) is the Python
+    path's; ``independent`` overrides the independent velocity indices (not with operational velocities)."""
+    op = getattr(robot, "operational", None)
+    fast = None if coriolis else compiled_model(robot)
+    if fast is not None:
+        if op is not None:
+            op.check(nu)  # the Python path's InputError, before the compiled call
+            out = fast.reduced(q, nu)
+        else:
+            out = fast.reduced(q, nu, robot.independent_indices if independent is None else independent)
+        if out is not None:
+            return out
+    out = reference(robot, q, nu, coriolis, independent)
+    if fast is not None:
+        fast.select(out.projection)  # the compiled model uses the Python path's row choice from now on
+    return out
+
+
+__all__ = ["available", "enabled", "use_compiled", "compiled_model", "why_not", "reduce"]

@@ -1,0 +1,711 @@
+"""Declarative constraint files: any robot from a URDF/Xacro plus a small TOML file.
+
+A constraint file names, for one URDF/Xacro description, the root joint, the wheels, the loop closures, the
+motors, the terrain and optionally the independent velocities, locked joints and scenarios. :func:`read` parses
+and validates it against the description and returns a :class:`ConstraintFile` whose ``SPEC`` is the same
+:class:`~robotdyn.robot.RobotSpec` object a robot module supplies: a user's robot and the built-in robots go
+through one path (``Robot(spec)``). Every mistake gives one line naming the file and the entry, e.g.
+``tiago.toml: wheels[1] (left): no joint named 'wheel_lft_joint'; did you mean 'wheel_left_joint'?``.
+
+Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
+
+    name = "tiago"                      # default: the file's stem
+    title = "one line"
+    urdf = "robot.urdf.xacro"           # relative to this file, absolute, or package://PKG/path (optional when
+                                        # the description is given separately, e.g. robotdyn ... --urdf FILE)
+    root = "planar"                     # fixed | planar (x, y, psi) | floating (x, y, z, yaw, pitch, roll)
+    package_dirs = ["meshes_root"]      # directories searched for ROS packages ($(find PKG), package://PKG; relative
+                                        # to this file; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are searched too), and
+                                        # from which meshes may be read (robotdyn/description/ros_packages.py, visual_geometry.py)
+    root_height = "auto"                # planar root: height [m] of the root link above the ground (default "auto":
+                                        # found from the wheels at the neutral configuration; 0 keeps it on it)
+    massless = ["some_link"]            # links whose URDF inertial is ignored
+    independent = ["theta_R", "theta_L"]  # coordinate labels or joint names (default: automatic)
+    xacro_args = { wheel_radius = "0.1" }
+    labels = { wheel_right_joint = "theta_R" }      # display names of coordinates
+    neutral = { torso_lift_joint = 0.1 }            # a valid configuration (default all zero)
+    locked = { "arm_*" = 0.0 }                      # joints held fixed (glob patterns allowed)
+
+    [packages]                          # ROS packages by name (directories relative to this file)
+    my_robot_description = "../my_robot_description"
+
+    [twist]                             # independent velocities that are a frame's twist instead of `independent`
+    frame = "base_link"; components = ["vx", "vy", "wz"]   # default; axes = "body" (default) or "world"
+    # names = ["vx", "vy", "wz"]        # display names (default: the components)
+
+    [terrain]                           # default flat z = 0
+    kind = "ramp"                       # flat (height) | ramp (slope, heading) | bump (height, x0, width, length)
+    slope = 0.1                         # | sine (amplitude, kx, ky, phase)
+
+    [[parameters]]                      # numbers that wheels may refer to; xacro arguments of the description
+    name = "r"; default = 0.1; unit = "m"; description = "wheel radius"   # optional: choices, xacro
+
+    [[wheels]]
+    name = "right"
+    joint = "wheel_right_joint"         # the wheel's spin joint (its child link's origin is the wheel centre)
+    # frame = "wheel_right_link"        # ... or the wheel centre frame directly
+    radius = 0.0985                     # a number > 0 or a parameter name
+    axis = [0, 0, 1]                    # axle in the wheel frame (default: the spin joint's axis)
+    kind = "standard"                   # standard | omni (with roller_angle: rad, or "45 deg") | caster (a wheel on a
+                                        # steering joint of the URDF: nothing special) | support (touches the
+                                        # ground only: normal row, frictionless, e.g. a free castor or a skid)
+    mu = 0.8                            # friction coefficient (traction checks; the coulomb law's mu)
+    friction = "rolling"                # rolling (no slip, default) | coulomb (regularised: slip_velocity [m/s],
+                                        # default 1e-3) | linear (stiffness [s/m], saturated at mu if given)
+    slip = "both"                       # with a friction law: both | lateral (rolls along its rolling direction
+                                        # and slides sideways: only the lateral force follows the law)
+    [[closures]]
+    frame1 = "a"; frame2 = "b"; components = "x y z"   # subset of x y z rx ry rz in frame1's axes
+
+    [[motors]]
+    name = "tau_R"; joint = "wheel_right_joint"; reaction = "base_link"   # reaction optional
+
+    [[scenarios]]                       # constant-torque manoeuvres for robotdyn simulate
+    name = "spin"; t_end = 2.0; torque = [0.5, -0.5]; q0 = { psi = 0.0 }; nu0 = { theta_R = 1.0 }
+    # torque = { tau_R = 0.5, tau_L = -0.5 }   # ... or by motor name (motors not named: 0)
+    # nu0 = { vx = 0.3 }                       # with [twist]: by twist component name
+"""
+
+from __future__ import annotations
+
+import difflib
+import fnmatch
+import inspect
+import math
+import os
+import re
+import sysconfig
+import tomllib
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..description.urdf import _ROOT_CHAINS, ROOT_KINDS, expand_xacro
+from ..errors import InputError, RobotDynError
+from ..contact.friction import LAWS, make_law
+from ..robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
+from ..description.ros_packages import HINT, PackageIndex
+from ..simulation.scenario import Scenario
+from ..contact.sliding import SLIP_DIRECTIONS
+from ..constraints.terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
+from ..simulation.torque_profile import Constant
+
+
+class ConstraintFileError(RobotDynError):
+    """A constraint file that cannot be read or does not match its description (one line naming file and entry)."""
+
+
+TOP_KEYS = (
+    "name", "title", "urdf", "root", "package_dirs", "massless", "independent", "xacro_args", "labels", "neutral",
+    "locked", "terrain", "parameters", "wheels", "closures", "motors", "scenarios", "paper", "packages",
+    "root_height", "twist",
+)
+TWIST_KEYS = ("frame", "components", "axes", "names")
+PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro")
+WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
+              "slip_velocity", "stiffness", "slip")
+MAX_RADIUS = 1e4
+"""Largest wheel radius accepted [m] (larger values only overflow the dynamics)."""
+MAX_FILE_BYTES = 1_000_000
+"""Largest constraint file read (a robot's description is a few kB; larger files are refused, not parsed)."""
+WHEEL_KINDS = ("standard", "omni", "caster", "support")
+CLOSURE_KEYS = ("name", "frame1", "frame2", "components")
+MOTOR_KEYS = ("name", "joint", "reaction")
+SCENARIO_KEYS = ("name", "description", "t_end", "torque", "q0", "nu0")
+TERRAINS: dict[str, type[Terrain]] = {
+    "flat": FlatTerrain, "ramp": RampTerrain, "bump": BumpTerrain, "sine": SineTerrain,
+}
+ROTATING = ("revolute", "continuous")
+
+
+def _suggest(name: str, candidates) -> str:
+    close = difflib.get_close_matches(str(name), list(candidates), n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def package_search_dirs(extra=()) -> list[Path]:
+    """Directories where ``package://NAME/...`` is looked up: ``extra``, ``ROS_PACKAGE_PATH``, and the
+    ``cmeel.prefix/share`` directory of pip-installed robot data (e.g. example-robot-data), if present.
+    (:class:`robotdyn.description.ros_packages.PackageIndex` is the lookup itself.)"""
+    dirs = [Path(d) for d in extra]
+    dirs += [Path(d) for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
+    share = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
+    if share.is_dir():
+        dirs.append(share)
+    return dirs
+
+
+def resolve_path(text: str, base: Path, package_dirs=(), packages: PackageIndex | None = None) -> Path:
+    """Resolve a description path: ``package://PKG/rest`` with a :class:`~robotdyn.description.ros_packages.PackageIndex`
+    (default: one of ``package_dirs`` and the environment), a relative path against ``base``. Raises
+    :class:`ConstraintFileError` if the file does not exist."""
+    if text.startswith("package://"):
+        index = packages if packages is not None else PackageIndex.create(dirs=package_dirs)
+        path, missing = index.resolve_uri(text)
+        if missing is not None:
+            raise ConstraintFileError(f"cannot resolve {text}: packages not found: {missing}; {HINT}")
+        if not path.is_file():
+            raise ConstraintFileError(f"cannot resolve {text}: no file {path}")
+        return path
+    path = Path(os.path.expanduser(text))
+    if not path.is_absolute():
+        path = base / path
+    if not path.is_file():
+        raise ConstraintFileError(f"description file not found: {path}")
+    return path.resolve()
+
+
+@dataclass
+class _Tree:
+    """What the constraint file is checked against: links, joints and rigid bodies of the URDF."""
+
+    links: list[str]
+    joints: dict[str, dict]  # name -> type, parent, child, axis
+    xacro_args: list[str] = field(default_factory=list)
+
+    @classmethod
+    def parse(cls, urdf: str, declared: list[str]) -> _Tree:
+        tree = ET.fromstring(urdf)
+        links = [el.get("name") for el in tree.findall("link")]
+        joints = {}
+        for j in tree.findall("joint"):
+            axis = j.find("axis")
+            joints[j.get("name")] = {
+                "type": j.get("type"),
+                "parent": j.find("parent").get("link"),
+                "child": j.find("child").get("link"),
+                "axis": [float(x) for x in axis.get("xyz").split()] if axis is not None else [1.0, 0.0, 0.0],
+            }
+        return cls(links, joints, declared)
+
+    def movable(self, locked=()) -> list[str]:
+        return [n for n, j in self.joints.items() if j["type"] != "fixed" and n not in locked]
+
+    def body_of(self, locked) -> dict[str, str]:
+        """Representative link of the rigid body each link belongs to (fixed and locked joints merge bodies)."""
+        root = {link: link for link in self.links}
+
+        def find(a: str) -> str:
+            while root[a] != a:
+                root[a] = root[root[a]]
+                a = root[a]
+            return a
+
+        for name, j in self.joints.items():
+            if j["type"] == "fixed" or name in locked:
+                root[find(j["child"])] = find(j["parent"])
+        return {link: find(link) for link in self.links}
+
+
+class _Reader:
+    """Validation helpers that prefix every message with the file and the entry."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def fail(self, where: str, msg: str) -> None:
+        raise ConstraintFileError(f"{self.path}: {where}: {msg}" if where else f"{self.path}: {msg}")
+
+    def keys(self, where: str, table, allowed) -> None:
+        if not isinstance(table, dict):
+            self.fail(where, f"expected a table, got {type(table).__name__} {table!r}")
+        for k in table:
+            if k not in allowed:
+                self.fail(where, f"unknown key {k!r}{_suggest(k, allowed)} (allowed: {', '.join(allowed)})")
+
+    def number(self, where: str, x, what: str) -> float:
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+            self.fail(where, f"{what} = {x!r}; expected a finite number")
+        return float(x)
+
+    def angle(self, where: str, x, what: str) -> float:
+        """An angle in rad: a number in [-pi, pi], or a string with its unit ("45 deg", "0.785 rad"); a bare
+        number beyond pi is refused (it is almost always degrees written without their unit)."""
+        if isinstance(x, str):
+            match = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(deg|rad)\s*", x)
+            if not match:
+                self.fail(where, f"{what} = {x!r}; expected a number in rad or a string like '45 deg' or '0.79 rad'")
+            value = self.number(where, float(match.group(1)), what)
+            return float(np.radians(value)) if match.group(2) == "deg" else value
+        value = self.number(where, x, what)
+        if abs(value) > np.pi:
+            self.fail(where, f"{what} = {value:g}; a bare number is in rad and expected in [-pi, pi]: write "
+                             f"'{value:g} deg' for degrees")
+        return value
+
+    def string(self, where: str, x, what: str) -> str:
+        if not isinstance(x, str) or not x:
+            self.fail(where, f"{what} = {x!r}; expected a non-empty string")
+        return x
+
+    def strings(self, where: str, x, what: str) -> list[str]:
+        if isinstance(x, str):
+            x = x.split()
+        if not isinstance(x, list) or not all(isinstance(s, str) for s in x):
+            self.fail(where, f"{what} = {x!r}; expected a list of strings")
+        return list(x)
+
+    def table_list(self, data: dict, key: str) -> list[dict]:
+        items = data.get(key, [])
+        if not isinstance(items, list) or not all(isinstance(t, dict) for t in items):
+            self.fail(key, f"expected an array of tables ([[{key}]])")
+        return items
+
+
+@dataclass
+class ConstraintFile:
+    """A validated constraint file: the robot's :class:`RobotSpec` and scenarios (module-like: ``SPEC``,
+    ``SCENARIOS``), plus where they came from."""
+
+    path: Path
+    SPEC: RobotSpec
+    SCENARIOS: dict[str, Scenario] = field(default_factory=dict)
+
+    def robot(self, params: dict | None = None, terrain: Terrain | None = None) -> Robot:
+        """Build the robot; core errors are prefixed with the file name."""
+        try:
+            robot = Robot(self.SPEC, params, terrain)
+        except ConstraintFileError:
+            raise
+        except RobotDynError as exc:
+            raise ConstraintFileError(f"{self.path}: {exc}") from None
+        for i, sc in enumerate(self.SCENARIOS.values()):
+            for name in sc.nu0:
+                if name not in robot.velocity_names:
+                    raise ConstraintFileError(
+                        f"{self.path}: scenarios[{i}] ({sc.name}): nu0 {name.removesuffix('_dot')!r} is not an "
+                        "independent velocity; expected one of "
+                        f"{', '.join(v.removesuffix('_dot') for v in robot.velocity_names)}"
+                    )
+        return robot
+
+
+def read(
+    path: str | Path,
+    urdf: str | Path | None = None,
+    xacro_args: dict[str, str] | None = None,
+    package_dirs=(),
+    packages: dict[str, str] | None = None,
+    twist: str | None = None,
+) -> ConstraintFile:
+    """Read and validate a constraint file.
+
+    Args:
+        path: The TOML file.
+        urdf: The URDF/Xacro description (overrides the file's ``urdf``); a relative path is relative to the
+            current directory; ``package://PKG/...`` is resolved with the packages (:mod:`robotdyn.description.ros_packages`).
+        xacro_args: Xacro arguments (override the file's ``xacro_args``).
+        package_dirs: Extra directories searched for ROS packages (``$(find)``, ``package://``).
+        packages: Extra ROS packages by name (name -> directory; override the file's ``[packages]``).
+        twist: Independent velocities that are a body twist instead (overrides the file's ``independent`` and
+            ``twist``): ``FRAME`` (components vx vy wz) or ``FRAME:vx,vy,wz``.
+
+    Raises:
+        ConstraintFileError: one line naming the file, the entry and what was expected.
+    """
+    path = Path(path)
+    r = _Reader(path)
+    if not path.is_file():
+        raise ConstraintFileError(f"constraint file not found: {path}")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise ConstraintFileError(f"{path}: {path.stat().st_size:,} bytes; expected a constraint file of at most "
+                                  f"{MAX_FILE_BYTES:,} bytes")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConstraintFileError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError:
+        raise ConstraintFileError(f"{path}: not UTF-8 text; expected a TOML constraint file") from None
+    except OSError as exc:
+        raise ConstraintFileError(f"{path}: cannot read: {exc.strerror}") from None
+    try:
+        return _read(path, r, data, urdf, xacro_args, package_dirs, packages or {}, twist)
+    except (TypeError, AttributeError, KeyError, IndexError, ValueError, RecursionError) as exc:
+        if isinstance(exc, RobotDynError):
+            raise
+        # the last line of defence: a value of a shape the reader did not expect is an error of the file
+        raise ConstraintFileError(f"{path}: malformed constraint file ({type(exc).__name__}: "
+                                  f"{' '.join(str(exc).split())}); see the format in robotdyn/interfaces/constraint_file.py"
+                                  ) from None
+
+
+def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, packages, twist) -> ConstraintFile:
+    """The body of :func:`read`, on the parsed TOML data."""
+    r.keys("", data, TOP_KEYS)
+    base = path.resolve().parent
+
+    # ------------------------------------------------------------------------------------- description
+    pdirs = [str((base / d).resolve()) for d in r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")]
+    pdirs += [str(Path(d).resolve()) for d in package_dirs]
+    for d in pdirs:
+        if not Path(d).is_dir():
+            r.fail("package_dirs", f"{d}: no such directory; expected directories holding ROS packages (or --package "
+                                   "DIR)")
+    pkg_table = data.get("packages", {})
+    r.keys("packages", pkg_table, list(pkg_table))
+    named = {k: str((base / r.string(f"packages.{k}", v, "directory")).resolve()) for k, v in pkg_table.items()}
+    named.update({k: str(Path(v).resolve()) for k, v in packages.items()})
+    try:
+        index = PackageIndex.create(named, pdirs)
+    except RobotDynError as exc:
+        r.fail("packages", str(exc))
+    if urdf is not None:
+        desc = resolve_path(str(urdf), Path.cwd(), pdirs, index)
+    elif "urdf" in data:
+        try:
+            desc = resolve_path(r.string("urdf", data["urdf"], "urdf"), base, pdirs, index)
+        except ConstraintFileError as exc:
+            r.fail("urdf", str(exc))
+    else:
+        r.fail("", "no description: give --urdf FILE or a 'urdf' key in the file")
+    root = data.get("root", "planar")
+    if root not in ROOT_KINDS:
+        r.fail("root", f"{root!r}{_suggest(root, ROOT_KINDS)}; expected one of {', '.join(ROOT_KINDS)}")
+    file_args = data.get("xacro_args", {})
+    r.keys("xacro_args", file_args, list(file_args))
+    xargs = {str(k): str(v) for k, v in {**file_args, **(xacro_args or {})}.items()}
+    declared = re.findall(r"<xacro:arg\s+name=\"([^\"]+)\"", desc.read_text(errors="replace"))
+
+    # ------------------------------------------------------------------------------------- parameters
+    params: list[Parameter] = []
+    for i, p in enumerate(r.table_list(data, "parameters")):
+        where = f"parameters[{i}]"
+        r.keys(where, p, PARAMETER_KEYS)
+        name = r.string(where, p.get("name"), "name")
+        where = f"parameters[{i}] ({name})"
+        if "default" not in p:
+            r.fail(where, "missing 'default'")
+        choices = p.get("choices")
+        if choices is not None:
+            choices = tuple(r.strings(where, choices, "choices"))
+            if str(p["default"]) not in choices:
+                r.fail(where, f"default {p['default']!r} is not one of the choices {', '.join(choices)}")
+            default = str(p["default"])
+        else:
+            default = r.number(where, p["default"], "default")
+        use_xacro = p.get("xacro", name in declared)
+        if not isinstance(use_xacro, bool):
+            r.fail(where, f"xacro = {use_xacro!r}; expected true or false")
+        if any(q.name == name for q in params):
+            r.fail(where, f"parameter {name!r} is declared twice")
+        params.append(Parameter(name, default, str(p.get("unit", "")), str(p.get("description", "")), choices,
+                                use_xacro))
+    pvalues = {p.name: p.default for p in params}
+    for name in xargs:
+        if any(p.name == name and p.xacro for p in params):
+            r.fail("xacro_args", f"{name!r} is a parameter of this file; set it with --param {name}=VALUE")
+    try:
+        text = expand_xacro(desc, {**xargs, **{p.name: p.default for p in params if p.xacro}}, index)
+        tree = _Tree.parse(text, declared)
+    except RobotDynError as exc:
+        raise ConstraintFileError(f"{path}: {exc}") from None
+    except (ET.ParseError, AttributeError, ValueError) as exc:
+        raise ConstraintFileError(f"{path}: description {desc.name} is not a valid URDF: {exc}") from None
+
+    chain = [name for name, _, _ in _ROOT_CHAINS[root]]
+    frames = tree.links + list(tree.joints) + chain
+
+    def frame(where: str, name, what: str) -> str:
+        name = r.string(where, name, what)
+        if name not in frames:
+            r.fail(where, f"{what}: no frame named {name!r} in {desc.name}{_suggest(name, frames)}")
+        return name
+
+    def joint(where: str, name, what: str, movable: bool = True) -> str:
+        name = r.string(where, name, what)
+        if name not in tree.joints:
+            r.fail(where, f"{what}: no joint named {name!r} in {desc.name}{_suggest(name, tree.joints)}")
+        if movable and tree.joints[name]["type"] == "fixed":
+            r.fail(where, f"{what}: joint {name!r} is fixed in {desc.name}; expected a moving joint")
+        return name
+
+    # ---------------------------------------------------------------------------------- locked, massless
+    locked: dict[str, float] = {}
+    lock_table = data.get("locked", {})
+    r.keys("locked", lock_table, list(lock_table))
+    movable = tree.movable()
+    for pattern, value in lock_table.items():
+        where = f"locked.{pattern}"
+        value = r.number(where, value, "value")
+        hits = [j for j in movable if fnmatch.fnmatchcase(j, pattern)]
+        if not hits:
+            r.fail(where, f"no moving joint of {desc.name} matches {pattern!r}{_suggest(pattern, movable)}")
+        for j in hits:
+            locked[j] = value
+    massless = r.strings("massless", data.get("massless", []), "massless")
+    for name in massless:
+        if name not in tree.links:
+            r.fail("massless", f"no link named {name!r} in {desc.name}{_suggest(name, tree.links)}")
+    body = tree.body_of(locked)
+
+    def body_of_frame(name: str) -> str | None:
+        if name in tree.joints:
+            return body[tree.joints[name]["child"]]
+        return body.get(name)
+
+    labels = data.get("labels", {})
+    r.keys("labels", labels, list(labels))
+    for j, label in labels.items():
+        if j not in chain:
+            joint(f"labels.{j}", j, "label")
+        r.string(f"labels.{j}", label, "label")
+    coordinates = chain + [j for j in movable if j not in locked]
+    names = coordinates + [labels[j] for j in labels]
+
+    def coordinate(where: str, name) -> str:
+        name = r.string(where, name, "coordinate")
+        if name in locked:
+            r.fail(where, f"coordinate {name!r} is locked")
+        if name not in names:
+            r.fail(where, f"no coordinate named {name!r}{_suggest(name, names)}; coordinates are {', '.join(names)}")
+        return name
+
+    # ------------------------------------------------------------------------------------------- wheels
+    wheels: list[Wheel] = []
+    for i, w in enumerate(r.table_list(data, "wheels")):
+        where = f"wheels[{i}]" + (f" ({w['name']})" if isinstance(w, dict) and "name" in w else "")
+        r.keys(where, w, WHEEL_KEYS)
+        if ("joint" in w) == ("frame" in w):
+            r.fail(where, "give exactly one of 'joint' (the spin joint) or 'frame' (the wheel centre)")
+        spin = None
+        if "joint" in w:
+            spin = joint(where, w["joint"], "joint", movable=False)
+            if tree.joints[spin]["type"] not in ROTATING:
+                r.fail(where, f"joint {spin!r} is {tree.joints[spin]['type']}; a wheel spins about a revolute or "
+                              "continuous joint (a fixed caster is a support, not a rolling wheel)")
+            if spin in locked:
+                r.fail(where, f"joint {spin!r} is locked; a wheel must spin")
+            fname = tree.joints[spin]["child"]
+        else:
+            fname = frame(where, w["frame"], "frame")
+            parents = [n for n, j in tree.joints.items() if j["child"] == fname and j["type"] in ROTATING]
+            spin = parents[0] if parents else None
+        if "axis" in w:
+            axis = w["axis"]
+            if not isinstance(axis, list) or len(axis) != 3:
+                r.fail(where, f"axis = {axis!r}; expected 3 numbers")
+            axis = [r.number(where, a, "axis component") for a in axis]
+        elif spin is not None:
+            axis = tree.joints[spin]["axis"]
+        else:
+            r.fail(where, f"frame {fname!r} has no spin joint: give 'axis' (the axle in the wheel frame)")
+        if np.linalg.norm(axis) < 1e-12:
+            r.fail(where, f"axis {axis} has zero length; expected the axle direction in the wheel frame")
+        if "radius" not in w:
+            r.fail(where, "missing 'radius' (a number in m or a parameter name)")
+        radius = w["radius"]
+        if isinstance(radius, str):
+            if radius not in pvalues:
+                r.fail(where, f"radius {radius!r} is not a parameter{_suggest(radius, pvalues)}; "
+                              "expected a number in m or a declared parameter")
+            rv = pvalues[radius]
+        else:
+            rv = radius = r.number(where, radius, "radius")
+        if "radius_joint" in w:
+            joint(where, w["radius_joint"], "radius_joint")
+        elif not isinstance(rv, (int, float)) or not rv > 0:
+            r.fail(where, f"radius {rv!r} is not > 0; expected a positive radius in m")
+        elif rv > MAX_RADIUS:
+            r.fail(where, f"radius {rv!r} m is above {MAX_RADIUS:g} m; expected a wheel radius in m")
+        kind = w.get("kind", "standard")
+        if kind not in WHEEL_KINDS:
+            r.fail(where, f"kind {kind!r}{_suggest(kind, WHEEL_KINDS)}; expected one of {', '.join(WHEEL_KINDS)}")
+        roller = w.get("roller_angle", 0.0)
+        if "roller_angle" in w:
+            if kind != "omni":
+                r.fail(where, "roller_angle is only meaningful for kind = 'omni'")
+            if not (isinstance(roller, str) and roller in pvalues):
+                roller = r.angle(where, roller, "roller_angle")
+        friction = w.get("friction", "rolling")
+        if not isinstance(friction, str):
+            r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
+        numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness") if key in w}
+        slip = w.get("slip", "both")
+        if slip not in SLIP_DIRECTIONS:
+            r.fail(where, f"slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")
+        wheel = Wheel(fname, radius, tuple(float(a) for a in axis), kind if kind in ("omni", "support") else "standard",
+                      roller, w.get("radius_joint"), w.get("name", fname), friction=friction, slip=slip, **numbers)
+        try:  # the friction keys' physics (mu >= 0, a known law with its parameters) in one line
+            if friction != "rolling":
+                if wheel.kind != "standard":
+                    raise InputError(f"friction law {friction!r} on a {wheel.kind} wheel; expected a standard wheel "
+                                     "(support wheels are frictionless, omni wheels roll on their rollers)")
+                make_law(friction, wheel.mu, wheel.slip_velocity, wheel.stiffness, wheel.name)
+                if friction == "stick_slip" and slip != "both":
+                    raise InputError("slip = 'lateral' with friction = 'stick_slip'; exact stick-slip switches the "
+                                     "whole tangential force (expected slip = 'both')")
+            elif slip != "both":
+                raise InputError("slip = 'lateral' needs friction = 'coulomb' or 'linear'")
+            elif wheel.mu is not None and not (math.isfinite(wheel.mu) and wheel.mu >= 0):
+                raise InputError(f"mu = {wheel.mu}; expected a friction coefficient >= 0")
+            elif wheel.slip_velocity is not None or wheel.stiffness is not None:
+                raise InputError("slip_velocity/stiffness need friction = 'coulomb' or 'linear'")
+        except InputError as exc:
+            r.fail(where, str(exc))
+        wheels.append(wheel)
+
+    # ----------------------------------------------------------------------------------------- closures
+    closures: list[Closure] = []
+    for i, c in enumerate(r.table_list(data, "closures")):
+        where = f"closures[{i}]" + (f" ({c['name']})" if isinstance(c, dict) and "name" in c else "")
+        r.keys(where, c, CLOSURE_KEYS)
+        f1, f2 = frame(where, c.get("frame1"), "frame1"), frame(where, c.get("frame2"), "frame2")
+        if f1 not in chain and f2 not in chain and body_of_frame(f1) == body_of_frame(f2):
+            r.fail(where, f"{f1!r} and {f2!r} are on the same rigid body; a closure joins two different bodies")
+        comps = r.strings(where, c.get("components", ["x", "y", "z"]), "components")
+        allowed = ("x", "y", "z", "rx", "ry", "rz")
+        bad = [s for s in comps if s not in allowed]
+        if bad or not comps or len(set(comps)) != len(comps):
+            r.fail(where, f"components {comps} invalid; expected distinct entries of {' '.join(allowed)}")
+        closures.append(Closure(f1, f2, tuple(comps), c.get("name")))
+
+    # ------------------------------------------------------------------------------------------- motors
+    motors: list[MotorSpec] = []
+    for i, m in enumerate(r.table_list(data, "motors")):
+        where = f"motors[{i}]" + (f" ({m['name']})" if isinstance(m, dict) and "name" in m else "")
+        r.keys(where, m, MOTOR_KEYS)
+        j = joint(where, m.get("joint"), "joint")
+        if j in locked:
+            r.fail(where, f"joint {j!r} is locked; a motor needs a moving joint")
+        reaction = m.get("reaction")
+        if reaction is not None:
+            reaction = frame(where, reaction, "reaction")
+        motors.append(MotorSpec(r.string(where, m.get("name", j), "name"), j, reaction))
+
+    # -------------------------------------------------------------------------------- coordinates, misc
+    independent = data.get("independent")
+    if independent is not None:
+        independent = [coordinate("independent", x) for x in r.strings("independent", independent, "independent")]
+        if not independent:
+            r.fail("independent", "empty; expected the names of the independent coordinates (or no 'independent' "
+                                  "key: chosen automatically)")
+    neutral_table = data.get("neutral", {})
+    r.keys("neutral", neutral_table, list(neutral_table))
+    neutral = {coordinate(f"neutral.{k}", k): r.number(f"neutral.{k}", v, "value") for k, v in neutral_table.items()}
+    terrain = None
+    if "terrain" in data:
+        t = dict(data["terrain"]) if isinstance(data["terrain"], dict) else r.fail("terrain", "expected a table")
+        kind = t.pop("kind", "flat")
+        if not isinstance(kind, str):
+            r.fail("terrain", f"kind = {kind!r}; expected one of {', '.join(TERRAINS)}")
+        if kind not in TERRAINS:
+            r.fail("terrain", f"kind {kind!r}{_suggest(kind, TERRAINS)}; expected one of {', '.join(TERRAINS)}")
+        cls = TERRAINS[kind]
+        allowed = [a for a in inspect.signature(cls.__init__).parameters if a != "self"]
+        r.keys(f"terrain ({kind})", t, allowed)
+        try:
+            terrain = cls(**{k: r.number("terrain", v, k) for k, v in t.items()})
+        except TypeError as exc:
+            r.fail(f"terrain ({kind})", f"{exc}; arguments are {', '.join(allowed)}")
+
+    # ------------------------------------------------------------------------- root height, body twist
+    root_height = data.get("root_height", "auto")
+    if root_height == "auto":
+        root_height = None
+    else:
+        root_height = r.number("root_height", root_height, "root_height")
+        if root == "fixed":
+            r.fail("root_height", "a fixed root has no height; expected root = 'planar' or 'floating'")
+        if abs(root_height) > MAX_RADIUS:
+            r.fail("root_height", f"{root_height:g} m; expected the root link's height above the ground in m")
+    operational = None
+    twist_table = data.get("twist")
+    if twist is not None:
+        frame_name, _, comps = str(twist).partition(":")
+        twist_table = {"frame": frame_name, **({"components": comps.replace(",", " ")} if comps else {})}
+        independent = None
+    if twist_table is not None:
+        from ..reduction.operational_space import COMPONENTS, OperationalVelocities
+
+        r.keys("twist", twist_table, TWIST_KEYS)
+        if independent is not None:
+            r.fail("twist", "give either 'independent' (coordinates) or 'twist' (a body twist), not both")
+        tframe = frame("twist", twist_table.get("frame"), "frame")
+        comps = r.strings("twist", twist_table.get("components", ["vx", "vy", "wz"]), "components")
+        if not comps or len(set(comps)) != len(comps) or any(c not in COMPONENTS for c in comps):
+            r.fail("twist", f"components {comps}; expected distinct entries of {' '.join(COMPONENTS)}")
+        axes = twist_table.get("axes", "body")
+        if axes not in ("body", "local", "world"):
+            r.fail("twist", f"axes = {axes!r}; expected 'body' (the frame's own axes) or 'world'")
+        tnames = r.strings("twist", twist_table.get("names", comps), "names")
+        if len(tnames) != len(comps) or len(set(tnames)) != len(tnames):
+            r.fail("twist", f"names {tnames}; expected {len(comps)} distinct names, one per component")
+        operational = OperationalVelocities(tframe, tuple(comps), "world" if axes == "world" else "local", tnames)
+
+    spec = RobotSpec(
+        name=r.string("name", data.get("name", path.stem), "name"),
+        title=str(data.get("title", f"{path.stem} (from {path.name} and {desc.name})")),
+        xacro=desc,
+        root=root,
+        parameters=params,
+        wheels=wheels,
+        closures=closures,
+        motors=motors,
+        labels=dict(labels),
+        independent=independent,
+        terrain=terrain,
+        paper=str(data.get("paper", "")),
+        neutral=neutral,
+        xacro_args=xargs,
+        package_dirs=pdirs,
+        locked=locked,
+        massless=massless,
+        packages=named,
+        root_height=root_height,
+        operational=operational,
+    )
+
+    # ---------------------------------------------------------------------------------------- scenarios
+    scenarios: dict[str, Scenario] = {}
+    for i, s in enumerate(r.table_list(data, "scenarios")):
+        where = f"scenarios[{i}]"
+        r.keys(where, s, SCENARIO_KEYS)
+        name = r.string(where, s.get("name"), "name")
+        if name in scenarios:
+            r.fail(where, f"a second scenario named {name!r}; expected unique scenario names")
+        where = f"scenarios[{i}] ({name})"
+        for key in ("q0", "nu0"):
+            if not isinstance(s.get(key, {}), dict):
+                r.fail(where, f"{key} = {s[key]!r}; expected a table of values by coordinate name")
+        t_end = r.number(where, s.get("t_end"), "t_end")
+        if t_end <= 0:
+            r.fail(where, f"t_end = {t_end}; expected a positive duration in s")
+        tau = s.get("torque", [0.0] * len(motors))
+        motor_names = [m.name for m in motors]
+        if isinstance(tau, dict):  # by motor name, the others zero
+            r.keys(f"{where}: torque", tau, motor_names)
+            tau = [tau.get(name, 0.0) for name in motor_names]
+        if not isinstance(tau, list) or len(tau) != len(motors):
+            r.fail(where, f"torque = {tau!r}; expected {len(motors)} numbers ({', '.join(motor_names)}) or a table "
+                          "by motor name")
+        tau = np.array([r.number(where, x, "torque") for x in tau])
+        q0 = {coordinate(where, k): r.number(where, v, k) for k, v in s.get("q0", {}).items()}
+        nu0 = {}
+        for k, v in s.get("nu0", {}).items():
+            if operational is not None:
+                if k not in operational.names:
+                    r.fail(where, f"nu0 {k!r} is not a twist component; expected one of {', '.join(operational.names)}")
+                nu0[k] = r.number(where, v, k)
+                continue
+            label = coordinate(where, k)
+            nu0[f"{labels.get(label, label)}_dot"] = r.number(where, v, k)
+        scenarios[name] = Scenario(name, str(s.get("description", f"constant torques {tau.tolist()}")), t_end,
+                                   Constant(tau), q0, nu0)  # torques as data: simulated compiled
+    return ConstraintFile(path, spec, scenarios)
+
+
+def load_robot(
+    path: str | Path,
+    urdf: str | Path | None = None,
+    xacro_args: dict[str, str] | None = None,
+    params: dict | None = None,
+    terrain: Terrain | None = None,
+    package_dirs=(),
+) -> Robot:
+    """Read a constraint file (see :func:`read`) and build its :class:`~robotdyn.robot.Robot`."""
+    return read(path, urdf, xacro_args, package_dirs).robot(params, terrain)
+
+
+__all__ = ["ConstraintFile", "ConstraintFileError", "read", "load_robot", "package_search_dirs", "resolve_path"]

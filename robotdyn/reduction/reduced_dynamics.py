@@ -1,0 +1,252 @@
+"""Equations of motion in minimal (independent) velocities.
+
+With :math:`v = S\\nu` and :math:`a = S\\dot\\nu + w` (:math:`w = \\dot S \\nu`, see :mod:`robotdyn.reduction.projection`),
+D'Alembert's principle (constraint forces do no work on admissible motions) gives
+
+.. math:: M_r \\dot\\nu + C_r \\nu + g_r = B_r \\tau,\\qquad
+          M_r = S^T M S,\\; C_r = S^T(M\\dot S + C S),\\; g_r = S^T g,\\; B_r = S^T B,
+
+where :math:`C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, S\\nu, w)` (one RNEA call gives the whole reduced bias) and
+:math:`\\dot M_r - 2C_r` is skew-symmetric because Pinocchio's C is Christoffel-consistent.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import InputError, NonFiniteError
+from .actuation import input_matrix
+from ..constraints.constraint import ConstraintRows, KinematicState
+from .projection import Projection, project
+from ..constraints.loop_closure import LoopGroup
+from ..constraints.loop_closure import groupable as groupable_loop
+from ..constraints.wheel_group import WheelGroup
+from ..constraints.wheel_group import groupable as groupable_wheel
+
+
+@dataclass
+class ReducedDynamics:
+    """The minimal-coordinate model at one state (q, nu).
+
+    Attributes:
+        M: :math:`M_r` (k, k) [kg m^2 or kg].
+        h: :math:`C_r\\nu + g_r` (k,), the whole bias [N m or N].
+        g: :math:`g_r` (k,).
+        B: :math:`B_r` (k, n_motors).
+        S: (n, k) with v = S nu.
+        w: :math:`\\dot S\\nu` (n,), the acceleration offset.
+        v: Full velocity :math:`S\\nu` (n,).
+        C: :math:`C_r` (k, k), only when requested (else ``None``).
+        Sdot: :math:`\\dot S` (n, k), only with C.
+        projection: The :class:`~robotdyn.reduction.projection.Projection` used.
+        jacobian_rows: The stacked constraint rows without their time derivative (A, residual, labels).
+
+    The property :attr:`rows` gives the stacked constraint rows with ``Adot`` (computed on first access).
+    """
+
+    M: np.ndarray
+    h: np.ndarray
+    g: np.ndarray
+    B: np.ndarray
+    S: np.ndarray
+    w: np.ndarray
+    v: np.ndarray
+    projection: Projection
+    jacobian_rows: ConstraintRows
+    C: np.ndarray | None = None
+    Sdot: np.ndarray | None = None
+    _full_rows: ConstraintRows | Callable[[], ConstraintRows] | None = None
+
+    @property
+    def rows(self) -> ConstraintRows:
+        """All constraint rows at (q, v), with ``Adot``."""
+        if callable(self._full_rows):
+            self._full_rows = self._full_rows()
+        return self._full_rows
+
+    def __repr__(self) -> str:
+        return f"ReducedDynamics(k={self.M.shape[0]}, n={self.S.shape[0]}, motors={self.B.shape[1]})"
+
+
+class ConstraintSet:
+    """A robot's constraints evaluated together: the rolling wheels in one
+    :class:`~robotdyn.constraints.wheel_group.WheelGroup` pass, the loop closures in one vectorised
+    :class:`~robotdyn.constraints.loop_closure.LoopGroup` pass, the others one by one; rows stacked in the order of
+    ``constraints`` (the same rows as stacking each constraint's own :meth:`~robotdyn.constraints.constraint.Constraint.jacobian`
+    and :meth:`~robotdyn.constraints.constraint.Constraint.drift`).
+
+    Args:
+        constraints: The constraints, in row order.
+        nv: Number of velocities.
+    """
+
+    def __init__(self, constraints, nv: int) -> None:
+        self.constraints = tuple(constraints)
+        self.nv = nv
+        self.groups = []
+        wheels = [c for c in self.constraints if groupable_wheel(c)]
+        if wheels:
+            self.groups.append((WheelGroup(wheels), wheels))
+        loops = [c for c in self.constraints if groupable_loop(c)]
+        if loops:
+            self.groups.append((LoopGroup(loops), loops))
+        grouped = {id(c) for _, members in self.groups for c in members}
+        self.others = [c for c in self.constraints if id(c) not in grouped]
+        self._order: dict[tuple[int, ...], np.ndarray | None] = {}
+
+    def current(self, constraints) -> bool:
+        """Whether this set still describes ``constraints`` (the same objects, and the wheels still on the terrain
+        and with the radius they had, e.g. after :func:`robotdyn.constraints.posture.set_terrain` changed them in place)."""
+        if len(constraints) != len(self.constraints) or any(a is not b for a, b in zip(constraints, self.constraints)):
+            return False
+        return all(group.current() for group, _ in self.groups)
+
+    def _permutation(self, counts: tuple[int, ...]) -> np.ndarray | None:
+        """Row permutation from [groups' rows, other constraints' rows] to constraint order (None: identity)."""
+        if counts not in self._order:
+            sizes = {}
+            start = 0
+            for group, members in self.groups:
+                for c, k in zip(members, group.row_counts):
+                    sizes[id(c)] = np.arange(start, start + k)
+                    start += k
+            for c, k in zip(self.others, counts):
+                sizes[id(c)] = np.arange(start, start + k)
+                start += k
+            perm = np.concatenate([sizes[id(c)] for c in self.constraints]) if self.constraints else np.zeros(0, int)
+            self._order[counts] = None if np.array_equal(perm, np.arange(perm.size)) else perm
+        return self._order[counts]
+
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        """All rows without their time derivative, stacked in constraint order."""
+        others = [c.jacobian(kin) for c in self.others]
+        parts = [group.jacobian(kin) for group, _ in self.groups] + others
+        rows = ConstraintRows.stack(parts, self.nv) if len(parts) != 1 else parts[0]
+        perm = self._permutation(tuple(p.A.shape[0] for p in others))
+        if perm is not None:
+            rows = ConstraintRows(rows.A[perm], None, rows.residual[perm], rows.holonomic[perm],
+                                  [rows.labels[i] for i in perm])
+        return rows
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        """All drift terms :math:`\\dot A v`, stacked in constraint order."""
+        others = [c.drift(kin) for c in self.others]
+        parts = [group.drift(kin) for group, _ in self.groups] + others
+        if not parts:
+            return np.zeros(0)
+        out = np.concatenate(parts) if len(parts) != 1 else parts[0]
+        perm = self._permutation(tuple(len(p) for p in others))
+        return out if perm is None else out[perm]
+
+
+def constraint_set(robot) -> ConstraintSet:
+    """The robot's :class:`ConstraintSet` (built once, rebuilt if ``robot.constraints`` was changed)."""
+    cset = getattr(robot, "_constraint_set", None)
+    if cset is None or not cset.current(robot.constraints):
+        cset = ConstraintSet(robot.constraints, robot.model.nv)
+        robot._constraint_set = cset
+    return cset
+
+
+def _project_at(robot, q: np.ndarray, independent) -> tuple[KinematicState, ConstraintRows, Projection]:
+    """Kinematics at rest, the stacked rows without their derivative and the projection at q (the projection
+    becomes the robot's hint for the next state)."""
+    model = robot.model
+    kin0 = KinematicState(model, robot.data, q, np.zeros(model.nv))
+    rows0 = constraint_set(robot).jacobian(kin0)
+    proj = project(rows0.A, independent, robot.velocity_labels, hint=robot._projection_hint)
+    robot._projection_hint = proj
+    return kin0, rows0, proj
+
+
+def velocity(robot, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, ConstraintRows]:
+    """Only :math:`v = S(q)\\nu` and the constraint rows at q (one kinematics pass, no dynamics): the same ``v`` and
+    ``jacobian_rows`` as :func:`reduce` (or the robot's operational reduction) at a fraction of the cost."""
+    if getattr(robot, "operational", None) is not None:
+        red = robot.reduced(q, nu)
+        return red.v, red.jacobian_rows
+    _, rows0, proj = _project_at(robot, q, robot.independent_indices)
+    return proj.S @ np.asarray(nu, float), rows0
+
+
+def assemble(robot, q: np.ndarray, proj, rows0: ConstraintRows, v: np.ndarray, w: np.ndarray, B: np.ndarray,
+             coriolis: bool, sdot: Callable[[np.ndarray], np.ndarray]) -> ReducedDynamics:
+    """The dynamics shared by every reduction, once S, v = S nu, w and B are known:
+    :math:`M_r = S^TMS`, :math:`C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, v, w)`, :math:`g_r`, :math:`B_r`, and with
+    ``coriolis`` :math:`C_r = S^T(M\\dot S + CS)`, :math:`\\dot S` = ``sdot(Adot)``.
+    """
+    model, data = robot.model, robot.data
+    S = proj.S
+    # all rows with Adot, on first access: a fresh kinematics pass, since data may hold another state by then
+    full_rows = lambda: robot.constraint_rows(KinematicState(model, data, q, v))  # noqa: E731
+    if coriolis:
+        full_rows = full_rows()
+    M = pin.crba(model, data, q)
+    g = pin.computeGeneralizedGravity(model, data, q)
+    h = S.T @ pin.rnea(model, data, q, v, w)
+    out = ReducedDynamics(S.T @ M @ S, h, S.T @ g, S.T @ B, S, w, v, proj, rows0, _full_rows=full_rows)
+    if coriolis:
+        Sdot = sdot(full_rows.Adot)
+        C = pin.computeCoriolisMatrix(model, data, q, v)
+        out.C = S.T @ (M @ Sdot + C @ S)
+        out.Sdot = Sdot
+    return out
+
+
+def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
+    """Evaluate the reduced model of ``robot`` at (q, nu) in Python: the reference of the compiled fast path
+    (:mod:`robotdyn.fast`; :func:`robotdyn.fast.dispatch.reduce` chooses between the two).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,), already validated.
+        nu: Independent velocities (k,).
+        coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`).
+        independent: Override of the independent velocity indices.
+    """
+    ind = robot.independent_indices if independent is None else independent
+    kin0, rows0, proj = _project_at(robot, q, ind)
+    v = proj.S @ nu
+    kin = kin0.with_velocity(v)
+    drift = constraint_set(robot).drift(kin)
+    B = input_matrix(robot.motors, kin)
+    return assemble(robot, q, proj, rows0, v, proj.offset(drift), B, coriolis, proj.Sdot)
+
+
+def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:math:`M^{-1} b` for a reduced mass matrix, which must be positive definite (Cholesky); else a one-line
+    :class:`~robotdyn.errors.InputError` naming the likely cause."""
+    try:
+        L = np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        eig = np.linalg.eigvalsh(M) if np.all(np.isfinite(M)) else np.array([np.nan])
+        raise InputError(f"the reduced mass matrix is not positive definite (smallest eigenvalue {eig.min():.3g}): "
+                         "massless or zero-inertia bodies move freely; expected positive masses and inertias"
+                         ) from None
+    return np.linalg.solve(L.T, np.linalg.solve(L, b))
+
+
+def reference(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
+    """The Python reference of the robot's reduced model: :func:`reduce`, or the robot's operational reduction
+    (``robot.operational.reduce``) where its independent velocities are a frame twist."""
+    op = getattr(robot, "operational", None)
+    if op is not None:
+        return op.reduce(robot, q, nu, coriolis)
+    return reduce(robot, q, nu, coriolis, independent)
+
+
+def checked(out: ReducedDynamics, q, nu) -> ReducedDynamics:
+    """``out``, after checking that its M, h and w are finite.
+
+    Raises:
+        NonFiniteError: They are not (a state beyond what double precision holds).
+    """
+    if not (np.isfinite(out.M).all() and np.isfinite(out.h).all() and np.isfinite(out.w).all()):
+        raise NonFiniteError(f"the reduced model at this state is not finite (|q| up to "
+                             f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g}): the "
+                             "state is beyond what double precision holds")
+    return out

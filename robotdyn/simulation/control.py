@@ -1,0 +1,241 @@
+"""Input-output linearising control on the reduced (minimal-coordinate) model.
+
+With :math:`v = S\\nu`, the reduced equations :math:`M_r\\dot\\nu + h = B_r\\tau` become :math:`\\dot\\nu = u` under
+the computed torque :math:`B_r\\tau = M_r u + h` (state-space form :math:`\\dot x = [S\\nu; 0] + [0; I]u`, the
+feedback linearisation of Yamamoto and Yun). Outputs :math:`y(q)` (points of frames, coordinates) have
+:math:`\\dot y = J v = J S\\nu` and :math:`\\ddot y = JS\\,u + J w + \\dot J v` (:math:`w = \\dot S\\nu`), so the new input
+
+.. math:: u = (JS)^+\\,(\\ddot y_d + K_d(\\dot y_d - \\dot y) + K_p(y_d - y) - Jw - \\dot J v) - N K_\\nu \\nu
+
+gives :math:`\\ddot e + K_d\\dot e + K_p e = 0` for the output error :math:`e = y_d - y` (N projects onto the null
+space of JS; the last term damps the redundant motion). Underactuated directions (rank-deficient
+:math:`B_r`) are handled by solving :math:`M_r\\dot\\nu + h = B_r\\tau` for the torques and the free accelerations
+of the uncontrolled velocities together (collocated partial feedback linearisation).
+
+Units: SI (m, rad, s, N, N m). Frames' points and Jacobians are in world axes (LOCAL_WORLD_ALIGNED).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..constraints.constraint import KinematicState, skew
+from ..errors import InputError
+from .scenario import Scenario
+from .engine import Trajectory, simulate
+
+Reference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
+"""A reference: t -> (y_d, y_d', y_d'') as arrays of the task's dimension."""
+
+
+def hold(values) -> Reference:
+    """A constant reference."""
+    y = np.atleast_1d(np.asarray(values, dtype=float))
+    z = np.zeros_like(y)
+    return lambda t: (y, z, z)
+
+
+class Task:
+    """An output y(q) with its Jacobian rows J (on the full velocity v) and drift :math:`\\dot J v`."""
+
+    reference: Reference
+
+    def evaluate(self, robot, kin: KinematicState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return (y, J, Jdot_v) at the state of ``kin``."""
+        raise NotImplementedError
+
+
+@dataclass
+class PointTask(Task):
+    """The world position of a point fixed in a frame (selected world axes 0=x, 1=y, 2=z).
+
+    Attributes:
+        frame: Frame name. offset: The point in the frame's axes [m]. axes: Controlled world components.
+        reference: t -> (p_d, p_d', p_d'') of the controlled components.
+    """
+
+    frame: str
+    reference: Reference
+    offset: Sequence[float] = (0.0, 0.0, 0.0)
+    axes: Sequence[int] = (0, 1, 2)
+
+    def evaluate(self, robot, kin):
+        fid = robot.description.frame_id(self.frame)
+        placement, jac, djac = kin.frame(fid)
+        r = placement.rotation @ np.asarray(self.offset, float)
+        omega = jac[3:] @ kin.v
+        J = jac[:3] - skew(r) @ jac[3:]
+        drift = djac[:3] @ kin.v + np.cross(djac[3:] @ kin.v, r) + np.cross(omega, np.cross(omega, r))
+        ax = list(self.axes)
+        return (placement.translation + r)[ax], J[ax], drift[ax]
+
+
+@dataclass
+class CoordinateTask(Task):
+    """Natural coordinates by label (a joint-space task)."""
+
+    labels: Sequence[str]
+    reference: Reference
+
+    def evaluate(self, robot, kin):
+        idx = [robot.coordinate_index(c) for c in self.labels]
+        J = np.zeros((len(idx), robot.nq))
+        J[np.arange(len(idx)), idx] = 1.0
+        return kin.q[idx], J, np.zeros(len(idx))
+
+
+def computed_torque(red, nudot: np.ndarray, controlled: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Motor torques realising the accelerations ``nudot`` of the ``controlled`` independent velocities.
+
+    Solves :math:`M_r\\dot\\nu + h = B_r\\tau` for (tau, the uncontrolled accelerations) in least squares
+    (minimum norm when the motors are redundant).
+
+    Returns:
+        ``(tau, nudot_all)``: the torques and the full vector of independent accelerations they produce.
+    """
+    k = red.M.shape[0]
+    ctrl = np.arange(k) if controlled is None else np.asarray(controlled, dtype=int)
+    free = np.setdiff1d(np.arange(k), ctrl)
+    m = red.B.shape[1]
+    lhs = np.hstack([red.B, -red.M[:, free]])
+    rhs = red.M[:, ctrl] @ nudot[ctrl] + red.h
+    sol, *_ = np.linalg.lstsq(lhs, rhs, rcond=None)
+    tau = sol[:m]
+    out = np.array(nudot, dtype=float)
+    out[free] = sol[m:]
+    return tau, out
+
+
+@dataclass
+class LinearisingController:
+    """Computed torque on the reduced model plus PD output feedback (see the module docstring).
+
+    Attributes:
+        robot: The robot (its reduced model is the controller's model).
+        tasks: Outputs to track, stacked.
+        kp, kd: Proportional [1/s^2] and derivative [1/s] gains (the same for every output).
+        damping: Gain [1/s] on the independent velocities in the null space of the outputs.
+        controlled: Labels of the independent velocities the motors act on (``None``: all).
+        secondary: Lower-priority tasks, tracked in the null space of ``tasks`` (least squares).
+    """
+
+    robot: object
+    tasks: list[Task]
+    kp: float = 4.0
+    kd: float = 4.0
+    damping: float = 2.0
+    controlled: Sequence[str] | None = None
+    secondary: list[Task] = field(default_factory=list)
+    _ctrl: np.ndarray | None = field(default=None, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.kp < 0 or self.kd < 0 or self.damping < 0:
+            raise InputError(f"gains kp = {self.kp}, kd = {self.kd}, damping = {self.damping}; expected >= 0")
+        names = self.robot.velocity_names
+        if self.controlled is not None:
+            unknown = [c for c in self.controlled if f"{c}_dot" not in names and c not in names]
+            if unknown:
+                raise InputError(f"controlled velocities {unknown} are not independent velocities {names}")
+            self._ctrl = np.array([names.index(c if c in names else f"{c}_dot") for c in self.controlled])
+
+    def outputs(self, q, nu, t: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(y, y', y_d, y_d') of the stacked tasks at (q, nu)."""
+        red = self.robot.reduced(q, nu)
+        kin = KinematicState(self.robot.model, self.robot.data, q, red.v)
+        ys, yds, ydots, yddots = [], [], [], []
+        for task in self.tasks:
+            y, J, _ = task.evaluate(self.robot, kin)
+            yd, ydd, _ = task.reference(t)
+            ys.append(y), ydots.append(J @ red.v), yds.append(yd), yddots.append(ydd)
+        return np.concatenate(ys), np.concatenate(ydots), np.concatenate(yds), np.concatenate(yddots)
+
+    def command(self, t: float, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The new input u (eq: nu' = u) and the motor torques at (t, q, nu)."""
+        red = self.robot.reduced(q, nu)
+        kin = KinematicState(self.robot.model, self.robot.data, q, red.v)
+        A, b = self._rows(self.tasks, t, kin, red)
+        pinv = np.linalg.pinv(A, rcond=1e-10)
+        u = pinv @ b
+        N = np.eye(A.shape[1]) - pinv @ A
+        if self.secondary:
+            A2, b2 = self._rows(self.secondary, t, kin, red)
+            A2N = A2 @ N
+            pinv2 = np.linalg.pinv(A2N, rcond=1e-8)
+            u = u + pinv2 @ (b2 - A2 @ u)
+            N = N @ (np.eye(A.shape[1]) - pinv2 @ A2N)
+        if self.damping:
+            u -= N @ (self.damping * nu)
+        tau, _ = computed_torque(red, u, self._ctrl)
+        return u, tau
+
+    def _rows(self, tasks, t, kin, red) -> tuple[np.ndarray, np.ndarray]:
+        """Stacked JS and the commanded output accelerations minus Jw + Jdot v (eq 25)."""
+        rows, rhs = [], []
+        for task in tasks:
+            y, J, drift = task.evaluate(self.robot, kin)
+            yd, yd_dot, yd_ddot = (np.atleast_1d(np.asarray(a, float)) for a in task.reference(t))
+            ydot = J @ red.v
+            rows.append(J @ red.S)
+            rhs.append(yd_ddot + self.kd * (yd_dot - ydot) + self.kp * (yd - y) - J @ red.w - drift)
+        return np.vstack(rows), np.concatenate(rhs)
+
+    def __call__(self, t: float, q: np.ndarray, nu: np.ndarray) -> np.ndarray:
+        return self.command(t, q, nu)[1]
+
+
+def tracking_errors(controller: LinearisingController, traj: Trajectory, task: int = 0,
+                    after: float = 0.0) -> dict[str, float]:
+    """Position error norms :math:`\\|y_d - y\\|` of one task along a trajectory: mean, RMS and max [same unit as y]."""
+    errs = []
+    for t, q, nu in zip(traj.t, traj.q, traj.nu):
+        if t < after:
+            continue
+        red = controller.robot.reduced(q, nu)
+        kin = KinematicState(controller.robot.model, controller.robot.data, q, red.v)
+        y, _, _ = controller.tasks[task].evaluate(controller.robot, kin)
+        yd = np.atleast_1d(controller.tasks[task].reference(t)[0])
+        errs.append(float(np.linalg.norm(yd - y)))
+    e = np.array(errs)
+    return {"mean": float(e.mean()), "rms": float(np.sqrt(np.mean(e**2))), "max": float(e.max()),
+            "final": float(e[-1])}
+
+
+@dataclass
+class ControlledScenario(Scenario):
+    """A scenario whose torque law is built for the robot it runs on (e.g. a model-based controller).
+
+    Attributes:
+        make_controller: robot -> controller (a callable tau(t, q, nu)).
+        adapt_robot: Optional robot -> robot (e.g. the same robot with other contacts) used for the run.
+        initial: Optional robot -> (q0, nu0) overriding ``q0``/``nu0``.
+    """
+
+    make_controller: Callable | None = None
+    adapt_robot: Callable | None = None
+    initial: Callable | None = None
+
+    def prepare(self, robot):
+        """(robot used, controller) for a run on ``robot``."""
+        if self.adapt_robot is not None:
+            robot = self.adapt_robot(robot)
+        controller = self.make_controller(robot) if self.make_controller is not None else self.torque
+        return robot, controller
+
+    def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs) -> Trajectory:
+        robot, controller = self.prepare(robot)
+        q0, nu0 = self.initial(robot) if self.initial is not None else self.initial_state(robot)
+        t_end = self.t_end if t_end is None else t_end
+        n_out = n_out or max(2, int(round(self.n_out * t_end / self.t_end)))
+        kwargs.setdefault("rtol", 1e-8)
+        kwargs.setdefault("atol", 1e-10)
+        traj = simulate(robot, t_end, q0, nu0, controller, n_out=n_out, **kwargs)
+        traj.stats["controller"] = controller
+        traj.stats["robot"] = robot
+        return traj
+
+
+__all__ = ["LinearisingController", "PointTask", "CoordinateTask", "Task", "hold", "computed_torque",
+           "tracking_errors", "ControlledScenario"]

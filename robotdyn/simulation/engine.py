@@ -1,0 +1,363 @@
+"""Forward simulation in minimal coordinates.
+
+State: natural coordinates q (n) and independent velocities nu (k). The ODE is
+
+.. math:: \\dot q = S(q)\\nu - \\alpha\\, A_h^+ \\phi(q),\\qquad M_r \\dot\\nu = B_r \\tau(t, q, \\nu) - C_r\\nu - g_r,
+
+integrated either wholly in C++ (:mod:`robotdyn.simulation.compiled_engine`, where the robot is compiled and the torques
+are a :class:`~robotdyn.simulation.torque_profile.TorqueProfile`) or by scipy's ``solve_ivp`` loop (the reference), whose
+right-hand side is one call of the robot's compiled model (:mod:`robotdyn.fast.compiled`) where it serves the robot,
+else the Python path. Velocity constraints hold exactly (v = S nu by construction); the position residuals
+:math:`\\phi` of holonomic rows (loop closures, contacts on a sloped or curved terrain) are pulled back with the
+stabilisation gain :math:`\\alpha` [1/s] (0 disables it, :mod:`robotdyn.reduction.pull_back`) and reported.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..fast.compiled import Fallback
+from ..fast.dispatch import compiled_model
+from .compiled_engine import METHODS, choose_engine, simulate_compiled
+from ..errors import NonFiniteError, RobotDynError, TimeLimitError
+from ..reduction.projection import solve
+from ..reduction.pull_back import correction, failure_note, start_offsets
+from ..reduction.reduced_dynamics import velocity
+from ..contact.sliding import forward as forward_sliding
+from ..contact.sliding import lift_off_message, slipping_wheels
+from .torque_profile import TorqueProfile, as_profile
+
+TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+
+MAX_SAMPLES = 5_000_000
+"""Largest number of output samples of one simulation (memory: 8 bytes x (2n + 3) columns each)."""
+
+
+@dataclass
+class Trajectory:
+    """A simulated motion.
+
+    Attributes:
+        t: Times (N,) [s].
+        q: Natural coordinates (N, n), named by ``coordinates``.
+        nu: Independent velocities (N, k), named by ``velocity_names``.
+        energy: Total mechanical energy at each time (N,) [J].
+        residual: Largest holonomic residual at each time (N,).
+        coordinates, velocity_names: Column names.
+        stats: Integrator statistics (nfev, wall time).
+        units: Unit of each column by name (m, rad, m/s, rad/s).
+        friction_work: Work done by the slipping wheels' friction forces since t = 0 (N,) [J] (<= 0; ``None``
+            without slipping wheels): energy balance E(t) - E(0) = motor work + friction_work.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    nu: np.ndarray
+    energy: np.ndarray
+    residual: np.ndarray
+    coordinates: list[str]
+    velocity_names: list[str]
+    stats: dict = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+    friction_work: np.ndarray | None = None
+
+    def __repr__(self) -> str:
+        return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"
+
+    def column(self, name: str) -> np.ndarray:
+        """A coordinate or independent velocity by name."""
+        if name in self.coordinates:
+            return self.q[:, self.coordinates.index(name)]
+        if name in self.velocity_names:
+            return self.nu[:, self.velocity_names.index(name)]
+        raise RobotDynError(f"no column {name!r}; expected one of {', '.join(self.coordinates + self.velocity_names)}")
+
+    def to_csv(self, path, extra: dict[str, np.ndarray] | None = None) -> None:
+        """Write ``t``, the q columns, the nu columns, then any ``extra`` columns by name (e.g. the wheel loads of
+        :meth:`robotdyn.contact.traction.Traction.columns`)."""
+        from ..output import atomic_output
+
+        extra = extra or {}
+        header = ",".join(["t", *self.coordinates, *self.velocity_names, *extra])
+        data = np.column_stack([self.t, self.q, self.nu, *extra.values()])
+        partial = self.stats.get("partial")
+        with atomic_output(path, "CSV file") as tmp:
+            np.savetxt(tmp, data, delimiter=",", header=header, comments="",
+                       footer=f"# partial: {partial}" if partial else "")  # a comment line: loadtxt skips it
+
+
+class _Progress:
+    """Prints the simulated time to stderr at most once a second, once the run has taken more than a second, and
+    raises :class:`~robotdyn.errors.TimeLimitError` once the run has taken longer than its wall-clock limit."""
+
+    def __init__(self, t_end: float, enabled: bool, time_limit: float | None = None) -> None:
+        self.t_end, self.enabled, self.time_limit = t_end, enabled, time_limit
+        self.start = self.last = time.perf_counter()
+
+    @property
+    def needed(self) -> bool:
+        """Whether calling it can do anything (print or stop)."""
+        return self.enabled or self.time_limit is not None
+
+    def __call__(self, t: float) -> None:
+        if not self.needed:
+            return
+        now = time.perf_counter()
+        if self.time_limit is not None and now - self.start > self.time_limit:
+            raise TimeLimitError(f"the run exceeded its time limit of {self.time_limit:g} s at t = {t:.3g} s of "
+                                 f"{self.t_end:g} s (a stiff or blown-up run; a longer time limit allows more)")
+        if self.enabled and now - self.last >= 1.0:
+            self.last = now
+            print(f"simulate: t = {t:.2f} / {self.t_end:g} s ({100 * t / self.t_end:.0f}%)", file=sys.stderr, flush=True)
+
+
+def simulate(
+    robot,
+    t_end: float,
+    q0,
+    nu0,
+    torque: TorqueFunction | None = None,
+    n_out: int = 1001,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    method: str | None = None,
+    stabilisation: float = 10.0,
+    progress: bool = True,
+    engine: str = "auto",
+    time_limit: float | None = None,
+) -> Trajectory:
+    """Integrate the reduced equations from (q0, nu0) over [0, t_end].
+
+    Two engines integrate the same ODE: the compiled one (:mod:`robotdyn.simulation.compiled_engine`: the whole run in
+    C++, Boost.Odeint's adaptive Adams-Bashforth-Moulton by default) and scipy's (``solve_ivp``'s DOP853 loop, the
+    reference, with a Python call per evaluation). Both restart at the breakpoints of a torque profile. ``engine="auto"`` takes the compiled one where the robot has a compiled
+    model (:func:`robotdyn.fast.compiled.why_not`; slipping wheels with a compiled friction law included, exact
+    stick-slip not), and the torques are ``None`` or a
+    :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (a Python callable needs the scipy engine); ``stats["engine"]``
+    says which ran.
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        t_end: Final time [s] (> 0).
+        q0: Initial natural coordinates (must satisfy the holonomic constraints).
+        nu0: Initial independent velocities.
+        torque: Motor torques: a :class:`~robotdyn.simulation.torque_profile.TorqueProfile`, any callable ``tau(t, q, nu)``
+            (scipy engine), or ``None`` for no actuation.
+        n_out: Number of output samples.
+        rtol, atol: Error tolerances (relative, absolute per component) of either engine.
+        method: The integrator: a ``scipy.integrate.solve_ivp`` method (default DOP853) or one of
+            :data:`robotdyn.simulation.compiled_engine.METHODS` (default adams); it selects the engine too.
+        stabilisation: Gain [1/s] pulling holonomic residuals back to zero (:mod:`robotdyn.reduction.pull_back`).
+        progress: Print progress to stderr on long runs.
+        engine: ``auto``, ``compiled`` (an error naming why where it cannot run) or ``scipy``.
+        time_limit: Wall-clock limit of the run [s] (None: none): past it the run raises
+            :class:`~robotdyn.errors.TimeLimitError` (checked at every evaluation on the Python paths, about every
+            50 ms on the compiled engine), so that a stiff or blown-up run in a sweep cannot stall it.
+    """
+    if not np.isfinite(t_end) or t_end <= 0:
+        raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
+    if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
+        raise RobotDynError(f"time_limit = {time_limit} s; expected a positive wall-clock duration or None")
+    if not 2 <= n_out <= MAX_SAMPLES:
+        width = 2 * robot.nq + 3
+        raise RobotDynError(f"{n_out:.3g} output samples for t_end = {t_end:g} s ({8 * width * n_out / 1e9:.3g} GB); "
+                            f"expected 2 to {MAX_SAMPLES:,} samples: give a shorter duration or fewer samples")
+    q0 = robot.check_q(q0)
+    nu0 = robot.check_nu(nu0)
+    if isinstance(torque, TorqueProfile):
+        as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
+    robot.check_constraints(q0)
+    offsets = start_offsets(robot, q0, stabilisation)
+    compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
+    if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):  # exact switching: segment by segment
+        from .stick_slip import simulate as simulate_stick_slip
+
+        return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
+                                   method or "DOP853", stabilisation, progress, time_limit=time_limit)
+    if compiled_engine:
+        return simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
+                                 stabilisation, _Progress(t_end, progress, time_limit), offsets)
+    method = method or "DOP853"
+    n = robot.nq
+    zero_tau = np.zeros(len(robot.motors))
+    report = _Progress(t_end, progress, time_limit)
+
+    from scipy.integrate import solve_ivp
+
+    slipping = slipping_wheels(robot)
+    fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path
+    k = robot.mobility
+
+    # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.reduction.reduced_dynamics.solve_mass)
+    robot.forward_dynamics(q0, nu0, zero_tau if torque is None else np.asarray(torque(0.0, q0, nu0), float))
+
+    def finite(t: float, y: np.ndarray) -> None:  # on the Python paths only: the compiled one stays lean
+        if not np.isfinite(y).all():
+            raise NonFiniteError(f"the state became non-finite at t = {t:.6g} s (the dynamics blew up: massless "
+                                 "bodies, a singular state, or torques beyond what double precision holds)")
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        q, nu = y[:n], y[n:n + k]
+        tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
+        if slipping:  # normal loads and friction solved with the accelerations; y[-1] is the friction work
+            finite(t, y)
+            st = forward_sliding(robot, q, nu, tau)
+            report(t)
+            return np.concatenate([_qdot(st.reduced, stabilisation), st.nudot, [st.power]])
+        if fast is not None:
+            try:  # the whole right-hand side in one compiled call (robotdyn.fast.compiled)
+                out = fast.rhs(q, nu, tau, stabilisation)
+                report(t)
+                return out
+            except Fallback:
+                pass
+        finite(t, y)
+        red = robot.reduced(q, nu)
+        nudot = solve(red.M, red.B @ tau - red.h)  # numpy.linalg.solve's LAPACK call, without its overhead
+        report(t)
+        return np.concatenate([_qdot(red, stabilisation), nudot])
+
+    events = None
+    if slipping:
+        def lift_off(t: float, y: np.ndarray) -> float:  # the smallest normal load of a slipping wheel [N]
+            q, nu = y[:n], y[n:n + k]
+            tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
+            return float(np.min(forward_sliding(robot, q, nu, tau).normal))
+
+        lift_off.terminal, lift_off.direction = True, -1.0
+        events = [lift_off]
+    t_eval = np.linspace(0.0, t_end, n_out)
+    start = time.perf_counter()
+    y0 = np.concatenate([q0, nu0, [0.0] if slipping else []])
+    interrupted = None
+    if events is None:
+        breaks = torque.breakpoints() if isinstance(torque, TorqueProfile) else ()
+        sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks)
+    else:
+        sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
+    wall = time.perf_counter() - start
+    if not sol.success:
+        raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}"
+                            + failure_note(robot, sol.y[:n, -1], stabilisation))
+    stats_event = None
+    if slipping and sol.status == 1:  # a slipping wheel's load reached zero: the contact model ends there
+        t_ev, y_ev = sol.t_events[0][0], sol.y_events[0][0]
+        stats_event = lift_off_message(robot, t_ev, y_ev[:n], y_ev[n:n + k], zero_tau if torque is None else
+                                       np.asarray(torque(t_ev, y_ev[:n], y_ev[n:n + k]), float))
+        print(f"simulate: {stats_event}", file=sys.stderr, flush=True)
+    q, nu = sol.y[:n].T, sol.y[n:n + k].T
+    energy = np.empty(len(sol.t))
+    residual = np.zeros(len(sol.t))
+    times = sol.t
+    try:
+        for i in range(len(sol.t)):
+            v, res, holonomic = _velocity(robot, fast, q[i], nu[i])
+            energy[i] = robot.energy(q[i], v)
+            if holonomic.any():
+                residual[i] = np.max(np.abs(res[holonomic]))
+    except KeyboardInterrupt:  # keep the samples whose energy and residual are known
+        times, q, nu, energy, residual = sol.t[:i], q[:i], nu[:i], energy[:i], residual[:i]
+        interrupted = (f"interrupted after the integration, while computing energies: samples up to t = "
+                       f"{times[-1] if i else 0.0:.6g} s of {t_end:g} s")
+    stats = {"nfev": int(sol.nfev), "wall": wall, "method": method, "rtol": rtol, "engine": f"scipy ({method})"}
+    if interrupted is not None:
+        stats["partial"] = interrupted
+    if stats_event:
+        stats["event"] = stats_event
+        stats["t_event"] = float(sol.t_events[0][0])
+    if offsets:
+        stats["offsets"] = offsets
+    return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
+                      robot.units, sol.y[n + k][: len(times)] if slipping else None)
+
+
+def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarray, rtol: float, atol: float,
+               breaks=()):
+    """scipy's ``solve_ivp`` loop (the same solver, steps and dense output at ``t_eval``, so the same numbers),
+    written out so that an interruption (Ctrl-C, SIGTERM) keeps what was computed: returns the solution object
+    and, if interrupted, a message saying up to which time the samples reach. The solver is restarted at each of
+    ``breaks`` inside (0, t_end) (the kinks of a torque profile), so that no step spans one."""
+    from types import SimpleNamespace
+
+    from scipy.integrate._ivp.ivp import METHODS as SCIPY
+
+    bounds = [0.0, *sorted(float(b) for b in breaks if 0.0 < b < t_end), t_end]
+    ts, ys, i, status, message, interrupted, nfev = [], [], 0, None, "", None, 0
+    y, solver = y0, None
+    try:
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            if solver is not None:
+                nfev += solver.nfev
+            solver = SCIPY[method](rhs, a, y, b, rtol=rtol, atol=atol)
+            status = None
+            while status is None:
+                message = solver.step()
+                if solver.status == "finished":
+                    status = 0
+                elif solver.status == "failed":
+                    status = -1
+                    break
+                j = np.searchsorted(t_eval, solver.t, side="right")
+                if j > i:
+                    dense = solver.dense_output()
+                    ts.append(t_eval[i:j])
+                    ys.append(np.atleast_2d(dense(t_eval[i:j])).reshape(len(y0), j - i))
+                    i = j
+            if status == -1:
+                break
+            y = solver.y
+    except KeyboardInterrupt:
+        status = 0
+        del ts[len(ys):], ys[len(ts):]  # the signal may fall between the two appends
+        reached = float(ts[-1][-1]) if ts else 0.0
+        now = solver.t if solver is not None else 0.0
+        interrupted = f"interrupted at t = {now:.6g} s: samples up to t = {reached:.6g} s of {t_end:g} s"
+    nfev += solver.nfev if solver is not None else 0
+    t = np.concatenate(ts) if ts else np.zeros(0)
+    y = np.hstack(ys) if ys else np.zeros((len(y0), 0))
+    if status == -1:
+        t, y = np.append(t, solver.t), np.column_stack([y, solver.y]) if y.size else solver.y[:, None]
+    return SimpleNamespace(t=t, y=y, success=status >= 0, message=message or "", nfev=nfev,
+                           status=status), interrupted
+
+
+def _qdot(red, stabilisation: float) -> np.ndarray:
+    """:math:`\\dot q = v - \\alpha A_h^+\\phi`: the velocity with the holonomic residuals pulled back."""
+    qdot = red.v
+    rows = red.jacobian_rows
+    hol = rows.holonomic
+    if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
+        qdot = qdot - stabilisation * correction(rows.A[hol], rows.residual[hol])
+    return qdot
+
+
+def _velocity(robot, fast, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """v = S nu, the constraint residuals and which rows are holonomic: from the compiled model when it serves
+    the robot, else from the Python path's kinematics (without dynamics)."""
+    if fast is not None:
+        try:
+            out = fast.evaluate(q, nu)
+            return out[6], out[8], fast.holonomic
+        except Fallback:
+            pass
+    v, rows = velocity(robot, q, nu)
+    return v, rows.residual, rows.holonomic
+
+
+def power(robot, traj: Trajectory, torque: TorqueFunction | None) -> np.ndarray:
+    """Motor power :math:`\\tau^T B_r^T \\nu` [W] along a trajectory (dE/dt must equal it without friction)."""
+    out = np.zeros(len(traj.t))
+    if torque is None:
+        return out
+    for i, t in enumerate(traj.t):
+        red = robot.reduced(traj.q[i], traj.nu[i])
+        out[i] = np.asarray(torque(t, traj.q[i], traj.nu[i]), float) @ red.B.T @ traj.nu[i]
+    return out
+
+
+__all__ = ["simulate", "power", "Trajectory"]

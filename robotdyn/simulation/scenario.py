@@ -1,0 +1,64 @@
+"""Named scenarios: an initial state, an input law and a duration, run through :func:`robotdyn.simulation.engine.simulate`."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import RobotDynError
+from .engine import Trajectory, simulate
+
+
+@dataclass
+class Scenario:
+    """A reproducible manoeuvre.
+
+    Attributes:
+        name: Identifier (``robotdyn simulate ROBOT --scenario NAME``).
+        description: One line, citing the paper's section.
+        t_end: Default duration [s].
+        torque: Motor torques: a :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (simulated by the compiled engine)
+            or any ``tau(t, q, nu)`` (the scipy engine); None: unactuated.
+        q0, nu0: Initial coordinates and independent velocities by name (missing entries are zero).
+        n_out: Default number of output samples.
+        plot: Columns to plot (the paper's figures); default all independent velocities.
+        zoom: Length [s] of the zoomed transient window in plots (``None``: no zoom column).
+        references: Horizontal reference lines per plotted column (the paper's printed values).
+    """
+
+    name: str
+    description: str
+    t_end: float
+    torque: Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None = None
+    q0: dict[str, float] = field(default_factory=dict)
+    nu0: dict[str, float] = field(default_factory=dict)
+    n_out: int = 1801
+    plot: list[str] = field(default_factory=list)
+    zoom: float | None = None
+    references: dict[str, list[tuple[float, str]]] = field(default_factory=dict)
+
+    def initial_state(self, robot) -> tuple[np.ndarray, np.ndarray]:
+        """(q0, nu0) as vectors for ``robot``."""
+        q0 = robot.neutral()
+        for label, value in self.q0.items():
+            q0[robot.coordinate_index(label)] = value
+        nu0 = np.zeros(robot.mobility)
+        for label, value in self.nu0.items():
+            nu0[robot.velocity_names.index(label)] = value
+        return q0, nu0
+
+    def span(self, t_end: float | None = None, n_out: int | None = None) -> tuple[float, int]:
+        """The duration [s] (default the scenario's; checked finite and positive) and the number of output samples
+        (default: the scenario's sampling rate over that duration)."""
+        t_end = self.t_end if t_end is None else float(t_end)
+        if not np.isfinite(t_end) or t_end <= 0:
+            raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
+        return t_end, n_out or max(2, int(round(self.n_out * t_end / self.t_end)))
+
+    def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs) -> Trajectory:
+        """Simulate the scenario on ``robot`` (keyword arguments go to :func:`~robotdyn.simulation.engine.simulate`)."""
+        t_end, n_out = self.span(t_end, n_out)
+        q0, nu0 = self.initial_state(robot)
+        return simulate(robot, t_end, q0, nu0, self.torque, n_out=n_out, **kwargs)

@@ -1,0 +1,276 @@
+"""Exact stick-slip: wheels that roll without slipping while their contact force lies inside the friction cone
+and slide under Coulomb friction when it would leave it, switched by events of the integrator (no regularisation).
+
+A :class:`StickSlipWheel` is in one of two phases:
+
+- **stick**: the three rolling rows (longitudinal, lateral, normal) are constraints; its contact force
+  :math:`(\\lambda_t, \\lambda_n)` comes from :mod:`robotdyn.contact.contact_forces`. Event: :math:`\\mu\\lambda_n -
+  \\|\\lambda_t\\| = 0` (decreasing) switches it to sliding, with the slip direction
+  :math:`\\hat s_0 = -\\lambda_t/\\|\\lambda_t\\|` (the friction force is continuous at the switch: the motion starts
+  opposite to the force the ground was exerting).
+- **slide**: only the normal row is a constraint; the friction force is Coulomb's :math:`-\\mu f_n \\hat s` with
+  :math:`\\hat s = s/\\|s\\|` (:math:`\\hat s_0` while :math:`\\|s\\|` is below 1e-12 m/s), the normal load solved
+  together with the accelerations (:func:`robotdyn.contact.sliding.forward`). Event: :math:`s\\cdot\\hat s_0 = 0`
+  (decreasing) tries sticking: the wheel sticks if the sticking solution's force lies inside the cone, else it
+  keeps sliding in the direction of that force (``shared/notes/contact-forces-and-friction.md``).
+
+Lift-off (a normal load reaching zero, decreasing) stops the run with a message naming the wheel, time and load.
+The independent velocities change with the phases, so :func:`simulate` integrates segment by segment and reports
+the full velocities v; the projection is rebuilt at every switch.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from ..contact.contact_forces import constraint_forces
+from ..errors import RobotDynError
+from ..reduction.projection import auto_independent
+from ..constraints.rolling_contact import RollingWheel
+from ..contact.sliding import forward as forward_sliding
+from ..contact.sliding import sliding_now
+from ..contact.sliding import tangential as slip
+
+_STICK = (np.eye(3), ("longitudinal", "lateral", "normal"))
+_SLIDE = (np.array([[0.0, 0.0, 1.0]]), ("normal",))
+SLIP_ZERO = 1e-12
+"""Slip speed [m/s] below which a sliding wheel's friction keeps the direction it started with."""
+
+
+class StickSlipWheel(RollingWheel):
+    """A standard wheel with Coulomb friction coefficient ``mu`` that sticks (rolls) or slides (see the module).
+
+    Takes the arguments of :class:`~robotdyn.constraints.rolling_contact.RollingWheel` and:
+
+    Args:
+        mu: Friction coefficient (>= 0), the same for sticking and sliding.
+    """
+
+    def __init__(self, description, frame: str, radius: float, mu: float, **kwargs) -> None:
+        super().__init__(description, frame, radius, **kwargs)
+        self.mu = float(mu)
+        self.set_phase("stick")
+
+    def __repr__(self) -> str:
+        return f"StickSlipWheel(frame={self.frame!r}, radius={self.radius}, mu={self.mu}, phase={self.phase!r})"
+
+    def set_phase(self, phase: str, direction: np.ndarray | None = None) -> None:
+        """Switch to ``stick`` or to ``slide`` (with the initial slip direction (2,) in (t1, t2))."""
+        self.phase = phase
+        self._directions, self._row_names = _STICK if phase == "stick" else _SLIDE
+        self.direction = None if direction is None else np.asarray(direction, float) / np.linalg.norm(direction)
+
+    @property
+    def sliding(self) -> bool:
+        """Whether its tangential force currently comes from Coulomb friction."""
+        return self.phase == "slide"
+
+    def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
+        """Coulomb's :math:`\\mu\\hat s` (the friction force is :math:`-f_n\\mu\\hat s`)."""
+        speed = float(np.hypot(s[0], s[1]))
+        return self.mu * (s / speed if speed > SLIP_ZERO else self.direction)
+
+    def jacobian(self, kin):  # an override keeps the wheel off the grouped and compiled paths (its rows change)
+        return super().jacobian(kin)
+
+
+def _configure(robot) -> None:
+    """Choose the independent velocities for the wheels' current phases (the spec's choice where it still fits)."""
+    robot._projection_hint = None
+    A = robot.rows_at(robot._stick_slip_q).A
+    mobility = robot.nq - np.linalg.matrix_rank(A) if A.size else robot.nq
+    spec = robot.spec.independent
+    if spec is not None and len(spec) == mobility:
+        robot.independent_indices = np.array([robot.coordinate_index(c) for c in spec], dtype=int)
+    else:
+        robot.independent_indices = auto_independent(A)
+    robot.velocity_names = [robot.velocity_labels[i] for i in robot.independent_indices]
+
+
+def _phases(robot) -> list[StickSlipWheel]:
+    return [c for c in robot.constraints if isinstance(c, StickSlipWheel)]
+
+
+def _forces(robot, q, nu, tau):
+    return constraint_forces(robot, q, nu, tau=tau)
+
+
+def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: float = 1e-10,
+             atol: float = 1e-12, method: str = "DOP853", stabilisation: float = 10.0, progress: bool = True,
+             max_switches: int = 10_000, time_limit: float | None = None):
+    """Integrate a robot with stick-slip wheels over [0, t_end] from (q0, v0), switching phases exactly.
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` with :class:`StickSlipWheel` constraints.
+        t_end: Duration [s] (> 0).
+        q0: Initial natural coordinates; v0: initial full velocities (n,) (each wheel starts sliding where its
+            slip speed exceeds 1e-9 m/s, else sticking; a sticking wheel outside its cone starts sliding).
+        torque: Motor torques ``tau(t, q, nu)`` (None: unactuated); nu are the current phase's independent
+            velocities, so torque laws should use q (or the returned full velocities) only.
+        max_switches: Bound on the number of phase switches (Zeno behaviour stops the run with a message).
+        time_limit: Wall-clock limit [s] (None: none), as in :func:`robotdyn.simulation.engine.simulate`.
+
+    Returns:
+        A :class:`~robotdyn.simulation.engine.Trajectory` whose velocity columns are the full velocities v (named
+        ``<coordinate>_dot``), with ``friction_work`` and ``stats["switches"]`` (time, wheel, phase) and, where the
+        run stopped early, ``stats["event"]``.
+    """
+    from scipy.integrate import solve_ivp
+
+    from .engine import Trajectory, _Progress, _qdot
+
+    if not np.isfinite(t_end) or t_end <= 0:
+        raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
+    wheels = _phases(robot)
+    q = robot.check_q(q0)
+    v = np.asarray(v0, float)
+    if v.shape != (robot.nq,) or not np.all(np.isfinite(v)):
+        raise RobotDynError(f"v0 has shape {v.shape}; expected {robot.nq} finite full velocities")
+    robot.check_constraints(q)
+    zero_tau = np.zeros(len(robot.motors))
+    n = robot.nq
+    kin = _kin(robot, q, v)
+    for w in wheels:
+        s = slip(w, kin)[1]
+        w.set_phase("slide", s) if np.linalg.norm(s) > 1e-9 else w.set_phase("stick")
+    grid = np.linspace(0.0, t_end, n_out)
+    out_t, out_q, out_v, out_w = [], [], [], []
+    switches, stop, work, t = [], None, 0.0, 0.0
+    start = time.perf_counter()
+    nfev = 0
+    last_report = start
+    limit = _Progress(t_end, False, time_limit)  # raises past the time limit (the reports are printed below)
+    while True:
+        robot._stick_slip_q = q
+        _configure(robot)
+        nu = v[robot.independent_indices]
+        tau_at = (lambda tt, qq, nn: zero_tau) if torque is None else \
+            (lambda tt, qq, nn: np.asarray(torque(tt, qq, nn), float))
+        # a sticking wheel whose force is outside the cone starts sliding at once (opposite to that force)
+        forces = _forces(robot, q, nu, tau_at(t, q, nu))
+        unknown = [w.name for w in wheels if w.phase == "stick" and not forces.wheel(w.name).load_determined]
+        if unknown:
+            raise RobotDynError(
+                f"the sticking forces of wheels {', '.join(unknown)} are not determined by rigid-body dynamics at "
+                f"t = {t:.6g} s (statically indeterminate contacts), so the friction cone cannot decide sticking; "
+                "expected determinate contacts, or a compliant friction law (friction = 'linear' or 'coulomb')")
+        moved = False
+        for w in wheels:
+            if w.phase == "stick":
+                f = forces.wheel(w.name)
+                if w.mu * f.normal - np.hypot(f.force[0], f.force[1]) < -1e-12 * max(1.0, abs(f.normal)):
+                    w.set_phase("slide", -f.force[:2])
+                    switches.append({"t": t, "wheel": w.name, "phase": "slide"})
+                    moved = True
+        if moved:
+            continue
+        k = len(nu)
+
+        def rhs(tt, y, k=k):
+            nonlocal nfev, last_report
+            nfev += 1
+            qq, nn = y[:n], y[n:n + k]
+            tau = tau_at(tt, qq, nn)
+            limit(tt)
+            if progress and time.perf_counter() - last_report > 1.0:
+                last_report = time.perf_counter()
+                print(f"simulate: t = {tt:.3f} / {t_end:g} s", file=sys.stderr, flush=True)
+            if sliding_now(robot):
+                st = forward_sliding(robot, qq, nn, tau)
+                return np.concatenate([_qdot(st.reduced, stabilisation), st.nudot, [st.power]])
+            red = robot.reduced(qq, nn)
+            return np.concatenate([_qdot(red, stabilisation), np.linalg.solve(red.M, red.B @ tau - red.h), [0.0]])
+
+        events = _events(robot, wheels, n, k, tau_at)
+        seg = grid[(grid > t) | ((grid == 0.0) & (t == 0.0))]
+        if len(seg) and seg[-1] < t_end:
+            seg = np.append(seg, t_end)
+        sol = solve_ivp(rhs, (t, t_end), np.concatenate([q, nu, [work]]), method=method, rtol=rtol, atol=atol,
+                        t_eval=seg if len(seg) else None, events=[e for e, _, _ in events])
+        if not sol.success:
+            raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}")
+        for i, tt in enumerate(sol.t):
+            if tt in grid or tt == t_end:
+                out_t.append(tt)
+                out_q.append(sol.y[:n, i])
+                out_v.append(robot.velocity(sol.y[:n, i], sol.y[n:n + k, i]))
+                out_w.append(sol.y[-1, i])
+        if sol.status != 1:
+            break
+        fired = [i for i, te in enumerate(sol.t_events) if len(te)]
+        i = min(fired, key=lambda j: sol.t_events[j][0])
+        t, y = float(sol.t_events[i][0]), sol.y_events[i][0]
+        q, nu, work = y[:n], y[n:n + k], float(y[-1])
+        v = robot.velocity(q, nu)
+        _, wheel, kind = events[i]
+        if kind == "lift-off":
+            load = _forces(robot, q, nu, tau_at(t, q, nu)).wheel(wheel.name).normal
+            stop = (f"lift-off of wheel {wheel.name} at t = {t:.6g} s (normal load {load:.3g} N): the run stops "
+                    "there (a wheel in flight is not modelled)")
+            print(f"simulate: {stop}", file=sys.stderr, flush=True)
+            break
+        if kind == "slide":  # the cone is reached: slide opposite to the sticking force
+            f = _forces(robot, q, nu, tau_at(t, q, nu)).wheel(wheel.name)
+            wheel.set_phase("slide", -f.force[:2])
+        else:  # the slip along its initial direction reached zero: stick, if the sticking force is in the cone
+            wheel.set_phase("stick")
+            robot._stick_slip_q = q
+            _configure(robot)
+            v = robot.velocity(q, v[robot.independent_indices])  # the rolling rows hold from here on
+        switches.append({"t": t, "wheel": wheel.name, "phase": wheel.phase})
+        if len(switches) > max_switches:
+            stop = f"more than {max_switches} phase switches by t = {t:.6g} s (Zeno behaviour); the run stops there"
+            print(f"simulate: {stop}", file=sys.stderr, flush=True)
+            break
+    wall = time.perf_counter() - start
+    T = np.array(out_t)
+    Q = np.array(out_q).reshape(len(T), n)
+    V = np.array(out_v).reshape(len(T), n)
+    energy = np.array([robot.energy(qq, vv) for qq, vv in zip(Q, V)])
+    residual = np.array([np.max(np.abs(robot.constraint_residual(qq)), initial=0.0) for qq in Q])
+    stats = {"nfev": nfev, "wall": wall, "method": method, "rtol": rtol, "switches": switches}
+    if stop:
+        stats["event"] = stop
+    return Trajectory(T, Q, V, energy, residual, list(robot.coordinates), list(robot.velocity_labels), stats,
+                      robot.units, np.array(out_w))
+
+
+def _kin(robot, q, v):
+    from ..constraints.constraint import KinematicState
+
+    return KinematicState(robot.model, robot.data, q, v)
+
+
+def _events(robot, wheels, n, k, tau_at):
+    """Event functions of the current phases: (function, wheel, the phase it leads to or ``lift-off``)."""
+    out = []
+
+    def state(t, y):
+        qq, nn = y[:n], y[n:n + k]
+        return qq, nn, _forces(robot, qq, nn, tau_at(t, qq, nn))
+
+    for w in wheels:
+        if w.phase == "stick":
+            def cone(t, y, w=w):
+                f = state(t, y)[2].wheel(w.name)
+                return w.mu * f.normal - np.hypot(f.force[0], f.force[1])
+
+            cone.terminal, cone.direction = True, -1.0
+            out.append((cone, w, "slide"))
+        else:
+            def stops(t, y, w=w):
+                qq, nn = y[:n], y[n:n + k]
+                return float(slip(w, _kin(robot, qq, robot.velocity(qq, nn)))[1] @ w.direction)
+
+            stops.terminal, stops.direction = True, -1.0
+            out.append((stops, w, "stick"))
+
+        def lift(t, y, w=w):
+            return state(t, y)[2].wheel(w.name).normal
+
+        lift.terminal, lift.direction = True, -1.0
+        out.append((lift, w, "lift-off"))
+    return out

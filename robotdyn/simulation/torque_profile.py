@@ -1,0 +1,238 @@
+"""Motor torques as data: profiles of time that the compiled integrator evaluates without Python.
+
+A scenario's torques ``tau(t, q, nu)`` may be any Python callable on the scipy path of
+:func:`robotdyn.simulation.engine.simulate`; the compiled integrator (:mod:`robotdyn.simulation.compiled_engine`) runs without
+the GIL and therefore takes torques as data: a :class:`TorqueProfile`, a sum of terms, each a vector over the
+motors [N m or N] times a scalar function of time:
+
+- :class:`Constant`: :math:`\\tau = c`;
+- :class:`Sine`: :math:`\\tau = c \\sin(\\omega t + \\varphi)` inside a window :math:`t_0 \\le t \\le t_1`, zero
+  outside (e.g. Staicu's Quasimoro pulse, eq 19: :math:`0.1 \\sin(\\pi t)` for :math:`t \\le 1` s);
+- :class:`Table`: piecewise-linear interpolation of values at increasing times, held constant outside them;
+- sums of these (``a + b``, or :class:`Sum`).
+
+A profile is callable with the scipy path's signature ``profile(t, q, nu)`` (q and nu are ignored), and
+:meth:`TorqueProfile.encode` gives the flat arrays the C++ side reads (``robotdyn/_compiled.cpp``,
+``TorqueProfile``), which evaluates every term with the same floating-point operations in the same order (libm's
+``sin`` on both sides), so that both paths see the same torques bit for bit (``tests/test_torque_profile.py``).
+:meth:`TorqueProfile.breakpoints` lists the times where a profile is not smooth (window edges, table knots): the
+compiled integrator steps onto them instead of stepping across a kink. Profiles pickle (for worker processes).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InputError
+
+CONSTANT, SINE, TABLE = 0, 1, 2
+"""Term kinds in :meth:`TorqueProfile.encode` (the C++ side's codes)."""
+
+
+def _values(values, what: str) -> np.ndarray:
+    out = np.atleast_1d(np.asarray(values, dtype=float))
+    if out.ndim != 1 or not np.all(np.isfinite(out)):
+        raise InputError(f"{what} = {values!r}; expected a finite torque per motor [N m or N]")
+    return out
+
+
+class TorqueProfile:
+    """Base class: a sum of terms (see the module docstring). Subclasses define :meth:`_terms`."""
+
+    @property
+    def motors(self) -> int:
+        """Number of motors (length of the torque vector)."""
+        return self._all()[0][1].shape[-1]
+
+    def _all(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        """:meth:`_terms`, built once (profiles are not changed after construction)."""
+        terms = self.__dict__.get("_cache")
+        if terms is None:
+            terms = self.__dict__["_cache"] = self._terms()
+        return terms
+
+    def _terms(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        """``(kind, coefficients, parameters)`` per term (see :meth:`encode`)."""
+        raise NotImplementedError
+
+    def __call__(self, t: float, q=None, nu=None) -> np.ndarray:
+        """The motor torques at time t [s] (q, nu ignored: the scipy path's ``tau(t, q, nu)`` signature)."""
+        t = float(t)
+        terms = self._all()
+        out = np.zeros(terms[0][1].shape[-1])
+        for kind, coef, par in terms:
+            if kind == CONSTANT:
+                out = out + coef
+            elif kind == SINE:
+                if par[2] <= t <= par[3]:
+                    out = out + coef * math.sin(par[0] * t + par[1])
+            else:  # coef: (points, motors) values, par: the times
+                out = out + _interpolate(par, coef, t)
+        return out
+
+    def breakpoints(self) -> np.ndarray:
+        """Sorted times [s] where the profile or its derivative jumps (window edges, table knots)."""
+        points = []
+        for kind, _, par in self._all():
+            if kind == SINE:
+                points += [x for x in par[2:4] if math.isfinite(x)]
+            elif kind == TABLE:
+                points += list(par)
+        return np.unique(np.asarray(points, float))
+
+    def encode(self) -> tuple[list[int], list[np.ndarray], list[np.ndarray]]:
+        """The terms as the C++ side reads them: kinds, coefficient arrays ((motors,) or (points, motors)) and
+        parameter arrays (sine: omega [rad/s], phase [rad], window start and end [s]; table: the times [s])."""
+        terms = self._all()
+        return ([k for k, _, _ in terms], [np.ascontiguousarray(c, float) for _, c, _ in terms],
+                [np.ascontiguousarray(p, float) for _, _, p in terms])
+
+    def __add__(self, other: TorqueProfile) -> Sum:
+        if not isinstance(other, TorqueProfile):
+            return NotImplemented
+        return Sum(self, other)
+
+    def scaled(self, factor: float) -> TorqueProfile:
+        """The profile times a finite scalar ``factor`` (every term's coefficients scaled)."""
+        return Scaled(self, factor)
+
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, TorqueProfile):
+            return NotImplemented
+        a, b = self._all(), other._all()
+        return len(a) == len(b) and all(ka == kb and np.array_equal(ca, cb) and np.array_equal(pa, pb)
+                                        for (ka, ca, pa), (kb, cb, pb) in zip(a, b))
+
+    __hash__ = None
+
+
+def _interpolate(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
+    """Piecewise-linear interpolation, held constant outside [times[0], times[-1]] (the C++ side's formula)."""
+    if t <= times[0]:
+        return values[0]
+    if t >= times[-1]:
+        return values[-1]
+    i = int(np.searchsorted(times, t, side="right")) - 1
+    s = (t - times[i]) / (times[i + 1] - times[i])
+    return values[i] + s * (values[i + 1] - values[i])
+
+
+class Constant(TorqueProfile):
+    """Constant torques ``values`` (one per motor) [N m or N]."""
+
+    def __init__(self, values) -> None:
+        self.values = _values(values, "torques")
+
+    def _terms(self):
+        return [(CONSTANT, self.values, np.zeros(0))]
+
+    def __repr__(self) -> str:
+        return f"Constant({self.values.tolist()})"
+
+
+class Sine(TorqueProfile):
+    """:math:`\\tau = a \\sin(\\omega t + \\varphi)` for ``start <= t <= stop``, zero outside.
+
+    Args:
+        amplitude: Per motor [N m or N].
+        omega: Angular frequency [rad/s].
+        phase: [rad].
+        start, stop: The window [s] (default: always on).
+    """
+
+    def __init__(self, amplitude, omega: float, phase: float = 0.0, start: float = -math.inf,
+                 stop: float = math.inf) -> None:
+        self.amplitude = _values(amplitude, "amplitude")
+        self.omega, self.phase, self.start, self.stop = float(omega), float(phase), float(start), float(stop)
+        if not (math.isfinite(self.omega) and math.isfinite(self.phase)):
+            raise InputError(f"sine torque: omega = {omega!r}, phase = {phase!r}; expected finite numbers")
+        if math.isnan(self.start) or math.isnan(self.stop) or self.start > self.stop:
+            raise InputError(f"sine torque window [{start!r}, {stop!r}] s; expected start <= stop")
+
+    def _terms(self):
+        return [(SINE, self.amplitude, np.array([self.omega, self.phase, self.start, self.stop]))]
+
+    def __repr__(self) -> str:
+        return (f"Sine({self.amplitude.tolist()}, omega={self.omega:g}, phase={self.phase:g}, "
+                f"window=[{self.start:g}, {self.stop:g}] s)")
+
+
+class Table(TorqueProfile):
+    """Piecewise-linear torques through ``values[i]`` at ``times[i]`` (strictly increasing) [s], held at the first
+    and last values outside them.
+
+    Args:
+        times: (points,) [s].
+        values: (points, motors) [N m or N].
+    """
+
+    def __init__(self, times, values) -> None:
+        self.times = np.asarray(times, dtype=float)
+        self.values = np.asarray(values, dtype=float)
+        if self.values.ndim == 1:
+            self.values = self.values[:, None]
+        if (self.times.ndim != 1 or self.times.size < 1 or self.values.shape[0] != self.times.size
+                or self.values.shape[1] == 0):
+            raise InputError(f"torque table: times {self.times.shape}, values {self.values.shape}; expected "
+                             "(points,) and (points, motors)")
+        if not (np.all(np.isfinite(self.times)) and np.all(np.isfinite(self.values))):
+            raise InputError("torque table: expected finite times and values")
+        if np.any(np.diff(self.times) <= 0):
+            raise InputError("torque table: expected strictly increasing times")
+
+    def _terms(self):
+        return [(TABLE, self.values, self.times)]
+
+    def __repr__(self) -> str:
+        return f"Table({self.times.size} points, {self.times[0]:g} .. {self.times[-1]:g} s)"
+
+
+class Sum(TorqueProfile):
+    """The sum of profiles (all with the same number of motors)."""
+
+    def __init__(self, *parts: TorqueProfile) -> None:
+        if not parts or not all(isinstance(p, TorqueProfile) for p in parts):
+            raise InputError("a sum of torque profiles needs at least one TorqueProfile")
+        if len({p.motors for p in parts}) != 1:
+            raise InputError(f"torque profiles for {sorted({p.motors for p in parts})} motors cannot be added")
+        self.parts = parts
+
+    def _terms(self):
+        return [term for p in self.parts for term in p._terms()]
+
+    def __repr__(self) -> str:
+        return " + ".join(repr(p) for p in self.parts)
+
+
+class Scaled(TorqueProfile):
+    """A profile times a scalar (:meth:`TorqueProfile.scaled`)."""
+
+    def __init__(self, part: TorqueProfile, factor: float) -> None:
+        if not isinstance(part, TorqueProfile):
+            raise InputError("only a TorqueProfile can be scaled as a profile")
+        if not math.isfinite(factor):
+            raise InputError(f"torque scale {factor!r}; expected a finite number")
+        self.part, self.factor = part, float(factor)
+
+    def _terms(self):
+        return [(kind, self.factor * coef, par) for kind, coef, par in self.part._terms()]
+
+    def __repr__(self) -> str:
+        return f"{self.factor:g} * ({self.part!r})"
+
+
+def as_profile(torque, motors: int) -> TorqueProfile | None:
+    """``torque`` as a profile for a robot with ``motors`` motors: ``None`` (no torque) as zero constants, a
+    profile as itself (checked), anything else (a Python callable) as ``None``, meaning "Python only"."""
+    if torque is None:
+        return Constant(np.zeros(motors))
+    if isinstance(torque, TorqueProfile):
+        if torque.motors != motors:
+            raise InputError(f"torque profile for {torque.motors} motors; the robot has {motors}")
+        return torque
+    return None
+
+
+__all__ = ["TorqueProfile", "Constant", "Sine", "Table", "Sum", "Scaled", "as_profile"]

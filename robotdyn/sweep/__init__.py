@@ -1,0 +1,22 @@
+"""Stage 10, sweep: parameter sweeps on Dask into Parquet.
+
+Owns ``spec`` (the sweep TOML), ``plan`` (runs and their identity), ``chunk`` (what a worker runs), ``store``
+(Parquet), ``plot`` and ``runner`` (:func:`run`, :func:`load`). Imports every earlier stage (robots included),
+never robotdyn.cli. ``robotdyn.sweep.run`` and ``robotdyn.sweep.load`` still work (re-exported lazily).
+
+Import rule (tests/test_layout.py enforces it): the stages are, in order, foundation (robotdyn.errors, robotdyn.inputs,
+robotdyn.output) < description < constraints < reduction < fast < contact < robotdyn.robot < simulation <
+interfaces < robotdyn.robots < sweep < cli; a module imports from its own stage and earlier ones only, eagerly or lazily.
+"""
+
+
+_EXPORTS = {'run': 'runner', 'load': 'runner', 'load_trajectory': 'runner', 'SweepResult': 'runner'}
+
+
+def __getattr__(name: str):
+    """The public names of the former flat module of this name, imported on first use."""
+    if name in _EXPORTS:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

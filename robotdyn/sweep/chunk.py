@@ -1,0 +1,223 @@
+"""One chunk of a sweep's runs, computed where it is sent (a Dask worker, or this process): :func:`run_chunk`.
+
+Each run builds its robot afresh (parameters, terrain), takes its scenario's initial state and torque profile
+(times the run's torque scale) and integrates them with :func:`robotdyn.simulation.engine.simulate`; it returns one
+summary row (and optionally the trajectory). A run that raises, or whose numbers are not finite, gives an error row
+naming why; the other runs of the chunk go on. Nothing depends on which process computes a run or what it computed
+before, so a run's numbers are the same bits on one worker, on two, or in this process.
+
+:func:`run_chunk` is the one place to change when the runs of a chunk go to a batch simulation API instead (one
+call for the chunk's (robot, q0, nu0, torque) tuples, built by :func:`prepare`).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import functools
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import RobotDynError
+from ..simulation.scenario import Scenario
+from .spec import RunInput
+from ..simulation.torque_profile import TorqueProfile
+
+
+@dataclass(frozen=True)
+class RunContext:
+    """What every run of a sweep shares, sent with each chunk.
+
+    Attributes:
+        source: ``{"robot": name}`` or ``{"constraints": path, "urdf": path | None, "xacro_args": {...},
+            "digest": sha256 of the file}`` (workers read the file by its path: on a cluster, a shared one).
+        fixed: Parameter values held for every run (name -> value text).
+        terrains: Terrain definitions by label: ``("named", name)`` (the robot module's ``TERRAINS``) or
+            ``("kind", kind, {arg: value})`` (:data:`robotdyn.interfaces.constraint_file.TERRAINS`).
+        t_end, n_out: Duration [s] and output samples (``None``: the scenario's).
+        tolerances: ``rtol``/``atol`` given to the integrator (absent: the scenario's own choice).
+        columns: Columns whose maximum and minimum are summarised.
+        trajectories: Also return each run's trajectory.
+        compiled: Whether the compiled fast path is on (as in the process that planned the sweep).
+        time_limit: Wall-clock limit [s] of one run (``None``: none), ``simulate(..., time_limit=...)`` (not in
+            scenarios that build their own torque law): a run that crawls (a stiff or blown-up state) becomes an
+            error row instead of stalling the sweep.
+    """
+
+    source: dict
+    fixed: dict = field(default_factory=dict)
+    terrains: dict = field(default_factory=dict)
+    t_end: float | None = None
+    n_out: int | None = None
+    tolerances: dict = field(default_factory=dict)
+    columns: tuple[str, ...] = ()
+    trajectories: bool = False
+    compiled: bool = True
+    time_limit: float | None = None
+
+
+@functools.lru_cache(maxsize=8)
+def _load(source_key: tuple):
+    """The robot module or constraint file of a source (cached per process; a constraint file's source holds
+    the digest of its bytes, so an edited file is read again)."""
+    source = dict(source_key)
+    if "robot" in source:
+        from ..robots import module
+
+        return module(source["robot"])
+    from ..interfaces.constraint_file import read
+
+    return read(source["constraints"], source.get("urdf"), dict(source.get("xacro_args") or ()))
+
+
+def load_source(source: dict):
+    """The module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``) of a sweep's robot."""
+    key = tuple(sorted((k, tuple(sorted(v.items())) if isinstance(v, dict) else v) for k, v in source.items()))
+    return _load(key)
+
+
+def build_terrain(mod, definition: tuple):
+    """A terrain from its definition (see :class:`RunContext`)."""
+    if definition[0] == "named":
+        return mod.TERRAINS[definition[1]]()
+    from ..interfaces.constraint_file import TERRAINS
+
+    return TERRAINS[definition[1]](**definition[2])
+
+
+def overrides_run(scenario) -> bool:
+    """Whether a scenario builds its own torque law in its ``run`` (a controller, feed-forward torques): then
+    its torques cannot be scaled from outside."""
+    return type(scenario).run is not Scenario.run
+
+
+def prepare(ctx: RunContext, run: RunInput):
+    """The robot, scenario (a copy, on the run's terrain), duration and sample count of one run."""
+    mod = load_source(ctx.source)
+    params = {**ctx.fixed, **{k: v for k, v in run.params if k != "torque_scale"}}
+    terrain = build_terrain(mod, ctx.terrains[run.terrain]) if run.terrain is not None else None
+    robot = _robot(mod, params, terrain)
+    scenario = copy.copy(mod.SCENARIOS[run.scenario])
+    if run.terrain is not None and dataclasses.is_dataclass(scenario) and hasattr(scenario, "terrain"):
+        scenario = dataclasses.replace(scenario, terrain=ctx.terrains[run.terrain][1])  # it picks its own by name
+    t_end, n_out = scenario.span(ctx.t_end, ctx.n_out)
+    return robot, scenario, t_end, n_out
+
+
+def _robot(mod, params: dict, terrain):
+    """A robot module's robot, or a constraint file's (which also checks its scenarios against the robot)."""
+    from ..interfaces.constraint_file import ConstraintFile
+    from ..robot import Robot
+
+    return mod.robot(params, terrain) if isinstance(mod, ConstraintFile) else Robot(mod.SPEC, params, terrain)
+
+
+def _scaled(torque, scale: float):
+    """The torques times the run's scale: a profile stays a profile (the compiled engine runs it)."""
+    if torque is None or scale == 1.0:
+        return torque
+    if isinstance(torque, TorqueProfile):
+        return torque.scaled(scale)
+    return lambda t, q, nu: scale * np.asarray(torque(t, q, nu), float)
+
+
+SCENARIO_LAW = "the scenario's own torque law"
+"""The torque law a :func:`simulate_run` reports for scenarios that build theirs inside their ``run``."""
+
+
+def simulate_run(ctx: RunContext, run: RunInput):
+    """Simulate one run: (robot, trajectory, torque law: a function, ``None`` without torques, or
+    :data:`SCENARIO_LAW` when the scenario builds its own)."""
+    from ..simulation.engine import simulate
+
+    robot, scenario, t_end, n_out = prepare(ctx, run)
+    if overrides_run(scenario):
+        traj = scenario.run(robot, t_end=t_end, n_out=n_out, progress=False, **ctx.tolerances)
+        return robot, traj, SCENARIO_LAW
+    q0, nu0 = scenario.initial_state(robot)  # may set the scenario's torque law (it is a copy)
+    torque = _scaled(scenario.torque, run.torque_scale)
+    traj = simulate(robot, t_end, q0, nu0, torque, n_out=n_out, progress=False, time_limit=ctx.time_limit,
+                    **ctx.tolerances)
+    return robot, traj, torque
+
+
+def energy_drift(traj, torque) -> float | None:
+    """Largest :math:`|E(t) - E(t_0)|` [J] over the output samples from the first one after which the motor
+    torques are zero at every sample (the whole run without torques), with the friction work of slipping wheels
+    added back; ``None`` when the torques never stop or are built by the scenario itself."""
+    if torque is SCENARIO_LAW:
+        return None
+    if torque is None:
+        start = 0
+    else:
+        active = [bool(np.any(np.asarray(torque(t, q, nu), float) != 0.0))
+                  for t, q, nu in zip(traj.t, traj.q, traj.nu)]
+        if active[-1]:
+            return None
+        start = len(active) - int(np.argmax(active[::-1])) if any(active) else 0
+    if start >= len(traj.t) - 1:
+        return None
+    e = traj.energy[start:] - (traj.friction_work[start:] if traj.friction_work is not None else 0.0)
+    return float(np.max(np.abs(e - e[0])))
+
+
+def summary(mod, robot, traj, torque, columns) -> dict:
+    """The summary outputs of one run (see :mod:`robotdyn.sweep.runner`)."""
+    names = traj.coordinates + traj.velocity_names
+    data = np.column_stack([traj.q, traj.nu])
+    row = {f"final.{c}": float(x) for c, x in zip(names, data[-1])}
+    for c in columns:
+        col = data[:, names.index(c)]
+        row[f"max.{c}"], row[f"min.{c}"] = float(col.max()), float(col.min())
+    row["t_reached"] = float(traj.t[-1])
+    row["energy.start"], row["energy.end"] = float(traj.energy[0]), float(traj.energy[-1])
+    row["energy.drift"] = energy_drift(traj, torque)
+    row["residual.max"] = float(np.max(traj.residual)) if traj.residual.size else 0.0
+    drift = getattr(mod, "drift", None)  # a robot module's own invariant (e.g. an integrated constraint)
+    if callable(drift):
+        row["drift"] = float(drift(robot, traj))
+    row["nfev"] = int(traj.stats.get("nfev", 0))
+    row["wall"] = float(traj.stats.get("wall", np.nan))
+    return row
+
+
+def _one(ctx: RunContext, run: RunInput) -> tuple[dict, dict | None]:
+    start = time.perf_counter()
+    row = {"run_id": run.run_id, "status": "ok", "error": None}
+    traj_out = None
+    try:
+        robot, traj, torque = simulate_run(ctx, run)
+        if "partial" in traj.stats:  # simulate() kept what it had when interrupted: the sweep stops, not the run
+            raise KeyboardInterrupt
+        row.update(summary(load_source(ctx.source), robot, traj, torque, ctx.columns))
+        bad = [k for k, v in row.items() if isinstance(v, float) and not np.isfinite(v) and k != "wall"]
+        if bad:
+            raise RobotDynError(f"non-finite result ({', '.join(bad[:3])}): the dynamics blew up")
+        if "event" in traj.stats:  # e.g. a slipping wheel lifting off: the run ends there by the model's rules
+            row["status"], row["error"] = "stopped", str(traj.stats["event"])
+        if ctx.trajectories:
+            traj_out = {"t": traj.t, **{c: traj.q[:, i] for i, c in enumerate(traj.coordinates)},
+                        **{c: traj.nu[:, i] for i, c in enumerate(traj.velocity_names)},
+                        "energy": traj.energy, "residual": traj.residual}
+    except Exception as exc:  # one failed run is an error row, never the end of the sweep
+        message = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        if not isinstance(exc, RobotDynError):
+            message = f"{type(exc).__name__}: {message}"
+        row = {"run_id": run.run_id, "status": "error", "error": message[:1000]}
+        traj_out = None
+    row["run_wall"] = time.perf_counter() - start
+    return row, traj_out
+
+
+def run_chunk(ctx: RunContext, runs: list[RunInput]) -> list[tuple[dict, dict | None]]:
+    """Compute a chunk of runs, one after the other: for each, its summary row (``status`` ok, stopped or
+    error, with the message) and its trajectory columns (``None`` unless ``ctx.trajectories``)."""
+    from ..fast.dispatch import use_compiled
+
+    with use_compiled(ctx.compiled), np.errstate(all="ignore"):
+        return [_one(ctx, run) for run in runs]
+
+
+__all__ = ["RunContext", "run_chunk", "simulate_run", "prepare", "load_source", "energy_drift", "overrides_run"]

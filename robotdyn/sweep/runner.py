@@ -1,0 +1,238 @@
+"""Parameter sweeps on Dask: :func:`run` (and ``robotdyn sweep``).
+
+A sweep (:class:`~robotdyn.sweep.spec.SweepSpec`) crosses robot parameters (a grid, or a seeded random or Latin
+hypercube sample, in the parameters' units), scenarios, terrains and a torque scale. :func:`plan` checks it
+against the robot and lists the runs, each with an id derived from its inputs; :func:`run` sends them in chunks
+(:func:`robotdyn.sweep.chunk.run_chunk`) to Dask: an in-process ``LocalCluster`` of ``workers`` single-threaded
+worker processes by default, the cluster of a ``scheduler`` address, or a given ``client`` (``workers=0``: no
+Dask, in this process). Each finished chunk is written to Parquet at once (:mod:`robotdyn.sweep.store`), so a
+sweep that is interrupted and run again computes only the runs it has not finished.
+
+Results (``results.parquet``, :func:`load`): one row per run with its inputs (``run_id``, ``run_index``,
+``robot``, ``scenario``, ``terrain``, ``torque_scale``, ``t_end`` and the varied parameters, units in each
+field's metadata), ``status`` (``ok``; ``stopped`` when an event ended the run early; ``error``) and ``error``
+(the message), and the outputs: the final state ``final.<column>``, ``max.<column>`` and ``min.<column>`` of the
+chosen columns, ``t_reached`` [s], ``energy.start``/``energy.end`` [J], ``energy.drift`` [J] (the largest energy
+change once the torques have stopped: :func:`robotdyn.sweep.chunk.energy_drift`), ``residual.max`` (the largest
+holonomic residual), ``drift`` (the robot module's own invariant, where it defines ``drift``), ``nfev``, ``wall``
+[s] (the integration) and ``run_wall`` [s] (the whole run). Error rows have no outputs (null), never NaN.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import sys
+import time
+from contextlib import ExitStack
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import store as sweep_store
+from ..errors import RobotDynError
+from .chunk import RunContext, load_source, run_chunk
+from .plan import Plan, plan
+from .spec import RunInput, SweepSpec, from_toml
+
+CONNECT_TIMEOUT = "20s"
+"""How long to try reaching a Dask scheduler given by address."""
+load = sweep_store.load
+load_trajectory = sweep_store.load_trajectory
+
+
+@dataclass
+class SweepResult:
+    """What a sweep did: its directory, the results table (pyarrow; :meth:`frame` for pandas), counts."""
+
+    out: Path
+    table: object
+    total: int
+    computed: int
+    resumed: int
+    wall: float
+    plot: Path | None = None
+    interrupted: str | None = None
+    statuses: dict[str, int] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        return (f"SweepResult({str(self.out)!r}, runs={self.total}, computed={self.computed}, "
+                f"resumed={self.resumed}, {self.statuses}, wall={self.wall:.3g} s"
+                + (", interrupted" if self.interrupted else "") + ")")
+
+    def frame(self):
+        """The results as a pandas DataFrame."""
+        return self.table.to_pandas()
+
+
+class _Progress:
+    """One line on stderr at most every ``every`` seconds: runs done, errors, rate, time left."""
+
+    def __init__(self, total: int, resumed: int, enabled: bool, every: float = 1.0) -> None:
+        self.total, self.resumed, self.enabled, self.every = total, resumed, enabled, every
+        self.done = self.errors = 0
+        self.start = self.last = time.perf_counter()
+
+    def __call__(self, rows: list[dict], final: bool = False) -> None:
+        self.done += len(rows)
+        self.errors += sum(r["status"] == "error" for r in rows)
+        now = time.perf_counter()
+        if not self.enabled or (now - self.last < self.every and not final):
+            return
+        self.last = now
+        rate = self.done / max(now - self.start, 1e-9)
+        left = (self.total - self.resumed - self.done) / rate if rate > 0 else float("inf")
+        print(f"sweep: {self.resumed + self.done}/{self.total} runs"
+              + (f" ({self.resumed} resumed)" if self.resumed else "")
+              + (f", {self.errors} error(s)" if self.errors else "")
+              + f", {rate:.3g} runs/s" + ("" if final else f", about {_duration(left)} left"),
+              file=sys.stderr, flush=True)
+
+
+def _duration(s: float) -> str:
+    if not math.isfinite(s):
+        return "?"
+    return f"{s:.0f} s" if s < 120 else f"{s / 60:.0f} min"
+
+
+def _chunks(runs: list[RunInput], size: int) -> list[list[RunInput]]:
+    return [runs[i:i + size] for i in range(0, len(runs), size)]
+
+
+def _worker_info() -> str:
+    import robotdyn
+
+    return robotdyn.__version__
+
+
+def _connect(stack: ExitStack, workers: int, scheduler: str | None):
+    """A Dask client: on the cluster of ``scheduler``, or on a new LocalCluster of ``workers`` processes."""
+    from dask.distributed import Client, LocalCluster
+
+    import robotdyn
+
+    if scheduler is not None:
+        try:
+            client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT))
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise RobotDynError(f"cannot reach the Dask scheduler at {scheduler!r} ({exc}); expected an address "
+                                "like tcp://HOST:8786 of a running scheduler") from None
+        try:
+            versions = client.run(_worker_info)
+        except Exception as exc:
+            raise RobotDynError(f"the Dask workers at {scheduler!r} cannot run robotdyn ({type(exc).__name__}: "
+                                f"{exc}); expected robotdyn {robotdyn.__version__} installed on every worker") from None
+        if not versions:
+            raise RobotDynError(f"the Dask scheduler at {scheduler!r} has no workers; expected at least one")
+        other = {w: v for w, v in versions.items() if v != robotdyn.__version__}
+        if other:
+            raise RobotDynError(f"Dask workers run another robotdyn ({other}); expected {robotdyn.__version__}")
+        return client
+    if workers < 1:
+        raise RobotDynError(f"workers = {workers}; expected at least 1 (or 0: in this process, without Dask)")
+    cluster = stack.enter_context(LocalCluster(
+        n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",  # the scheduler's HTTP server on a free local port, never a fixed one
+        silence_logs=logging.ERROR, preload=["robotdyn.sweep.chunk"]))  # each worker imports robotdyn once
+    return stack.enter_context(Client(cluster))
+
+
+def _execute(chunks, ctx: RunContext, workers: int, scheduler: str | None, client, on_chunk) -> None:
+    """Run the chunks (in this process, or on Dask) and hand each finished one to ``on_chunk(runs, results)``."""
+    if client is None and scheduler is None and workers == 0:
+        for chunk in chunks:
+            on_chunk(chunk, run_chunk(ctx, chunk))
+        return
+    from dask.distributed import as_completed
+    from distributed.scheduler import KilledWorker
+
+    with ExitStack() as stack:
+        if client is None:
+            client = _connect(stack, workers, scheduler)
+        futures = {}
+        for chunk in chunks:
+            futures[client.submit(run_chunk, ctx, chunk, pure=False)] = chunk
+        pending = as_completed(list(futures))
+        try:
+            for fut in pending:
+                chunk = futures.pop(fut)
+                try:
+                    results = fut.result()
+                except KilledWorker as exc:  # a run took its worker process down: isolate it
+                    if len(chunk) > 1:
+                        for run in chunk:
+                            single = client.submit(run_chunk, ctx, [run], pure=False)
+                            futures[single] = [run]
+                            pending.add(single)
+                        continue
+                    results = [({"run_id": chunk[0].run_id, "status": "error",
+                                 "error": f"the worker process died during this run ({exc})"}, None)]
+                on_chunk(chunk, results)
+        finally:
+            client.cancel(list(futures))
+
+
+def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: str | None = None,
+        chunk_size: int | None = None, progress: bool = True, retry_errors: bool = False, plot: bool = True,
+        client=None) -> SweepResult:
+    """Run a sweep and write its results to the directory ``out`` (see the module docstring).
+
+    Args:
+        spec: A :class:`~robotdyn.sweep.spec.SweepSpec` or the path of a sweep TOML file.
+        out: The sweep directory (created; a rerun there resumes: finished runs are not computed again).
+        workers: Worker processes of the local Dask cluster (0: in this process, without Dask).
+        scheduler: Address of a running Dask scheduler (e.g. ``tcp://host:8786``) instead of a local cluster.
+        chunk_size: Runs per Dask task (default: about 32 tasks per worker, at most 32 runs each,
+            so that the last tasks leave no worker idle for long).
+        progress: Progress lines on stderr.
+        retry_errors: Compute the runs again whose rows on disk are errors (others are kept).
+        plot: Write ``summary.png`` (the plot column against each varied parameter).
+        client: An existing ``dask.distributed.Client`` to use.
+
+    Returns:
+        A :class:`SweepResult`; after an interruption (Ctrl-C) it holds what was finished, with ``interrupted``
+        saying so: running the same sweep again resumes.
+    """
+    spec = from_toml(spec) if isinstance(spec, (str, Path)) else spec
+    start = time.perf_counter()
+    p = plan(spec)
+    out = sweep_store.prepare(out)
+    done = sweep_store.finished(out)
+    todo = [r for r in p.runs if r.run_id not in done or (retry_errors and done[r.run_id] == "error")]
+    resumed = len(p.runs) - len(todo)
+    sweep_store.write_json(out / "sweep.json", {"spec": spec.to_dict(), "runs": len(p.runs)})
+    n_workers = workers
+    if client is not None:
+        n_workers = len(client.scheduler_info()["workers"]) or 1
+    size = chunk_size or max(1, min(32, math.ceil(len(todo) / (32 * max(n_workers, 1)))))
+    if size < 1:
+        raise RobotDynError(f"chunk_size = {chunk_size}; expected at least 1 run per chunk")
+    report = _Progress(len(p.runs), resumed, progress)
+    inputs = {r.run_id: p.inputs(r) for r in p.runs}
+
+    def on_chunk(chunk: list[RunInput], results) -> None:
+        rows = [{**inputs[row["run_id"]], **row} for row, _ in results]
+        sweep_store.write_chunk(out, rows, [traj for _, traj in results], p.schema)
+        report(rows)
+
+    interrupted = None
+    try:
+        if todo:
+            _execute(_chunks(todo, size), p.context, workers, scheduler, client, on_chunk)
+    except KeyboardInterrupt:
+        interrupted = (f"interrupted after {resumed + report.done} of {len(p.runs)} runs; run the same sweep again "
+                       "to resume")
+    finally:
+        if todo and progress:
+            report([], final=True)
+    table = sweep_store.consolidate(out, {r.run_id: r.index for r in p.runs}, p.schema)
+    statuses = {s: table.column("status").to_pylist().count(s) for s in ("ok", "stopped", "error")}
+    image = None
+    if plot and table.num_rows:
+        from .plot import plot_summary
+
+        image = plot_summary(table, p, out / "summary.png")
+    return SweepResult(out, table, len(p.runs), report.done, resumed, time.perf_counter() - start, image,
+                       interrupted, statuses)
+
+
+__all__ = ["run", "plan", "load", "load_trajectory", "SweepResult", "SweepSpec", "Plan", "load_source"]

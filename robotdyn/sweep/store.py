@@ -1,0 +1,140 @@
+"""A sweep's results on disk, in Parquet (pyarrow), written so that an interrupted sweep resumes.
+
+Layout of a sweep directory::
+
+    runs/part-<hash>.parquet            one file per finished chunk: one row per run (inputs and outputs)
+    trajectories/run_id=<id>/part-0.parquet   each run's trajectory (optional; a Hive-partitioned dataset)
+    results.parquet                     this sweep's rows, in run order (rewritten at the end of every session)
+    sweep.json                          the specification last run, and its run count
+
+Every file is written to a temporary name and renamed (:func:`robotdyn.output.atomic_output`), trajectories before
+the chunk's row file, so a row file on disk means its runs are complete. Rows are keyed by ``run_id``, a hash of
+the run's inputs (:func:`robotdyn.sweep.spec.run_id`): rerunning a sweep skips the runs whose rows exist.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+from ..errors import OutputError
+from ..output import atomic_output
+
+RUNS = "runs"
+TRAJECTORIES = "trajectories"
+RESULTS = "results.parquet"
+
+
+def schema(fields: list[tuple[str, str, str]], metadata: dict | None = None):
+    """A pyarrow schema from (column, type, unit) triples, type one of ``float``, ``int``, ``str``; each field
+    carries its unit in its metadata (``unit``)."""
+    import pyarrow as pa
+
+    types = {"float": pa.float64(), "int": pa.int64(), "str": pa.string()}
+    return pa.schema([pa.field(name, types[kind], metadata={"unit": unit}) for name, kind, unit in fields],
+                     metadata={k: json.dumps(v) for k, v in (metadata or {}).items()})
+
+
+def prepare(out) -> Path:
+    """Create the sweep directory (and ``runs/``); an existing file in the way is a one-line error."""
+    out = Path(out)
+    try:
+        (out / RUNS).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create sweep directory {str(out)!r}: {exc.strerror or exc}") from None
+    return out
+
+
+def _write(table, path: Path, what: str) -> None:
+    import pyarrow.parquet as pq
+
+    with atomic_output(path, what) as tmp:
+        pq.write_table(table, tmp)
+
+
+def write_chunk(out: Path, rows: list[dict], trajectories: list[dict | None], schema) -> Path:
+    """Write a finished chunk: its trajectories (if any), then its row file; returns the row file's path."""
+    import pyarrow as pa
+
+    for row, traj in zip(rows, trajectories):
+        if traj is not None:
+            folder = out / TRAJECTORIES / f"run_id={row['run_id']}"
+            folder.mkdir(parents=True, exist_ok=True)
+            _write(pa.table(traj), folder / "part-0.parquet", "trajectory file")
+    table = pa.Table.from_pylist([{k: row.get(k) for k in schema.names} for row in rows], schema=schema)
+    name = hashlib.sha256(",".join(sorted(r["run_id"] for r in rows)).encode()).hexdigest()[:16]
+    path = out / RUNS / f"part-{name}.parquet"
+    _write(table, path, "results file")
+    return path
+
+
+def _parts(out: Path) -> list[Path]:
+    return sorted((out / RUNS).glob("part-*.parquet"))
+
+
+def finished(out: Path) -> dict[str, str]:
+    """The runs with a row on disk: run_id -> status (``ok``, ``stopped`` or ``error``)."""
+    import pyarrow.parquet as pq
+
+    done: dict[str, str] = {}
+    for path in _parts(out):
+        try:
+            table = pq.read_table(path, columns=["run_id", "status"])
+        except Exception as exc:  # a foreign or damaged file: say which, never resume from it silently
+            raise OutputError(f"cannot read sweep results {str(path)!r} ({exc}); expected a file written by "
+                              "robotdyn sweep: move it away") from None
+        done.update(zip(table.column("run_id").to_pylist(), table.column("status").to_pylist()))
+    return done
+
+
+def consolidate(out: Path, order: dict[str, int], schema):
+    """Gather this sweep's rows (the run ids in ``order``) from the row files, sorted by run order, and write
+    them to ``results.parquet``; returns the table."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+
+    tables, seen = [], set()
+    for path in _parts(out):
+        table = pq.read_table(path)
+        ids = table.column("run_id")
+        mask = pc.is_in(ids, value_set=pa.array(sorted(set(order) - seen), pa.string()))
+        table = table.filter(mask)
+        if table.num_rows:
+            seen.update(table.column("run_id").to_pylist())
+            tables.append(table.select(schema.names).cast(schema))
+    table = pa.concat_tables(tables) if tables else schema.empty_table()
+    index = pa.array([order[i] for i in table.column("run_id").to_pylist()], pa.int64())
+    table = table.take(pc.sort_indices(index))
+    _write(table.replace_schema_metadata(schema.metadata), out / RESULTS, "results file")
+    return table
+
+
+def write_json(path: Path, data: dict) -> None:
+    with atomic_output(path, "sweep description") as tmp:
+        tmp.write_text(json.dumps(data, indent=2, default=str))
+
+
+def load(out):
+    """A sweep's results as a pandas DataFrame (one row per run, in run order)."""
+    import pyarrow.parquet as pq
+
+    path = Path(out) / RESULTS
+    if not path.is_file():
+        raise OutputError(f"no sweep results at {str(path)!r}; expected a directory written by robotdyn sweep")
+    return pq.read_table(path).to_pandas()
+
+
+def load_trajectory(out, run_id: str):
+    """One run's trajectory (t, coordinates, velocities, energy, residual) as a pandas DataFrame."""
+    import pyarrow.parquet as pq
+
+    path = Path(out) / TRAJECTORIES / f"run_id={run_id}" / "part-0.parquet"
+    if not path.is_file():
+        raise OutputError(f"no trajectory for run {run_id!r} in {str(out)!r} (was the sweep run with "
+                          "trajectories = true?)")
+    return pq.read_table(path).to_pandas()
+
+
+__all__ = ["schema", "prepare", "write_chunk", "finished", "consolidate", "load", "load_trajectory"]

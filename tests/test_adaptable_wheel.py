@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robotdyn.constraint import KinematicState
+from robotdyn.constraints.constraint import KinematicState
 from robotdyn.errors import RobotDynError
-from robotdyn.joint_coupling import JointCoupling
-from robotdyn.projection import project
+from robotdyn.constraints.joint_coupling import JointCoupling
+from robotdyn.reduction.projection import project
 from robotdyn.robot import Robot
 from robotdyn.robots.adaptable_wheel import model as aw
 from robotdyn.robots.adaptable_wheel import paper as aw_paper
@@ -177,7 +177,7 @@ def test_ik_yaw_follows_path_tangent(mission1):
     """Eqs 18-23 with the body level: q_zd = direction of the path tangent of x = sin t, y = cos t, i.e. -t."""
     np.testing.assert_allclose(mission1.yaw, -mission1.t, atol=1e-12)
     # the CG is h_CG above the path point along the normal (eq 6)
-    from robotdyn.terrain import SineTerrain
+    from robotdyn.constraints.terrain import SineTerrain
     terrain = SineTerrain(1 / 15, 0.5, 0.5)
     for i in (0, 123, 400):
         x, y = np.sin(mission1.t[i]), np.cos(mission1.t[i])
@@ -205,7 +205,7 @@ def test_ik_mission2_constant_on_ramp(mission2):
     ],
 )
 def test_ik_out_of_range_names_wheel_and_limit(cmd, wheel, limit, robot):
-    from robotdyn.terrain import FlatTerrain
+    from robotdyn.constraints.terrain import FlatTerrain
     with pytest.raises(aw_paper.MechanismRangeError) as exc:
         aw_paper.solve_ik(cmd, robot.params, FlatTerrain())
     msg = str(exc.value)
@@ -222,7 +222,7 @@ def test_ik_mission_out_of_range_reports_time():
 def test_statics_flat_lever_rule(robot):
     """Flat ground, level body: the CG is midway between the front axle and the rear wheel, so the rear wheel
     carries m g / 2 and each front wheel m g / 4 (not the m g / 3 of eq 35); no friction is needed."""
-    from robotdyn.terrain import FlatTerrain
+    from robotdyn.constraints.terrain import FlatTerrain
     p = robot.params
     cmd = aw_paper.Commands(0.0, 0.0, 0.15)
     x, _, _ = aw_paper.solve_ik(cmd, p, FlatTerrain())
@@ -256,7 +256,7 @@ def test_statics_equilibrium_cone_and_virtual_work(name, request):
 def test_statics_friction_cone_enforced():
     """A steep ramp with little friction: the KKT minimum leaves the cone, the optimiser must respect it or fail
     with a one-line error."""
-    from robotdyn.statics import solve_contact_forces
+    from robotdyn.contact.statics import solve_contact_forces
     pts = np.array([[0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.0, 0.0]])
     n = np.array([0.0, -0.3, 1.0]) / np.sqrt(1.09)
     nrm = np.tile(n, (3, 1))
@@ -372,7 +372,7 @@ def test_front_radii_singularity():
     """Three fixed parallel axles: with equal front radii on flat ground the two front lateral rows coincide
     (rank 11, the core reports the mismatch); the smallest singular value grows linearly with the difference."""
     from robotdyn.errors import SingularConstraintError
-    from robotdyn.terrain import FlatTerrain
+    from robotdyn.constraints.terrain import FlatTerrain
     r = Robot(aw.SPEC, {"terrain": "flat"})
     ratios = []
     for roll in (0.0, 0.01, 0.1):
@@ -406,7 +406,7 @@ def test_cli_compare_simulate_and_errors(capsys):
 
 
 def test_generic_modules_reject_bad_input(robot):
-    from robotdyn.statics import solve_contact_forces
+    from robotdyn.contact.statics import solve_contact_forces
     with pytest.raises(RobotDynError, match="driven and driver"):
         JointCoupling(robot.description, "adjust_fr_joint", "adjust_fr_joint", np.cos, np.sin, np.cos)
     with pytest.raises(RobotDynError, match="no joint"):
@@ -427,7 +427,7 @@ def friction_run():
 
 def test_mission1_lateral_friction_energy_balance(friction_run):
     """Wheels rolling along t1 and sliding sideways under Coulomb friction (mu = 1, Table 1): the torques and loads
-    of robotdyn.sliding.inverse close the energy balance dE/dt = motor power + friction power (finite differences of
+    of robotdyn.contact.sliding.inverse close the energy balance dE/dt = motor power + friction power (finite differences of
     Pinocchio's energy, O(dt^2) = 1e-4 of the ~100 W powers), and the friction only dissipates."""
     fr = friction_run
     assert np.all(fr.rank == 15) and fr.residual.max() < 1e-9

@@ -1,5 +1,5 @@
 """Slipping wheels on the compiled engine (robotdyn/_compiled.cpp: Evaluator.slip_rhs, robotdyn/_integrator.hpp: the
-lift-off event) against the Python reference path (robotdyn.sliding.forward, scipy's solve_ivp with its event) and
+lift-off event) against the Python reference path (robotdyn.contact.sliding.forward, scipy's solve_ivp with its event) and
 closed forms: one state at a time, whole trajectories of the skid-steer rover (both directions and lateral slip,
 linear and Coulomb laws), a disc sliding down an incline (g (sin a - mu cos a) when tan a > 3 mu), the energy
 balance with the friction work, and a disc lifting off over a bump."""
@@ -14,17 +14,17 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from robotdyn.compiled import compiled_model
-from robotdyn.compiled_simulation import choose_engine
-from robotdyn.constraint_file import read
+from robotdyn.fast.dispatch import compiled_model
+from robotdyn.simulation.compiled_engine import choose_engine
+from robotdyn.interfaces.constraint_file import read
 from robotdyn.errors import RobotDynError
-from robotdyn.friction import RegularisedCoulomb
-from robotdyn.posture import set_terrain
+from robotdyn.contact.friction import RegularisedCoulomb
+from robotdyn.constraints.posture import set_terrain
 from robotdyn.robot import Robot
 from robotdyn.simulation import simulate
-from robotdyn.sliding import forward, slipping_wheels
-from robotdyn.terrain import BumpTerrain
-from robotdyn.torque_profile import Constant
+from robotdyn.contact.sliding import forward, slipping_wheels
+from robotdyn.constraints.terrain import BumpTerrain
+from robotdyn.simulation.torque_profile import Constant
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_sliding import G, disc  # noqa: E402
@@ -51,7 +51,7 @@ ROVERS = {
 @pytest.mark.parametrize("kind", ROVERS)
 def test_one_state_equals_the_python_path(kind):
     """Accelerations, normal loads, slip velocities, friction forces and power of Evaluator.slip_rhs equal
-    robotdyn.sliding.forward at random states (tilted chassis, random velocities and torques)."""
+    robotdyn.contact.sliding.forward at random states (tilted chassis, random velocities and torques)."""
     robot = _rover(**ROVERS[kind])
     fast = compiled_model(robot)
     assert fast.slip_refusal is None and fast.ev.slipping == 4
@@ -229,7 +229,7 @@ def test_engine_choice():
 
 
 def test_simulate_many_refuses_slipping_wheels():
-    from robotdyn.many_runs import simulate_many
+    from robotdyn.simulation.many_runs import simulate_many
 
     robot = _rover()
     with pytest.raises(RobotDynError, match="slipping wheels") as exc:

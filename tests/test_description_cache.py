@@ -1,4 +1,4 @@
-"""The cache of expanded descriptions (robotdyn.description_cache): a hit returns exactly what xacro would, and
+"""The cache of expanded descriptions (robotdyn.description.cache): a hit returns exactly what xacro would, and
 any change to what the expansion depends on (an included file, an argument, the packages) is a miss."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from robotdyn import description_cache
+from robotdyn.description import cache as description_cache
 from robotdyn.description import expand_xacro
 
 MAIN = """<?xml version="1.0"?>

@@ -31,7 +31,7 @@ from robotdyn.robots.mmr12_eod import model as mm
 from robotdyn.robots.mmr12_eod import paper as mm_paper
 from robotdyn.robots.omni_caster import model as oc
 from robotdyn.robots.omni_caster import paper as oc_paper
-from robotdyn.terrain import RampTerrain
+from robotdyn.constraints.terrain import RampTerrain
 
 
 def _defaults(spec, **overrides):

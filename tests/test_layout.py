@@ -32,11 +32,11 @@ STAGE = {top: i for i, (_, tops) in enumerate(STAGES) for top in tops}
 
 # known exceptions, each an import inside a function: (importing module, imported module)
 UPWARD = {
-    # the robot modules register their own subcommands (they belong to another branch: robotdyn/robots/*)
-    ("robots.adaptable_wheel", "cli.commands"),
-    ("robots.linkage_suspension", "cli.commands"),
-    ("robots.mmr12_eod", "cli.fk"),
-    ("robots.omni_caster", "cli.commands"),
+    # the robot modules register their own subcommands (and print with the CLI's helpers)
+    ("robots.adaptable_wheel.comparison", "cli.commands"),
+    ("robots.linkage_suspension.model", "cli.commands"),
+    ("robots.mmr12_eod.model", "cli.fk"),
+    ("robots.omni_caster.model", "cli.commands"),
     # friction = "stick_slip": StickSlipWheel (a contact constraint) is defined next to its engine (to split)
     ("robot", "simulation.stick_slip"),
     # simulate_many(robot="quasimoro"): a robot given by its registered name
@@ -48,6 +48,8 @@ LAZY_CIRCLES = {
     frozenset({"simulation.engine", "simulation.stick_slip"}),  # Trajectory <-> the stick-slip engine
     frozenset({"cli.commands", "cli.sweep"}),  # the sweep subcommand registers itself, and prints with _emit
     frozenset({"cli.commands", "cli.fk"}),
+    # the adaptable wheel's hold scenario (model) starts from the paper's IK placement (comparison, missions)
+    frozenset({"robots.adaptable_wheel.model", "robots.adaptable_wheel.comparison", "robots.adaptable_wheel.missions"}),
 }
 
 
@@ -194,5 +196,4 @@ def test_no_circles_but_the_known_lazy_ones():
 
 @pytest.mark.parametrize("pair", sorted(tuple(sorted(c)) for c in LAZY_CIRCLES))
 def test_known_lazy_circles_are_within_one_stage(pair):
-    a, b = pair
-    assert _stage(a) == _stage(b)
+    assert len({_stage(m) for m in pair}) == 1

@@ -12,14 +12,14 @@ import pinocchio as pin
 import pytest
 from scipy.optimize import minimize_scalar
 
-from robotdyn.constraint import KinematicState
+from robotdyn.constraints.constraint import KinematicState
 from robotdyn.errors import ConstraintError, RobotDynError
-from robotdyn.posture import set_terrain, solve_posture
-from robotdyn.projection import project
+from robotdyn.constraints.posture import set_terrain, solve_posture
+from robotdyn.reduction.projection import project
 from robotdyn.robot import Robot
 from robotdyn.robots.linkage_suspension import model as ls
 from robotdyn.robots.linkage_suspension import comparison as ls_cmp
-from robotdyn.terrain import BumpTerrain, FlatTerrain, FunctionTerrain, RampTerrain, SineTerrain
+from robotdyn.constraints.terrain import BumpTerrain, FlatTerrain, FunctionTerrain, RampTerrain, SineTerrain
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +53,7 @@ def _rim_gap(robot, q, terrain, frame, radius):
 
 
 def _closure_errors(robot, q):
-    """Loop-closure errors straight from the frame placements (independent of robotdyn.loop_closure)."""
+    """Loop-closure errors straight from the frame placements (independent of robotdyn.constraints.loop_closure)."""
     pin.forwardKinematics(robot.model, robot.data, q)
     pin.updateFramePlacements(robot.model, robot.data)
     oMf = robot.data.oMf

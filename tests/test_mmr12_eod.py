@@ -161,7 +161,7 @@ def test_out_of_range_joint_is_a_clear_error(robot, label, value):
 
 
 # ------------------------------------------------------------------------------------- forward kinematics
-from robotdyn.kinematics import check_pose, frame_names, frame_pose, is_rotation, position_ik, relative_pose  # noqa: E402
+from robotdyn.description.kinematics import check_pose, frame_names, frame_pose, is_rotation, position_ik, relative_pose  # noqa: E402
 
 _FK_NAMES = ["x", "y", "psi", "lambda_C", "theta1", "lambda2", "theta3", "theta4", "lambda6"]
 
@@ -404,7 +404,7 @@ def test_feedback_linearisation_gives_nudot_equal_u(robot):
 @pytest.mark.parametrize("name, t_end, bound", [("straight", 2.0, 1e-6), ("sinusoid", 2.0, 1e-6),
                                                 ("orientation", 3.0, 0.06)])
 def test_table4_tracking_is_bounded(robot, name, t_end, bound):
-    from robotdyn.control import tracking_errors
+    from robotdyn.simulation.control import tracking_errors
 
     traj = mm.SCENARIOS[name].run(robot, t_end=t_end, n_out=31, rtol=1e-7, atol=1e-9, progress=False)
     err = tracking_errors(traj.stats["controller"], traj)
@@ -419,7 +419,7 @@ def test_table4_tracking_is_bounded(robot, name, t_end, bound):
 
 
 def test_manipulation_reaches_the_target_in_range(robot):
-    from robotdyn.control import tracking_errors
+    from robotdyn.simulation.control import tracking_errors
 
     traj = mm.SCENARIOS["manipulation"].run(robot, t_end=3.0, n_out=31, rtol=1e-7, atol=1e-9, progress=False)
     err = tracking_errors(traj.stats["controller"], traj)
@@ -450,8 +450,8 @@ def test_cli_simulate_and_compare(capsys):
 def test_point_task_jacobian_and_drift_by_finite_differences(robot):
     """y'' = J a + Jdot v for the look-ahead point, against the second difference of its position along the
     curve q(t) = q + v t + a t^2 / 2 (natural coordinates: q'' = a)."""
-    from robotdyn.constraint import KinematicState
-    from robotdyn.control import PointTask, hold
+    from robotdyn.constraints.constraint import KinematicState
+    from robotdyn.simulation.control import PointTask, hold
 
     task = PointTask("link3", hold([0.0, 0.0, 0.0]), offset=(0.1, -0.05, 0.2))
     rng = np.random.default_rng(30)

@@ -308,8 +308,8 @@ def test_sigterm_stops_the_sweep_and_keeps_what_finished(tmp_path):
 
 def test_sweep_rows_are_the_in_process_batch_bit_for_bit(tmp_path):
     """The Dask sweep (2 workers) over torque scales gives the final states that one in-process batch call
-    (robotdyn.batch.simulate_many, C++ threads) computes for the same scaled profiles: the same bits."""
-    from robotdyn.batch import simulate_many
+    (robotdyn.simulation.batch.simulate_many, C++ threads) computes for the same scaled profiles: the same bits."""
+    from robotdyn.simulation.batch import simulate_many
 
     scales = [0.25, 0.5, 1.0, 2.0]
     spec = SweepSpec(robot="quasimoro", axes=[Axis("torque_scale", scales)], scenarios=["rectilinear"], t_end=T_END)

@@ -81,6 +81,19 @@ class SlippingWheel(SupportWheel):
         """The tangential rows :math:`J_t` (2, nv) and the slip velocity (2,) [m/s]: :func:`tangential`."""
         return tangential(self, kin)
 
+    def compiled_friction(self) -> tuple[tuple, np.ndarray] | str:
+        """What the compiled evaluator needs for this wheel's friction: its law as data
+        (:meth:`~robotdyn.contact.friction.FrictionLaw.encode`) and the mask of its free directions (t1, t2); or,
+        as a string, why its friction stays on the Python path (a subclass with its own formulas, a law without
+        compiled formula)."""
+        if type(self).friction_coefficient is not SlippingWheel.friction_coefficient or \
+                type(self).slip is not SlippingWheel.slip:
+            return f"wheel {self.name!r} ({type(self).__name__}) is simulated on the Python path"
+        code = self.law.encode()
+        if code is None:
+            return f"wheel {self.name!r} has the friction law {self.law!r}, whose formula is not compiled"
+        return code, np.asarray(self._free, float)
+
 
 def tangential(wheel, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
     """A wheel's tangential rows :math:`J_t` (2, nv) (t1 longitudinal, t2 lateral of the contact frame) and its slip

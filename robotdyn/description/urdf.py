@@ -87,13 +87,13 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
             ``ROS_PACKAGE_PATH``/``AMENT_PREFIX_PATH``); no ROS installation is needed.
 
     Returns:
-        The URDF XML text (from :mod:`robotdyn.description_cache` when none of the files it reads changed).
+        The URDF XML text (from :mod:`robotdyn.description.cache` when none of the files it reads changed).
 
     Raises:
         MissingPackagesError: Packages the description includes were not found (all of them, at once).
         DescriptionError: The file is missing or xacro cannot expand it.
     """
-    from . import description_cache
+    from . import cache as description_cache
     from .ros_packages import PackageIndex
 
     path = Path(path)
@@ -133,8 +133,8 @@ cache of validated texts does not skip a new check)."""
 
 def _validated_cache() -> Path | None:
     """The file listing the URDF texts (by SHA-256, with yourdfpy's stamp) that passed :func:`validate_urdf`, in
-    :func:`robotdyn.description_cache.cache_dir` (None: caching is off)."""
-    from .description_cache import cache_dir
+    :func:`robotdyn.description.cache.cache_dir` (None: caching is off)."""
+    from .cache import cache_dir
 
     root = cache_dir()
     return None if root is None else root / "validated-urdf.txt"
@@ -151,7 +151,7 @@ def validate_urdf(urdf: str) -> None:
     """
     import hashlib
 
-    from .description_cache import package_stamp
+    from .cache import package_stamp
 
     stamp = hashlib.sha256(package_stamp("yourdfpy").encode()).hexdigest()[:16]
     key = f"{hashlib.sha256(urdf.encode()).hexdigest()} yourdfpy-{stamp} checks-{_CHECKS}"

@@ -198,23 +198,21 @@ class CompiledModel:
         self._compute, self._generation, self._views = ev.compute, -1, None
 
     def _add_slipping(self, ev, robot) -> str | None:
-        """Give the evaluator the slipping wheels' friction laws (:mod:`robotdyn.sliding`): returns why their
-        friction is not compiled (``None``: it is, or there are none). Their rows are compiled either way."""
-        from .sliding import SlippingWheel, sliding_now
-
-        sliding = sliding_now(robot)
+        """Give the evaluator the slipping wheels' friction laws (each wheel's ``compiled_friction()``, see
+        :class:`robotdyn.contact.sliding.SlippingWheel`; this stage does not import the contact stage): returns why
+        their friction is not compiled (``None``: it is, or there are none). Their rows are compiled either way."""
+        sliding = [c for c in robot.constraints if getattr(c, "sliding", False)]  # contact.sliding.sliding_now
         if not sliding:
             return None
         labels = robot.rows_at(robot.neutral()).labels
         laws = []
         for c in sliding:
-            if not (isinstance(c, SlippingWheel) and type(c).friction_coefficient is SlippingWheel.friction_coefficient
-                    and type(c).slip is SlippingWheel.slip):
-                return f"wheel {c.name!r} ({type(c).__name__}) is simulated on the Python path"
-            code = c.law.encode()
-            if code is None:
-                return f"wheel {c.name!r} has the friction law {c.law!r}, whose formula is not compiled"
-            laws.append((self.wheels.index(c), labels.index(f"{c.name}.normal"), code, np.asarray(c._free, float)))
+            friction = c.compiled_friction() if hasattr(c, "compiled_friction") else \
+                f"wheel {c.name!r} ({type(c).__name__}) is simulated on the Python path"
+            if isinstance(friction, str):
+                return friction
+            code, free = friction
+            laws.append((self.wheels.index(c), labels.index(f"{c.name}.normal"), code, free))
         for wheel, row, (law, p0, p1), free in laws:
             ev.add_slipping(wheel, row, law, float(p0), float(p1), free)
         return None

@@ -18,9 +18,9 @@ check for signals (Ctrl-C keeps the samples so far, as on the scipy path) and to
 Where the compiled model's row choice stops working (:class:`robotdyn.fast.compiled.Fallback`) the C++ side asks the
 Python path for a new one at that state (:func:`rechooser`), or gets its usual error, as the scipy path does.
 
-Robots with slipping wheels (:mod:`robotdyn.sliding`, laws :class:`~robotdyn.friction.RegularisedCoulomb` and
-:class:`~robotdyn.friction.LinearTyre`, encoded by :meth:`~robotdyn.friction.FrictionLaw.encode`) run here too: the
-accelerations and normal loads come from the same coupled linear system as :func:`robotdyn.sliding.forward`
+Robots with slipping wheels (:mod:`robotdyn.contact.sliding`, laws :class:`~robotdyn.contact.friction.RegularisedCoulomb` and
+:class:`~robotdyn.contact.friction.LinearTyre`, encoded by :meth:`~robotdyn.contact.friction.FrictionLaw.encode`) run here too: the
+accelerations and normal loads come from the same coupled linear system as :func:`robotdyn.contact.sliding.forward`
 (``Evaluator.slip_rhs``), the friction work is an extra state, a singular system raises the Python path's
 Painleve error, and the terminal lift-off event (the smallest normal load of a slipping wheel crossing zero
 downwards) is located on the stepper's dense output, or for Adams on a Dormand-Prince re-integration of the step,
@@ -96,7 +96,7 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
                            native, breaks, method, progress, rechooser(robot, fast))
     status, t_stop = out["status"], float(out["t_stop"])
     if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's errors
-        from .sliding import painleve_error, redundant_load_error
+        from ..contact.sliding import painleve_error, redundant_load_error
 
         wheels = slipping_wheels(robot)
         if out["slip_error"] == 0:
@@ -172,7 +172,7 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
         stats["partial"] = out["interrupted"]
     k = robot.mobility
     if out["event"] is not None:  # a slipping wheel's load reached zero: the contact model ends there
-        from .sliding import lift_off_message
+        from ..contact.sliding import lift_off_message
 
         t_ev, y_ev = out["event"]
         stats["event"] = lift_off_message(robot, t_ev, y_ev[:n], y_ev[n:n + k], profile(t_ev))

@@ -13,11 +13,11 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ...actuation import input_matrix
-from ...comparison import Comparison
-from ...constraint import KinematicState
+from ...reduction.actuation import input_matrix
+from ...interfaces.comparison import Comparison
+from ...constraints.constraint import KinematicState
 from ...errors import InputError
-from ...joint_coupling import JointCoupling
+from ...constraints.joint_coupling import JointCoupling
 from ...robot import Robot
 from .missions import MISSIONS, run_mission
 from .model import SPEC, WHEELS, _terrain
@@ -169,7 +169,7 @@ def cmd_ik(args) -> int:
     """``robotdyn ik adaptable_wheel --commands x_d y_d h_CG q_xd q_yd q_zd``: eqs 4-24 and the static torques."""
     import json
 
-    from ...cli import _jsonable
+    from ...cli.commands import _jsonable
     from ...inputs import as_vector, parse_assignments
 
     if args.robot != SPEC.name:

@@ -16,12 +16,12 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ...actuation import input_matrix
-from ...constraint import KinematicState
+from ...reduction.actuation import input_matrix
+from ...constraints.constraint import KinematicState
 from ...errors import InputError
-from ...joint_coupling import JointCoupling
+from ...constraints.joint_coupling import JointCoupling
 from ...robot import Robot
-from ...terrain import Terrain
+from ...constraints.terrain import Terrain
 from .comparison import euler_zyx, model_configuration
 from .missions import IKRun
 from .model import SPEC, WHEELS
@@ -94,7 +94,7 @@ class MissionModel:
     velocities nu (five-point differences of the commanded pose); Pinocchio's RNEA gives the generalised forces
     :math:`\\tau_{RNEA}(q, v, a)`. Its six root rows are the wrench the contacts must supply (weight plus inertial
     forces: eq 25 with inertia); the contact forces are chosen as in eqs 28-30
-    (:func:`robotdyn.statics.solve_contact_forces`); the remaining rows give the six motor torques and the three
+    (:func:`robotdyn.contact.statics.solve_contact_forces`); the remaining rows give the six motor torques and the three
     coupling forces by least squares (residual reported).
 
     Args:
@@ -126,7 +126,7 @@ class MissionModel:
 
     def state(self, t: float) -> tuple[Commands, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(commands, IK solution, q, v, a) at time t (natural coordinates of the model)."""
-        from ...reduced_dynamics import reduce
+        from ...reduction.reduced_dynamics import reduce
 
         cmd, x = self.ik_at(t)
         q = model_configuration(self.slip, cmd, x)
@@ -204,7 +204,7 @@ class FrictionRun:
     The wheels roll along their rolling direction and slide sideways under the law of ``lateral`` (Coulomb with the
     robot's mu, Table 1: 1.0), so each lateral force is :math:`-\\mu f_n` times the slip direction: known once the
     normal loads are. Torques, normal loads and traction then follow from one square linear system per state
-    (:func:`robotdyn.sliding.inverse`).
+    (:func:`robotdyn.contact.sliding.inverse`).
 
     Attributes:
         t: (N,) times [s].
@@ -242,7 +242,7 @@ def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None =
         params: Parameter overrides (e.g. ``mu``).
         every: Use every n-th step of the run.
     """
-    from ...sliding import inverse
+    from ...contact.sliding import inverse
 
     if lateral not in ("coulomb", "linear"):
         raise InputError(f"lateral = {lateral!r}; expected a friction law: coulomb or linear")

@@ -8,10 +8,10 @@ Model (derived by Pinocchio from the description): floating body (x, y, z, yaw, 
 three wheels fr, fl, r at the eq-8 positions, each with a spin joint ``theta_<i>`` (wheel motor), an adjustment
 angle ``q_<i>`` (adjustment motor, 0-180 deg) and a prismatic radius ``Rch_<i>`` (the close-loop pattern radius).
 The wheel radius is :math:`R_T = R_{ru} + R_{ch}` and the mechanism law of eq 1,
-:math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)`, is a holonomic :class:`~robotdyn.joint_coupling.JointCoupling` (its own
-:class:`~robotdyn.joint_coupling.CosineLaw`, compared with the paper's :func:`.paper.radius_law` in the tests), so
+:math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)`, is a holonomic :class:`~robotdyn.constraints.joint_coupling.JointCoupling` (its own
+:class:`~robotdyn.constraints.joint_coupling.CosineLaw`, compared with the paper's :func:`.paper.radius_law` in the tests), so
 the radius follows the configuration through the constraint layer. Each wheel rolls on the terrain
-(:class:`~robotdyn.rolling_contact.RollingWheel` with ``radius_joint``); ``lateral=slip`` drops the lateral
+(:class:`~robotdyn.constraints.rolling_contact.RollingWheel` with ``radius_joint``); ``lateral=slip`` drops the lateral
 no-slip row (the paper's kinematic missions turn the robot about a vertical axis away from its wheel axles,
 which rolling without lateral slip forbids: see ``docs/errata/adaptable_wheel.md``).
 
@@ -27,14 +27,14 @@ from functools import partial
 
 import numpy as np
 
-from ...friction import LinearTyre, RegularisedCoulomb
-from ...joint_coupling import CosineLaw, JointCoupling
+from ...contact.friction import LinearTyre, RegularisedCoulomb
+from ...constraints.joint_coupling import CosineLaw, JointCoupling
 from ...robot import MotorSpec, Parameter, Robot, RobotSpec
-from ...rolling_contact import OmniWheel, RollingWheel
-from ...scenario import Scenario
-from ...sliding import SlippingWheel
-from ...terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
-from ...torque_profile import Constant
+from ...constraints.rolling_contact import OmniWheel, RollingWheel
+from ...simulation.scenario import Scenario
+from ...contact.sliding import SlippingWheel
+from ...constraints.terrain import FlatTerrain, RampTerrain, SineTerrain, Terrain
+from ...simulation.torque_profile import Constant
 
 WHEELS = ("fr", "fl", "r")
 """Wheel tags: front right, front left, rear (eq 8)."""

@@ -5,9 +5,9 @@ Improvement" (``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``)
 derivative (eq 33), the wheel offsets of eq 8, the inverse kinematics of eqs 3-17 and 24 (:func:`solve_ik`, eq 24's
 Newton-Raphson replaced by scipy's hybrid root finder), the yaw update of eqs 18-23, the statics of eqs 25-34
 (:func:`static_torques`; the free contact-force components of eqs 28-30 are chosen by the generic
-:func:`robotdyn.statics.solve_contact_forces`), the torque estimate of eq 35 and Table 2. How each garbled
+:func:`robotdyn.contact.statics.solve_contact_forces`), the torque estimate of eq 35 and Table 2. How each garbled
 equation was read: ``docs/errata/adaptable_wheel.md``. Parameters are a plain dict (Table 1 names of
-:data:`.model.SPEC`), the surface any :class:`robotdyn.terrain.Terrain`.
+:data:`.model.SPEC`), the surface any :class:`robotdyn.constraints.terrain.Terrain`.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from functools import partial
 import numpy as np
 
 from ...errors import ConstraintError, InputError
-from ...statics import solve_contact_forces
-from ...terrain import Terrain
+from ...contact.statics import solve_contact_forces
+from ...constraints.terrain import Terrain
 
 _WHEELS = ("fr", "fl", "r")
 """The paper's wheels (eq 8): front right, front left, rear."""

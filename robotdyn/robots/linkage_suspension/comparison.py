@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ...comparison import Comparison
-from ...constraint import KinematicState
+from ...interfaces.comparison import Comparison
+from ...constraints.constraint import KinematicState
 from ...robot import Robot
-from ...terrain import BumpTerrain, FlatTerrain
+from ...constraints.terrain import BumpTerrain, FlatTerrain
 from .model import SPEC, kinematic_run, profile_distance
 from .paper import (
     PEAK_CENTROID_SPEED,
@@ -177,7 +177,7 @@ def rolling_comparison(cmp: Comparison, robot: Robot, states: int = 12, seed: in
     Rows compare the printed eq (9) (phi' = the wheel's spin relative to its carrier) and the same formula with
     the wheel's absolute rate about its axle; then a straight run on flat ground with rollers at rho = 0.4 rad.
     """
-    from ...posture import set_terrain, solve_posture
+    from ...constraints.posture import set_terrain, solve_posture
 
     rng = np.random.default_rng(seed)
     rec = _Worst()
@@ -226,7 +226,7 @@ def rolling_comparison(cmp: Comparison, robot: Robot, states: int = 12, seed: in
 def section3_comparison(cmp: Comparison, robot: Robot) -> dict[str, dict]:
     """Section 3: straight line and pivot steering under the wheel-speed profile (Figs. 6-12), on flat ground
     (the paper's XOZ plane)."""
-    from ...posture import set_terrain
+    from ...constraints.posture import set_terrain
 
     old = robot.terrain
     set_terrain(robot, FlatTerrain())

@@ -29,10 +29,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ...constraint import KinematicState
+from ...constraints.constraint import KinematicState
 from ...robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ...scenario import Scenario
-from ...terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
+from ...simulation.scenario import Scenario
+from ...constraints.terrain import BumpTerrain, FlatTerrain, RampTerrain, SineTerrain, Terrain
 
 
 THETA0 = np.pi / 3
@@ -143,7 +143,7 @@ def kinematic_run(robot: Robot, direction: tuple[float, float], q0: np.ndarray |
     """
     from scipy.integrate import solve_ivp
 
-    from ...posture import solve_posture
+    from ...constraints.posture import solve_posture
 
     sgn = np.asarray(direction, float)
     if q0 is None:
@@ -194,7 +194,7 @@ class TerrainScenario(Scenario):
     start: dict[str, float] = field(default_factory=lambda: {"x": 0.0, "y": 0.0, "yaw": 0.0})
 
     def initial_state(self, robot) -> tuple[np.ndarray, np.ndarray]:
-        from ...posture import set_terrain, solve_posture
+        from ...constraints.posture import set_terrain, solve_posture
 
         set_terrain(robot, TERRAINS[self.terrain]())
         q0 = solve_posture(robot, self.start).q
@@ -239,10 +239,10 @@ SCENARIOS = {
 def _cmd_posture(args) -> int:
     import json
 
-    from ...cli import _jsonable
+    from ...cli.commands import _jsonable
     from ...errors import InputError
     from ...inputs import parse_assignments
-    from ...posture import set_terrain, solve_posture
+    from ...constraints.posture import set_terrain, solve_posture
 
     if args.terrain not in TERRAINS:
         raise InputError(f"unknown terrain {args.terrain!r}; expected one of {', '.join(TERRAINS)}")
@@ -283,7 +283,7 @@ def side_bump(height: float = 0.06, x0: float = 0.0, length: float = 0.5, width:
               side_width: float = 0.04) -> Terrain:
     """A smooth plateau of ``height`` [m] for x in [x0, x0 + length] under the right-hand wheels only (y < 0):
     :math:`z = h\\,s(x)\\,\\tfrac12(1 - \\tanh(y / w_y))`, s a tanh plateau of ramp width ``width``."""
-    from ...terrain import FunctionTerrain
+    from ...constraints.terrain import FunctionTerrain
 
     bx = BumpTerrain(height, x0, width, length)
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...comparison import Comparison
+from ...interfaces.comparison import Comparison
 from ...robot import Robot
 from .model import _ARMS, SPEC, climbing_balance, state
 from .paper import (
@@ -26,7 +26,7 @@ from .paper import (
 def model_lift(robot: Robot, theta_C: float, arm: int = 1) -> float:
     """Delta lambda_C from the model: how far the platform must rise for arm ``arm``'s tip wheel (radius r) at
     angle theta_C to touch the ground, i.e. max(0, r - z_tip) with z_tip the tip-frame height at lambda_C = 0."""
-    from ...kinematics import frame_pose
+    from ...description.kinematics import frame_pose
 
     q = state(robot, lambda_C=0.0, **{f"theta_C{arm}": theta_C})
     z_tip = frame_pose(robot, q, f"CS{arm}")[2, 3]
@@ -60,7 +60,7 @@ def printed_states(p: dict) -> dict[str, tuple[dict, dict, str, str]]:
 
 def model_printed(robot: Robot, key: str) -> np.ndarray:
     """The model's pose for printed equation ``key`` (see :func:`printed_states`)."""
-    from ...kinematics import frame_pose
+    from ...description.kinematics import frame_pose
 
     overrides, values, frame, _ = printed_states(robot.params)[key]
     rob = robot if not overrides else Robot(robot.spec, {**robot.params, **overrides})
@@ -85,7 +85,7 @@ def ik_cases(robot: Robot, n: int = 5, seed: int = 0) -> list[dict]:
     (x, y) putting the end effector E on the target. A second, fully numerical IK solves (x, y, psi, theta1,
     lambda2, theta3) from the neutral posture with minimum change.
     """
-    from ...kinematics import position_ik
+    from ...description.kinematics import position_ik
 
     rng = np.random.default_rng(seed)
     out = []
@@ -117,7 +117,7 @@ def compare(robot: Robot | None = None, states: int = 50, seed: int = 0) -> Comp
     dev_printed = np.zeros((4, 4))
     dev_chain = np.zeros((4, 4))
     first = None
-    from ...kinematics import frame_pose
+    from ...description.kinematics import frame_pose
 
     for _ in range(states):
         vals = dict(x=rng.uniform(-3, 3), y=rng.uniform(-3, 3), psi=rng.uniform(-np.pi, np.pi),
@@ -190,6 +190,6 @@ def compare(robot: Robot | None = None, states: int = 50, seed: int = 0) -> Comp
 
 
 def _defects(R: np.ndarray) -> tuple[float, float]:
-    from ...kinematics import rotation_defects
+    from ...description.kinematics import rotation_defects
 
     return rotation_defects(R)

@@ -105,8 +105,8 @@ def state(robot: Robot, **values: float) -> np.ndarray:
 
 # ------------------------------------------------------------------------------------------------- CLI
 def register_cli(subparsers, parents) -> None:
-    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.kinematics`)."""
-    from ...kinematics import register_fk_cli
+    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.description.kinematics`)."""
+    from ...cli.fk import register_fk_cli
 
     register_fk_cli(subparsers, parents)
 
@@ -151,14 +151,14 @@ def table4_reference(name: str, omega: float = 0.5) -> Callable:
 
 
 def _hold_task(robot: Robot, labels, q0):
-    from ...control import CoordinateTask, hold
+    from ...simulation.control import CoordinateTask, hold
 
     return CoordinateTask(list(labels), hold([q0[robot.coordinate_index(c)] for c in labels]))
 
 
 def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
     """Eqs 23-25 for a Table 4 trajectory: P tracks the reference, every other actuated joint holds its value."""
-    from ...control import LinearisingController, PointTask
+    from ...simulation.control import LinearisingController, PointTask
 
     q0 = robot.neutral() if q0 is None else q0
     others = [c for c in ACTUATED if c not in ("theta_R", "theta_L")]
@@ -189,7 +189,7 @@ MANIPULATION_TARGET = np.array([2.0, 2.0, 1.5])
 def manipulation_goal(robot: Robot, q0: np.ndarray | None = None):
     """A final configuration putting E on MANIPULATION_TARGET: numerical IK over (x, y, theta3) with the heading
     kept and the boom raised to theta1 = 2.7 rad, lambda2 = 1.1 m (inside the joint ranges)."""
-    from ...kinematics import position_ik
+    from ...description.kinematics import position_ik
 
     q0 = manipulation_initial(robot)[0] if q0 is None else q0
     guess = q0.copy()
@@ -202,8 +202,8 @@ def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float
     """End effector E to MANIPULATION_TARGET along a rest-to-rest quintic over T s (primary output, eq 25); arms,
     theta4 and the load hold; in the null space, (theta1, lambda2, theta3) follow quintics to the IK goal posture
     so that the joints stay in range and the platform drives the rest."""
-    from ...control import CoordinateTask, LinearisingController, PointTask
-    from ...kinematics import frame_pose
+    from ...simulation.control import CoordinateTask, LinearisingController, PointTask
+    from ...description.kinematics import frame_pose
 
     q0 = manipulation_initial(robot)[0] if q0 is None else q0
     start = frame_pose(robot, q0, "E")[:3, 3]
@@ -261,7 +261,7 @@ def lifting_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
 def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
     """Arm 1 (the others follow through the contacts) along a quintic from the contact angle to ``end`` in T s,
     the manipulator, load and wheels hold; x, y, psi are unactuated (free on frictionless tips)."""
-    from ...control import CoordinateTask, LinearisingController
+    from ...simulation.control import CoordinateTask, LinearisingController
 
     q0 = lifting_initial(robot)[0]
     th0 = contact_angle(robot.params)
@@ -314,7 +314,7 @@ def climbing_robot(slope: float, robot: Robot | None = None) -> Robot:
     wheels rolling without slipping and the rear arms' tip wheels (3, 4) as frictionless supports, the front arms
     raised (sec 2.11 e's climbing with the arms as outriggers; the real robot's tracks are not in the
     description)."""
-    from ...terrain import RampTerrain
+    from ...constraints.terrain import RampTerrain
 
     if not np.isfinite(slope) or abs(slope) >= np.pi / 2:
         raise InputError(f"slope = {slope} rad; expected |slope| < pi/2")
@@ -336,7 +336,7 @@ def climbing_state(robot: Robot, slope: float) -> np.ndarray:
 
 def climbing_forces(slope: float, robot: Robot | None = None):
     """Contact forces holding the robot at rest on a ramp of ``slope`` [rad] (:func:`climbing_robot`, every motor
-    holding its coordinate): the :class:`~robotdyn.contact_forces.ConstraintForces` (drive-wheel traction and
+    holding its coordinate): the :class:`~robotdyn.contact.contact_forces.ConstraintForces` (drive-wheel traction and
     loads, tip loads, ``minimum_mu``: the smallest friction coefficient that holds the robot there)."""
     climber = climbing_robot(slope, robot)
     zero = np.zeros(climber.mobility)
@@ -345,7 +345,7 @@ def climbing_forces(slope: float, robot: Robot | None = None):
 
 # ------------------------------------------------------------------------------------------- scenarios
 def _scenarios() -> dict:
-    from ...control import ControlledScenario
+    from ...simulation.control import ControlledScenario
 
     out = {}
     for name, desc in (

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...comparison import Comparison
+from ...interfaces.comparison import Comparison
 from ...robot import Robot
 from .model import (
     CHAINS,
@@ -56,7 +56,7 @@ def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
     eta_i' is the offset link's absolute yaw rate (its frame Jacobian), theta_i', phi_i' the joint rates; all from
     S of the operational projection (the model's constraint Jacobians).
     """
-    from ...constraint import KinematicState
+    from ...constraints.constraint import KinematicState
 
     red = robot.reduced(q, np.zeros(3))
     kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
@@ -146,7 +146,7 @@ def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Com
     fit = fit_printed_matrix(p, starts=20)
     cmp.add("sec 5 printed with-wheel I_uu*: best fit over steering angles (max |residual|)", 0.0, fit["max_abs"],
             5e-4, "phi = (" + ", ".join(f"{np.degrees(x):.1f}" for x in fit["phi"]) + ") deg")
-    from ...impulse import impulse_curve
+    from ...contact.impulse import impulse_curve
 
     for name, deg in IMPULSE_CONFIGS.items():
         Mi = robot.reduced(steering_configuration(robot, np.radians(deg)), np.zeros(3)).M

@@ -8,14 +8,14 @@ dynamic modeling including wheel dynamics for an omni-directional mobile robot w
 Coordinates: (x, y, psi) of the platform centre C and heading (world, m and rad), the steering angles phi_i
 (platform relative to offset link i, eq 9-11: omega = eta_i' + phi_i') and the wheel angles theta_i.
 Minimal velocities: the platform twist in BODY axes, u' = (v_cx, v_cy, omega) of eq (2) -- eq (6)-(8) write v_c in
-the platform's unit vectors i, j -- through :mod:`robotdyn.operational_space`, so that the reduced inertia is the
+the platform's unit vectors i, j -- through :mod:`robotdyn.reduction.operational_space`, so that the reduced inertia is the
 paper's operational-space inertia I_uu* (eq 48) and the reduced bias its u'^T P_uuu* u' (eq 49).
 Each wheel rolls without slipping (both tangential rows) and touches the floor; the 9 rows have rank 6 (the normal
 rows vanish on the plane) and the mobility is 3 (Grubler count of section 2).
 
 This module holds ``SPEC`` (Tables 1-2), the paper's NOC coordinates as a second spec (eq A9), the section-5
 trajectories (eq 61) and their feed-forward scenarios, the impulse study of Figs. 16-19 on the model (eq 60 is
-:func:`robotdyn.impulse.impact`) and the ``impulse`` CLI subcommand. The paper's closed forms (eqs 12-19, 43,
+:func:`robotdyn.contact.impulse.impact`) and the ``impulse`` CLI subcommand. The paper's closed forms (eqs 12-19, 43,
 48-51, 60, A7-A9) are in :mod:`.paper`, the comparison in :mod:`.comparison`.
 """
 
@@ -26,9 +26,9 @@ import dataclasses
 import numpy as np
 
 from ...errors import InputError, SingularConstraintError
-from ...operational_space import OperationalVelocities
+from ...reduction.operational_space import OperationalVelocities
 from ...robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ...scenario import Scenario
+from ...simulation.scenario import Scenario
 
 
 CHAINS = (1, 2, 3)
@@ -322,7 +322,7 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
     Returns:
         {figure: (angles [rad], magnitudes [N s])} for :data:`IMPULSE_CONFIGS`.
     """
-    from ...impulse import impulse_curve
+    from ...contact.impulse import impulse_curve
 
     out = {}
     for name, deg in IMPULSE_CONFIGS.items():
@@ -332,8 +332,8 @@ def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, s
 
 
 def _cmd_impulse(args) -> int:
-    from ...cli import _emit, _load
-    from ...impulse import impact
+    from ...cli.commands import _emit, _load
+    from ...contact.impulse import impact
     from ...inputs import as_vector
 
     _, robot = _load(args)

@@ -109,7 +109,7 @@ def paper_bias(p: dict, phi, nu, platform_terms: bool = True) -> np.ndarray:
 
 
 def paper_impulse(I_uu: np.ndarray, n, u_dot, e: float) -> float:
-    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.impulse)."""
+    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.contact.impulse)."""
     n = np.asarray(n, float)
     return float(-(1 + e) * np.dot(u_dot, n) / (n @ np.linalg.inv(I_uu) @ n))
 

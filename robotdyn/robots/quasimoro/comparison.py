@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...comparison import Comparison, quadratic_coefficients
+from ...interfaces.comparison import Comparison, quadratic_coefficients
 from ...robot import Robot
 from .model import SCENARIOS, SPEC, steady_amplitude
 from .paper import (

@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
-from ...scenario import Scenario
-from ...torque_profile import Sine
+from ...simulation.scenario import Scenario
+from ...simulation.torque_profile import Sine
 
 
 SPEC = RobotSpec(
@@ -56,7 +56,7 @@ def _pulse(t: float) -> float:
 
 
 def pulse(signs: tuple[float, float]) -> Sine:
-    """Eq 19 on both motors as a torque profile (compiled: robotdyn.torque_profile): m_i = sign_i m° sin(pi t) for
+    """Eq 19 on both motors as a torque profile (compiled: robotdyn.simulation.torque_profile): m_i = sign_i m° sin(pi t) for
     0 <= t <= 1 s, zero afterwards."""
     return Sine([signs[0] * PULSE_AMPLITUDE, signs[1] * PULSE_AMPLITUDE], np.pi, start=0.0, stop=1.0)
 

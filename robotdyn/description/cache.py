@@ -5,7 +5,7 @@ expansion is a pure function of the files it reads, the arguments, the packages 
 version, so its result is kept under :func:`cache_dir` and reused while all of these are unchanged:
 
 - the key hashes the file's resolved path, the (already validated) argument values, the package index
-  (:class:`~robotdyn.ros_packages.PackageIndex`'s ``repr``: explicit packages, search paths, prefixes) and a stamp
+  (:class:`~robotdyn.description.ros_packages.PackageIndex`'s ``repr``: explicit packages, search paths, prefixes) and a stamp
   of the installed xacro (its path, size and modification time);
 - the entry lists every file xacro read (the file itself and each include or YAML file) with its SHA-256, and is
   used only while each of them still has that hash;
@@ -22,7 +22,7 @@ import json
 import os
 from pathlib import Path
 
-from .errors import RobotDynError
+from ..errors import RobotDynError
 
 REVISION = 1
 """Revision of the entry format (raise it when the format or what a key covers changes)."""
@@ -94,7 +94,7 @@ def store(path: Path, mappings: dict[str, str], index, files: list[str], urdf: s
         digests[str(Path(f).resolve())] = hashlib.sha256(text).hexdigest()
     data = {"files": digests, "used": {k: str(v) for k, v in index.used.items()}, "urdf": urdf}
     try:
-        from .output import atomic_output
+        from ..output import atomic_output
 
         entry.parent.mkdir(parents=True, exist_ok=True)
         with atomic_output(entry, "cache") as tmp:

@@ -41,8 +41,7 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
 
     [[parameters]]                      # numbers that wheels may refer to; xacro arguments of the description
     name = "r"; default = 0.1; unit = "m"; description = "wheel radius"   # optional: choices, xacro, minimum
-                                        # (a length in m with a positive default must stay > 0 unless a
-                                        # minimum is given; masses and inertias >= 0)
+                                        # (the smallest physical value; masses and inertias: >= 0 by default)
 
     [[wheels]]
     name = "right"

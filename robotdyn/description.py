@@ -229,7 +229,7 @@ def _check_numbers(urdf: str) -> None:
                 axis = el.find("axis")
                 if axis is not None:
                     xyz = _numbers(axis, "xyz", 3, f"{name} axis")
-                    if xyz and max(map(abs, xyz)) == 0:
+                    if xyz and max(map(abs, xyz)) == 0 and el.get("type") in ("revolute", "continuous", "prismatic"):
                         raise DescriptionError(f"{name} axis: xyz={axis.get('xyz')!r} has zero length; expected a "
                                                "direction")
                 limit = el.find("limit")

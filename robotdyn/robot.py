@@ -61,8 +61,7 @@ class Parameter:
     description: str = ""
     choices: tuple[str, ...] | None = None
     xacro: bool = True
-    minimum: float | None = None  # smallest physical value (default: 0 for masses and inertias, by their unit;
-    # a length in m whose default is positive must stay > 0: give a minimum for an offset that may change sign)
+    minimum: float | None = None  # smallest physical value (default: 0 for masses and inertias, by their unit)
 
     def convert(self, value) -> float | str:
         """Validate and convert a user value."""
@@ -80,10 +79,6 @@ class Parameter:
         if low is not None and out < low:
             raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a value >= {low:g} "
                              f"({self.description or self.name})")
-        if (self.minimum is None and self.unit == "m" and isinstance(self.default, (int, float))
-                and self.default > 0 and out <= 0):
-            raise InputError(f"parameter {self.name} = {out:g} m; expected a length > 0 "
-                             f"({self.description or self.name}; its default is {self.default:g} m)")
         limit = PARAMETER_LIMITS.get(self.unit)
         if limit is not None and abs(out) > limit:
             raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a magnitude <= {limit:g} "

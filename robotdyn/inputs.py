@@ -8,8 +8,18 @@ import numpy as np
 
 from .errors import InputError
 
+MAX_POSITION = 1e6
+"""Largest magnitude of a coordinate [m or rad] accepted as input (beyond it sines and products lose every digit)."""
+MAX_VELOCITY = 1e6
+"""Largest magnitude of a velocity [m/s or rad/s] accepted as input (its squares stay far from overflow)."""
+MAX_ACCELERATION = 1e9
+"""Largest magnitude of an acceleration [m/s^2 or rad/s^2] accepted as input."""
+MAX_FORCE = 1e9
+"""Largest magnitude of a motor torque [N m] or force [N] accepted as input."""
 
-def as_vector(values, n: int, what: str, names: Sequence[str] | None = None) -> np.ndarray:
+
+def as_vector(values, n: int, what: str, names: Sequence[str] | None = None,
+              limit: float | None = None, unit: str = "") -> np.ndarray:
     """Convert ``values`` to a finite float vector of length ``n``.
 
     Args:
@@ -17,9 +27,11 @@ def as_vector(values, n: int, what: str, names: Sequence[str] | None = None) -> 
         n: Expected length.
         what: What the vector is, for the message (e.g. ``"q"``).
         names: Names of the entries, listed in the message when the length is wrong.
+        limit: Largest magnitude accepted (None: any finite number), e.g. :data:`MAX_VELOCITY`.
+        unit: Unit of the entries, for the message.
 
     Raises:
-        InputError: Wrong length, non-numeric or non-finite entries.
+        InputError: Wrong length, non-numeric, non-finite or too large entries.
     """
     if isinstance(values, str):
         values = values.replace(",", " ").split()
@@ -39,6 +51,9 @@ def as_vector(values, n: int, what: str, names: Sequence[str] | None = None) -> 
             raise InputError(f"{what}[{label}] = {x!r} is not a number; expected {expected}") from None
         if not np.isfinite(out[i]):
             raise InputError(f"{what}[{label}] = {x!r} is not finite; expected finite numbers")
+        if limit is not None and abs(out[i]) > limit:
+            raise InputError(f"{what}[{label}] = {out[i]:g}{' ' + unit if unit else ''} is beyond what a robot "
+                             f"reaches; expected |{what}| <= {limit:g}{' ' + unit if unit else ''}")
     return out
 
 

@@ -27,6 +27,8 @@ def check_target(path, what: str = "output file", suffixes: tuple[str, ...] | No
     p = Path(path)
     if p.is_dir():
         raise OutputError(f"{what} {str(path)!r} is a directory; expected a file name")
+    if p.exists() and not p.is_file():  # a device or pipe would be replaced by the atomic rename (e.g. /dev/null)
+        raise OutputError(f"{what} {str(path)!r} is not a regular file (a device or pipe); expected a file name")
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
         raise OutputError(f"{what} {str(path)!r}: directory {str(parent)!r} does not exist; expected an existing "

@@ -22,9 +22,9 @@ from .reduction.actuation import Motor
 from .constraints.constraint import ConstraintRows, KinematicState
 from .description.urdf import _ROOT_CHAINS, URDF_DIR, Description, build_description, expand_xacro
 from .reduction.dynamics import energy
-from .errors import ConstraintError, InputError, NonFiniteError, RobotDynWarning
+from .errors import ConstraintError, DescriptionError, InputError, NonFiniteError, RobotDynWarning
 from .contact.friction import make_law
-from .inputs import as_vector
+from .inputs import MAX_ACCELERATION, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector
 from .constraints.loop_closure import LoopClosure
 from .reduction.projection import auto_independent
 from .fast.dispatch import reduce
@@ -33,6 +33,10 @@ from .constraints.rolling_contact import OmniWheel, RollingWheel, SupportWheel
 from .contact.sliding import SlippingWheel, sliding_now
 from .contact.sliding import forward as forward_sliding
 from .constraints.terrain import FlatTerrain, Terrain
+
+
+PARAMETER_LIMITS = {"m": 1e4, "kg": 1e9, "kg m^2": 1e9, "m/s^2": 1e4, "rad": 1e6}
+"""Largest magnitude of a parameter by unit (beyond these no robot is described: the dynamics only overflow)."""
 
 
 @dataclass
@@ -63,6 +67,10 @@ class Parameter:
         if low is not None and out < low:
             raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a value >= {low:g} "
                              f"({self.description or self.name})")
+        limit = PARAMETER_LIMITS.get(self.unit)
+        if limit is not None and abs(out) > limit:
+            raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a magnitude <= {limit:g} "
+                             f"{self.unit} ({self.description or self.name})")
         return out
 
 
@@ -198,10 +206,16 @@ class Robot:
 
         dirs = [str(d) for d in spec.package_dirs]
         self.packages = PackageIndex.create(spec.packages, dirs)
-        self.description: Description = build_description(
-            expand_xacro(path, xacro_args, self.packages), spec.root, dirs, spec.locked, spec.massless,
-            packages=self.packages, source=path, root_height=spec.root_height or 0.0,
-        )
+        try:
+            self.description: Description = build_description(
+                expand_xacro(path, xacro_args, self.packages), spec.root, dirs, spec.locked, spec.massless,
+                packages=self.packages, source=path, root_height=spec.root_height or 0.0,
+            )
+        except DescriptionError as exc:
+            if not params:
+                raise
+            given = ", ".join(f"{k}={v}" for k, v in params.items())
+            raise DescriptionError(f"with the parameters {given}: {exc}") from None
         for message in self.description.visual_report.warnings:
             warnings.warn(message, RobotDynWarning, stacklevel=2)
         self.model = self.description.model
@@ -332,7 +346,7 @@ class Robot:
 
     def check_q(self, q) -> np.ndarray:
         """Validate a configuration (length, finiteness, joint limits)."""
-        q = as_vector(q, self.nq, "q", self.coordinates)
+        q = as_vector(q, self.nq, "q", self.coordinates, MAX_POSITION, "m or rad")
         lo, hi = self.description.lower, self.description.upper
         bad = np.flatnonzero((q < lo - 1e-12) | (q > hi + 1e-12))
         if bad.size:
@@ -344,11 +358,12 @@ class Robot:
 
     def check_nu(self, nu, what: str = "v") -> np.ndarray:
         """Validate a vector of independent velocities (or accelerations)."""
-        return as_vector(nu, self.mobility, what, self.velocity_names)
+        limit = MAX_ACCELERATION if what in ("a", "nudot") else MAX_VELOCITY
+        return as_vector(nu, self.mobility, what, self.velocity_names, limit)
 
     def check_tau(self, tau) -> np.ndarray:
         """Validate motor torques."""
-        return as_vector(tau, len(self.motors), "tau", [m.name for m in self.motors])
+        return as_vector(tau, len(self.motors), "tau", [m.name for m in self.motors], MAX_FORCE, "N m or N")
 
     # ------------------------------------------------------------------------------------------ constraints
     def constraint_rows(self, kin: KinematicState) -> ConstraintRows:

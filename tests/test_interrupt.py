@@ -37,3 +37,17 @@ def test_stopped_simulation_writes_partial_csv(tmp_path, sig):
     data = np.loadtxt(csv, delimiter=",", skiprows=1)
     assert 2 <= len(data) and data[-1, 0] < 900
     assert np.all(np.diff(data[:, 0]) > 0)
+
+
+def test_complete_simulation_is_not_marked_partial(tmp_path, capsys):
+    """The counterpart: a run that reaches its end writes every sample up to t_end and no partial marker."""
+    from robotdyn.cli import main
+
+    csv = tmp_path / "run.csv"
+    assert main(["simulate", "quasimoro", "--scenario", "rectilinear", "--t-end", "2", "--quiet", "--csv",
+                 str(csv)]) == 0
+    assert "partial" not in capsys.readouterr().err
+    text = csv.read_text()
+    assert "# partial" not in text
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert data[0, 0] == 0.0 and abs(data[-1, 0] - 2.0) < 1e-12

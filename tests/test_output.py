@@ -57,7 +57,7 @@ def test_atomic_output_replaces_only_on_success(tmp_path):
     (["--t-end", "1e300"], "output samples"),
     (["--t-end", "nan"], "expected a positive duration"),
     (["--t-end", "-1"], "expected a positive duration"),
-    (["--t-end", "abc"], "invalid float value: 'abc'"),
+    (["--t-end", "abc"], "--t-end: 'abc' is not a number"),
     (["--bogus"], "unrecognized arguments: --bogus"),
 ])
 def test_simulate_bad_outputs_and_numbers_are_one_line(tmp_path, capsys, args, message):
@@ -84,7 +84,7 @@ def test_huge_states_are_refused_not_returned(capsys):
     assert main(["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "1e200", "1e200", "1e200",
                  "--tau", "1", "1"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "not finite" in err
+    assert err.count("\n") == 1 and "v[theta1_dot] = 1e+200" in err and "expected |v| <= 1e+06" in err
     assert main(["simulate", "omni_caster", "--scenario", "circle", "--t-end", "inf", "--quiet"]) == 2
     assert "expected a positive duration" in capsys.readouterr().err
 
@@ -108,7 +108,7 @@ def test_negative_numbers_in_scientific_notation_are_values(capsys):
 
 
 @pytest.mark.parametrize("params, message", [
-    (["M=0", "m=0", "J1=0", "J2=0"], "not positive definite"),
+    (["M=0", "m=0", "J1=0", "J2=0"], "total mass of 0 kg"),
     (["m=-1"], "parameter m = -1 kg; expected a value >= 0"),
     (["J2=-0.4"], "parameter J2 = -0.4 kg m^2; expected a value >= 0"),
     (["r=0"], "radius 0.0 is not > 0"),

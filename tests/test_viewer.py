@@ -286,7 +286,7 @@ def test_cli_view_exports_html(tmp_path, run_cli):
 
 @pytest.mark.parametrize("args, message", [
     (["--scenario", "nope"], "unknown scenario 'nope' for quasimoro; expected one of"),
-    (["--scenario", "rectilinear", "--t-end", "-1"], "--t-end -1; expected a positive duration"),
+    (["--scenario", "rectilinear", "--t-end", "-1"], "--t-end: '-1'; expected a positive duration"),
     (["--param", "r=abc"], "parameter r = 'abc' is not a number"),
 ])
 def test_cli_view_bad_input(tmp_path, args, message, run_cli):

@@ -17,7 +17,7 @@ import sys
 import numpy as np
 
 from ..errors import RobotDynError
-from ..inputs import as_vector, parse_assignments
+from ..inputs import MAX_ACCELERATION, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector, parse_assignments
 from ..reduction.reduced_dynamics import solve_mass
 from ..constraints.rolling_contact import RollingWheel
 
@@ -44,6 +44,9 @@ def _load(args):
         raise RobotDynError("no robot given: expected ROBOT (robotdyn list) or --urdf FILE --constraints FILE")
     if getattr(args, "package", []):
         raise RobotDynError("--package is for your own robot (--constraints FILE); the built-in robots need none")
+    if getattr(args, "xacro_arg", []):
+        raise RobotDynError("--xacro-arg is for your own robot's description (--constraints FILE); a built-in "
+                            "robot's numbers are its parameters: --param NAME=VALUE (robotdyn info ROBOT lists them)")
     mod = module(args.robot)
     spec = mod.SPEC
     if getattr(args, "twist", None):
@@ -139,23 +142,23 @@ def cmd_info(args) -> int:
 
 def cmd_dump(args) -> int:
     _, robot = _load(args)
-    q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates)
+    q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates, MAX_POSITION)
     for name, x in _numbers(args.set, "--set", "a value in m or rad").items():
         q[robot.coordinate_index(name)] = x
     q = robot.check_q(q)
     if args.full:
-        v = as_vector(args.v, robot.nq, "v", robot.velocity_labels)
+        v = as_vector(args.v, robot.nq, "v", robot.velocity_labels, MAX_VELOCITY)
         M, C, g = robot.full(q, v)
         out = {"coordinates": robot.coordinates, "velocities": robot.velocity_labels, "M": M, "C": C, "g": g}
         text = [_matrix_text("M (full)", robot.coordinates, robot.coordinates, M),
                 _matrix_text("C (full)", robot.coordinates, robot.coordinates, C),
                 _vector_text("g (full)", robot.coordinates, g)]
         if args.a is not None:
-            a = as_vector(args.a, robot.nq, "a", robot.velocity_labels)
+            a = as_vector(args.a, robot.nq, "a", robot.velocity_labels, MAX_ACCELERATION)
             out["tau"] = M @ a + C @ v + g
             text.append(_vector_text("tau (full, M a + C v + g)", robot.coordinates, out["tau"]))
         elif args.tau is not None:
-            tau = as_vector(args.tau, robot.nq, "tau", robot.coordinates)
+            tau = as_vector(args.tau, robot.nq, "tau", robot.coordinates, MAX_FORCE)
             out["a"] = np.linalg.solve(M, tau - C @ v - g)
             text.append(_vector_text("a (full)", robot.velocity_labels, out["a"]))
         _emit(args, out, "\n".join(text))
@@ -322,9 +325,24 @@ def cmd_simulate(args) -> int:
 
 
 def _nonnegative(text: str) -> float:
-    value = float(text)
+    """An argparse type: a finite number >= 0 (argparse names the option in its one-line error)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; expected a finite number >= 0") from None
     if not (np.isfinite(value) and value >= 0):
-        raise ValueError(text)
+        raise argparse.ArgumentTypeError(f"{text!r}; expected a finite number >= 0")
+    return value
+
+
+def _duration(text: str) -> float:
+    """An argparse type: a duration [s], finite and > 0 (argparse names the option in its one-line error)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; expected a positive duration in s") from None
+    if not (np.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}; expected a positive duration in s")
     return value
 
 
@@ -442,13 +460,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_dump)
     p = sub.add_parser("simulate", parents=[common, robot_args], help="run a scenario")
     p.add_argument("--scenario", required=True, help="scenario name (robotdyn info ROBOT lists them)")
-    p.add_argument("--t-end", type=float, default=None, help="duration [s] (default: the scenario's)")
+    p.add_argument("--t-end", type=_duration, default=None, help="duration [s] (default: the scenario's)")
     p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file")
     p.add_argument("--plot", help="save the paper's figures reproduced to this image file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--stabilisation", type=_nonnegative, default=None, metavar="ALPHA",
                    help="gain [1/s] pulling holonomic residuals back (default 10; 0 turns the pull-back off)")
-    p.add_argument("--mu", type=float, default=None,
+    p.add_argument("--mu", type=_nonnegative, default=None,
                    help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
     p.add_argument("--traction-plot", metavar="FILE",
                    help="save the wheel loads and required friction against time to this image file")
@@ -458,7 +476,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("view", parents=[common, robot_args],
                        help="meshcat viewer (live on localhost, or a standalone HTML file with --html)")
     p.add_argument("--scenario", help="animate this scenario (robotdyn info ROBOT lists them)")
-    p.add_argument("--t-end", type=float, default=None, help="duration [s] of the scenario (default: the scenario's)")
+    p.add_argument("--t-end", type=_duration, default=None,
+                   help="duration [s] of the scenario (default: the scenario's)")
     p.add_argument("--html", help="write a standalone HTML file (opens offline) instead of starting a server")
     p.add_argument("--frames", action="store_true", help="show the link frames initially")
     p.add_argument("--open", action="store_true", help="open the live viewer in the default web browser")
@@ -529,6 +548,15 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("robotdyn: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
-        sys.stderr.close()
-        return 0
+    except RecursionError:  # a nesting deeper than any valid input (e.g. a hostile TOML or XML file)
+        print("robotdyn: error: input nested too deeply; expected a robot description or constraint file of "
+              "ordinary depth", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a file the checks above did not foresee (read or write): still one line, naming it
+        if isinstance(exc, BrokenPipeError):  # output piped into e.g. `head`, which closed early
+            sys.stderr.close()
+            return 0
+        name = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        print(f"robotdyn: error: cannot access file{name}: {exc.strerror or exc}; expected a readable input or a "
+              "writable output in an existing directory", file=sys.stderr)
+        return 2

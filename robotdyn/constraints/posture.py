@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ConstraintError, InputError, RobotDynError
+from ..inputs import MAX_POSITION
 from .terrain import Terrain
 
 
@@ -100,6 +101,9 @@ def solve_posture(
         value = float(value)
         if not np.isfinite(value):
             raise InputError(f"prescribed coordinate {label} = {value}; expected a finite number")
+        if abs(float(value)) > MAX_POSITION:
+            raise InputError(f"prescribed coordinate {label} = {float(value):g}; expected a magnitude <= "
+                             f"{MAX_POSITION:g} m or rad")
         q[i] = value
         fixed_idx.append(i)
     free = np.setdiff1d(np.arange(n), fixed_idx)

@@ -126,7 +126,7 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
     return urdf
 
 
-_CHECKS = 1
+_CHECKS = 2
 """Revision of robotdyn's own checks in :func:`_validate_with_yourdfpy` (raise it when they change, so that the
 cache of validated texts does not skip a new check)."""
 
@@ -175,8 +175,97 @@ def validate_urdf(urdf: str) -> None:
         pass
 
 
+MAX_DESCRIPTION_LENGTH = 1e6
+"""Largest offset or size in a description [m] (beyond it the kinematics lose every digit)."""
+
+
+def _numbers(el, attr: str, count: int, what: str) -> list[float]:
+    """``count`` finite numbers of an attribute (one line naming the element otherwise)."""
+    text = el.get(attr)
+    if text is None:
+        return []
+    parts = text.split()
+    try:
+        values = [float(x) for x in parts]
+    except ValueError:
+        raise DescriptionError(f"{what}: {attr}={text!r} is not {count} number(s)") from None
+    if len(values) != count:
+        raise DescriptionError(f"{what}: {attr}={text!r} has {len(values)} number(s); expected {count}")
+    if not all(math.isfinite(v) for v in values):
+        raise DescriptionError(f"{what}: {attr}={text!r} is not finite; expected finite numbers")
+    return values
+
+
+def _check_numbers(urdf: str) -> None:
+    """Every number of a URDF that robotdyn reads, checked before any parser sees it: finite and of the right
+    count (origins, axes, masses, inertias, limits, geometry), masses >= 0, sizes >= 0, offsets within
+    :data:`MAX_DESCRIPTION_LENGTH`, joint limits ordered, a total mass > 0.
+
+    Raises:
+        DescriptionError: naming the link or joint and the attribute.
+    """
+    try:
+        tree = ET.fromstring(urdf)
+    except ET.ParseError as exc:
+        raise DescriptionError(f"invalid URDF (not XML): {exc}") from None
+    if tree.tag != "robot":
+        raise DescriptionError(f"invalid URDF: root element <{tree.tag}>; expected <robot>")
+    total, links = 0.0, 0
+    for kind in ("link", "joint"):
+        for el in tree.iter(kind):
+            name = f"{kind} {el.get('name')!r}"
+            for origin in el.iter("origin"):
+                xyz = _numbers(origin, "xyz", 3, f"{name} origin")
+                _numbers(origin, "rpy", 3, f"{name} origin")
+                if xyz and max(map(abs, xyz)) > MAX_DESCRIPTION_LENGTH:
+                    raise DescriptionError(f"{name} origin: xyz={origin.get('xyz')!r}; expected offsets of magnitude "
+                                           f"<= {MAX_DESCRIPTION_LENGTH:g} m")
+            if kind == "link":
+                links += 1
+                mass = el.find("inertial/mass")
+                if mass is not None:
+                    m = _numbers(mass, "value", 1, f"{name} mass")
+                    if m and m[0] < 0:
+                        raise DescriptionError(f"{name} mass: value={m[0]:g} kg; expected a mass >= 0")
+                    total += m[0] if m else 0.0
+                inertia = el.find("inertial/inertia")
+                if inertia is not None:
+                    for attr in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"):
+                        _numbers(inertia, attr, 1, f"{name} inertia")
+                for shape in el.iter():
+                    if shape.tag in ("box", "cylinder", "sphere", "capsule"):
+                        for attr, count in (("size", 3), ("radius", 1), ("length", 1)):
+                            values = _numbers(shape, attr, count, f"{name} {shape.tag}")
+                            if values and min(values) < 0:
+                                raise DescriptionError(f"{name} {shape.tag}: {attr}={shape.get(attr)!r}; expected "
+                                                       "sizes >= 0 m")
+            else:
+                axis = el.find("axis")
+                if axis is not None:
+                    xyz = _numbers(axis, "xyz", 3, f"{name} axis")
+                    if xyz and max(map(abs, xyz)) == 0 and el.get("type") in ("revolute", "continuous", "prismatic"):
+                        raise DescriptionError(f"{name} axis: xyz={axis.get('xyz')!r} has zero length; expected a "
+                                               "direction")
+                limit = el.find("limit")
+                if limit is not None:
+                    lower = _numbers(limit, "lower", 1, f"{name} limit")
+                    upper = _numbers(limit, "upper", 1, f"{name} limit")
+                    for attr in ("effort", "velocity"):
+                        v = _numbers(limit, attr, 1, f"{name} limit")
+                        if v and v[0] < 0:
+                            raise DescriptionError(f"{name} limit: {attr}={v[0]:g}; expected a value >= 0")
+                    if lower and upper and lower[0] > upper[0] and el.get("type") in ("revolute", "prismatic"):
+                        raise DescriptionError(f"{name} limit: lower={lower[0]:g} > upper={upper[0]:g}; expected "
+                                               "lower <= upper")
+    if links and total <= 0:
+        raise DescriptionError("the description's links have a total mass of 0 kg; expected positive masses (a "
+                               "robot without mass has no dynamics)")
+
+
 def _validate_with_yourdfpy(urdf: str) -> None:
     import yourdfpy
+
+    _check_numbers(urdf)
 
     try:
         robot = yourdfpy.URDF.load(io.StringIO(urdf), build_scene_graph=False, load_meshes=False)

@@ -5,7 +5,9 @@ motors, the terrain and optionally the independent velocities, locked joints and
 and validates it against the description and returns a :class:`ConstraintFile` whose ``SPEC`` is the same
 :class:`~robotdyn.robot.RobotSpec` object a robot module supplies: a user's robot and the built-in robots go
 through one path (``Robot(spec)``). Every mistake gives one line naming the file and the entry, e.g.
-``tiago.toml: wheels[1] (left): no joint named 'wheel_lft_joint'; did you mean 'wheel_left_joint'?``.
+``tiago.toml: wheels[1] (left): no joint named 'wheel_lft_joint'; did you mean 'wheel_left_joint'?``. Types, shapes,
+ranges and key names are checked first against a JSON schema (:mod:`robotdyn.constraint_schema`); the names are
+then checked against the description. The file is data: nothing in it is evaluated.
 
 Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
 
@@ -38,7 +40,8 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     slope = 0.1                         # | sine (amplitude, kx, ky, phase)
 
     [[parameters]]                      # numbers that wheels may refer to; xacro arguments of the description
-    name = "r"; default = 0.1; unit = "m"; description = "wheel radius"   # optional: choices, xacro
+    name = "r"; default = 0.1; unit = "m"; description = "wheel radius"   # optional: choices, xacro, minimum
+                                        # (the smallest physical value; masses and inertias: >= 0 by default)
 
     [[wheels]]
     name = "right"
@@ -103,7 +106,7 @@ TOP_KEYS = (
     "root_height", "twist",
 )
 TWIST_KEYS = ("frame", "components", "axes", "names")
-PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro")
+PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro", "minimum")
 WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
               "slip_velocity", "stiffness", "slip")
 MAX_RADIUS = 1e4
@@ -271,6 +274,15 @@ class ConstraintFile:
             raise
         except RobotDynError as exc:
             raise ConstraintFileError(f"{self.path}: {exc}") from None
+        independent = self.SPEC.independent
+        if independent:  # more independent velocities than the constraints leave free cannot be independent
+            A = robot.rows_at(robot.neutral()).A
+            free = robot.nq - (int(np.linalg.matrix_rank(A)) if A.size else 0)
+            if len(independent) > free:
+                raise ConstraintFileError(
+                    f"{self.path}: independent: {len(independent)} coordinates ({', '.join(independent)}) but the "
+                    f"constraints leave {free} velocities free at the neutral configuration (n = {robot.nq}, rank A = "
+                    f"{robot.nq - free}); expected at most {free}")
         for i, sc in enumerate(self.SCENARIOS.values()):
             for name in sc.nu0:
                 if name not in robot.velocity_names:
@@ -320,6 +332,14 @@ def read(
         raise ConstraintFileError(f"{path}: not UTF-8 text; expected a TOML constraint file") from None
     except OSError as exc:
         raise ConstraintFileError(f"{path}: cannot read: {exc.strerror}") from None
+    except RecursionError:
+        raise ConstraintFileError(f"{path}: not valid TOML: nested too deeply; expected a constraint file of "
+                                  "ordinary depth") from None
+    from .constraint_schema import schema_problem
+
+    problem = schema_problem(data)  # types, shapes, ranges and keys, before anything reads a value
+    if problem is not None:
+        raise ConstraintFileError(f"{path}: {problem}")
     try:
         return _read(path, r, data, urdf, xacro_args, package_dirs, packages or {}, twist)
     except (TypeError, AttributeError, KeyError, IndexError, ValueError, RecursionError) as exc:
@@ -390,12 +410,21 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
             r.fail(where, f"xacro = {use_xacro!r}; expected true or false")
         if any(q.name == name for q in params):
             r.fail(where, f"parameter {name!r} is declared twice")
-        params.append(Parameter(name, default, str(p.get("unit", "")), str(p.get("description", "")), choices,
-                                use_xacro))
+        minimum = p.get("minimum")
+        param = Parameter(name, default, str(p.get("unit", "")), str(p.get("description", "")), choices, use_xacro,
+                          None if minimum is None else float(minimum))
+        try:  # the default itself must be a physical value of the parameter
+            param.convert(default)
+        except RobotDynError as exc:
+            r.fail(where, f"default: {exc}")
+        params.append(param)
     pvalues = {p.name: p.default for p in params}
     for name in xargs:
         if any(p.name == name and p.xacro for p in params):
             r.fail("xacro_args", f"{name!r} is a parameter of this file; set it with --param {name}=VALUE")
+        if name not in declared:
+            r.fail("xacro_args", f"{name!r} is not an argument of {desc.name}{_suggest(name, declared)}; expected "
+                                 f"one of {', '.join(declared) or '(none declared with <xacro:arg>)'}")
     try:
         text = expand_xacro(desc, {**xargs, **{p.name: p.default for p in params if p.xacro}}, index)
         tree = _Tree.parse(text, declared)
@@ -452,6 +481,13 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
             joint(f"labels.{j}", j, "label")
         r.string(f"labels.{j}", label, "label")
     coordinates = chain + [j for j in movable if j not in locked]
+    seen: dict[str, str] = {}
+    for j, label in labels.items():
+        if label in seen:
+            r.fail(f"labels.{j}", f"label {label!r} is also the label of {seen[label]!r}; expected distinct labels")
+        if label != j and label in coordinates:
+            r.fail(f"labels.{j}", f"label {label!r} is the name of another coordinate; expected a new name")
+        seen[label] = j
     names = coordinates + [labels[j] for j in labels]
 
     def coordinate(where: str, name) -> str:
@@ -544,6 +580,12 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
                 raise InputError("slip_velocity/stiffness need friction = 'coulomb' or 'linear'")
         except InputError as exc:
             r.fail(where, str(exc))
+        for other in wheels:
+            if other.name == wheel.name:
+                r.fail(where, f"a second wheel named {wheel.name!r}; expected unique wheel names")
+            if other.frame == wheel.frame:
+                r.fail(where, f"wheel centre {wheel.frame!r}" + (f" (spin joint {spin!r})" if spin else "")
+                       + f" is also wheel {other.name!r}'s; expected one wheel per spin joint (frame)")
         wheels.append(wheel)
 
     # ----------------------------------------------------------------------------------------- closures
@@ -552,6 +594,9 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         where = f"closures[{i}]" + (f" ({c['name']})" if isinstance(c, dict) and "name" in c else "")
         r.keys(where, c, CLOSURE_KEYS)
         f1, f2 = frame(where, c.get("frame1"), "frame1"), frame(where, c.get("frame2"), "frame2")
+        if f1 in chain and f2 in chain:
+            r.fail(where, f"{f1!r} and {f2!r} are both frames of the {root} root's own coordinates; a closure joins "
+                          "two bodies of the description")
         if f1 not in chain and f2 not in chain and body_of_frame(f1) == body_of_frame(f2):
             r.fail(where, f"{f1!r} and {f2!r} are on the same rigid body; a closure joins two different bodies")
         comps = r.strings(where, c.get("components", ["x", "y", "z"]), "components")
@@ -567,6 +612,8 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         where = f"motors[{i}]" + (f" ({m['name']})" if isinstance(m, dict) and "name" in m else "")
         r.keys(where, m, MOTOR_KEYS)
         j = joint(where, m.get("joint"), "joint")
+        if any(mm.name == m.get("name", j) for mm in motors):
+            r.fail(where, f"a second motor named {m.get('name', j)!r}; expected unique motor names")
         if j in locked:
             r.fail(where, f"joint {j!r} is locked; a motor needs a moving joint")
         reaction = m.get("reaction")
@@ -578,6 +625,9 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
     independent = data.get("independent")
     if independent is not None:
         independent = [coordinate("independent", x) for x in r.strings("independent", independent, "independent")]
+        twice = sorted({x for x in independent if independent.count(x) > 1})
+        if twice:
+            r.fail("independent", f"{', '.join(map(repr, twice))} listed twice; expected distinct coordinates")
         if not independent:
             r.fail("independent", "empty; expected the names of the independent coordinates (or no 'independent' "
                                   "key: chosen automatically)")

@@ -36,6 +36,8 @@ TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
 MAX_SAMPLES = 5_000_000
 """Largest number of output samples of one simulation (memory: 8 bytes x (2n + 3) columns each)."""
+MIN_DURATION = 1e-6
+"""Shortest simulation [s] (below it the output times are not distinct in double precision)."""
 
 
 @dataclass
@@ -161,6 +163,8 @@ def simulate(
     """
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
+    if t_end < MIN_DURATION:
+        raise RobotDynError(f"t_end = {t_end:g} s; expected a duration of at least {MIN_DURATION:g} s")
     if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
         raise RobotDynError(f"time_limit = {time_limit} s; expected a positive wall-clock duration or None")
     if not 2 <= n_out <= MAX_SAMPLES:

@@ -52,10 +52,18 @@ class Scenario:
     def span(self, t_end: float | None = None, n_out: int | None = None) -> tuple[float, int]:
         """The duration [s] (default the scenario's; checked finite and positive) and the number of output samples
         (default: the scenario's sampling rate over that duration)."""
+        from .simulation import MAX_SAMPLES, MIN_DURATION
+
         t_end = self.t_end if t_end is None else float(t_end)
         if not np.isfinite(t_end) or t_end <= 0:
             raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
-        return t_end, n_out or max(2, int(round(self.n_out * t_end / self.t_end)))
+        if t_end < MIN_DURATION:
+            raise RobotDynError(f"t_end = {t_end:g} s; expected a duration of at least {MIN_DURATION:g} s")
+        n = float(n_out) if n_out else max(2.0, round(self.n_out * t_end / self.t_end))
+        if not 2 <= n <= MAX_SAMPLES:
+            raise RobotDynError(f"{n:.3g} output samples for t_end = {t_end:g} s; expected 2 to {MAX_SAMPLES:,} "
+                                "samples (memory): give a shorter duration or fewer samples")
+        return t_end, int(n)
 
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs) -> Trajectory:
         """Simulate the scenario on ``robot`` (keyword arguments go to :func:`~robotdyn.simulation.engine.simulate`)."""

@@ -175,7 +175,7 @@ def plan(spec: SweepSpec) -> Plan:
         try:
             spans[name] = scenarios[name].span(spec.t_end, spec.n_out)
         except RobotDynError as exc:
-            raise SweepSpecError(f"t_end: {exc}") from None
+            raise SweepSpecError(f"t_end/n_out: {exc}") from None
     pts = points(spec, axes)
     total = len(pts) * len(chosen) * max(1, len(terrains))
     if total > MAX_RUNS:

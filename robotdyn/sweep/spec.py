@@ -194,8 +194,8 @@ def _count(x, where: str) -> int:
         n = int(x)
     except (TypeError, ValueError):
         raise SweepSpecError(f"{where}: n = {x!r}; expected a whole number of points >= 1") from None
-    if isinstance(x, float) and x != n or n < 1:
-        raise SweepSpecError(f"{where}: n = {x!r}; expected a whole number of points >= 1")
+    if isinstance(x, float) and x != n or not 1 <= n <= MAX_RUNS:
+        raise SweepSpecError(f"{where}: n = {x!r}; expected a whole number of points from 1 to {MAX_RUNS:,}")
     return n
 
 
@@ -305,6 +305,11 @@ def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
         if spec.n is not None:
             raise SweepSpecError(f"n = {spec.n} samples with sample = 'grid'; expected sample = 'lhs' or 'random' "
                                  "(a grid's size is its axes' points)")
+        total = 1
+        for a in axes:
+            total *= len(a.values) if not a.ranged else (a.n or 1)
+        if total > MAX_RUNS:
+            raise SweepSpecError(f"{total:,} runs on the grid; expected at most {MAX_RUNS:,}: fewer points")
         grids = [a.grid() for a in axes]
         return [dict(zip([a.name for a in axes], combo)) for combo in itertools.product(*grids)]
     ranged = [a for a in axes if a.ranged]
@@ -313,6 +318,9 @@ def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
         raise SweepSpecError(f"sample = {spec.sample!r} needs at least one range to sample (NAME=LO:HI)")
     if spec.n is None or spec.n < 1:
         raise SweepSpecError(f"sample = {spec.sample!r}: n = {spec.n}; expected the number of samples >= 1")
+    if spec.n * int(np.prod([len(a.values) for a in listed])) > MAX_RUNS:
+        raise SweepSpecError(f"n = {spec.n:,} samples crossed with the listed values; expected at most {MAX_RUNS:,} "
+                             "runs")
     rng = np.random.default_rng(spec.seed)
     if spec.sample == "random":
         u = rng.random((spec.n, len(ranged)))

@@ -1,4 +1,4 @@
-"""The constraint file's schema (robotdyn/constraint_schema.py) and the physical ranges of parameters (issue 15):
+"""The constraint file's schema (robotdyn/interfaces/constraint_schema.py) and the physical ranges of parameters (issue 15):
 every shipped constraint file is valid, mistakes are one line naming the entry with a suggestion for a misspelt
 key, and a parameter's physical range follows its unit unless the file declares a minimum."""
 
@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from robotdyn.constraint_file import ConstraintFileError, load_robot
-from robotdyn.constraint_schema import schema_problem
+from robotdyn.interfaces.constraint_file import ConstraintFileError, load_robot
+from robotdyn.interfaces.constraint_schema import schema_problem
 from robotdyn.errors import InputError
 from robotdyn.robot import Parameter
 

@@ -6,7 +6,7 @@ and validates it against the description and returns a :class:`ConstraintFile` w
 :class:`~robotdyn.robot.RobotSpec` object a robot module supplies: a user's robot and the built-in robots go
 through one path (``Robot(spec)``). Every mistake gives one line naming the file and the entry, e.g.
 ``tiago.toml: wheels[1] (left): no joint named 'wheel_lft_joint'; did you mean 'wheel_left_joint'?``. Types, shapes,
-ranges and key names are checked first against a JSON schema (:mod:`robotdyn.constraint_schema`); the names are
+ranges and key names are checked first against a JSON schema (:mod:`robotdyn.interfaces.constraint_schema`); the names are
 then checked against the description. The file is data: nothing in it is evaluated.
 
 Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::

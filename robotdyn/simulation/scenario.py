@@ -52,7 +52,7 @@ class Scenario:
     def span(self, t_end: float | None = None, n_out: int | None = None) -> tuple[float, int]:
         """The duration [s] (default the scenario's; checked finite and positive) and the number of output samples
         (default: the scenario's sampling rate over that duration)."""
-        from .simulation import MAX_SAMPLES, MIN_DURATION
+        from .engine import MAX_SAMPLES, MIN_DURATION
 
         t_end = self.t_end if t_end is None else float(t_end)
         if not np.isfinite(t_end) or t_end <= 0:

@@ -1,5 +1,5 @@
 """The constraint file's schema: types, shapes, ranges and allowed keys of every entry, checked with jsonschema
-before anything reads the file (:mod:`robotdyn.constraint_file` then checks the names against the description).
+before anything reads the file (:mod:`robotdyn.interfaces.constraint_file` then checks the names against the description).
 
 A constraint file is data: nothing in it is evaluated (xacro argument values are checked to be numbers or plain
 words by :func:`robotdyn.description.xacro_value` before xacro sees them). A value of the wrong type or shape, out
@@ -16,8 +16,8 @@ from collections.abc import Iterable
 import jsonschema
 from jsonschema import validators
 
-from .description import ROOT_KINDS
-from .inputs import MAX_FORCE, MAX_POSITION, MAX_VELOCITY
+from ..description import ROOT_KINDS
+from ..inputs import MAX_FORCE, MAX_POSITION, MAX_VELOCITY
 
 MAX_RADIUS = 1e4
 """Largest wheel radius accepted [m] (larger values only overflow the dynamics)."""
@@ -110,7 +110,7 @@ SCHEMA: dict = _table({
     "terrain": {**_table({"kind": {"enum": ["flat", "ramp", "bump", "sine"],
                                    "expected": "one of flat, ramp, bump, sine"}, **_TERRAIN_NUMBERS},
                          expected="a table with kind and its numbers"),
-                "additionalProperties": True},  # keys by kind: robotdyn.constraint_file names the kind's own
+                "additionalProperties": True},  # keys by kind: robotdyn.interfaces.constraint_file names the kind's own
     "twist": _table({
         "frame": _string("a frame name"),
         "components": _strings(f"distinct entries of {' '.join(TWIST_COMPONENTS)}", 1),

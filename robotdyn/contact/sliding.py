@@ -50,7 +50,7 @@ class SlippingWheel(SupportWheel):
     Args:
         law: The :class:`~robotdyn.contact.friction.FrictionLaw` of its tangential force.
         slip: ``both`` (default) or ``lateral`` (:data:`SLIP_DIRECTIONS`).
-        Other arguments as :class:`~robotdyn.constraints.rolling_contact.RollingWheel`.
+        **kwargs: The other arguments of :class:`~robotdyn.constraints.rolling_contact.RollingWheel`.
     """
 
     sliding = True  # its friction force comes from a law (robotdyn.contact.sliding.forward)

@@ -74,7 +74,7 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
         q0, nu0: Initial state.
         profile: Motor torques.
         t_eval: Output times (sorted, from 0 to t_end).
-        rtol, atol: Tolerances of the stepper's error control (per component: atol + rtol |y_i|).
+        rtol, atol: Tolerances of the stepper's error control (per component: :math:`atol + rtol |y_i|`).
         stabilisation: Gain [1/s] of the holonomic pull-back.
         method: One of :data:`METHODS`.
         progress: ``progress(t)`` called about every 50 ms (None: not called).

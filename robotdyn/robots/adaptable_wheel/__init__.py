@@ -1,12 +1,12 @@
 """The tricycle with adaptable-radius wheels (Mardani & Ebrahimi 2016): the model and the paper, kept apart.
 
-- :mod:`.model`: what robotdyn derives from ``urdf/adaptable_wheel.urdf.xacro`` -- ``SPEC`` (Table 1), the
+- :mod:`robotdyn.robots.adaptable_wheel.model`: what robotdyn derives from ``urdf/adaptable_wheel.urdf.xacro`` -- ``SPEC`` (Table 1), the
   terrains, ``SCENARIOS``.
-- :mod:`.paper`: the paper's closed forms (eqs 1, 3-35) and Table 2, transcribed
+- :mod:`robotdyn.robots.adaptable_wheel.paper`: the paper's closed forms (eqs 1, 3-35) and Table 2, transcribed
   (``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``).
-- :mod:`.missions`: the kinematic missions of section 7, solved by the paper's inverse kinematics.
-- :mod:`.dynamics`: the model driven along those missions, with inertia or sideways friction (beyond the paper).
-- :mod:`.comparison`: ``compare``, the model against the paper, and the ``ik`` CLI
+- :mod:`robotdyn.robots.adaptable_wheel.missions`: the kinematic missions of section 7, solved by the paper's inverse kinematics.
+- :mod:`robotdyn.robots.adaptable_wheel.dynamics`: the model driven along those missions, with inertia or sideways friction (beyond the paper).
+- :mod:`robotdyn.robots.adaptable_wheel.comparison`: ``compare``, the model against the paper, and the ``ik`` CLI
   (``docs/errata/adaptable_wheel.md``).
 
 The names of all five are re-exported here (``robotdyn.robots.module("adaptable_wheel")``).

@@ -1,7 +1,7 @@
 """Adaptable-wheel tricycle: the full model driven along the section-7 missions (beyond the paper).
 
-The paper stops at kinematics and statics; here the model of :mod:`.model` follows the missions of
-:mod:`.missions` (the body's pose from the paper's IK, eqs 4-6 and 18-23) and Pinocchio's RNEA gives the motor
+The paper stops at kinematics and statics; here the model of :mod:`robotdyn.robots.adaptable_wheel.model` follows the missions of
+:mod:`robotdyn.robots.adaptable_wheel.missions` (the body's pose from the paper's IK, eqs 4-6 and 18-23) and Pinocchio's RNEA gives the motor
 torques with inertia (:func:`mission_dynamics`, contact forces chosen as in eqs 28-30), or the wheels slide sideways
 under a friction law (:func:`mission_friction`). Both report the paper's eq 35 and eqs 25-34 beside the model's
 torques. Discussion: ``docs/errata/adaptable_wheel.md``

@@ -9,15 +9,15 @@ three wheels fr, fl, r at the eq-8 positions, each with a spin joint ``theta_<i>
 angle ``q_<i>`` (adjustment motor, 0-180 deg) and a prismatic radius ``Rch_<i>`` (the close-loop pattern radius).
 The wheel radius is :math:`R_T = R_{ru} + R_{ch}` and the mechanism law of eq 1,
 :math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)`, is a holonomic :class:`~robotdyn.constraints.joint_coupling.JointCoupling` (its own
-:class:`~robotdyn.constraints.joint_coupling.CosineLaw`, compared with the paper's :func:`.paper.radius_law` in the tests), so
+:class:`~robotdyn.constraints.joint_coupling.CosineLaw`, compared with the paper's :func:`robotdyn.robots.adaptable_wheel.paper.radius_law` in the tests), so
 the radius follows the configuration through the constraint layer. Each wheel rolls on the terrain
 (:class:`~robotdyn.constraints.rolling_contact.RollingWheel` with ``radius_joint``); ``lateral=slip`` drops the lateral
 no-slip row (the paper's kinematic missions turn the robot about a vertical axis away from its wheel axles,
 which rolling without lateral slip forbids: see ``docs/errata/adaptable_wheel.md``).
 
 This module holds ``SPEC``, the terrains of Table 1 and mission 2 and ``SCENARIOS``. The paper's transcription
-(eqs 1, 3-24, 25-35, Table 2) is in :mod:`.paper`, the section-7 missions in :mod:`.missions`, the model driven
-along them (beyond the paper) in :mod:`.dynamics`, the comparison and the ``ik`` CLI in :mod:`.comparison`.
+(eqs 1, 3-24, 25-35, Table 2) is in :mod:`robotdyn.robots.adaptable_wheel.paper`, the section-7 missions in :mod:`robotdyn.robots.adaptable_wheel.missions`, the model driven
+along them (beyond the paper) in :mod:`robotdyn.robots.adaptable_wheel.dynamics`, the comparison and the ``ik`` CLI in :mod:`robotdyn.robots.adaptable_wheel.comparison`.
 """
 
 from __future__ import annotations

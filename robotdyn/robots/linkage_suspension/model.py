@@ -17,8 +17,8 @@ omni wheels, the default).
 
 This module holds ``SPEC`` (the paper prints no dimensions: ours), the section-3 wheel-speed profile and the
 kinematic runs on the model, example terrains, ``SCENARIOS``, the ``linkage-posture`` CLI subcommand and the
-posture-versus-rigid-chassis study. The paper's closed forms (Table 1, eqs 1-4, 10) are in :mod:`.paper`, the
-comparison (eqs 3, 4, 9, 10, section 3) in :mod:`.comparison`.
+posture-versus-rigid-chassis study. The paper's closed forms (Table 1, eqs 1-4, 10) are in :mod:`robotdyn.robots.linkage_suspension.paper`, the
+comparison (eqs 3, 4, 9, 10, section 3) in :mod:`robotdyn.robots.linkage_suspension.comparison`.
 """
 
 from __future__ import annotations

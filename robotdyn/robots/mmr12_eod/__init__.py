@@ -1,10 +1,10 @@
 """The MMR12-EOD mobile manipulator (Zuniga-Aviles et al. 2014): the model and the paper, kept apart.
 
-- :mod:`.model`: what robotdyn derives from ``urdf/mmr12_eod.urdf.xacro`` -- ``SPEC``, the control ``SCENARIOS``
+- :mod:`robotdyn.robots.mmr12_eod.model`: what robotdyn derives from ``urdf/mmr12_eod.urdf.xacro`` -- ``SPEC``, the control ``SCENARIOS``
   (Table 4 tracking, manipulation, lifting), the climbing balance, the ``fk`` CLI hook.
-- :mod:`.paper`: the paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31), transcribed
+- :mod:`robotdyn.robots.mmr12_eod.paper`: the paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31), transcribed
   (``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``).
-- :mod:`.comparison`: ``compare``, the model against the paper (``docs/errata/mmr12_eod.md``).
+- :mod:`robotdyn.robots.mmr12_eod.comparison`: ``compare``, the model against the paper (``docs/errata/mmr12_eod.md``).
 
 The names of all three are re-exported here (``robotdyn.robots.module("mmr12_eod")``).
 """

@@ -16,7 +16,7 @@ dependent through the rolling constraints of Table 3 (eqs 12-14) and the wheels'
 This module holds ``SPEC`` (Table 2, section 3; masses assumed), the CLI hook, the control scenarios (eqs 23-25 on
 the model: Table 4 tracking, the Fig. 9 manipulation, the sec 2.11 d lifting), the climbing balance of
 sec 2.11 e and the climbing posture's contact forces on a ramp (:func:`climbing_forces`). The paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31) are in
-:mod:`.paper`, the comparison in :mod:`.comparison`.
+:mod:`robotdyn.robots.mmr12_eod.paper`, the comparison in :mod:`robotdyn.robots.mmr12_eod.comparison`.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ rows vanish on the plane) and the mobility is 3 (Grubler count of section 2).
 This module holds ``SPEC`` (Tables 1-2), the paper's NOC coordinates as a second spec (eq A9), the section-5
 trajectories (eq 61) and their feed-forward scenarios, the impulse study of Figs. 16-19 on the model (eq 60 is
 :func:`robotdyn.contact.impulse.impact`) and the ``impulse`` CLI subcommand. The paper's closed forms (eqs 12-19, 43,
-48-51, 60, A7-A9) are in :mod:`.paper`, the comparison in :mod:`.comparison`.
+48-51, 60, A7-A9) are in :mod:`robotdyn.robots.omni_caster.paper`, the comparison in :mod:`robotdyn.robots.omni_caster.comparison`.
 """
 
 from __future__ import annotations

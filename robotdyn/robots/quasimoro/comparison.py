@@ -1,6 +1,6 @@
 """Quasimoro: the model against the paper (:func:`compare`) and the model-side helper it needs.
 
-Brings :mod:`.model` (Pinocchio's reduced dynamics of ``urdf/quasimoro.urdf.xacro``) and :mod:`.paper` (eqs 23-31
+Brings :mod:`robotdyn.robots.quasimoro.model` (Pinocchio's reduced dynamics of ``urdf/quasimoro.urdf.xacro``) and :mod:`robotdyn.robots.quasimoro.paper` (eqs 23-31
 of ``shared/papers/staicu_quasimoro_virtual_powers.txt``) together; disagreements are discussed in
 ``docs/errata/quasimoro.md``.
 """

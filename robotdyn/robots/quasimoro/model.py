@@ -9,7 +9,7 @@ Coordinates (x, y, psi) of the axle midpoint C2 and yaw; theta1, theta2 the whee
 frame (about +y, forward rolling positive); theta3 the body's inclination (about -y, mass centre forward positive).
 Independent velocities: the paper's (theta1_dot, theta2_dot, theta3_dot).
 
-The paper's closed forms (eqs 23-31) are in :mod:`.paper`, their comparison with this model in :mod:`.comparison`.
+The paper's closed forms (eqs 23-31) are in :mod:`robotdyn.robots.quasimoro.paper`, their comparison with this model in :mod:`robotdyn.robots.quasimoro.comparison`.
 """
 
 from __future__ import annotations

@@ -265,6 +265,7 @@ class Evaluator {
 
   int nv() const { return nv_; }
   double condition() const { return cond_; }
+  py::tuple slip_condition() const { return py::make_tuple(slip_kappa1_, slip_kappa2_); }
   int nrows() const { return static_cast<int>(holonomic_.size()); }
   int mobility() const {
     return operational_ ? static_cast<int>(op_select_.size()) : static_cast<int>(independent_.size());
@@ -354,7 +355,7 @@ class Evaluator {
     } else if (nr) {
       rhs_.resize(nr);
       for (int r = 0; r < nr; ++r) rhs_[r] = drift_[rows_[r]];
-      lu_solve(rhs_);
+      lu_solve(lu_, rhs_);
       wd_ = -rhs_;
       for (int r = 0; r < nr; ++r) w_[dependent_[r]] = wd_[r];
     }
@@ -442,9 +443,9 @@ class Evaluator {
   // A_R the projection's rows, J_t,i = (t1, t2)^T A_w,i the tangential rows of slipping wheel i, s_i = J_t,i v its
   // slip velocity, c_i = c(s_i), e_i selecting its normal load; W-dot = sum_i F_i . s_i, F_i = -f_n,i c_i (the
   // friction power). The system's 2-norm condition number above 1e12 is the Painleve case (SlipError 0), decided
-  // as numpy.linalg.cond would: the exact 1-norm number kappa_1 (from the inverse) bounds it, kappa_2 <= n kappa_1,
-  // and only where n kappa_1 exceeds 1e12 are the singular values computed. Leaves the normal loads in
-  // slip_normal_ and their minimum (the lift-off event's value) in slip_min_.
+  // as numpy.linalg.cond would: LAPACK's 1-norm estimate from the LU factors clears regular states, the singular
+  // values decide near the threshold (the rule below). Leaves the normal loads in slip_normal_ and their minimum
+  // (the lift-off event's value) in slip_min_, the condition numbers of the test in slip_kappa1_, slip_kappa2_.
   void slip_rhs_into(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                      const Eigen::Ref<const VectorXd>& tau, double alpha, Eigen::Ref<VectorXd> out) {
     configure(q);
@@ -480,13 +481,25 @@ class Evaluator {
     bs_ -= data_.tau;  // C v + g (dynamics)
     bs_.noalias() -= data_.M * w_;
     slip_lu_.compute(Ks_);
-    Ksinv_ = slip_lu_.inverse();
-    const double kappa1 = Ks_.cwiseAbs().colwise().sum().maxCoeff() * Ksinv_.cwiseAbs().colwise().sum().maxCoeff();
-    if (!(std::isfinite(kappa1) && nv_ * kappa1 <= 1e12)) {
+    // Painleve test, the decision of the Python path's np.linalg.cond(K) > 1e12 (2-norm) without an O(n^3) inverse
+    // or SVD at regular states. From the LU factors just computed, LAPACK's O(n^2) estimate e of ||K^-1||_1 (the
+    // projection's estimator, inverse_norm_estimate) gives kappa_1 ~ ||K||_1 e. For n x n matrices
+    // kappa_2 <= n kappa_1, and e <= ||K^-1||_1 underestimates by a small factor in practice (the projection
+    // counts on 100: its estimate decides below 1e8 against its bound 1e10). So:
+    //   n ||K||_1 e <= 1e12 / 100  ->  regular, no further work (kappa_2 <= 1e12 unless e underestimates by > 100);
+    //   otherwise (near the threshold, beyond it, or NaN / inf from a zero pivot) the singular values decide,
+    //   exactly as numpy.linalg.cond does (kappa_2 = s_max / s_min, singular above 1e12 or not finite), and give
+    //   the value the Python path reports.
+    // The band [1e10 / n, 1e12] of estimates that pay for the SVD is a factor 100 n wide: only a state near
+    // Painleve pays there.
+    slip_kappa1_ = Ks_.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm_estimate(slip_lu_);
+    slip_kappa2_ = std::numeric_limits<double>::quiet_NaN();  // (not computed)
+    if (!(nv_ * slip_kappa1_ <= 1e12 / 100)) {  // NaN too
       slip_svd_.compute(Ks_);
       const VectorXd& sv = slip_svd_.singularValues();
       const double cond = sv[0] / sv[sv.size() - 1];
-      if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, std::isnan(cond) ? HUGE_VAL : cond);
+      slip_kappa2_ = std::isnan(cond) ? HUGE_VAL : cond;
+      if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, slip_kappa2_);
     }
     xs_ = slip_lu_.solve(bs_);
     out.head(nv_) = v_;
@@ -616,7 +629,7 @@ class Evaluator {
     } else {
       lr_.resize(nr);
       for (int r = 0; r < nr; ++r) lr_[r] = e_[dependent_[r]];
-      lu_solve_transposed(lr_);
+      lu_solve_transposed(lu_, lr_);
     }
     for (int r = 0; r < nr; ++r) lambda_[rows_[r]] = lr_[r];
   }
@@ -1045,12 +1058,13 @@ class Evaluator {
   }
 
  private:
-  // A_d^-1 x in place, with the LU factors (P A_d = L U): vector triangular solves, no temporaries
-  void lu_solve(Eigen::Ref<VectorXd> x) {
+  // A^-1 x in place, with LU factors P A = L U (the projection's A_d in lu_, the slipping system's K in slip_lu_):
+  // vector triangular solves, no temporaries
+  void lu_solve(const Eigen::PartialPivLU<MatrixXd>& lu, Eigen::Ref<VectorXd> x) {
     // substitutions written out: for the small blocks of a projection they cost a fraction of Eigen's generic
     // triangular solvers
-    const MatrixXd& LU = lu_.matrixLU();
-    const auto& perm = lu_.permutationP().indices();  // (P x)[perm[i]] = x[i]
+    const MatrixXd& LU = lu.matrixLU();
+    const auto& perm = lu.permutationP().indices();  // (P x)[perm[i]] = x[i]
     const Eigen::Index n = x.size();
     perm_.resize(n);
     for (Eigen::Index i = 0; i < n; ++i) perm_[perm[i]] = x[i];
@@ -1066,9 +1080,9 @@ class Evaluator {
     }
     x = perm_;
   }
-  // A_d^-T x in place (A_d = P^T L U, so A_d^T = U^T L^T P)
-  void lu_solve_transposed(Eigen::Ref<VectorXd> x) {
-    const MatrixXd& LU = lu_.matrixLU();
+  // A^-T x in place (A = P^T L U, so A^T = U^T L^T P)
+  void lu_solve_transposed(const Eigen::PartialPivLU<MatrixXd>& lu, Eigen::Ref<VectorXd> x) {
+    const MatrixXd& LU = lu.matrixLU();
     const Eigen::Index n = x.size();
     for (Eigen::Index i = 0; i < n; ++i) {  // U^T (lower)
       double s = x[i];
@@ -1080,16 +1094,17 @@ class Evaluator {
       for (Eigen::Index j = i + 1; j < n; ++j) s -= LU(j, i) * x[j];
       x[i] = s;
     }
-    const auto& perm = lu_.permutationP().indices();  // (P^T x)[i] = x[perm[i]]
+    const auto& perm = lu.permutationP().indices();  // (P^T x)[i] = x[perm[i]]
     perm_.resize(n);
     for (Eigen::Index i = 0; i < n; ++i) perm_[i] = x[perm[i]];
     x = perm_;
   }
-  // LAPACK's estimate of ||A_d^-1||_1 (Hager and Higham, as Eigen's rcond estimate) with the solves above
-  double inverse_norm_estimate() {
-    const Eigen::Index n = lu_.rows();
+  // LAPACK's estimate of ||A^-1||_1 (Hager and Higham, as Eigen's rcond estimate) with the solves above: a lower
+  // bound of the exact norm (in exact arithmetic), in practice within a small factor of it
+  double inverse_norm_estimate(const Eigen::PartialPivLU<MatrixXd>& lu) {
+    const Eigen::Index n = lu.rows();
     est_v_.setConstant(n, 1.0 / static_cast<double>(n));
-    lu_solve(est_v_);
+    lu_solve(lu, est_v_);
     double lower = est_v_.lpNorm<1>();
     if (n == 1) return lower;
     auto signs = [](const VectorXd& v, VectorXd& out) {
@@ -1098,20 +1113,20 @@ class Evaluator {
     };
     signs(est_v_, est_old_);
     est_v_ = est_old_;
-    lu_solve_transposed(est_v_);
+    lu_solve_transposed(lu, est_v_);
     Eigen::Index index, old_index;
     est_v_.cwiseAbs().maxCoeff(&index);
     double old_lower = lower;
     for (int k = 0; k < 4; ++k) {
       est_v_.setZero(n);
       est_v_[index] = 1.0;
-      lu_solve(est_v_);
+      lu_solve(lu, est_v_);
       lower = est_v_.lpNorm<1>();
       if (lower <= old_lower) break;
       signs(est_v_, est_s_);
       if (est_s_ == est_old_) break;
       est_v_ = est_s_;
-      lu_solve_transposed(est_v_);
+      lu_solve_transposed(lu, est_v_);
       old_index = index;
       est_v_.cwiseAbs().maxCoeff(&index);
       if (index == old_index) break;
@@ -1124,7 +1139,7 @@ class Evaluator {
       est_v_[i] = alternate * (1.0 + static_cast<double>(i) / static_cast<double>(n - 1));
       alternate = -alternate;
     }
-    lu_solve(est_v_);
+    lu_solve(lu, est_v_);
     return std::max(lower, 2.0 * est_v_.lpNorm<1>() / (3.0 * static_cast<double>(n)));
   }
 
@@ -1346,7 +1361,7 @@ class Evaluator {
       // LAPACK's estimate (O(n^2), inverse_norm_estimate) decides far from that bound; from an estimate of 1e8 on, the exact
       // number (an O(n^3) inverse) decides, as in Python. The exact number is reported by the Python side
       // (robotdyn.compiled.LazyProjection), from A.
-      cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm_estimate();
+      cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm_estimate(lu_);
       if (std::isnan(cond_)) cond_ = std::numeric_limits<double>::infinity();
       if (!(cond_ < 1e8)) {
         Adinv_ = lu_.inverse();
@@ -1354,7 +1369,7 @@ class Evaluator {
         if (!(std::isfinite(cond_) && cond_ <= 1e10)) throw Fallback("singular");
       }
       Sd_ = Ai_;
-      for (int c = 0; c < k; ++c) lu_solve(Sd_.col(c));
+      for (int c = 0; c < k; ++c) lu_solve(lu_, Sd_.col(c));
       if (!Sd_.allFinite()) throw Fallback("singular");  // an exactly singular block (a zero pivot)
       for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -Sd_.row(r);
     }
@@ -1424,12 +1439,13 @@ class Evaluator {
   Eigen::JacobiSVD<MatrixXd> svd_;
   double cond_ = 1.0;
   // slipping wheels' work buffers (slip_rhs_into), the lift-off event's cache and the state of a SlipError
-  MatrixXd Ks_, Ksinv_, Jt_;
+  MatrixXd Ks_, Jt_;
   VectorXd bs_, xs_, slip_normal_;
   Eigen::Matrix<double, Eigen::Dynamic, 2> slip_s_, slip_c_;
   std::vector<int> slip_pos_;
   Eigen::PartialPivLU<MatrixXd> slip_lu_;
   Eigen::JacobiSVD<MatrixXd> slip_svd_;
+  double slip_kappa1_ = 0.0, slip_kappa2_ = 0.0;  // the last Painleve test (slip_condition)
   double slip_min_ = HUGE_VAL, event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
   double slip_error_t_ = 0.0;
   std::vector<double> event_y_, event_dy_, slip_error_y_;
@@ -1467,6 +1483,10 @@ PYBIND11_MODULE(_compiled, m) {
       .def("add_motor", &Evaluator::add_motor)
       .def("add_slipping", &Evaluator::add_slipping)
       .def_property_readonly("slipping", &Evaluator::slipping)
+      .def_property_readonly("slip_condition", &Evaluator::slip_condition,
+                             "The last slipping evaluation's Painleve test: (||K||_1 times LAPACK's estimate of "
+                             "||K^-1||_1, the 2-norm condition number from the singular values or NaN where the "
+                             "estimate cleared the state)")
       .def("slip_rhs", &Evaluator::slip_rhs)
       .def("set_selection", &Evaluator::set_selection)
       .def("set_operational", &Evaluator::set_operational)

@@ -235,3 +235,111 @@ def test_simulate_many_refuses_slipping_wheels():
     with pytest.raises(RobotDynError, match="slipping wheels") as exc:
         simulate_many(robot, 0.1, robot.neutral(), np.zeros(robot.mobility))
     assert "\n" not in str(exc.value)
+
+
+# ------------------------------------------------------------------ the Painleve test (singularity of the coupled system)
+def _python_condition(monkeypatch):
+    """A spy on np.linalg.cond as robotdyn.contact.sliding.forward calls it: the coupled system K of its last call."""
+    seen = {}
+    cond = np.linalg.cond
+
+    def spy(K, p=None):
+        if p is None:
+            seen["K"] = np.array(K, copy=True)
+        return cond(K, p)
+
+    monkeypatch.setattr(np.linalg, "cond", spy)
+    return seen
+
+
+@pytest.mark.parametrize("kind", ROVERS)
+def test_painleve_test_clears_regular_states_from_the_estimate(kind, monkeypatch):
+    """At the regular states of test_one_state_equals_the_python_path, Evaluator.slip_rhs takes the Python path's
+    decision (np.linalg.cond(K) <= 1e12: no error) from LAPACK's 1-norm estimate alone (no singular values), and
+    that estimate is the exact 1-norm condition number of K to within the factor 100 the rule relies on."""
+    seen = _python_condition(monkeypatch)
+    robot = _rover(**ROVERS[kind])
+    fast = compiled_model(robot)
+    rng = np.random.default_rng(3)
+    k = robot.mobility
+    for _ in range(5):
+        q = robot.neutral()
+        q[robot.coordinate_index("roll")] = rng.uniform(-0.05, 0.05)
+        q[robot.coordinate_index("yaw")] = rng.uniform(-np.pi, np.pi)
+        nu, tau = rng.uniform(-1.0, 1.0, k), rng.uniform(-1.0, 1.0, 4)
+        ref = forward(robot, q, nu, tau)
+        K = seen["K"]
+        assert np.linalg.cond(K) <= 1e12  # regular on the Python path
+        fast.select(ref.reduced.projection)
+        fast.ev.slip_rhs(q, nu, tau, 0.0)  # regular on the compiled path (a SlipError would raise)
+        estimate, exact = fast.ev.slip_condition
+        assert np.isnan(exact)  # decided by the estimate
+        kappa1 = np.linalg.cond(K, 1)
+        assert kappa1 / 100 <= estimate <= kappa1 * (1 + 1e-9)
+        assert len(K) * estimate <= 1e10
+
+
+def test_painleve_decision_near_the_singular_friction_coefficient(monkeypatch):
+    """A constructed Painleve case: at a fixed state of the rover (Coulomb law, both directions slip) K is affine
+    in mu, K(mu) = K0 + mu D, and singular at a real mu* (about 6.7 here: an eigenvalue of -K0^-1 D). At friction
+    coefficients far from mu* and approaching it from both sides, conditions from 1e3 to beyond 1e15, Evaluator.slip_rhs raises
+    exactly where np.linalg.cond(K) > 1e12 (on the Python path, sliding.forward raises there), with the same
+    condition number; the states near the threshold (2-norm condition above 1e10) all went to the singular values
+    (none was cleared by the estimate)."""
+    from robotdyn.contact.friction import RegularisedCoulomb as Coulomb
+    from robotdyn.errors import SingularConstraintError
+
+    seen = _python_condition(monkeypatch)
+    robot = _rover(**ROVERS["coulomb"])
+    k = robot.mobility
+    q = robot.neutral()
+    q[robot.coordinate_index("roll")] = -0.007
+    nu = np.array([0.17, 0.48, 0.91, -0.43, 0.3, 0.39, -0.41])
+    tau = np.array([-1.0, 0.95, -0.4, -0.37])
+    assert len(nu) == k
+
+    def with_mu(mu):
+        for wheel in slipping_wheels(robot):
+            wheel.law = Coulomb(mu, 0.01)  # a new law object: the compiled model is rebuilt with it
+
+    def python_K(mu):
+        with_mu(mu)
+        try:
+            forward(robot, q, nu, tau)
+        except SingularConstraintError:
+            pass
+        return seen["K"]
+
+    K0, K1 = python_K(0.0), python_K(1.0)
+    eig = np.linalg.eigvals(-np.linalg.solve(K0, K1 - K0))
+    roots = [1 / e.real for e in eig if abs(e) > 1e-12 and abs(e.imag) <= 1e-9 * abs(e)]
+    mu_star = min((r for r in roots if r > 0), default=None)
+    assert mu_star is not None and 1.0 < mu_star < 20.0, roots
+    projection = robot.reduced(q, nu).projection  # K's row choice does not depend on mu
+    # cond(K(mu* + d)) ~ a / |d| near the root: distances for conditions of about 1e3 ... 1e15
+    a = np.linalg.cond(python_K(mu_star * 0.999)) * mu_star * 1e-3
+    mus = [0.5, 0.5 * mu_star, 2.0 * mu_star]  # far from it
+    for target in (1e8, 1e9, 1e10, 1e11, 3e11, 6e11, 1.6e12, 3e12, 1e13, 1e15):
+        mus += [mu_star - a / target, mu_star + a / target]
+    results = []
+    for mu in mus:
+        cond = np.linalg.cond(python_K(mu))  # the Python path's decision
+        python_singular = not np.isfinite(cond) or cond > 1e12
+        fast = compiled_model(robot)
+        fast.select(projection)
+        try:
+            fast.ev.slip_rhs(q, nu, tau, 0.0)
+            compiled_singular = False
+        except RuntimeError as exc:
+            assert "singular slipping contact problem" in str(exc)
+            compiled_singular = True
+        estimate, exact = fast.ev.slip_condition
+        results.append((mu, cond, compiled_singular))
+        assert compiled_singular == python_singular, (mu, cond, estimate, exact)
+        if cond > 1e10:
+            assert not np.isnan(exact), (mu, cond, estimate)  # the singular values decided
+        if not np.isnan(exact) and cond < 1e14:  # the same number (both from singular values)
+            assert exact == pytest.approx(cond, rel=1e-3)
+    conds = [c for _, c, _ in results]
+    assert min(conds) < 1e5 and max(conds) > 1e14  # the sweep spans the threshold widely
+    assert any(1e11 < c <= 1e12 for c in conds) and any(1e12 < c < 1e13 for c in conds)  # and near it

@@ -73,7 +73,7 @@ class StickSlipWheel(RollingWheel):
         speed = float(np.hypot(s[0], s[1]))
         return self.mu * (s / speed if speed > SLIP_ZERO else self.direction)
 
-    def jacobian(self, kin):  # an override keeps the wheel off the grouped and compiled paths (its rows change)
+    def jacobian(self, kin):  # an override keeps the wheel off the compiled path (its rows change)
         return super().jacobian(kin)
 
 

@@ -37,8 +37,6 @@ UPWARD = {
     ("robots.linkage_suspension.model", "cli.commands"),
     ("robots.mmr12_eod.model", "cli.fk"),
     ("robots.omni_caster.model", "cli.commands"),
-    # friction = "stick_slip": StickSlipWheel (a contact constraint) is defined next to its engine (to split)
-    ("robot", "simulation.stick_slip"),
     # simulate_many(robot="quasimoro"): a robot given by its registered name
     ("simulation.many_runs", ""),
 }

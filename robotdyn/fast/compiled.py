@@ -79,7 +79,7 @@ _COMPILED_FORMULAS = {
 
 def _compiled_formulas(constraint, base: type) -> bool:
     """Whether ``constraint`` is a ``base`` evaluated by ``base``'s own formulas (a subclass overriding one of them,
-    e.g. :class:`robotdyn.simulation.stick_slip.StickSlipWheel`, is not what the C++ code computes)."""
+    e.g. :class:`robotdyn.contact.stick_slip_wheel.StickSlipWheel`, is not what the C++ code computes)."""
     cls = type(constraint)
     return isinstance(constraint, base) and all(getattr(cls, m) is getattr(base, m) for m in _COMPILED_FORMULAS[base])
 

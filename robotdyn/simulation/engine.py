@@ -30,6 +30,7 @@ from ..reduction.pull_back import correction, failure_note, start_offsets
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import lift_off_message, slipping_wheels
+from ..contact.stick_slip_wheel import StickSlipWheel
 from .torque_profile import TorqueProfile, as_profile
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
@@ -178,7 +179,7 @@ def simulate(
     robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
-    if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):  # exact switching: segment by segment
+    if any(isinstance(c, StickSlipWheel) for c in robot.constraints):  # exact switching: segment by segment
         from .stick_slip import simulate as simulate_stick_slip
 
         return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,

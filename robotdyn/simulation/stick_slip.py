@@ -1,7 +1,7 @@
 """Exact stick-slip: wheels that roll without slipping while their contact force lies inside the friction cone
 and slide under Coulomb friction when it would leave it, switched by events of the integrator (no regularisation).
 
-A :class:`StickSlipWheel` is in one of two phases:
+A :class:`~robotdyn.contact.stick_slip_wheel.StickSlipWheel` is in one of two phases:
 
 - **stick**: the three rolling rows (longitudinal, lateral, normal) are constraints; its contact force
   :math:`(\\lambda_t, \\lambda_n)` comes from :mod:`robotdyn.contact.contact_forces`. Event: :math:`\\mu\\lambda_n -
@@ -29,53 +29,10 @@ import numpy as np
 from ..contact.contact_forces import constraint_forces
 from ..errors import RobotDynError
 from ..reduction.projection import auto_independent
-from ..constraints.rolling_contact import RollingWheel
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import sliding_now
 from ..contact.sliding import tangential as slip
-
-_STICK = (np.eye(3), ("longitudinal", "lateral", "normal"))
-_SLIDE = (np.array([[0.0, 0.0, 1.0]]), ("normal",))
-SLIP_ZERO = 1e-12
-"""Slip speed [m/s] below which a sliding wheel's friction keeps the direction it started with."""
-
-
-class StickSlipWheel(RollingWheel):
-    """A standard wheel with Coulomb friction coefficient ``mu`` that sticks (rolls) or slides (see the module).
-
-    Takes the arguments of :class:`~robotdyn.constraints.rolling_contact.RollingWheel` and:
-
-    Args:
-        mu: Friction coefficient (>= 0), the same for sticking and sliding.
-    """
-
-    def __init__(self, description, frame: str, radius: float, mu: float, **kwargs) -> None:
-        super().__init__(description, frame, radius, **kwargs)
-        self.mu = float(mu)
-        self.set_phase("stick")
-
-    def __repr__(self) -> str:
-        return f"StickSlipWheel(frame={self.frame!r}, radius={self.radius}, mu={self.mu}, phase={self.phase!r})"
-
-    def set_phase(self, phase: str, direction: np.ndarray | None = None) -> None:
-        """Switch to ``stick`` or to ``slide`` (with the initial slip direction (2,) in (t1, t2))."""
-        self.phase = phase
-        self._directions, self._row_names = _STICK if phase == "stick" else _SLIDE
-        self.direction = None if direction is None else np.asarray(direction, float) / np.linalg.norm(direction)
-
-    @property
-    def sliding(self) -> bool:
-        """Whether its tangential force currently comes from Coulomb friction."""
-        return self.phase == "slide"
-
-    def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
-        """Coulomb's :math:`\\mu\\hat s` (the friction force is :math:`-f_n\\mu\\hat s`)."""
-        speed = float(np.hypot(s[0], s[1]))
-        return self.mu * (s / speed if speed > SLIP_ZERO else self.direction)
-
-    def jacobian(self, kin):  # an override keeps the wheel off the compiled path (its rows change)
-        return super().jacobian(kin)
-
+from ..contact.stick_slip_wheel import StickSlipWheel
 
 def _configure(robot) -> None:
     """Choose the independent velocities for the wheels' current phases (the spec's choice where it still fits)."""

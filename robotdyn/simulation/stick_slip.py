@@ -33,6 +33,9 @@ from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import sliding_now
 from ..contact.sliding import tangential as slip
 from ..contact.stick_slip_wheel import StickSlipWheel
+from ..reduction.pull_back import position_rate
+from .progress import Progress
+from .trajectory import Trajectory
 
 def _configure(robot) -> None:
     """Choose the independent velocities for the wheels' current phases (the spec's choice where it still fits)."""
@@ -71,13 +74,12 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         time_limit: Wall-clock limit [s] (None: none), as in :func:`robotdyn.simulation.engine.simulate`.
 
     Returns:
-        A :class:`~robotdyn.simulation.engine.Trajectory` whose velocity columns are the full velocities v (named
+        A :class:`~robotdyn.simulation.trajectory.Trajectory` whose velocity columns are the full velocities v (named
         ``<coordinate>_dot``), with ``friction_work`` and ``stats["switches"]`` (time, wheel, phase) and, where the
         run stopped early, ``stats["event"]``.
     """
     from scipy.integrate import solve_ivp
 
-    from .engine import Trajectory, _Progress, _qdot
 
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
@@ -99,7 +101,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     start = time.perf_counter()
     nfev = 0
     last_report = start
-    limit = _Progress(t_end, False, time_limit)  # raises past the time limit (the reports are printed below)
+    limit = Progress(t_end, False, time_limit)  # raises past the time limit (the reports are printed below)
     while True:
         robot._stick_slip_q = q
         _configure(robot)
@@ -137,9 +139,9 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                 print(f"simulate: t = {tt:.3f} / {t_end:g} s", file=sys.stderr, flush=True)
             if sliding_now(robot):
                 st = forward_sliding(robot, qq, nn, tau)
-                return np.concatenate([_qdot(st.reduced, stabilisation), st.nudot, [st.power]])
+                return np.concatenate([position_rate(st.reduced, stabilisation), st.nudot, [st.power]])
             red = robot.reduced(qq, nn)
-            return np.concatenate([_qdot(red, stabilisation), np.linalg.solve(red.M, red.B @ tau - red.h), [0.0]])
+            return np.concatenate([position_rate(red, stabilisation), np.linalg.solve(red.M, red.B @ tau - red.h), [0.0]])
 
         events = _events(robot, wheels, n, k, tau_at)
         seg = grid[(grid > t) | ((grid == 0.0) & (t == 0.0))]

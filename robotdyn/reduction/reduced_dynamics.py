@@ -97,7 +97,8 @@ class ConstraintSet:
 
     def drift(self, kin: KinematicState) -> np.ndarray:
         """All drift terms :math:`\\dot A v`, stacked in constraint order."""
-        parts = [c.drift(kin) for c in self.constraints]
+        with np.errstate(over="ignore", invalid="ignore"):  # beyond double precision: refused by checked, in one line
+            parts = [c.drift(kin) for c in self.constraints]
         if not parts:
             return np.zeros(0)
         return np.concatenate(parts) if len(parts) != 1 else parts[0]

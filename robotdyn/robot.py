@@ -32,6 +32,7 @@ from .reduction.reduced_dynamics import ReducedDynamics, checked, solve_mass
 from .constraints.rolling_contact import OmniWheel, RollingWheel, SupportWheel
 from .contact.sliding import SlippingWheel, sliding_now
 from .contact.sliding import forward as forward_sliding
+from .contact.stick_slip_wheel import StickSlipWheel
 from .constraints.terrain import FlatTerrain, Terrain
 
 
@@ -289,8 +290,6 @@ class Robot:
                                  "standard wheel (support wheels are frictionless, omni wheels roll on rollers)")
             law = make_law(w.friction, w.mu, w.slip_velocity, w.stiffness, wheel=name)
             if w.friction == "stick_slip":
-                from .simulation.stick_slip import StickSlipWheel
-
                 if w.slip != "both":
                     raise InputError(f"wheel {name!r}: slip = {w.slip!r} with friction = 'stick_slip'; exact "
                                      "stick-slip switches the whole tangential force (expected slip = 'both')")

@@ -1,9 +1,11 @@
-"""The vectorised evaluation paths against the per-constraint rows they replace, on every registered robot.
+"""The rows the reduction evaluates against the full rows, and the batch path against one state at a time, on every
+registered robot.
 
-:class:`robotdyn.reduction.reduced_dynamics.ConstraintSet` (rolling wheels in one :class:`~robotdyn.constraints.wheel_group.WheelGroup`
-pass, loop closures through their vector drift) must give the same Jacobian rows, residuals and drift terms as
-stacking each constraint's full :meth:`rows` (whose ``Adot`` is checked against finite differences in the core
-tests), at states off the constraint manifold too (the formulas do not assume A v = 0).
+:class:`robotdyn.reduction.reduced_dynamics.ConstraintSet` stacks each constraint's :meth:`jacobian` (no
+:math:`\\dot A`) and :meth:`drift` (:math:`\\dot A v` from 3-vectors, no matrix :math:`\\dot A`); they must give the
+same Jacobian rows, residuals and drift terms as each constraint's full :meth:`rows` (whose ``Adot`` is checked
+against finite differences in tests/test_rolling_contact.py and tests/test_loop_closure.py), at states off the
+constraint manifold too (the formulas do not assume A v = 0).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ def robot(request):
     return robotdyn.load(request.param)
 
 
-def test_constraint_set_matches_per_constraint_rows(robot):
+def test_jacobian_and_drift_match_the_full_rows(robot):
     rng = np.random.default_rng(7)
     cset = constraint_set(robot)
     for trial in range(4):

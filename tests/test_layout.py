@@ -37,15 +37,11 @@ UPWARD = {
     ("robots.linkage_suspension.model", "cli.commands"),
     ("robots.mmr12_eod.model", "cli.fk"),
     ("robots.omni_caster.model", "cli.commands"),
-    # friction = "stick_slip": StickSlipWheel (a contact constraint) is defined next to its engine (to split)
-    ("robot", "simulation.stick_slip"),
     # simulate_many(robot="quasimoro"): a robot given by its registered name
     ("simulation.many_runs", ""),
 }
 # circles through imports inside functions, within one stage (a module-level circle is never allowed)
 LAZY_CIRCLES = {
-    frozenset({"simulation.engine", "simulation.compiled_engine"}),  # Trajectory <-> the compiled engine
-    frozenset({"simulation.engine", "simulation.stick_slip"}),  # Trajectory <-> the stick-slip engine
     frozenset({"cli.commands", "cli.sweep"}),  # the sweep subcommand registers itself, and prints with _emit
     frozenset({"cli.commands", "cli.fk"}),
     # the adaptable wheel's hold scenario (model) starts from the paper's IK placement (comparison, missions)

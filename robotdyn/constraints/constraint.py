@@ -30,27 +30,6 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-EPS = np.zeros((3, 3, 3))
-"""The Levi-Civita symbol: :math:`(a \\times b)_i = \\epsilon_{ijk} a_j b_k`."""
-EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0
-EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
-
-
-def vcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross products of two (m, 3) arrays (one numpy call)."""
-    return np.einsum("ijk,mj,mk->mi", EPS, a, b)
-
-
-def vdot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise dot products of two (m, 3) arrays, shape (m, 1)."""
-    return np.einsum("mi,mi->m", a, b)[:, None]
-
-
-def skews(x: np.ndarray) -> np.ndarray:
-    """Cross-product matrices of the rows of an (m, 3) array, shape (m, 3, 3)."""
-    return np.einsum("ijk,mj->mik", EPS, x)
-
-
 class KinematicState:
     """Kinematics of a model at one state (q, v), computed once.
 

@@ -16,11 +16,10 @@ All rows are holonomic.
 
 from __future__ import annotations
 
-
 import numpy as np
 import pinocchio as pin
 
-from .constraint import LWA, Constraint, ConstraintRows, KinematicState, cross, skew, skews, vcross
+from .constraint import Constraint, ConstraintRows, KinematicState, cross, skew
 from ..errors import DescriptionError
 
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -111,97 +110,3 @@ class LoopClosure(Constraint):
         out = np.concatenate([R1T @ (dkt - cross(w1, kt)), R1T @ (dkr - cross(w1, kr))])
         return out[self._sel]
 
-
-def groupable(constraint) -> bool:
-    """Whether :class:`LoopGroup` reproduces ``constraint``'s rows (a :class:`LoopClosure` not overriding them)."""
-    cls = type(constraint)
-    return isinstance(constraint, LoopClosure) and cls.jacobian is LoopClosure.jacobian and cls.drift is LoopClosure.drift
-
-
-class LoopGroup:
-    """Several loop closures evaluated together in one vectorised pass (arrays of shape (L, 3), (L, 6, nv)).
-
-    Same rows, residuals and drift terms as each closure's :meth:`LoopClosure.jacobian` and
-    :meth:`LoopClosure.drift`, stacked in the order of ``closures``.
-    """
-
-    def __init__(self, closures: list[LoopClosure]) -> None:
-        self.closures = list(closures)
-        self.f1 = [c.f1 for c in self.closures]
-        self.f2 = [c.f2 for c in self.closures]
-        self.keep = np.concatenate([6 * i + c._sel for i, c in enumerate(self.closures)])
-        self.labels = [f"{c.name}.{k}" for c in self.closures for k in c.components]
-        self.holonomic = np.ones(self.keep.size, bool)
-        self.row_counts = [c._sel.size for c in self.closures]
-        self._built = [c._sel for c in self.closures]
-        self.rotational = [i for i, c in enumerate(self.closures) if np.any(c._sel >= 3)]
-
-    def __repr__(self) -> str:
-        return f"LoopGroup({[c.name for c in self.closures]})"
-
-    def current(self) -> bool:
-        """Whether the closures still select the components this group was built with."""
-        return all(c._sel is sel for c, sel in zip(self.closures, self._built))
-
-    def _frames(self, kin: KinematicState) -> tuple:
-        m, nv = len(self.closures), kin.model.nv
-        model, data = kin.model, kin.data
-        J1, J2 = np.empty((m, 6, nv)), np.empty((m, 6, nv))
-        R1, R2 = np.empty((m, 3, 3)), np.empty((m, 3, 3))
-        p1, p2 = np.empty((m, 3)), np.empty((m, 3))
-        for i, (f1, f2) in enumerate(zip(self.f1, self.f2)):  # kin is the latest pass on its data
-            J1[i] = pin.getFrameJacobian(model, data, f1, LWA)
-            J2[i] = pin.getFrameJacobian(model, data, f2, LWA)
-            M1, M2 = data.oMf[f1], data.oMf[f2]
-            R1[i], R2[i] = M1.rotation, M2.rotation
-            p1[i], p2[i] = M1.translation, M2.translation
-        return J1, J2, R1, R2, p1, p2
-
-    def _geometry(self, kin: KinematicState) -> tuple:
-        key = (id(self), "frames")
-        if key not in kin.geometry:
-            kin.geometry[key] = self._frames(kin)
-        return kin.geometry[key]
-
-    def jacobian(self, kin: KinematicState) -> ConstraintRows:
-        """The stacked rows of all closures (``Adot`` is ``None``)."""
-        return self._rows(*self._geometry(kin))
-
-    def _rows(self, J1, J2, R1, R2, p1, p2) -> ConstraintRows:
-        """The rows from the frames' Jacobians (L, 6, nv), rotations (L, 3, 3) and origins (L, 3)."""
-        m = len(J1)
-        R1T = R1.transpose(0, 2, 1)
-        d = p2 - p1
-        K = J2 - J1
-        K[:, :3] += skews(d) @ J1[:, 3:]
-        A = (R1T[:, None] @ K.reshape(m, 2, 3, -1)).reshape(6 * m, -1)[self.keep]
-        residual = np.zeros((m, 6))
-        residual[:, :3] = (R1T @ d[:, :, None])[:, :, 0]
-        for i in self.rotational:
-            residual[i, 3:] = pin.log3(R1T[i] @ R2[i])
-        return ConstraintRows(A, None, residual.reshape(-1)[self.keep], self.holonomic, self.labels)
-
-    def drift(self, kin: KinematicState) -> np.ndarray:
-        """The stacked drift terms :math:`\\dot A v` of all closures."""
-        if not kin._moving:
-            return np.zeros(self.keep.size)
-        J1, J2, R1, _, p1, p2 = self._geometry(kin)
-        m, nv = len(self.closures), kin.model.nv
-        dJ1, dJ2 = np.empty((m, 6, nv)), np.empty((m, 6, nv))
-        for i, (f1, f2) in enumerate(zip(self.f1, self.f2)):  # kin is the latest pass on its data
-            dJ1[i] = pin.getFrameJacobianTimeVariation(kin.model, kin.data, f1, LWA)
-            dJ2[i] = pin.getFrameJacobianTimeVariation(kin.model, kin.data, f2, LWA)
-        v = kin.v
-        return self._drift(R1, p1, p2, J1 @ v, J2 @ v, dJ1 @ v, dJ2 @ v)
-
-    def _drift(self, R1, p1, p2, V1, V2, a1, a2) -> np.ndarray:
-        """The drift terms from the frames' rotations, origins, twists ``V`` = J v and ``a`` = dJ v (L, 6)."""
-        d = p2 - p1
-        w1 = V1[:, 3:]
-        ddot = V2[:, :3] - V1[:, :3]
-        kt = ddot + vcross(d, w1)
-        dkt = a2[:, :3] - a1[:, :3] + vcross(ddot, w1) + vcross(d, a1[:, 3:])
-        kr = V2[:, 3:] - V1[:, 3:]
-        dkr = a2[:, 3:] - a1[:, 3:]
-        x = np.stack([dkt - vcross(w1, kt), dkr - vcross(w1, kr)], axis=2)  # (L, 3, 2)
-        return (R1.transpose(0, 2, 1) @ x).transpose(0, 2, 1).reshape(-1)[self.keep]

@@ -1,8 +1,8 @@
 """Stage 5, contact: what the wheels transmit: constraint and contact forces, friction laws, slip.
 
 Owns ``contact_forces`` (the multipliers at a state), ``friction`` (laws), ``sliding`` (wheels that slip),
-``traction`` (loads and required friction along a trajectory), ``impulse`` (impacts) and ``statics``. Imports
-the foundation, description, constraints, reduction and fast only (not robotdyn.robot: the layer above).
+``stick_slip_wheel`` (wheels that stick or slide; their engine is robotdyn.simulation.stick_slip), ``traction``
+(loads and required friction along a trajectory), ``impulse`` (impacts) and ``statics``. Imports the foundation, description, constraints, reduction and fast only (not robotdyn.robot: the layer above).
 
 Import rule (tests/test_layout.py enforces it): the stages are, in order, foundation (robotdyn.errors, robotdyn.inputs,
 robotdyn.output) < description < constraints < reduction < fast < contact < robotdyn.robot < simulation <

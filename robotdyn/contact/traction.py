@@ -2,7 +2,7 @@
 no-slip assumption breaks.
 
 The forces come from :func:`robotdyn.contact.contact_forces.constraint_forces` at every output sample of a
-:class:`~robotdyn.simulation.engine.Trajectory` (a post-pass: the integrator is not slowed down). Per wheel:
+:class:`~robotdyn.simulation.trajectory.Trajectory` (a post-pass: the integrator is not slowed down). Per wheel:
 
 - the normal load :math:`f_n` [N] (positive: pressed on the ground);
 - the required friction coefficient :math:`\\mu_{req} = \\|f_t\\| / f_n` (``inf`` where :math:`f_n \\le 0`);
@@ -130,7 +130,7 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot` the trajectory was simulated with.
-        traj: The :class:`~robotdyn.simulation.engine.Trajectory`.
+        traj: The :class:`~robotdyn.simulation.trajectory.Trajectory`.
         torque: The motor torques ``tau(t, q, nu)`` it was simulated with (``None``: unactuated).
         mu: Friction coefficient of every wheel, or by wheel name; default each wheel's own ``mu`` (its spec),
             else no slip check.

@@ -32,13 +32,11 @@ import numpy as np
 from ..constraints.constraint import ConstraintRows, KinematicState
 from ..constraints.joint_coupling import CosineLaw, JointCoupling
 from ..constraints.loop_closure import LoopClosure
-from ..constraints.loop_closure import groupable as groupable_loop
 from ..reduction.operational_space import OperationalProjection
 from ..reduction.projection import Projection, inverse_and_condition
 from ..reduction.reduced_dynamics import ReducedDynamics, checked, reference
 from ..constraints.rolling_contact import RollingWheel
 from ..constraints.terrain import BumpTerrain, RampTerrain, SineTerrain
-from ..constraints.wheel_group import groupable as groupable_wheel
 
 try:
     from .. import _compiled
@@ -72,6 +70,20 @@ def _terrain_code(terrain) -> tuple[int, list[float]] | None:
     return None
 
 
+_COMPILED_FORMULAS = {
+    RollingWheel: ("rows", "jacobian", "drift", "contact", "_geometry", "_world_jacobian"),
+    LoopClosure: ("rows", "jacobian", "drift"),
+}
+"""The methods of each constraint class whose formulas ``_compiled.cpp`` reproduces."""
+
+
+def _compiled_formulas(constraint, base: type) -> bool:
+    """Whether ``constraint`` is a ``base`` evaluated by ``base``'s own formulas (a subclass overriding one of them,
+    e.g. :class:`robotdyn.contact.stick_slip_wheel.StickSlipWheel`, is not what the C++ code computes)."""
+    cls = type(constraint)
+    return isinstance(constraint, base) and all(getattr(cls, m) is getattr(base, m) for m in _COMPILED_FORMULAS[base])
+
+
 def why_not(robot) -> str | None:
     """Why ``robot`` cannot use the compiled path (``None``: it can)."""
     if _compiled is None:
@@ -82,14 +94,14 @@ def why_not(robot) -> str | None:
             return f"joint {robot.model.names[i]!r} of type {kind} is not compiled"
     terrains = set()
     for c in robot.constraints:
-        if isinstance(c, RollingWheel) and groupable_wheel(c):
+        if _compiled_formulas(c, RollingWheel):
             if _terrain_code(c.terrain) is None:
                 return f"wheel {c.name!r} rolls on {c.terrain!r}, whose formulas are not compiled"
             terrains.add(id(c.terrain))
         elif isinstance(c, JointCoupling) and type(c).rows is JointCoupling.rows:
             if not (isinstance(c.law, CosineLaw) and c.dlaw == c.law.d and c.ddlaw == c.law.dd):
                 return f"coupling {c.name!r} has a law other than a CosineLaw"
-        elif not (isinstance(c, LoopClosure) and groupable_loop(c)):
+        elif not _compiled_formulas(c, LoopClosure):
             return f"constraint {c!r} is not compiled"
     if len(terrains) > 1:
         return "the wheels roll on different terrains"

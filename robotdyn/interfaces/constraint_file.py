@@ -351,12 +351,103 @@ def read(
                                   ) from None
 
 
-def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, packages, twist) -> ConstraintFile:
-    """The body of :func:`read`, on the parsed TOML data."""
-    r.keys("", data, TOP_KEYS)
-    base = path.resolve().parent
+class _Context:
+    """What the steps of :func:`_read` share: the reader, the parsed TOML, and what earlier steps found (the
+    description, its tree, locked joints, coordinate names), with the checks of a frame, joint or coordinate name.
 
-    # ------------------------------------------------------------------------------------- description
+    Args:
+        path: The constraint file.
+        r: Its :class:`_Reader`.
+        data: The parsed TOML.
+    """
+
+    def __init__(self, path: Path, r: _Reader, data: dict) -> None:
+        self.path, self.r, self.data = path, r, data
+        self.base = path.resolve().parent
+
+    def frame(self, where: str, name, what: str) -> str:
+        """A frame of the description (a link, a joint or a frame of the root's own coordinates)."""
+        name = self.r.string(where, name, what)
+        if name not in self.frames:
+            self.r.fail(where, f"{what}: no frame named {name!r} in {self.desc.name}{_suggest(name, self.frames)}")
+        return name
+
+    def joint(self, where: str, name, what: str, movable: bool = True) -> str:
+        """A joint of the description (with ``movable``, not a fixed one)."""
+        r, joints = self.r, self.tree.joints
+        name = r.string(where, name, what)
+        if name not in joints:
+            r.fail(where, f"{what}: no joint named {name!r} in {self.desc.name}{_suggest(name, joints)}")
+        if movable and joints[name]["type"] == "fixed":
+            r.fail(where, f"{what}: joint {name!r} is fixed in {self.desc.name}; expected a moving joint")
+        return name
+
+    def body_of_frame(self, name: str) -> str | None:
+        """The rigid body (its representative link) a frame is on."""
+        if name in self.tree.joints:
+            return self.body[self.tree.joints[name]["child"]]
+        return self.body.get(name)
+
+    def coordinate(self, where: str, name) -> str:
+        """A coordinate of the robot (by joint name or label), not a locked one."""
+        name = self.r.string(where, name, "coordinate")
+        if name in self.locked:
+            self.r.fail(where, f"coordinate {name!r} is locked")
+        if name not in self.names:
+            self.r.fail(where, f"no coordinate named {name!r}{_suggest(name, self.names)}; coordinates are "
+                               f"{', '.join(self.names)}")
+        return name
+
+
+def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, packages, twist) -> ConstraintFile:
+    """The body of :func:`read`, on the parsed TOML data: one step per table of the file, in the order that
+    decides which of several problems is reported."""
+    r.keys("", data, TOP_KEYS)
+    cx = _Context(path, r, data)
+    _description(cx, urdf, xacro_args, package_dirs, packages)
+    params = _parameters(cx)
+    _tree(cx, params)
+    _locked(cx)
+    massless = _massless(cx)
+    cx.body = cx.tree.body_of(cx.locked)
+    _labels(cx)
+    wheels = _wheels(cx, {p.name: p.default for p in params})
+    closures = _closures(cx)
+    motors = _motors(cx)
+    independent = _independent(cx)
+    neutral = _neutral(cx)
+    terrain = _terrain(cx)
+    root_height = _root_height(cx)
+    operational, independent = _twist(cx, twist, independent)
+    spec = RobotSpec(
+        name=r.string("name", data.get("name", path.stem), "name"),
+        title=str(data.get("title", f"{path.stem} (from {path.name} and {cx.desc.name})")),
+        xacro=cx.desc,
+        root=cx.root,
+        parameters=params,
+        wheels=wheels,
+        closures=closures,
+        motors=motors,
+        labels=dict(cx.labels),
+        independent=independent,
+        terrain=terrain,
+        paper=str(data.get("paper", "")),
+        neutral=neutral,
+        xacro_args=cx.xargs,
+        package_dirs=cx.pdirs,
+        locked=cx.locked,
+        massless=massless,
+        packages=cx.named,
+        root_height=root_height,
+        operational=operational,
+    )
+    return ConstraintFile(path, spec, _scenarios(cx, motors, operational))
+
+
+def _description(cx: _Context, urdf, xacro_args, package_dirs, packages) -> None:
+    """``package_dirs``, ``[packages]``, ``urdf``, ``root`` and ``[xacro_args]``: sets ``cx.pdirs``, ``cx.named``,
+    ``cx.index``, ``cx.desc``, ``cx.root``, ``cx.xargs`` and ``cx.declared`` (the description's Xacro arguments)."""
+    r, data, base = cx.r, cx.data, cx.base
     pdirs = [str((base / d).resolve()) for d in r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")]
     pdirs += [str(Path(d).resolve()) for d in package_dirs]
     for d in pdirs:
@@ -385,12 +476,16 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         r.fail("root", f"{root!r}{_suggest(root, ROOT_KINDS)}; expected one of {', '.join(ROOT_KINDS)}")
     file_args = data.get("xacro_args", {})
     r.keys("xacro_args", file_args, list(file_args))
-    xargs = {str(k): str(v) for k, v in {**file_args, **(xacro_args or {})}.items()}
-    declared = re.findall(r"<xacro:arg\s+name=\"([^\"]+)\"", desc.read_text(errors="replace"))
+    cx.pdirs, cx.named, cx.index, cx.desc, cx.root = pdirs, named, index, desc, root
+    cx.xargs = {str(k): str(v) for k, v in {**file_args, **(xacro_args or {})}.items()}
+    cx.declared = re.findall(r"<xacro:arg\s+name=\"([^\"]+)\"", desc.read_text(errors="replace"))
 
-    # ------------------------------------------------------------------------------------- parameters
+
+def _parameters(cx: _Context) -> list[Parameter]:
+    """``[[parameters]]``: each with a default that is a physical value of it, declared once."""
+    r = cx.r
     params: list[Parameter] = []
-    for i, p in enumerate(r.table_list(data, "parameters")):
+    for i, p in enumerate(r.table_list(cx.data, "parameters")):
         where = f"parameters[{i}]"
         r.keys(where, p, PARAMETER_KEYS)
         name = r.string(where, p.get("name"), "name")
@@ -405,7 +500,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
             default = str(p["default"])
         else:
             default = r.number(where, p["default"], "default")
-        use_xacro = p.get("xacro", name in declared)
+        use_xacro = p.get("xacro", name in cx.declared)
         if not isinstance(use_xacro, bool):
             r.fail(where, f"xacro = {use_xacro!r}; expected true or false")
         if any(q.name == name for q in params):
@@ -418,69 +513,68 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         except RobotDynError as exc:
             r.fail(where, f"default: {exc}")
         params.append(param)
-    pvalues = {p.name: p.default for p in params}
-    for name in xargs:
+    return params
+
+
+def _tree(cx: _Context, params: list[Parameter]) -> None:
+    """The Xacro arguments against the parameters and the description, then the expanded description: sets
+    ``cx.tree``, ``cx.chain`` (the root's own coordinates) and ``cx.frames``."""
+    r, desc, declared = cx.r, cx.desc, cx.declared
+    for name in cx.xargs:
         if any(p.name == name and p.xacro for p in params):
             r.fail("xacro_args", f"{name!r} is a parameter of this file; set it with --param {name}=VALUE")
         if name not in declared:
             r.fail("xacro_args", f"{name!r} is not an argument of {desc.name}{_suggest(name, declared)}; expected "
                                  f"one of {', '.join(declared) or '(none declared with <xacro:arg>)'}")
     try:
-        text = expand_xacro(desc, {**xargs, **{p.name: p.default for p in params if p.xacro}}, index)
-        tree = _Tree.parse(text, declared)
+        text = expand_xacro(desc, {**cx.xargs, **{p.name: p.default for p in params if p.xacro}}, cx.index)
+        cx.tree = _Tree.parse(text, declared)
     except RobotDynError as exc:
-        raise ConstraintFileError(f"{path}: {exc}") from None
+        raise ConstraintFileError(f"{cx.path}: {exc}") from None
     except (ET.ParseError, AttributeError, ValueError) as exc:
-        raise ConstraintFileError(f"{path}: description {desc.name} is not a valid URDF: {exc}") from None
+        raise ConstraintFileError(f"{cx.path}: description {desc.name} is not a valid URDF: {exc}") from None
+    cx.chain = [name for name, _, _ in _ROOT_CHAINS[cx.root]]
+    cx.frames = cx.tree.links + list(cx.tree.joints) + cx.chain
 
-    chain = [name for name, _, _ in _ROOT_CHAINS[root]]
-    frames = tree.links + list(tree.joints) + chain
 
-    def frame(where: str, name, what: str) -> str:
-        name = r.string(where, name, what)
-        if name not in frames:
-            r.fail(where, f"{what}: no frame named {name!r} in {desc.name}{_suggest(name, frames)}")
-        return name
-
-    def joint(where: str, name, what: str, movable: bool = True) -> str:
-        name = r.string(where, name, what)
-        if name not in tree.joints:
-            r.fail(where, f"{what}: no joint named {name!r} in {desc.name}{_suggest(name, tree.joints)}")
-        if movable and tree.joints[name]["type"] == "fixed":
-            r.fail(where, f"{what}: joint {name!r} is fixed in {desc.name}; expected a moving joint")
-        return name
-
-    # ---------------------------------------------------------------------------------- locked, massless
-    locked: dict[str, float] = {}
+def _locked(cx: _Context) -> None:
+    """``[locked]``: joint name patterns and the values they are locked at; sets ``cx.movable`` (the moving
+    joints of the description) and ``cx.locked`` (joint -> value)."""
+    r, data = cx.r, cx.data
+    cx.locked = locked = {}
     lock_table = data.get("locked", {})
     r.keys("locked", lock_table, list(lock_table))
-    movable = tree.movable()
+    cx.movable = movable = cx.tree.movable()
     for pattern, value in lock_table.items():
         where = f"locked.{pattern}"
         value = r.number(where, value, "value")
         hits = [j for j in movable if fnmatch.fnmatchcase(j, pattern)]
         if not hits:
-            r.fail(where, f"no moving joint of {desc.name} matches {pattern!r}{_suggest(pattern, movable)}")
+            r.fail(where, f"no moving joint of {cx.desc.name} matches {pattern!r}{_suggest(pattern, movable)}")
         for j in hits:
             locked[j] = value
-    massless = r.strings("massless", data.get("massless", []), "massless")
+
+
+def _massless(cx: _Context) -> list[str]:
+    """``massless``: links of the description."""
+    massless = cx.r.strings("massless", cx.data.get("massless", []), "massless")
     for name in massless:
-        if name not in tree.links:
-            r.fail("massless", f"no link named {name!r} in {desc.name}{_suggest(name, tree.links)}")
-    body = tree.body_of(locked)
+        if name not in cx.tree.links:
+            cx.r.fail("massless", f"no link named {name!r} in {cx.desc.name}{_suggest(name, cx.tree.links)}")
+    return massless
 
-    def body_of_frame(name: str) -> str | None:
-        if name in tree.joints:
-            return body[tree.joints[name]["child"]]
-        return body.get(name)
 
-    labels = data.get("labels", {})
+def _labels(cx: _Context) -> None:
+    """``[labels]``: distinct new names of coordinates; sets ``cx.labels`` and ``cx.names`` (every name a
+    coordinate goes by)."""
+    r, chain = cx.r, cx.chain
+    labels = cx.data.get("labels", {})
     r.keys("labels", labels, list(labels))
     for j, label in labels.items():
         if j not in chain:
-            joint(f"labels.{j}", j, "label")
+            cx.joint(f"labels.{j}", j, "label")
         r.string(f"labels.{j}", label, "label")
-    coordinates = chain + [j for j in movable if j not in locked]
+    coordinates = chain + [j for j in cx.movable if j not in cx.locked]
     seen: dict[str, str] = {}
     for j, label in labels.items():
         if label in seen:
@@ -488,116 +582,132 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         if label != j and label in coordinates:
             r.fail(f"labels.{j}", f"label {label!r} is the name of another coordinate; expected a new name")
         seen[label] = j
-    names = coordinates + [labels[j] for j in labels]
+    cx.labels = labels
+    cx.names = coordinates + [labels[j] for j in labels]
 
-    def coordinate(where: str, name) -> str:
-        name = r.string(where, name, "coordinate")
-        if name in locked:
-            r.fail(where, f"coordinate {name!r} is locked")
-        if name not in names:
-            r.fail(where, f"no coordinate named {name!r}{_suggest(name, names)}; coordinates are {', '.join(names)}")
-        return name
 
-    # ------------------------------------------------------------------------------------------- wheels
+def _wheels(cx: _Context, pvalues: dict) -> list[Wheel]:
+    """``[[wheels]]``: one wheel per spin joint (frame), unique names."""
     wheels: list[Wheel] = []
-    for i, w in enumerate(r.table_list(data, "wheels")):
+    for i, w in enumerate(cx.r.table_list(cx.data, "wheels")):
         where = f"wheels[{i}]" + (f" ({w['name']})" if isinstance(w, dict) and "name" in w else "")
-        r.keys(where, w, WHEEL_KEYS)
-        if ("joint" in w) == ("frame" in w):
-            r.fail(where, "give exactly one of 'joint' (the spin joint) or 'frame' (the wheel centre)")
-        spin = None
-        if "joint" in w:
-            spin = joint(where, w["joint"], "joint", movable=False)
-            if tree.joints[spin]["type"] not in ROTATING:
-                r.fail(where, f"joint {spin!r} is {tree.joints[spin]['type']}; a wheel spins about a revolute or "
-                              "continuous joint (a fixed caster is a support, not a rolling wheel)")
-            if spin in locked:
-                r.fail(where, f"joint {spin!r} is locked; a wheel must spin")
-            fname = tree.joints[spin]["child"]
-        else:
-            fname = frame(where, w["frame"], "frame")
-            parents = [n for n, j in tree.joints.items() if j["child"] == fname and j["type"] in ROTATING]
-            spin = parents[0] if parents else None
-        if "axis" in w:
-            axis = w["axis"]
-            if not isinstance(axis, list) or len(axis) != 3:
-                r.fail(where, f"axis = {axis!r}; expected 3 numbers")
-            axis = [r.number(where, a, "axis component") for a in axis]
-        elif spin is not None:
-            axis = tree.joints[spin]["axis"]
-        else:
-            r.fail(where, f"frame {fname!r} has no spin joint: give 'axis' (the axle in the wheel frame)")
-        if np.linalg.norm(axis) < 1e-12:
-            r.fail(where, f"axis {axis} has zero length; expected the axle direction in the wheel frame")
-        if "radius" not in w:
-            r.fail(where, "missing 'radius' (a number in m or a parameter name)")
-        radius = w["radius"]
-        if isinstance(radius, str):
-            if radius not in pvalues:
-                r.fail(where, f"radius {radius!r} is not a parameter{_suggest(radius, pvalues)}; "
-                              "expected a number in m or a declared parameter")
-            rv = pvalues[radius]
-        else:
-            rv = radius = r.number(where, radius, "radius")
-        if "radius_joint" in w:
-            joint(where, w["radius_joint"], "radius_joint")
-        elif not isinstance(rv, (int, float)) or not rv > 0:
-            r.fail(where, f"radius {rv!r} is not > 0; expected a positive radius in m")
-        elif rv > MAX_RADIUS:
-            r.fail(where, f"radius {rv!r} m is above {MAX_RADIUS:g} m; expected a wheel radius in m")
-        kind = w.get("kind", "standard")
-        if kind not in WHEEL_KINDS:
-            r.fail(where, f"kind {kind!r}{_suggest(kind, WHEEL_KINDS)}; expected one of {', '.join(WHEEL_KINDS)}")
-        roller = w.get("roller_angle", 0.0)
-        if "roller_angle" in w:
-            if kind != "omni":
-                r.fail(where, "roller_angle is only meaningful for kind = 'omni'")
-            if not (isinstance(roller, str) and roller in pvalues):
-                roller = r.angle(where, roller, "roller_angle")
-        friction = w.get("friction", "rolling")
-        if not isinstance(friction, str):
-            r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
-        numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness") if key in w}
-        slip = w.get("slip", "both")
-        if slip not in SLIP_DIRECTIONS:
-            r.fail(where, f"slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")
-        wheel = Wheel(fname, radius, tuple(float(a) for a in axis), kind if kind in ("omni", "support") else "standard",
-                      roller, w.get("radius_joint"), w.get("name", fname), friction=friction, slip=slip, **numbers)
-        try:  # the friction keys' physics (mu >= 0, a known law with its parameters) in one line
-            if friction != "rolling":
-                if wheel.kind != "standard":
-                    raise InputError(f"friction law {friction!r} on a {wheel.kind} wheel; expected a standard wheel "
-                                     "(support wheels are frictionless, omni wheels roll on their rollers)")
-                make_law(friction, wheel.mu, wheel.slip_velocity, wheel.stiffness, wheel.name)
-                if friction == "stick_slip" and slip != "both":
-                    raise InputError("slip = 'lateral' with friction = 'stick_slip'; exact stick-slip switches the "
-                                     "whole tangential force (expected slip = 'both')")
-            elif slip != "both":
-                raise InputError("slip = 'lateral' needs friction = 'coulomb' or 'linear'")
-            elif wheel.mu is not None and not (math.isfinite(wheel.mu) and wheel.mu >= 0):
-                raise InputError(f"mu = {wheel.mu}; expected a friction coefficient >= 0")
-            elif wheel.slip_velocity is not None or wheel.stiffness is not None:
-                raise InputError("slip_velocity/stiffness need friction = 'coulomb' or 'linear'")
-        except InputError as exc:
-            r.fail(where, str(exc))
+        wheel, spin = _wheel(cx, where, w, pvalues)
         for other in wheels:
             if other.name == wheel.name:
-                r.fail(where, f"a second wheel named {wheel.name!r}; expected unique wheel names")
+                cx.r.fail(where, f"a second wheel named {wheel.name!r}; expected unique wheel names")
             if other.frame == wheel.frame:
-                r.fail(where, f"wheel centre {wheel.frame!r}" + (f" (spin joint {spin!r})" if spin else "")
-                       + f" is also wheel {other.name!r}'s; expected one wheel per spin joint (frame)")
+                cx.r.fail(where, f"wheel centre {wheel.frame!r}" + (f" (spin joint {spin!r})" if spin else "")
+                          + f" is also wheel {other.name!r}'s; expected one wheel per spin joint (frame)")
         wheels.append(wheel)
+    return wheels
 
-    # ----------------------------------------------------------------------------------------- closures
+
+def _wheel(cx: _Context, where: str, w, pvalues: dict) -> tuple[Wheel, str | None]:
+    """One ``[[wheels]]`` entry: the wheel and its spin joint (``None``: a frame without one)."""
+    r, tree = cx.r, cx.tree
+    r.keys(where, w, WHEEL_KEYS)
+    if ("joint" in w) == ("frame" in w):
+        r.fail(where, "give exactly one of 'joint' (the spin joint) or 'frame' (the wheel centre)")
+    spin = None
+    if "joint" in w:
+        spin = cx.joint(where, w["joint"], "joint", movable=False)
+        if tree.joints[spin]["type"] not in ROTATING:
+            r.fail(where, f"joint {spin!r} is {tree.joints[spin]['type']}; a wheel spins about a revolute or "
+                          "continuous joint (a fixed caster is a support, not a rolling wheel)")
+        if spin in cx.locked:
+            r.fail(where, f"joint {spin!r} is locked; a wheel must spin")
+        fname = tree.joints[spin]["child"]
+    else:
+        fname = cx.frame(where, w["frame"], "frame")
+        parents = [n for n, j in tree.joints.items() if j["child"] == fname and j["type"] in ROTATING]
+        spin = parents[0] if parents else None
+    if "axis" in w:
+        axis = w["axis"]
+        if not isinstance(axis, list) or len(axis) != 3:
+            r.fail(where, f"axis = {axis!r}; expected 3 numbers")
+        axis = [r.number(where, a, "axis component") for a in axis]
+    elif spin is not None:
+        axis = tree.joints[spin]["axis"]
+    else:
+        r.fail(where, f"frame {fname!r} has no spin joint: give 'axis' (the axle in the wheel frame)")
+    if np.linalg.norm(axis) < 1e-12:
+        r.fail(where, f"axis {axis} has zero length; expected the axle direction in the wheel frame")
+    if "radius" not in w:
+        r.fail(where, "missing 'radius' (a number in m or a parameter name)")
+    radius = w["radius"]
+    if isinstance(radius, str):
+        if radius not in pvalues:
+            r.fail(where, f"radius {radius!r} is not a parameter{_suggest(radius, pvalues)}; "
+                          "expected a number in m or a declared parameter")
+        rv = pvalues[radius]
+    else:
+        rv = radius = r.number(where, radius, "radius")
+    if "radius_joint" in w:
+        cx.joint(where, w["radius_joint"], "radius_joint")
+    elif not isinstance(rv, (int, float)) or not rv > 0:
+        r.fail(where, f"radius {rv!r} is not > 0; expected a positive radius in m")
+    elif rv > MAX_RADIUS:
+        r.fail(where, f"radius {rv!r} m is above {MAX_RADIUS:g} m; expected a wheel radius in m")
+    kind = w.get("kind", "standard")
+    if kind not in WHEEL_KINDS:
+        r.fail(where, f"kind {kind!r}{_suggest(kind, WHEEL_KINDS)}; expected one of {', '.join(WHEEL_KINDS)}")
+    roller = w.get("roller_angle", 0.0)
+    if "roller_angle" in w:
+        if kind != "omni":
+            r.fail(where, "roller_angle is only meaningful for kind = 'omni'")
+        if not (isinstance(roller, str) and roller in pvalues):
+            roller = r.angle(where, roller, "roller_angle")
+    friction = w.get("friction", "rolling")
+    if not isinstance(friction, str):
+        r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
+    numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness") if key in w}
+    slip = w.get("slip", "both")
+    if slip not in SLIP_DIRECTIONS:
+        r.fail(where, f"slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")
+    wheel = Wheel(fname, radius, tuple(float(a) for a in axis), kind if kind in ("omni", "support") else "standard",
+                  roller, w.get("radius_joint"), w.get("name", fname), friction=friction, slip=slip, **numbers)
+    try:  # the friction keys' physics (mu >= 0, a known law with its parameters) in one line
+        _check_friction(wheel)
+    except InputError as exc:
+        r.fail(where, str(exc))
+    return wheel, spin
+
+
+def _check_friction(wheel: Wheel) -> None:
+    """A wheel's friction keys: a known law with its parameters on a standard wheel, mu >= 0.
+
+    Raises:
+        InputError: They do not fit (one line, without the entry's name).
+    """
+    friction, slip = wheel.friction, wheel.slip
+    if friction != "rolling":
+        if wheel.kind != "standard":
+            raise InputError(f"friction law {friction!r} on a {wheel.kind} wheel; expected a standard wheel "
+                             "(support wheels are frictionless, omni wheels roll on their rollers)")
+        make_law(friction, wheel.mu, wheel.slip_velocity, wheel.stiffness, wheel.name)
+        if friction == "stick_slip" and slip != "both":
+            raise InputError("slip = 'lateral' with friction = 'stick_slip'; exact stick-slip switches the "
+                             "whole tangential force (expected slip = 'both')")
+    elif slip != "both":
+        raise InputError("slip = 'lateral' needs friction = 'coulomb' or 'linear'")
+    elif wheel.mu is not None and not (math.isfinite(wheel.mu) and wheel.mu >= 0):
+        raise InputError(f"mu = {wheel.mu}; expected a friction coefficient >= 0")
+    elif wheel.slip_velocity is not None or wheel.stiffness is not None:
+        raise InputError("slip_velocity/stiffness need friction = 'coulomb' or 'linear'")
+
+
+def _closures(cx: _Context) -> list[Closure]:
+    """``[[closures]]``: two frames on different bodies and the components they close."""
+    r, chain = cx.r, cx.chain
     closures: list[Closure] = []
-    for i, c in enumerate(r.table_list(data, "closures")):
+    for i, c in enumerate(r.table_list(cx.data, "closures")):
         where = f"closures[{i}]" + (f" ({c['name']})" if isinstance(c, dict) and "name" in c else "")
         r.keys(where, c, CLOSURE_KEYS)
-        f1, f2 = frame(where, c.get("frame1"), "frame1"), frame(where, c.get("frame2"), "frame2")
+        f1, f2 = cx.frame(where, c.get("frame1"), "frame1"), cx.frame(where, c.get("frame2"), "frame2")
         if f1 in chain and f2 in chain:
-            r.fail(where, f"{f1!r} and {f2!r} are both frames of the {root} root's own coordinates; a closure joins "
-                          "two bodies of the description")
-        if f1 not in chain and f2 not in chain and body_of_frame(f1) == body_of_frame(f2):
+            r.fail(where, f"{f1!r} and {f2!r} are both frames of the {cx.root} root's own coordinates; a closure "
+                          "joins two bodies of the description")
+        if f1 not in chain and f2 not in chain and cx.body_of_frame(f1) == cx.body_of_frame(f2):
             r.fail(where, f"{f1!r} and {f2!r} are on the same rigid body; a closure joins two different bodies")
         comps = r.strings(where, c.get("components", ["x", "y", "z"]), "components")
         allowed = ("x", "y", "z", "rx", "ry", "rz")
@@ -605,111 +715,120 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         if bad or not comps or len(set(comps)) != len(comps):
             r.fail(where, f"components {comps} invalid; expected distinct entries of {' '.join(allowed)}")
         closures.append(Closure(f1, f2, tuple(comps), c.get("name")))
+    return closures
 
-    # ------------------------------------------------------------------------------------------- motors
+
+def _motors(cx: _Context) -> list[MotorSpec]:
+    """``[[motors]]``: a moving joint each, unique names, an optional reaction frame."""
+    r = cx.r
     motors: list[MotorSpec] = []
-    for i, m in enumerate(r.table_list(data, "motors")):
+    for i, m in enumerate(r.table_list(cx.data, "motors")):
         where = f"motors[{i}]" + (f" ({m['name']})" if isinstance(m, dict) and "name" in m else "")
         r.keys(where, m, MOTOR_KEYS)
-        j = joint(where, m.get("joint"), "joint")
+        j = cx.joint(where, m.get("joint"), "joint")
         if any(mm.name == m.get("name", j) for mm in motors):
             r.fail(where, f"a second motor named {m.get('name', j)!r}; expected unique motor names")
-        if j in locked:
+        if j in cx.locked:
             r.fail(where, f"joint {j!r} is locked; a motor needs a moving joint")
         reaction = m.get("reaction")
         if reaction is not None:
-            reaction = frame(where, reaction, "reaction")
+            reaction = cx.frame(where, reaction, "reaction")
         motors.append(MotorSpec(r.string(where, m.get("name", j), "name"), j, reaction))
+    return motors
 
-    # -------------------------------------------------------------------------------- coordinates, misc
-    independent = data.get("independent")
+
+def _independent(cx: _Context) -> list[str] | None:
+    """``independent``: distinct coordinates (``None``: chosen automatically)."""
+    r = cx.r
+    independent = cx.data.get("independent")
     if independent is not None:
-        independent = [coordinate("independent", x) for x in r.strings("independent", independent, "independent")]
+        independent = [cx.coordinate("independent", x) for x in r.strings("independent", independent, "independent")]
         twice = sorted({x for x in independent if independent.count(x) > 1})
         if twice:
             r.fail("independent", f"{', '.join(map(repr, twice))} listed twice; expected distinct coordinates")
         if not independent:
             r.fail("independent", "empty; expected the names of the independent coordinates (or no 'independent' "
                                   "key: chosen automatically)")
-    neutral_table = data.get("neutral", {})
-    r.keys("neutral", neutral_table, list(neutral_table))
-    neutral = {coordinate(f"neutral.{k}", k): r.number(f"neutral.{k}", v, "value") for k, v in neutral_table.items()}
-    terrain = None
-    if "terrain" in data:
-        t = dict(data["terrain"]) if isinstance(data["terrain"], dict) else r.fail("terrain", "expected a table")
-        kind = t.pop("kind", "flat")
-        if not isinstance(kind, str):
-            r.fail("terrain", f"kind = {kind!r}; expected one of {', '.join(TERRAINS)}")
-        if kind not in TERRAINS:
-            r.fail("terrain", f"kind {kind!r}{_suggest(kind, TERRAINS)}; expected one of {', '.join(TERRAINS)}")
-        cls = TERRAINS[kind]
-        allowed = [a for a in inspect.signature(cls.__init__).parameters if a != "self"]
-        r.keys(f"terrain ({kind})", t, allowed)
-        try:
-            terrain = cls(**{k: r.number("terrain", v, k) for k, v in t.items()})
-        except TypeError as exc:
-            r.fail(f"terrain ({kind})", f"{exc}; arguments are {', '.join(allowed)}")
+    return independent
 
-    # ------------------------------------------------------------------------- root height, body twist
-    root_height = data.get("root_height", "auto")
+
+def _neutral(cx: _Context) -> dict[str, float]:
+    """``[neutral]``: values by coordinate name."""
+    r = cx.r
+    neutral_table = cx.data.get("neutral", {})
+    r.keys("neutral", neutral_table, list(neutral_table))
+    return {cx.coordinate(f"neutral.{k}", k): r.number(f"neutral.{k}", v, "value") for k, v in neutral_table.items()}
+
+
+def _terrain(cx: _Context) -> Terrain | None:
+    """``[terrain]``: a kind of :data:`TERRAINS` and its constructor's arguments (``None``: no table)."""
+    r, data = cx.r, cx.data
+    if "terrain" not in data:
+        return None
+    t = dict(data["terrain"]) if isinstance(data["terrain"], dict) else r.fail("terrain", "expected a table")
+    kind = t.pop("kind", "flat")
+    if not isinstance(kind, str):
+        r.fail("terrain", f"kind = {kind!r}; expected one of {', '.join(TERRAINS)}")
+    if kind not in TERRAINS:
+        r.fail("terrain", f"kind {kind!r}{_suggest(kind, TERRAINS)}; expected one of {', '.join(TERRAINS)}")
+    cls = TERRAINS[kind]
+    allowed = [a for a in inspect.signature(cls.__init__).parameters if a != "self"]
+    r.keys(f"terrain ({kind})", t, allowed)
+    try:
+        return cls(**{k: r.number("terrain", v, k) for k, v in t.items()})
+    except TypeError as exc:
+        r.fail(f"terrain ({kind})", f"{exc}; arguments are {', '.join(allowed)}")
+
+
+def _root_height(cx: _Context) -> float | None:
+    """``root_height`` [m] (``None``: "auto")."""
+    r = cx.r
+    root_height = cx.data.get("root_height", "auto")
     if root_height == "auto":
-        root_height = None
-    else:
-        root_height = r.number("root_height", root_height, "root_height")
-        if root == "fixed":
-            r.fail("root_height", "a fixed root has no height; expected root = 'planar' or 'floating'")
-        if abs(root_height) > MAX_RADIUS:
-            r.fail("root_height", f"{root_height:g} m; expected the root link's height above the ground in m")
-    operational = None
-    twist_table = data.get("twist")
+        return None
+    root_height = r.number("root_height", root_height, "root_height")
+    if cx.root == "fixed":
+        r.fail("root_height", "a fixed root has no height; expected root = 'planar' or 'floating'")
+    if abs(root_height) > MAX_RADIUS:
+        r.fail("root_height", f"{root_height:g} m; expected the root link's height above the ground in m")
+    return root_height
+
+
+def _twist(cx: _Context, twist: str | None, independent: list[str] | None) -> tuple:
+    """``[twist]`` (or the ``twist`` argument of :func:`read`, which overrides it and ``independent``): the
+    operational velocities (``None``: none) and the independent coordinates that remain."""
+    r = cx.r
+    twist_table = cx.data.get("twist")
     if twist is not None:
         frame_name, _, comps = str(twist).partition(":")
         twist_table = {"frame": frame_name, **({"components": comps.replace(",", " ")} if comps else {})}
         independent = None
-    if twist_table is not None:
-        from ..reduction.operational_space import COMPONENTS, OperationalVelocities
+    if twist_table is None:
+        return None, independent
+    from ..reduction.operational_space import COMPONENTS, OperationalVelocities
 
-        r.keys("twist", twist_table, TWIST_KEYS)
-        if independent is not None:
-            r.fail("twist", "give either 'independent' (coordinates) or 'twist' (a body twist), not both")
-        tframe = frame("twist", twist_table.get("frame"), "frame")
-        comps = r.strings("twist", twist_table.get("components", ["vx", "vy", "wz"]), "components")
-        if not comps or len(set(comps)) != len(comps) or any(c not in COMPONENTS for c in comps):
-            r.fail("twist", f"components {comps}; expected distinct entries of {' '.join(COMPONENTS)}")
-        axes = twist_table.get("axes", "body")
-        if axes not in ("body", "local", "world"):
-            r.fail("twist", f"axes = {axes!r}; expected 'body' (the frame's own axes) or 'world'")
-        tnames = r.strings("twist", twist_table.get("names", comps), "names")
-        if len(tnames) != len(comps) or len(set(tnames)) != len(tnames):
-            r.fail("twist", f"names {tnames}; expected {len(comps)} distinct names, one per component")
-        operational = OperationalVelocities(tframe, tuple(comps), "world" if axes == "world" else "local", tnames)
+    r.keys("twist", twist_table, TWIST_KEYS)
+    if independent is not None:
+        r.fail("twist", "give either 'independent' (coordinates) or 'twist' (a body twist), not both")
+    tframe = cx.frame("twist", twist_table.get("frame"), "frame")
+    comps = r.strings("twist", twist_table.get("components", ["vx", "vy", "wz"]), "components")
+    if not comps or len(set(comps)) != len(comps) or any(c not in COMPONENTS for c in comps):
+        r.fail("twist", f"components {comps}; expected distinct entries of {' '.join(COMPONENTS)}")
+    axes = twist_table.get("axes", "body")
+    if axes not in ("body", "local", "world"):
+        r.fail("twist", f"axes = {axes!r}; expected 'body' (the frame's own axes) or 'world'")
+    tnames = r.strings("twist", twist_table.get("names", comps), "names")
+    if len(tnames) != len(comps) or len(set(tnames)) != len(tnames):
+        r.fail("twist", f"names {tnames}; expected {len(comps)} distinct names, one per component")
+    return OperationalVelocities(tframe, tuple(comps), "world" if axes == "world" else "local", tnames), independent
 
-    spec = RobotSpec(
-        name=r.string("name", data.get("name", path.stem), "name"),
-        title=str(data.get("title", f"{path.stem} (from {path.name} and {desc.name})")),
-        xacro=desc,
-        root=root,
-        parameters=params,
-        wheels=wheels,
-        closures=closures,
-        motors=motors,
-        labels=dict(labels),
-        independent=independent,
-        terrain=terrain,
-        paper=str(data.get("paper", "")),
-        neutral=neutral,
-        xacro_args=xargs,
-        package_dirs=pdirs,
-        locked=locked,
-        massless=massless,
-        packages=named,
-        root_height=root_height,
-        operational=operational,
-    )
 
-    # ---------------------------------------------------------------------------------------- scenarios
+def _scenarios(cx: _Context, motors: list[MotorSpec], operational) -> dict[str, Scenario]:
+    """``[[scenarios]]``: constant torques [N m or N] (a list or a table by motor name), q0 by coordinate, nu0 by
+    coordinate or twist component."""
+    r, labels = cx.r, cx.labels
     scenarios: dict[str, Scenario] = {}
-    for i, s in enumerate(r.table_list(data, "scenarios")):
+    for i, s in enumerate(r.table_list(cx.data, "scenarios")):
         where = f"scenarios[{i}]"
         r.keys(where, s, SCENARIO_KEYS)
         name = r.string(where, s.get("name"), "name")
@@ -731,7 +850,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
             r.fail(where, f"torque = {tau!r}; expected {len(motors)} numbers ({', '.join(motor_names)}) or a table "
                           "by motor name")
         tau = np.array([r.number(where, x, "torque") for x in tau])
-        q0 = {coordinate(where, k): r.number(where, v, k) for k, v in s.get("q0", {}).items()}
+        q0 = {cx.coordinate(where, k): r.number(where, v, k) for k, v in s.get("q0", {}).items()}
         nu0 = {}
         for k, v in s.get("nu0", {}).items():
             if operational is not None:
@@ -739,11 +858,11 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
                     r.fail(where, f"nu0 {k!r} is not a twist component; expected one of {', '.join(operational.names)}")
                 nu0[k] = r.number(where, v, k)
                 continue
-            label = coordinate(where, k)
+            label = cx.coordinate(where, k)
             nu0[f"{labels.get(label, label)}_dot"] = r.number(where, v, k)
         scenarios[name] = Scenario(name, str(s.get("description", f"constant torques {tau.tolist()}")), t_end,
                                    Constant(tau), q0, nu0)  # torques as data: simulated compiled
-    return ConstraintFile(path, spec, scenarios)
+    return scenarios
 
 
 def load_robot(

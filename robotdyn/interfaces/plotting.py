@@ -30,7 +30,7 @@ def plot_trajectory(
     zoom: float | None = None,
     references: dict[str, list[tuple[float, str]]] | None = None,
 ):
-    """Plot columns of a :class:`~robotdyn.simulation.engine.Trajectory` against time.
+    """Plot columns of a :class:`~robotdyn.simulation.trajectory.Trajectory` against time.
 
     Args:
         traj: The trajectory.

@@ -383,7 +383,7 @@ class Viewer:
         time scrubber and a time scale).
 
         Args:
-            trajectory: A :class:`~robotdyn.simulation.engine.Trajectory`, or a pair ``(t, q)`` of times (N,) [s]
+            trajectory: A :class:`~robotdyn.simulation.trajectory.Trajectory`, or a pair ``(t, q)`` of times (N,) [s]
                 and natural coordinates (N, nq).
             fps: Keyframes per second; q is linearly interpolated between the trajectory's samples at the
                 times t0 + k / fps (and the last sample time).

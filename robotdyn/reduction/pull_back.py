@@ -53,6 +53,18 @@ def correction(A_h: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return Vt[:rank].T @ ((U[:, :rank].T @ phi) / s[:rank])
 
 
+def position_rate(red, stabilisation: float) -> np.ndarray:
+    """:math:`\\dot q = v - \\alpha A_h^+\\phi` (n,) [m/s or rad/s]: the velocity of a
+    :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` ``red`` with its holonomic residuals pulled back
+    at the gain ``stabilisation`` [1/s] (0: none)."""
+    qdot = red.v
+    rows = red.jacobian_rows
+    hol = rows.holonomic
+    if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
+        qdot = qdot - stabilisation * correction(rows.A[hol], rows.residual[hol])
+    return qdot
+
+
 def offsets(A_h: np.ndarray, phi: np.ndarray, labels) -> dict[str, float]:
     """The residuals that no coordinate of the model can change: the part of phi outside the range of
     :math:`A_h`'s rank-r part, by row label, where it exceeds :data:`OFFSET_TOL` (empty when every residual is

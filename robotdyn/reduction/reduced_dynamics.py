@@ -22,10 +22,6 @@ from ..errors import InputError, NonFiniteError
 from .actuation import input_matrix
 from ..constraints.constraint import ConstraintRows, KinematicState
 from .projection import Projection, project
-from ..constraints.loop_closure import LoopGroup
-from ..constraints.loop_closure import groupable as groupable_loop
-from ..constraints.wheel_group import WheelGroup
-from ..constraints.wheel_group import groupable as groupable_wheel
 
 
 @dataclass
@@ -73,11 +69,10 @@ class ReducedDynamics:
 
 
 class ConstraintSet:
-    """A robot's constraints evaluated together: the rolling wheels in one
-    :class:`~robotdyn.constraints.wheel_group.WheelGroup` pass, the loop closures in one vectorised
-    :class:`~robotdyn.constraints.loop_closure.LoopGroup` pass, the others one by one; rows stacked in the order of
-    ``constraints`` (the same rows as stacking each constraint's own :meth:`~robotdyn.constraints.constraint.Constraint.jacobian`
-    and :meth:`~robotdyn.constraints.constraint.Constraint.drift`).
+    """A robot's constraints evaluated together: each constraint's own
+    :meth:`~robotdyn.constraints.constraint.Constraint.jacobian` and
+    :meth:`~robotdyn.constraints.constraint.Constraint.drift` (the reference formulas of
+    :mod:`robotdyn.constraints`), rows stacked in the order of ``constraints``.
 
     Args:
         constraints: The constraints, in row order.
@@ -87,60 +82,26 @@ class ConstraintSet:
     def __init__(self, constraints, nv: int) -> None:
         self.constraints = tuple(constraints)
         self.nv = nv
-        self.groups = []
-        wheels = [c for c in self.constraints if groupable_wheel(c)]
-        if wheels:
-            self.groups.append((WheelGroup(wheels), wheels))
-        loops = [c for c in self.constraints if groupable_loop(c)]
-        if loops:
-            self.groups.append((LoopGroup(loops), loops))
-        grouped = {id(c) for _, members in self.groups for c in members}
-        self.others = [c for c in self.constraints if id(c) not in grouped]
-        self._order: dict[tuple[int, ...], np.ndarray | None] = {}
 
     def current(self, constraints) -> bool:
-        """Whether this set still describes ``constraints`` (the same objects, and the wheels still on the terrain
-        and with the radius they had, e.g. after :func:`robotdyn.constraints.posture.set_terrain` changed them in place)."""
-        if len(constraints) != len(self.constraints) or any(a is not b for a, b in zip(constraints, self.constraints)):
-            return False
-        return all(group.current() for group, _ in self.groups)
-
-    def _permutation(self, counts: tuple[int, ...]) -> np.ndarray | None:
-        """Row permutation from [groups' rows, other constraints' rows] to constraint order (None: identity)."""
-        if counts not in self._order:
-            sizes = {}
-            start = 0
-            for group, members in self.groups:
-                for c, k in zip(members, group.row_counts):
-                    sizes[id(c)] = np.arange(start, start + k)
-                    start += k
-            for c, k in zip(self.others, counts):
-                sizes[id(c)] = np.arange(start, start + k)
-                start += k
-            perm = np.concatenate([sizes[id(c)] for c in self.constraints]) if self.constraints else np.zeros(0, int)
-            self._order[counts] = None if np.array_equal(perm, np.arange(perm.size)) else perm
-        return self._order[counts]
+        """Whether this set still describes ``constraints`` (the same objects in the same order; a constraint
+        changed in place, e.g. by :func:`robotdyn.constraints.posture.set_terrain`, evaluates with its new
+        attributes)."""
+        return len(constraints) == len(self.constraints) and all(
+            a is b for a, b in zip(constraints, self.constraints))
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
         """All rows without their time derivative, stacked in constraint order."""
-        others = [c.jacobian(kin) for c in self.others]
-        parts = [group.jacobian(kin) for group, _ in self.groups] + others
-        rows = ConstraintRows.stack(parts, self.nv) if len(parts) != 1 else parts[0]
-        perm = self._permutation(tuple(p.A.shape[0] for p in others))
-        if perm is not None:
-            rows = ConstraintRows(rows.A[perm], None, rows.residual[perm], rows.holonomic[perm],
-                                  [rows.labels[i] for i in perm])
-        return rows
+        parts = [c.jacobian(kin) for c in self.constraints]
+        return ConstraintRows.stack(parts, self.nv) if len(parts) != 1 else parts[0]
 
     def drift(self, kin: KinematicState) -> np.ndarray:
         """All drift terms :math:`\\dot A v`, stacked in constraint order."""
-        others = [c.drift(kin) for c in self.others]
-        parts = [group.drift(kin) for group, _ in self.groups] + others
+        with np.errstate(over="ignore", invalid="ignore"):  # beyond double precision: refused by checked, in one line
+            parts = [c.drift(kin) for c in self.constraints]
         if not parts:
             return np.zeros(0)
-        out = np.concatenate(parts) if len(parts) != 1 else parts[0]
-        perm = self._permutation(tuple(len(p) for p in others))
-        return out if perm is None else out[perm]
+        return np.concatenate(parts) if len(parts) != 1 else parts[0]
 
 
 def constraint_set(robot) -> ConstraintSet:

@@ -1,9 +1,9 @@
 """Stage 7, simulation: time integration and everything that drives it.
 
-Owns ``engine`` (:func:`simulate`, :class:`Trajectory`, the scipy engine), ``compiled_engine`` (the C++ integrators),
-``stick_slip`` (exact switching), ``torque_profile``, ``scenario``, ``control``, ``many_runs``, ``batch`` and
-``model_variants``. Imports every earlier stage (up to robotdyn.robot). ``robotdyn.simulation.simulate`` and
-``robotdyn.simulation.Trajectory`` still work (re-exported lazily from ``engine``).
+Owns ``engine`` (:func:`simulate`, the scipy engine), ``trajectory`` (:class:`Trajectory`, what every engine
+returns), ``progress`` (a run's reporter), ``compiled_engine`` (the C++ integrators), ``stick_slip`` (exact
+switching), ``torque_profile``, ``scenario``, ``control``, ``many_runs``, ``batch`` and ``model_variants``. Imports every earlier stage (up to robotdyn.robot). ``robotdyn.simulation.simulate`` and
+``robotdyn.simulation.Trajectory`` still work (re-exported lazily from ``engine`` and ``trajectory``).
 
 Import rule (tests/test_layout.py enforces it): the stages are, in order, foundation (robotdyn.errors, robotdyn.inputs,
 robotdyn.output) < description < constraints < reduction < fast < contact < robotdyn.robot < simulation <
@@ -11,7 +11,7 @@ interfaces < robotdyn.robots < sweep < cli; a module imports from its own stage 
 """
 
 
-_EXPORTS = {'simulate': 'engine', 'Trajectory': 'engine', 'power': 'engine', 'MAX_SAMPLES': 'engine'}
+_EXPORTS = {'simulate': 'engine', 'Trajectory': 'trajectory', 'power': 'engine', 'MAX_SAMPLES': 'engine'}
 
 
 def __getattr__(name: str):

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,10 +41,10 @@ from ..fast.dispatch import compiled_model
 from ..errors import NonFiniteError, RobotDynError
 from ..reduction.pull_back import failure_note
 from ..contact.sliding import slipping_wheels
+from ..contact.stick_slip_wheel import StickSlipWheel
 from .torque_profile import TorqueProfile, as_profile
+from .trajectory import Trajectory
 
-if TYPE_CHECKING:
-    from .engine import Trajectory
 
 METHODS = ("adams", "bulirsch_stoer", "dopri5")
 """The compiled integrators (Boost.Odeint steppers); the first is the default."""
@@ -134,7 +133,7 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     if engine == "scipy" or (method is not None and engine == "auto"):
         return False
     reason = None
-    if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):
+    if any(isinstance(c, StickSlipWheel) for c in robot.constraints):
         reason = "stick-slip wheels (exact switching) are simulated on the Python path"
     elif compiled_model(robot) is None:
         from ..fast.dispatch import enabled
@@ -154,10 +153,8 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
 def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, stabilisation, progress,
                        offsets) -> Trajectory:
     """:func:`robotdyn.simulation.engine.simulate` on the compiled engine (:func:`run`), after its checks: a
-    :class:`~robotdyn.simulation.engine.Trajectory` with ``stats["engine"]``. ``progress`` is the run's reporter
-    (``robotdyn.simulation.engine._Progress``: prints, and raises past the run's time limit)."""
-    from .engine import Trajectory
-
+    :class:`~robotdyn.simulation.trajectory.Trajectory` with ``stats["engine"]``. ``progress`` is the run's reporter
+    (:class:`robotdyn.simulation.progress.Progress`: prints, and raises past the run's time limit)."""
     profile = as_profile(torque, len(robot.motors))
     robot.forward_dynamics(q0, nu0, profile(0.0))  # regular where the run starts (raises the Python path's error)
     fast = compiled_model(robot)

@@ -25,7 +25,8 @@ import numpy as np
 from ..constraints.constraint import KinematicState, skew
 from ..errors import InputError
 from .scenario import Scenario
-from .engine import Trajectory, simulate
+from .engine import simulate
+from .trajectory import Trajectory
 
 Reference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
 """A reference: t -> (y_d, y_d', y_d'') as arrays of the task's dimension."""

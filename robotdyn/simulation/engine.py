@@ -17,20 +17,22 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..fast.compiled import Fallback
 from ..fast.dispatch import compiled_model
 from .compiled_engine import METHODS, choose_engine, simulate_compiled
-from ..errors import NonFiniteError, RobotDynError, TimeLimitError
+from ..errors import NonFiniteError, RobotDynError
 from ..reduction.projection import solve
-from ..reduction.pull_back import correction, failure_note, start_offsets
+from ..reduction.pull_back import failure_note, position_rate, start_offsets
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import lift_off_message, slipping_wheels
+from ..contact.stick_slip_wheel import StickSlipWheel
+from .progress import Progress
 from .torque_profile import TorqueProfile, as_profile
+from .trajectory import Trajectory
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
@@ -38,84 +40,6 @@ MAX_SAMPLES = 5_000_000
 """Largest number of output samples of one simulation (memory: 8 bytes x (2n + 3) columns each)."""
 MIN_DURATION = 1e-6
 """Shortest simulation [s] (below it the output times are not distinct in double precision)."""
-
-
-@dataclass
-class Trajectory:
-    """A simulated motion.
-
-    Attributes:
-        t: Times (N,) [s].
-        q: Natural coordinates (N, n), named by ``coordinates``.
-        nu: Independent velocities (N, k), named by ``velocity_names``.
-        energy: Total mechanical energy at each time (N,) [J].
-        residual: Largest holonomic residual at each time (N,).
-        coordinates, velocity_names: Column names.
-        stats: Integrator statistics (nfev, wall time).
-        units: Unit of each column by name (m, rad, m/s, rad/s).
-        friction_work: Work done by the slipping wheels' friction forces since t = 0 (N,) [J] (<= 0; ``None``
-            without slipping wheels): energy balance E(t) - E(0) = motor work + friction_work.
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    nu: np.ndarray
-    energy: np.ndarray
-    residual: np.ndarray
-    coordinates: list[str]
-    velocity_names: list[str]
-    stats: dict = field(default_factory=dict)
-    units: dict[str, str] = field(default_factory=dict)
-    friction_work: np.ndarray | None = None
-
-    def __repr__(self) -> str:
-        return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"
-
-    def column(self, name: str) -> np.ndarray:
-        """A coordinate or independent velocity by name."""
-        if name in self.coordinates:
-            return self.q[:, self.coordinates.index(name)]
-        if name in self.velocity_names:
-            return self.nu[:, self.velocity_names.index(name)]
-        raise RobotDynError(f"no column {name!r}; expected one of {', '.join(self.coordinates + self.velocity_names)}")
-
-    def to_csv(self, path, extra: dict[str, np.ndarray] | None = None) -> None:
-        """Write ``t``, the q columns, the nu columns, then any ``extra`` columns by name (e.g. the wheel loads of
-        :meth:`robotdyn.contact.traction.Traction.columns`)."""
-        from ..output import atomic_output
-
-        extra = extra or {}
-        header = ",".join(["t", *self.coordinates, *self.velocity_names, *extra])
-        data = np.column_stack([self.t, self.q, self.nu, *extra.values()])
-        partial = self.stats.get("partial")
-        with atomic_output(path, "CSV file") as tmp:
-            np.savetxt(tmp, data, delimiter=",", header=header, comments="",
-                       footer=f"# partial: {partial}" if partial else "")  # a comment line: loadtxt skips it
-
-
-class _Progress:
-    """Prints the simulated time to stderr at most once a second, once the run has taken more than a second, and
-    raises :class:`~robotdyn.errors.TimeLimitError` once the run has taken longer than its wall-clock limit."""
-
-    def __init__(self, t_end: float, enabled: bool, time_limit: float | None = None) -> None:
-        self.t_end, self.enabled, self.time_limit = t_end, enabled, time_limit
-        self.start = self.last = time.perf_counter()
-
-    @property
-    def needed(self) -> bool:
-        """Whether calling it can do anything (print or stop)."""
-        return self.enabled or self.time_limit is not None
-
-    def __call__(self, t: float) -> None:
-        if not self.needed:
-            return
-        now = time.perf_counter()
-        if self.time_limit is not None and now - self.start > self.time_limit:
-            raise TimeLimitError(f"the run exceeded its time limit of {self.time_limit:g} s at t = {t:.3g} s of "
-                                 f"{self.t_end:g} s (a stiff or blown-up run; a longer time limit allows more)")
-        if self.enabled and now - self.last >= 1.0:
-            self.last = now
-            print(f"simulate: t = {t:.2f} / {self.t_end:g} s ({100 * t / self.t_end:.0f}%)", file=sys.stderr, flush=True)
 
 
 def simulate(
@@ -178,18 +102,18 @@ def simulate(
     robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
-    if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):  # exact switching: segment by segment
+    if any(isinstance(c, StickSlipWheel) for c in robot.constraints):  # exact switching: segment by segment
         from .stick_slip import simulate as simulate_stick_slip
 
         return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
                                    method or "DOP853", stabilisation, progress, time_limit=time_limit)
     if compiled_engine:
         return simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
-                                 stabilisation, _Progress(t_end, progress, time_limit), offsets)
+                                 stabilisation, Progress(t_end, progress, time_limit), offsets)
     method = method or "DOP853"
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
-    report = _Progress(t_end, progress, time_limit)
+    report = Progress(t_end, progress, time_limit)
 
     from scipy.integrate import solve_ivp
 
@@ -212,7 +136,7 @@ def simulate(
             finite(t, y)
             st = forward_sliding(robot, q, nu, tau)
             report(t)
-            return np.concatenate([_qdot(st.reduced, stabilisation), st.nudot, [st.power]])
+            return np.concatenate([position_rate(st.reduced, stabilisation), st.nudot, [st.power]])
         if fast is not None:
             try:  # the whole right-hand side in one compiled call (robotdyn.fast.compiled)
                 out = fast.rhs(q, nu, tau, stabilisation)
@@ -224,7 +148,7 @@ def simulate(
         red = robot.reduced(q, nu)
         nudot = solve(red.M, red.B @ tau - red.h)  # numpy.linalg.solve's LAPACK call, without its overhead
         report(t)
-        return np.concatenate([_qdot(red, stabilisation), nudot])
+        return np.concatenate([position_rate(red, stabilisation), nudot])
 
     events = None
     if slipping:
@@ -328,16 +252,6 @@ def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarra
         t, y = np.append(t, solver.t), np.column_stack([y, solver.y]) if y.size else solver.y[:, None]
     return SimpleNamespace(t=t, y=y, success=status >= 0, message=message or "", nfev=nfev,
                            status=status), interrupted
-
-
-def _qdot(red, stabilisation: float) -> np.ndarray:
-    """:math:`\\dot q = v - \\alpha A_h^+\\phi`: the velocity with the holonomic residuals pulled back."""
-    qdot = red.v
-    rows = red.jacobian_rows
-    hol = rows.holonomic
-    if stabilisation and hol.any() and rows.residual[hol].any():  # a zero residual needs no correction
-        qdot = qdot - stabilisation * correction(rows.A[hol], rows.residual[hol])
-    return qdot
 
 
 def _velocity(robot, fast, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

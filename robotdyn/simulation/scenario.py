@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import RobotDynError
-from .engine import Trajectory, simulate
+from .engine import simulate
+from .trajectory import Trajectory
 
 
 @dataclass

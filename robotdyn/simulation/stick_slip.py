@@ -1,7 +1,7 @@
 """Exact stick-slip: wheels that roll without slipping while their contact force lies inside the friction cone
 and slide under Coulomb friction when it would leave it, switched by events of the integrator (no regularisation).
 
-A :class:`StickSlipWheel` is in one of two phases:
+A :class:`~robotdyn.contact.stick_slip_wheel.StickSlipWheel` is in one of two phases:
 
 - **stick**: the three rolling rows (longitudinal, lateral, normal) are constraints; its contact force
   :math:`(\\lambda_t, \\lambda_n)` comes from :mod:`robotdyn.contact.contact_forces`. Event: :math:`\\mu\\lambda_n -
@@ -29,53 +29,13 @@ import numpy as np
 from ..contact.contact_forces import constraint_forces
 from ..errors import RobotDynError
 from ..reduction.projection import auto_independent
-from ..constraints.rolling_contact import RollingWheel
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import sliding_now
 from ..contact.sliding import tangential as slip
-
-_STICK = (np.eye(3), ("longitudinal", "lateral", "normal"))
-_SLIDE = (np.array([[0.0, 0.0, 1.0]]), ("normal",))
-SLIP_ZERO = 1e-12
-"""Slip speed [m/s] below which a sliding wheel's friction keeps the direction it started with."""
-
-
-class StickSlipWheel(RollingWheel):
-    """A standard wheel with Coulomb friction coefficient ``mu`` that sticks (rolls) or slides (see the module).
-
-    Takes the arguments of :class:`~robotdyn.constraints.rolling_contact.RollingWheel` and:
-
-    Args:
-        mu: Friction coefficient (>= 0), the same for sticking and sliding.
-    """
-
-    def __init__(self, description, frame: str, radius: float, mu: float, **kwargs) -> None:
-        super().__init__(description, frame, radius, **kwargs)
-        self.mu = float(mu)
-        self.set_phase("stick")
-
-    def __repr__(self) -> str:
-        return f"StickSlipWheel(frame={self.frame!r}, radius={self.radius}, mu={self.mu}, phase={self.phase!r})"
-
-    def set_phase(self, phase: str, direction: np.ndarray | None = None) -> None:
-        """Switch to ``stick`` or to ``slide`` (with the initial slip direction (2,) in (t1, t2))."""
-        self.phase = phase
-        self._directions, self._row_names = _STICK if phase == "stick" else _SLIDE
-        self.direction = None if direction is None else np.asarray(direction, float) / np.linalg.norm(direction)
-
-    @property
-    def sliding(self) -> bool:
-        """Whether its tangential force currently comes from Coulomb friction."""
-        return self.phase == "slide"
-
-    def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
-        """Coulomb's :math:`\\mu\\hat s` (the friction force is :math:`-f_n\\mu\\hat s`)."""
-        speed = float(np.hypot(s[0], s[1]))
-        return self.mu * (s / speed if speed > SLIP_ZERO else self.direction)
-
-    def jacobian(self, kin):  # an override keeps the wheel off the grouped and compiled paths (its rows change)
-        return super().jacobian(kin)
-
+from ..contact.stick_slip_wheel import StickSlipWheel
+from ..reduction.pull_back import position_rate
+from .progress import Progress
+from .trajectory import Trajectory
 
 def _configure(robot) -> None:
     """Choose the independent velocities for the wheels' current phases (the spec's choice where it still fits)."""
@@ -114,13 +74,12 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         time_limit: Wall-clock limit [s] (None: none), as in :func:`robotdyn.simulation.engine.simulate`.
 
     Returns:
-        A :class:`~robotdyn.simulation.engine.Trajectory` whose velocity columns are the full velocities v (named
+        A :class:`~robotdyn.simulation.trajectory.Trajectory` whose velocity columns are the full velocities v (named
         ``<coordinate>_dot``), with ``friction_work`` and ``stats["switches"]`` (time, wheel, phase) and, where the
         run stopped early, ``stats["event"]``.
     """
     from scipy.integrate import solve_ivp
 
-    from .engine import Trajectory, _Progress, _qdot
 
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
@@ -142,7 +101,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     start = time.perf_counter()
     nfev = 0
     last_report = start
-    limit = _Progress(t_end, False, time_limit)  # raises past the time limit (the reports are printed below)
+    limit = Progress(t_end, False, time_limit)  # raises past the time limit (the reports are printed below)
     while True:
         robot._stick_slip_q = q
         _configure(robot)
@@ -180,9 +139,9 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                 print(f"simulate: t = {tt:.3f} / {t_end:g} s", file=sys.stderr, flush=True)
             if sliding_now(robot):
                 st = forward_sliding(robot, qq, nn, tau)
-                return np.concatenate([_qdot(st.reduced, stabilisation), st.nudot, [st.power]])
+                return np.concatenate([position_rate(st.reduced, stabilisation), st.nudot, [st.power]])
             red = robot.reduced(qq, nn)
-            return np.concatenate([_qdot(red, stabilisation), np.linalg.solve(red.M, red.B @ tau - red.h), [0.0]])
+            return np.concatenate([position_rate(red, stabilisation), np.linalg.solve(red.M, red.B @ tau - red.h), [0.0]])
 
         events = _events(robot, wheels, n, k, tau_at)
         seg = grid[(grid > t) | ((grid == 0.0) & (t == 0.0))]

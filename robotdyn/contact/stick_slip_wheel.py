@@ -1,0 +1,60 @@
+"""A wheel with exact Coulomb friction that sticks (rolls without slipping) or slides, phase by phase.
+
+A :class:`StickSlipWheel` is in one of two phases:
+
+- **stick**: the three rolling rows (longitudinal, lateral, normal) are constraints;
+- **slide**: only the normal row is a constraint; the tangential force is Coulomb's :math:`-\\mu f_n \\hat s` with
+  :math:`\\hat s = s/\\|s\\|` the slip direction (:math:`\\hat s_0`, the direction the slide started with, while the
+  slip speed :math:`\\|s\\|` is below :data:`SLIP_ZERO`).
+
+The events that switch the phases, and the integration segment by segment, are the stick-slip engine's
+(:mod:`robotdyn.simulation.stick_slip`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..constraints.rolling_contact import RollingWheel
+
+_STICK = (np.eye(3), ("longitudinal", "lateral", "normal"))
+_SLIDE = (np.array([[0.0, 0.0, 1.0]]), ("normal",))
+SLIP_ZERO = 1e-12
+"""Slip speed [m/s] below which a sliding wheel's friction keeps the direction it started with."""
+
+
+class StickSlipWheel(RollingWheel):
+    """A standard wheel with Coulomb friction coefficient ``mu`` that sticks (rolls) or slides (see the module).
+
+    Takes the arguments of :class:`~robotdyn.constraints.rolling_contact.RollingWheel` and:
+
+    Args:
+        mu: Friction coefficient (>= 0), the same for sticking and sliding.
+    """
+
+    def __init__(self, description, frame: str, radius: float, mu: float, **kwargs) -> None:
+        super().__init__(description, frame, radius, **kwargs)
+        self.mu = float(mu)
+        self.set_phase("stick")
+
+    def __repr__(self) -> str:
+        return f"StickSlipWheel(frame={self.frame!r}, radius={self.radius}, mu={self.mu}, phase={self.phase!r})"
+
+    def set_phase(self, phase: str, direction: np.ndarray | None = None) -> None:
+        """Switch to ``stick`` or to ``slide`` (with the initial slip direction (2,) in (t1, t2))."""
+        self.phase = phase
+        self._directions, self._row_names = _STICK if phase == "stick" else _SLIDE
+        self.direction = None if direction is None else np.asarray(direction, float) / np.linalg.norm(direction)
+
+    @property
+    def sliding(self) -> bool:
+        """Whether its tangential force currently comes from Coulomb friction."""
+        return self.phase == "slide"
+
+    def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
+        """Coulomb's :math:`\\mu\\hat s` (the friction force is :math:`-f_n\\mu\\hat s`)."""
+        speed = float(np.hypot(s[0], s[1]))
+        return self.mu * (s / speed if speed > SLIP_ZERO else self.direction)
+
+    def jacobian(self, kin):  # an override keeps the wheel off the compiled path (its rows change)
+        return super().jacobian(kin)

@@ -1,0 +1,64 @@
+"""A simulated motion: the result of every engine (:func:`robotdyn.simulation.engine.simulate`, the compiled engine
+of :mod:`robotdyn.simulation.compiled_engine` and the stick-slip engine of :mod:`robotdyn.simulation.stick_slip`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import RobotDynError
+
+
+@dataclass
+class Trajectory:
+    """A simulated motion.
+
+    Attributes:
+        t: Times (N,) [s].
+        q: Natural coordinates (N, n), named by ``coordinates``.
+        nu: Independent velocities (N, k), named by ``velocity_names``.
+        energy: Total mechanical energy at each time (N,) [J].
+        residual: Largest holonomic residual at each time (N,).
+        coordinates, velocity_names: Column names.
+        stats: Integrator statistics (nfev, wall time).
+        units: Unit of each column by name (m, rad, m/s, rad/s).
+        friction_work: Work done by the slipping wheels' friction forces since t = 0 (N,) [J] (<= 0; ``None``
+            without slipping wheels): energy balance E(t) - E(0) = motor work + friction_work.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    nu: np.ndarray
+    energy: np.ndarray
+    residual: np.ndarray
+    coordinates: list[str]
+    velocity_names: list[str]
+    stats: dict = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+    friction_work: np.ndarray | None = None
+
+    def __repr__(self) -> str:
+        return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"
+
+    def column(self, name: str) -> np.ndarray:
+        """A coordinate or independent velocity by name."""
+        if name in self.coordinates:
+            return self.q[:, self.coordinates.index(name)]
+        if name in self.velocity_names:
+            return self.nu[:, self.velocity_names.index(name)]
+        raise RobotDynError(f"no column {name!r}; expected one of {', '.join(self.coordinates + self.velocity_names)}")
+
+    def to_csv(self, path, extra: dict[str, np.ndarray] | None = None) -> None:
+        """Write ``t``, the q columns, the nu columns, then any ``extra`` columns by name (e.g. the wheel loads of
+        :meth:`robotdyn.contact.traction.Traction.columns`)."""
+        from ..output import atomic_output
+
+        extra = extra or {}
+        header = ",".join(["t", *self.coordinates, *self.velocity_names, *extra])
+        data = np.column_stack([self.t, self.q, self.nu, *extra.values()])
+        partial = self.stats.get("partial")
+        with atomic_output(path, "CSV file") as tmp:
+            np.savetxt(tmp, data, delimiter=",", header=header, comments="",
+                       footer=f"# partial: {partial}" if partial else "")  # a comment line: loadtxt skips it

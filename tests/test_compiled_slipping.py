@@ -12,7 +12,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
 from robotdyn.fast.dispatch import compiled_model
 from robotdyn.simulation.compiled_engine import choose_engine
@@ -27,7 +26,7 @@ from robotdyn.constraints.terrain import BumpTerrain
 from robotdyn.simulation.torque_profile import Constant
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_sliding import G, disc  # noqa: E402
+from test_sliding import G, disc, on_ground  # noqa: E402
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skid_steer.toml"
 
@@ -163,14 +162,7 @@ def over_the_bump():
     zero on the step's convex edge (lift-off), on both engines."""
     robot, q = disc(0.0, friction="coulomb", mu=0.5, slip_velocity=1e-2)
     set_terrain(robot, BumpTerrain(0.1, 1.0, 0.3))
-    iz = robot.coordinate_index("z")
-
-    def gap(z):
-        qq = q.copy()
-        qq[iz] = z
-        return robot.constraint_residual(qq)[0]
-
-    q[iz] = brentq(gap, -2.0, 2.0, xtol=1e-15)
+    q = on_ground(robot, q)
     return robot, _both(robot, 0.3, q, [6.0, 0, 0, 0, 10.0], None, n_out=301)
 
 

@@ -24,7 +24,12 @@ def disc(slope: float = 0.0, independent=("x", "y", "psi", "lean", "spin"), **fr
     spec = RobotSpec(name="disc", title="sliding disc", xacro=DISC, root="planar",
                      wheels=[Wheel("disc", R, **friction)], independent=None if independent is None else list(independent))
     robot = Robot(spec, terrain=RampTerrain(slope))
-    q = np.zeros(robot.nq)
+    return robot, on_ground(robot, np.zeros(robot.nq))
+
+
+def on_ground(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """q with the disc's height z solving its contact row (Brent, to 1e-15 m)."""
+    q = q.copy()
     iz = robot.coordinate_index("z")
 
     def gap(z):
@@ -33,7 +38,7 @@ def disc(slope: float = 0.0, independent=("x", "y", "psi", "lean", "spin"), **fr
         return robot.constraint_residual(qq)[0]
 
     q[iz] = brentq(gap, -2.0, 2.0, xtol=1e-15)
-    return robot, q
+    return q
 
 
 @pytest.mark.parametrize("slope, mu", [(1.0, 0.1), (2.0, 0.3)])

@@ -10,13 +10,7 @@ interfaces < robotdyn.robots < sweep < cli; a module imports from its own stage 
 """
 
 
+from .._lazy import lazy_exports
+
 _EXPORTS = {'run': 'runner', 'load': 'runner', 'load_trajectory': 'runner', 'SweepResult': 'runner'}
-
-
-def __getattr__(name: str):
-    """The public names of the former flat module of this name, imported on first use."""
-    if name in _EXPORTS:
-        import importlib
-
-        return getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -46,6 +46,7 @@ UPWARD = {
 LAZY_CIRCLES = {
     frozenset({"simulation.engine", "simulation.compiled_engine"}),  # Trajectory <-> the compiled engine
     frozenset({"simulation.engine", "simulation.stick_slip"}),  # Trajectory <-> the stick-slip engine
+    frozenset({"simulation.engine", "simulation.streaming"}),  # simulate(sink=) <-> its segments' simulate calls
     frozenset({"cli.commands", "cli.sweep"}),  # the sweep subcommand registers itself, and prints with _emit
     frozenset({"cli.commands", "cli.fk"}),
     # the adaptable wheel's hold scenario (model) starts from the paper's IK placement (comparison, missions)

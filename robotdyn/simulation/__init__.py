@@ -1,7 +1,7 @@
 """Stage 7, simulation: time integration and everything that drives it.
 
 Owns ``engine`` (:func:`simulate`, :class:`Trajectory`, the scipy engine), ``compiled_engine`` (the C++ integrators),
-``stick_slip`` (exact switching), ``torque_profile``, ``scenario``, ``control``, ``many_runs``, ``batch`` and
+``stick_slip`` (exact switching), ``streaming`` (long runs written to a CSV file in segments), ``torque_profile``, ``scenario``, ``control``, ``many_runs``, ``batch`` and
 ``model_variants``. Imports every earlier stage (up to robotdyn.robot). ``robotdyn.simulation.simulate`` and
 ``robotdyn.simulation.Trajectory`` still work (re-exported lazily from ``engine``).
 
@@ -11,7 +11,8 @@ interfaces < robotdyn.robots < sweep < cli; a module imports from its own stage 
 """
 
 
-_EXPORTS = {'simulate': 'engine', 'Trajectory': 'engine', 'power': 'engine', 'MAX_SAMPLES': 'engine'}
+_EXPORTS = {'simulate': 'engine', 'Trajectory': 'engine', 'power': 'engine', 'MAX_SAMPLES': 'engine', 'CsvSink': 'streaming', 'StreamResult': 'streaming',
+            'stream': 'streaming'}
 
 
 def __getattr__(name: str):

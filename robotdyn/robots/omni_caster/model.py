@@ -293,7 +293,7 @@ class PathScenario(Scenario):
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
         from ...simulation import simulate
 
-        t_end, n_out = self.span(t_end, n_out)
+        t_end, n_out = self.span(t_end, n_out, streamed=kwargs.get("sink") is not None)
         q0, nu0 = self.initial_state(robot)
         kwargs.setdefault("method", "LSODA")
         kwargs.setdefault("rtol", 1e-9)

@@ -51,6 +51,7 @@ class Parameter:
     choices: tuple[str, ...] | None = None
     xacro: bool = True
     minimum: float | None = None  # smallest physical value (default: 0 for masses and inertias, by their unit)
+    positive: bool = False  # the value must be > 0 (a length such as a radius, a link length or a track)
 
     def convert(self, value) -> float | str:
         """Validate and convert a user value."""
@@ -64,6 +65,9 @@ class Parameter:
             raise InputError(f"parameter {self.name} = {value!r} is not a number [{self.unit}]") from None
         if not np.isfinite(out):
             raise InputError(f"parameter {self.name} = {value!r} is not finite; expected a number [{self.unit}]")
+        if self.positive and not out > 0:
+            raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a value > 0 {self.unit} "
+                             f"({self.description or self.name})")
         low = self.minimum if self.minimum is not None else (0.0 if self.unit in ("kg", "kg m^2") else None)
         if low is not None and out < low:
             raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a value >= {low:g} "

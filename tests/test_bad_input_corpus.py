@@ -271,6 +271,22 @@ case("param-omni-all-masses-zero", ["dump", "omni_caster", "--param", "m_pl=0", 
                                     "I_link_x=0", "--param", "I_link_y=0", "--param", "I_link_z=0",
                                     "--v", "0", "0", "0", "--tau", *["1"] * 6], "mass")
 case("param-adaptable-wheel-choice", ["info", "adaptable_wheel", "--param", "terrain=lunar"], "terrain")
+# lengths (and the masses that carry the whole robot) that must be > 0: zero and negative values refused, naming
+# the parameter and the bound; offsets that may be 0 or < 0 (a1, l3, p, ...) are not in this list
+POSITIVE = {"quasimoro": {"r": "m", "rho": "-", "M": "kg"},
+            "omni_caster": {"l": "m", "b": "m", "d": "m", "r": "m", "m_pl": "kg"},
+            "linkage_suspension": {"a5": "m", "d5": "m", "a6": "m", "a7": "m", "r": "m", "wL": "m", "hr": "m",
+                                   "m_body": "kg"},
+            "mmr12_eod": {"lambda_C0": "m", "b": "m", "l_cs1": "m", "r": "m", "lambda2_max": "m", "lambda6_max": "m",
+                          "m_platform": "kg"},
+            "adaptable_wheel": {"m": "kg", "w": "m", "Lx": "m", "Ly": "m", "body_height": "m"}}
+for robot, names in POSITIVE.items():
+    for name, unit in names.items():
+        for label, value in (("zero", "0"), ("negative", "-0.1")):
+            case(f"param-{robot}-{name}-positive-{label}", ["info", robot, "--param", f"{name}={value}"],
+                 f"parameter {name} = {float(value):g} {unit}; expected a value > 0 {unit}")
+case("param-adaptable-wheel-R_ru-negative", ["info", "adaptable_wheel", "--param", "R_ru=-0.01"],
+     "parameter R_ru = -0.01 m; expected a value >= 0")
 
 # ---------------------------------------------------------------------------------- robot-specific commands
 case("ik-commands-short", ["ik", "adaptable_wheel", "--commands", "0", "0"], "--commands")

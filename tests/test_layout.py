@@ -42,6 +42,7 @@ UPWARD = {
 }
 # circles through imports inside functions, within one stage (a module-level circle is never allowed)
 LAZY_CIRCLES = {
+    frozenset({"simulation.engine", "simulation.streaming"}),  # simulate(sink=) <-> its segments' simulate calls
     frozenset({"cli.commands", "cli.sweep"}),  # the sweep subcommand registers itself, and prints with _emit
     frozenset({"cli.commands", "cli.fk"}),
     # the adaptable wheel's hold scenario (model) starts from the paper's IK placement (comparison, missions)

@@ -108,10 +108,10 @@ def test_negative_numbers_in_scientific_notation_are_values(capsys):
 
 
 @pytest.mark.parametrize("params, message", [
-    (["M=0", "m=0", "J1=0", "J2=0"], "total mass of 0 kg"),
+    (["M=0", "m=0", "J1=0", "J2=0"], "parameter M = 0 kg; expected a value > 0 kg"),  # the body carries the robot
     (["m=-1"], "parameter m = -1 kg; expected a value >= 0"),
     (["J2=-0.4"], "parameter J2 = -0.4 kg m^2; expected a value >= 0"),
-    (["r=0"], "radius 0.0 is not > 0"),
+    (["r=0"], "parameter r = 0 m; expected a value > 0 m"),
 ])
 def test_physically_impossible_parameters_are_one_line(capsys, params, message):
     argv = ["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "1", "0.5", "0.2", "--tau", "0.1", "0.1"]

@@ -245,7 +245,7 @@ def test_toml_spec(tmp_path):
     (["--vary", "Mass=4:6:3"], "unknown parameter 'Mass' for quasimoro; expected one of m, M"),
     (["--vary", "M=4 g:6 g:3"], "unit 'g'; expected the parameter's unit 'kg'"),
     (["--vary", "M=4:6"], "a range on a grid needs its number of points"),
-    (["--vary", "M=-1,5"], "expected a value >= 0"),
+    (["--vary", "M=-1,5"], "parameter M = -1 kg; expected a value > 0 kg"),
     (["--scenario", "wobble"], "unknown scenario 'wobble' for quasimoro; expected one of rectilinear"),
     (["--sample", "lhs", "--vary", "M=4,5"], "needs at least one range"),
     (["--column", "theta9"], "unknown column 'theta9'"),

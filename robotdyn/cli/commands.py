@@ -251,6 +251,11 @@ def cmd_simulate(args) -> int:
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops the run like Ctrl-C: results kept
         signal.signal(signal.SIGTERM, _interrupt)
     extra = {} if args.stabilisation is None else {"stabilisation": args.stabilisation}
+    from ..simulation.streaming import SEGMENT
+
+    if args.csv and not (args.plot or args.traction_plot) and sc.span(args.t_end, None, streamed=True)[1] > SEGMENT \
+            and not any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):
+        return _simulate_streamed(args, robot, sc, extra)  # more samples than a segment: to disk as they come
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")
     tr = None
@@ -320,6 +325,66 @@ def cmd_simulate(args) -> int:
     if partial:
         written = ", ".join(p for p in (args.csv, args.plot, args.traction_plot) if p) or "nothing"
         print(f"robotdyn: {partial}; wrote the partial results: {written}", file=sys.stderr)
+        return 130
+    return 0
+
+
+def _simulate_streamed(args, robot, sc, extra: dict) -> int:
+    """``simulate --csv`` of a run longer than one segment (robotdyn.simulation.streaming): the samples go to the
+    CSV file segment by segment, with the wheel-load columns; only the ends and extremes stay in memory."""
+    from ..simulation.streaming import SEGMENT, CsvSink
+
+    has_wheels = any(isinstance(c, RollingWheel) for c in robot.constraints)
+    if args.mu is not None and not has_wheels:
+        raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
+    peaks: dict[str, list[float]] = {}  # wheel -> [min normal load, max required mu]
+    events: dict[tuple[str, str], object] = {}
+
+    def columns(traj) -> dict:
+        from ..contact.traction import traction
+
+        tr = traction(robot, traj, sc.torque, args.mu)
+        for j, w in enumerate(tr.wheels):
+            lo, hi = peaks.setdefault(w, [np.inf, -np.inf])
+            mus = tr.required_mu[:, j] if tr.friction_determined[j] else np.array([-np.inf])
+            peaks[w] = [min(lo, float(np.min(tr.normal[:, j]))), max(hi, float(np.max(mus)))]
+        for e in tr.events:
+            events.setdefault((e.kind, e.wheel), e)
+        return tr.columns()
+
+    res = sc.run(robot, t_end=args.t_end, progress=not args.quiet,
+                 sink=CsvSink(args.csv, columns if has_wheels else None, SEGMENT), **extra)
+    partial = res.stats.get("partial")
+    final = dict(zip(res.coordinates + res.velocity_names, np.concatenate([res.q, res.nu])))
+    out = {"scenario": sc.name, "t_end": res.t, "samples": res.samples, "final": final, "streamed": True,
+           "segments": res.stats["segments"], "energy_start": res.energy_start, "energy_end": res.energy_end,
+           "max_holonomic_residual": res.max_residual, "wall_time_s": res.stats["wall"], "csv": args.csv,
+           "plot": None, "engine": res.stats.get("engine")}
+    text = [f"{args.robot} / {sc.name}: {sc.description}",
+            f"simulated {res.t:g} s in {res.stats['wall']:.2f} s wall ({res.stats['nfev']} evaluations, "
+            f"{res.stats.get('engine', 'scipy')} engine), streamed in {res.stats['segments']} segment(s)",
+            "final state:", *(f"  {k:<14} {v: .8g}" for k, v in final.items()),
+            f"energy: {res.energy_start:.10g} J -> {res.energy_end:.10g} J; max holonomic residual "
+            f"{res.max_residual:.2e}"]
+    if peaks:
+        first = sorted(events.values(), key=lambda e: e.t)
+        out["traction"] = {"min_normal_load": {w: p[0] for w, p in peaks.items()},
+                           "max_required_mu": {w: p[1] for w, p in peaks.items() if np.isfinite(p[1])},
+                           "events": [vars(e) for e in first]}
+        text.append(f"loads {min(p[0] for p in peaks.values()):.4g} N minimum"
+                    + (f"; first: {first[0]}" if first else "; no lift-off or slip"))
+    if "offsets" in res.stats:
+        out["constant_offsets"] = res.stats["offsets"]
+    if "event" in res.stats:
+        out["stopped"] = res.stats["event"]
+        text.append(f"stopped early: {res.stats['event']}")
+    text.append(f"wrote {args.csv}")
+    if partial:
+        out["partial"] = partial
+        text.append(f"partial: {partial}")
+    _emit(args, out, "\n".join(text))
+    if partial:
+        print(f"robotdyn: {partial}; wrote the partial results: {args.csv}", file=sys.stderr)
         return 130
     return 0
 
@@ -461,7 +526,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("simulate", parents=[common, robot_args], help="run a scenario")
     p.add_argument("--scenario", required=True, help="scenario name (robotdyn info ROBOT lists them)")
     p.add_argument("--t-end", type=_duration, default=None, help="duration [s] (default: the scenario's)")
-    p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file")
+    p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file (a run of more than "
+                   "100,000 samples without --plot/--traction-plot streams to it in segments: any duration)")
     p.add_argument("--plot", help="save the paper's figures reproduced to this image file")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--stabilisation", type=_nonnegative, default=None, metavar="ALPHA",

@@ -2,7 +2,7 @@
 
 Owns ``engine`` (:func:`simulate`, the scipy engine), ``trajectory`` (:class:`Trajectory`, what every engine
 returns), ``progress`` (a run's reporter), ``compiled_engine`` (the C++ integrators), ``stick_slip`` (exact
-switching), ``torque_profile``, ``scenario``, ``control``, ``many_runs``, ``batch`` and ``model_variants``. Imports every earlier stage (up to robotdyn.robot). ``robotdyn.simulation.simulate`` and
+switching), ``streaming`` (long runs written to a CSV file in segments), ``torque_profile``, ``scenario``, ``control``, ``many_runs``, ``batch`` and ``model_variants``. Imports every earlier stage (up to robotdyn.robot). ``robotdyn.simulation.simulate`` and
 ``robotdyn.simulation.Trajectory`` still work (re-exported lazily from ``engine`` and ``trajectory``).
 
 Import rule (tests/test_layout.py enforces it): the stages are, in order, foundation (robotdyn.errors, robotdyn.inputs,
@@ -13,5 +13,6 @@ interfaces < robotdyn.robots < sweep < cli; a module imports from its own stage 
 
 from .._lazy import lazy_exports
 
-_EXPORTS = {'simulate': 'engine', 'Trajectory': 'trajectory', 'power': 'engine', 'MAX_SAMPLES': 'engine'}
+_EXPORTS = {'simulate': 'engine', 'Trajectory': 'trajectory', 'power': 'engine', 'MAX_SAMPLES': 'engine',
+            'CsvSink': 'streaming', 'StreamResult': 'streaming', 'stream': 'streaming'}
 __getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -63,20 +63,21 @@ def native_profile(profile: TorqueProfile):
 
 
 def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: TorqueProfile, t_eval: np.ndarray,
-        rtol: float, atol: float, stabilisation: float, method: str, progress=None) -> dict:
+        rtol: float, atol: float, stabilisation: float, method: str, progress=None, t0: float = 0.0) -> dict:
     """Integrate on the compiled model ``fast`` of ``robot``.
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
         fast: Its :class:`~robotdyn.fast.compiled.CompiledModel` (projection chosen).
         t_end: Final time [s].
-        q0, nu0: Initial state.
+        q0, nu0: Initial state (at time ``t0``).
         profile: Motor torques.
-        t_eval: Output times (sorted, from 0 to t_end).
+        t_eval: Output times (sorted, from t0 to t_end).
         rtol, atol: Tolerances of the stepper's error control (per component: :math:`atol + rtol |y_i|`).
         stabilisation: Gain [1/s] of the holonomic pull-back.
         method: One of :data:`METHODS`.
         progress: ``progress(t)`` called about every 50 ms (None: not called).
+        t0: Start time [s] (the profile is evaluated at absolute times).
 
     Returns:
         ``t`` (N,), ``y`` (N, n + k), ``energy`` (N,) [J], ``residual`` (N,), ``nfev``, ``steps`` and
@@ -89,9 +90,9 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     if method not in METHODS:
         raise RobotDynError(f"unknown compiled integrator {method!r}; expected one of {', '.join(METHODS)}")
     native = native_profile(profile)
-    breaks = [float(b) for b in profile.breakpoints() if 0.0 < b < t_end]
+    breaks = [float(b) for b in profile.breakpoints() if t0 < b < t_end]
     n = robot.nq
-    out = fast.ev.simulate(q0, nu0, 0.0, float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
+    out = fast.ev.simulate(q0, nu0, float(t0), float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
                            native, breaks, method, progress, rechooser(robot, fast))
     status, t_stop = out["status"], float(out["t_stop"])
     if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's errors
@@ -103,7 +104,7 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
         raise redundant_load_error(wheels[int(out["slip_value"])])
     interrupted = None
     if status == INTERRUPTED:
-        reached = float(out["t"][-1]) if len(out["t"]) else 0.0
+        reached = float(out["t"][-1]) if len(out["t"]) else t0
         interrupted = f"interrupted at t = {t_stop:.6g} s: samples up to t = {reached:.6g} s of {t_end:g} s"
     elif status == FAILED:
         message = out["message"]
@@ -151,16 +152,19 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
 
 
 def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, stabilisation, progress,
-                       offsets) -> Trajectory:
+                       offsets, t0: float = 0.0, times=None) -> Trajectory:
     """:func:`robotdyn.simulation.engine.simulate` on the compiled engine (:func:`run`), after its checks: a
     :class:`~robotdyn.simulation.trajectory.Trajectory` with ``stats["engine"]``. ``progress`` is the run's reporter
-    (:class:`robotdyn.simulation.progress.Progress`: prints, and raises past the run's time limit)."""
+    (:class:`robotdyn.simulation.progress.Progress`: prints, and raises past the run's time limit). The run
+    starts at ``t0`` [s] and samples ``times`` (default ``n_out`` evenly spaced from t0 to t_end)."""
+
     profile = as_profile(torque, len(robot.motors))
-    robot.forward_dynamics(q0, nu0, profile(0.0))  # regular where the run starts (raises the Python path's error)
+    robot.forward_dynamics(q0, nu0, profile(t0))  # regular where the run starts (raises the Python path's error)
     fast = compiled_model(robot)
     start = time.perf_counter()
-    out = run(robot, fast, t_end, q0, nu0, profile, np.linspace(0.0, t_end, n_out), rtol, atol,
-                       stabilisation, method, progress if progress.needed else None)
+    t_eval = np.linspace(t0, t_end, n_out) if times is None else times
+    out = run(robot, fast, t_end, q0, nu0, profile, t_eval, rtol, atol, stabilisation, method,
+              progress if progress.needed else None, t0)
     wall = time.perf_counter() - start
     n = robot.nq
     stats = {"nfev": out["nfev"], "steps": out["steps"], "wall": wall, "method": method, "rtol": rtol,

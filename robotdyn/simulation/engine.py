@@ -56,8 +56,12 @@ def simulate(
     progress: bool = True,
     engine: str = "auto",
     time_limit: float | None = None,
+    *,
+    t0: float = 0.0,
+    times=None,
+    sink=None,
 ) -> Trajectory:
-    """Integrate the reduced equations from (q0, nu0) over [0, t_end].
+    """Integrate the reduced equations from (q0, nu0) over [t0, t_end] (t0 = 0 unless continuing a run).
 
     Two engines integrate the same ODE: the compiled one (:mod:`robotdyn.simulation.compiled_engine`: the whole run in
     C++, Boost.Odeint's adaptive Adams-Bashforth-Moulton by default) and scipy's (``solve_ivp``'s DOP853 loop, the
@@ -84,10 +88,33 @@ def simulate(
         time_limit: Wall-clock limit of the run [s] (None: none): past it the run raises
             :class:`~robotdyn.errors.TimeLimitError` (checked at every evaluation on the Python paths, about every
             50 ms on the compiled engine), so that a stiff or blown-up run in a sweep cannot stall it.
+        t0: Start time [s] of (q0, nu0); torques are evaluated at absolute times. A run from t0 > 0 continues an
+            earlier one (:mod:`robotdyn.simulation.streaming`): q0 is not checked against the holonomic constraints
+            (its residual is the earlier run's drift, which the pull-back keeps reducing).
+        times: Output times [s] (sorted, from t0 to t_end) instead of ``n_out`` evenly spaced ones.
+        sink: A :class:`robotdyn.simulation.streaming.CsvSink`: the run streams to its file in segments of
+            ``sink.segment`` samples (memory bounded whatever the duration; any ``n_out`` >= 2) and returns a
+            :class:`robotdyn.simulation.streaming.StreamResult` instead of a Trajectory (see
+            :func:`robotdyn.simulation.streaming.stream`: the integrator restarts at each segment boundary).
     """
+    if sink is not None:
+        from .streaming import stream
+
+        return stream(robot, t_end, q0, nu0, torque, n_out, sink, rtol=rtol, atol=atol, method=method,
+                      stabilisation=stabilisation, progress=progress, engine=engine, time_limit=time_limit)
+    t0 = float(t0)
+    if times is not None:
+        times = np.asarray(times, float)
+        if times.ndim != 1 or len(times) < 2 or times[0] != t0 or times[-1] != t_end or np.any(np.diff(times) <= 0):
+            raise RobotDynError(f"times: expected increasing output times from t0 = {t0:g} s to t_end = {t_end:g} s")
+        n_out = len(times)
+    if not np.isfinite(t0) or t0 < 0:
+        raise RobotDynError(f"t0 = {t0} s; expected a finite start time >= 0")
+    if t0 and not t_end > t0:
+        raise RobotDynError(f"t_end = {t_end} s; expected a final time after t0 = {t0:g} s")
     if not np.isfinite(t_end) or t_end <= 0:
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
-    if t_end < MIN_DURATION:
+    if t_end - t0 < MIN_DURATION:
         raise RobotDynError(f"t_end = {t_end:g} s; expected a duration of at least {MIN_DURATION:g} s")
     if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
         raise RobotDynError(f"time_limit = {time_limit} s; expected a positive wall-clock duration or None")
@@ -99,17 +126,20 @@ def simulate(
     nu0 = robot.check_nu(nu0)
     if isinstance(torque, TorqueProfile):
         as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
-    robot.check_constraints(q0)
+    if not t0:  # a continuation starts where the earlier run ended (its drift is reported, not refused)
+        robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
     if any(isinstance(c, StickSlipWheel) for c in robot.constraints):  # exact switching: segment by segment
+        if t0 or times is not None:
+            raise RobotDynError("t0/times: stick-slip wheels are simulated from t = 0 on n_out samples only")
         from .stick_slip import simulate as simulate_stick_slip
 
         return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
                                    method or "DOP853", stabilisation, progress, time_limit=time_limit)
     if compiled_engine:
         return simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
-                                 stabilisation, Progress(t_end, progress, time_limit), offsets)
+                                 stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times)
     method = method or "DOP853"
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
@@ -122,7 +152,7 @@ def simulate(
     k = robot.mobility
 
     # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.reduction.reduced_dynamics.solve_mass)
-    robot.forward_dynamics(q0, nu0, zero_tau if torque is None else np.asarray(torque(0.0, q0, nu0), float))
+    robot.forward_dynamics(q0, nu0, zero_tau if torque is None else np.asarray(torque(t0, q0, nu0), float))
 
     def finite(t: float, y: np.ndarray) -> None:  # on the Python paths only: the compiled one stays lean
         if not np.isfinite(y).all():
@@ -159,15 +189,15 @@ def simulate(
 
         lift_off.terminal, lift_off.direction = True, -1.0
         events = [lift_off]
-    t_eval = np.linspace(0.0, t_end, n_out)
+    t_eval = np.linspace(t0, t_end, n_out) if times is None else times
     start = time.perf_counter()
     y0 = np.concatenate([q0, nu0, [0.0] if slipping else []])
     interrupted = None
     if events is None:
         breaks = torque.breakpoints() if isinstance(torque, TorqueProfile) else ()
-        sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks)
+        sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks, t0)
     else:
-        sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
+        sol = solve_ivp(rhs, (t0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)
     wall = time.perf_counter() - start
     if not sol.success:
         raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}"
@@ -205,16 +235,16 @@ def simulate(
 
 
 def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarray, rtol: float, atol: float,
-               breaks=()):
+               breaks=(), t0: float = 0.0):
     """scipy's ``solve_ivp`` loop (the same solver, steps and dense output at ``t_eval``, so the same numbers),
     written out so that an interruption (Ctrl-C, SIGTERM) keeps what was computed: returns the solution object
     and, if interrupted, a message saying up to which time the samples reach. The solver is restarted at each of
-    ``breaks`` inside (0, t_end) (the kinks of a torque profile), so that no step spans one."""
+    ``breaks`` inside (t0, t_end) (the kinks of a torque profile), so that no step spans one."""
     from types import SimpleNamespace
 
     from scipy.integrate._ivp.ivp import METHODS as SCIPY
 
-    bounds = [0.0, *sorted(float(b) for b in breaks if 0.0 < b < t_end), t_end]
+    bounds = [t0, *sorted(float(b) for b in breaks if t0 < b < t_end), t_end]
     ts, ys, i, status, message, interrupted, nfev = [], [], 0, None, "", None, 0
     y, solver = y0, None
     try:
@@ -242,8 +272,8 @@ def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarra
     except KeyboardInterrupt:
         status = 0
         del ts[len(ys):], ys[len(ts):]  # the signal may fall between the two appends
-        reached = float(ts[-1][-1]) if ts else 0.0
-        now = solver.t if solver is not None else 0.0
+        reached = float(ts[-1][-1]) if ts else t0
+        now = solver.t if solver is not None else t0
         interrupted = f"interrupted at t = {now:.6g} s: samples up to t = {reached:.6g} s of {t_end:g} s"
     nfev += solver.nfev if solver is not None else 0
     t = np.concatenate(ts) if ts else np.zeros(0)

@@ -50,9 +50,10 @@ class Scenario:
             nu0[robot.velocity_names.index(label)] = value
         return q0, nu0
 
-    def span(self, t_end: float | None = None, n_out: int | None = None) -> tuple[float, int]:
+    def span(self, t_end: float | None = None, n_out: int | None = None, streamed: bool = False) -> tuple[float, int]:
         """The duration [s] (default the scenario's; checked finite and positive) and the number of output samples
-        (default: the scenario's sampling rate over that duration)."""
+        (default: the scenario's sampling rate over that duration), at most MAX_SAMPLES unless ``streamed`` (a run
+        written to a file in segments, :mod:`robotdyn.simulation.streaming`)."""
         from .engine import MAX_SAMPLES, MIN_DURATION
 
         t_end = self.t_end if t_end is None else float(t_end)
@@ -61,13 +62,15 @@ class Scenario:
         if t_end < MIN_DURATION:
             raise RobotDynError(f"t_end = {t_end:g} s; expected a duration of at least {MIN_DURATION:g} s")
         n = float(n_out) if n_out else max(2.0, round(self.n_out * t_end / self.t_end))
-        if not 2 <= n <= MAX_SAMPLES:
+        if not 2 <= n <= (float("inf") if streamed else MAX_SAMPLES):
             raise RobotDynError(f"{n:.3g} output samples for t_end = {t_end:g} s; expected 2 to {MAX_SAMPLES:,} "
-                                "samples (memory): give a shorter duration or fewer samples")
+                                "samples (memory): give a shorter duration or fewer samples, or stream the run to a "
+                                "CSV file (robotdyn simulate --csv)")
         return t_end, int(n)
 
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs) -> Trajectory:
-        """Simulate the scenario on ``robot`` (keyword arguments go to :func:`~robotdyn.simulation.engine.simulate`)."""
-        t_end, n_out = self.span(t_end, n_out)
+        """Simulate the scenario on ``robot`` (keyword arguments go to :func:`~robotdyn.simulation.engine.simulate`;
+        with ``sink=`` the run streams to a file and returns a :class:`~robotdyn.simulation.streaming.StreamResult`)."""
+        t_end, n_out = self.span(t_end, n_out, streamed=kwargs.get("sink") is not None)
         q0, nu0 = self.initial_state(robot)
         return simulate(robot, t_end, q0, nu0, self.torque, n_out=n_out, **kwargs)

@@ -41,18 +41,19 @@ SPEC = RobotSpec(
     root="planar",
     paper="chung_yi_omni_caster_dynamics.txt",
     parameters=[
-        Parameter("l", 0.173, "m", "distance A1A2 between the front steering axes (Table 1)"),
-        Parameter("a", 0.05, "m", "A1, A2 lie a behind C along -j (Table 1, eq 6-7)"),
-        Parameter("b", 0.1, "m", "distance C A3 and platform radius (Table 1, eq 8, 50)"),
-        Parameter("h", 0.045, "m", "height of the steering joint above the wheel centre (Table 1, eq 6)"),
-        Parameter("d", 0.025, "m", "caster offset, steering axis to wheel centre (Table 1)"),
-        Parameter("r", 0.025, "m", "wheel radius (Table 1)"),
-        Parameter("m_pl", 5.0, "kg", "platform mass (from the printed diag(5, 5, 0.025) = eq 50; Table 2 garbled)"),
+        Parameter("l", 0.173, "m", "distance A1A2 between the front steering axes (Table 1)", positive=True),
+        Parameter("a", 0.05, "m", "A1, A2 lie a behind C along -j (Table 1, eq 6-7; an offset: 0 or < 0 valid)"),
+        Parameter("b", 0.1, "m", "distance C A3 and platform radius (Table 1, eq 8, 50)", positive=True),
+        Parameter("h", 0.045, "m", "height of the steering joint above the wheel centre (Table 1, eq 6; an offset: any sign)"),
+        Parameter("d", 0.025, "m", "caster offset, steering axis to wheel centre (Table 1)", positive=True),
+        Parameter("r", 0.025, "m", "wheel radius (Table 1)", positive=True),
+        Parameter("m_pl", 5.0, "kg", "platform mass (from the printed diag(5, 5, 0.025) = eq 50; Table 2 garbled)",
+                  positive=True),
         Parameter("m_wheel", 0.5, "kg", "mass of each wheel (Table 2)"),
         Parameter("I_wheel_axle", 1.5625e-4, "kg m^2", "wheel inertia about its axle (Table 2)"),
         Parameter("I_wheel_diam", 0.7813e-4, "kg m^2", "wheel inertia about a diameter, incl. the vertical (Table 2)"),
         Parameter("m_link", 0.025, "kg", "mass of each offset steering link (Table 2 as printed)"),
-        Parameter("p", 0.0125, "m", "wheel centre to link mass centre, towards A_i (eq 37; not printed: d/2)"),
+        Parameter("p", 0.0125, "m", "wheel centre to link mass centre, towards A_i (eq 37; not printed: d/2; 0 is valid: mass centre on the axle)"),
         Parameter("I_link_x", 8.438e-6, "kg m^2", "link central inertia about its x (A_i -> O_i) (Table 2)"),
         Parameter("I_link_y", 11.042e-6, "kg m^2", "link central inertia about its y (axle direction) (Table 2)"),
         Parameter("I_link_z", 2.604e-6, "kg m^2", "link central inertia about the vertical (Table 2)"),
@@ -292,7 +293,7 @@ class PathScenario(Scenario):
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
         from ...simulation import simulate
 
-        t_end, n_out = self.span(t_end, n_out)
+        t_end, n_out = self.span(t_end, n_out, streamed=kwargs.get("sink") is not None)
         q0, nu0 = self.initial_state(robot)
         kwargs.setdefault("method", "LSODA")
         kwargs.setdefault("rtol", 1e-9)

@@ -29,12 +29,12 @@ SPEC = RobotSpec(
     paper="staicu_quasimoro_virtual_powers.txt",
     parameters=[
         Parameter("m", 0.5, "kg", "mass of each wheel"),
-        Parameter("M", 5.0, "kg", "mass of the intermediate body"),
+        Parameter("M", 5.0, "kg", "mass of the intermediate body", positive=True),
         Parameter("J1", 0.2, "kg m^2", "body inertia about x_C (C2 -> G), eq 3"),
         Parameter("J2", 0.4, "kg m^2", "body inertia about y_C and z_C (the axle), eq 3"),
-        Parameter("r", 0.3, "m", "wheel radius"),
-        Parameter("d", 0.2, "m", "distance from the axle midpoint C2 to the body's mass centre"),
-        Parameter("rho", 0.5, "-", "r / l, l = distance between the wheel centres, eq 11"),
+        Parameter("r", 0.3, "m", "wheel radius", positive=True),
+        Parameter("d", 0.2, "m", "distance from the axle midpoint C2 to the body's mass centre (0 is valid: mass centre on the axle)"),
+        Parameter("rho", 0.5, "-", "r / l, l = distance between the wheel centres, eq 11", positive=True),
         Parameter(
             "inertia_about", "axle", "", "point about which diag(J1, J2, J2) is taken: axle (C2) or com (G)",
             choices=("axle", "com"),

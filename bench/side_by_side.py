@@ -31,6 +31,13 @@ def compiled_engine() -> dict | None:
     return {"engine": "compiled"} if "engine" in inspect.signature(simulate).parameters else None
 
 
+def scipy_engine() -> dict:
+    """Keyword arguments of ``simulate`` choosing the scipy reference path (DOP853), whatever ``engine="auto"``
+    would pick for a torque profile."""
+    kw = {"method": "DOP853"}
+    return {**kw, "engine": "scipy"} if "engine" in inspect.signature(simulate).parameters else kw
+
+
 def _robotdyn_run(robot, sc, t_end: float, repeat: int = REPEAT, **kw) -> tuple[object, float]:
     """The trajectory and the fastest wall time [s] of ``repeat`` whole ``simulate`` calls."""
     q0, nu0 = sc.initial_state(robot)
@@ -63,7 +70,7 @@ def manoeuvre(t_ends=(20.0, 90.0)) -> None:
             f"{'max|x-x_ref|':>12} {'penetration':>11} {'|x-r th1|':>10} {'psi drift':>9}")
     print(head + "\n" + "-" * len(head))
     for t_end in t_ends:
-        ref, wall_ref = _robotdyn_run(robot, sc, t_end)
+        ref, wall_ref = _robotdyn_run(robot, sc, t_end, **scipy_engine())
         rows = [("robotdyn scipy DOP853 1e-10", wall_ref, _as_run(ref, r), drift(robot, ref))]
         kw = compiled_engine()
         if kw is None:
@@ -107,8 +114,14 @@ def sweep_throughput(n: int | None = None, t_end: float = 2.0) -> None:
     tables, rates = {}, {}
     for workers in (1, 2):
         before = os.times()
-        with tempfile.TemporaryDirectory() as out:
-            res = sweep.run(spec, out, workers=workers, progress=False, plot=False)
+        with tempfile.TemporaryDirectory() as out, tempfile.TemporaryDirectory() as cache:
+            # each measurement starts with an empty description cache (robotdyn.description.cache): every run of
+            # this sweep is a new variant, and a cache the first measurement filled would favour the second
+            saved, os.environ["ROBOTDYN_CACHE"] = os.environ.get("ROBOTDYN_CACHE"), cache
+            try:
+                res = sweep.run(spec, out, workers=workers, progress=False, plot=False)
+            finally:
+                os.environ.pop("ROBOTDYN_CACHE") if saved is None else os.environ.__setitem__("ROBOTDYN_CACHE", saved)
         after = os.times()  # the workers' CPU time: they are this process's (reaped) descendants
         cpu = after.children_user + after.children_system - before.children_user - before.children_system
         rates[workers] = res.computed / res.wall

@@ -85,3 +85,21 @@ def test_off_switch_and_no_xacro_import_on_a_hit(files, tmp_path):
     off = {**env, "ROBOTDYN_CACHE": "off"}
     again = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=off, check=True)
     assert again.stdout.split()[0] == "True"
+
+
+def test_the_cache_keeps_a_bounded_number_of_entries(files, monkeypatch):
+    """A sweep expands a new variant per run: the oldest entries go beyond MAX_ENTRIES, the newest stay hits."""
+    import time
+
+    monkeypatch.setattr(description_cache, "MAX_ENTRIES", 3)
+    for mass in (1.0, 2.0, 3.0, 4.0, 5.0):
+        expand_xacro(files, {"mass": mass})
+        time.sleep(0.01)  # distinct modification times
+    assert len(entries(files)) == 3
+    calls = []
+    real = description_cache.store
+    monkeypatch.setattr(description_cache, "store", lambda *a: (calls.append(1), real(*a)))
+    expand_xacro(files, {"mass": 5.0})
+    assert calls == []  # the newest is still cached
+    expand_xacro(files, {"mass": 1.0})
+    assert calls == [1]  # the oldest was removed

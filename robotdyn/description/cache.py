@@ -11,7 +11,8 @@ version, so its result is kept under :func:`cache_dir` and reused while all of t
   used only while each of them still has that hash;
 - descriptions that read environment variables (``$(env ...)``, ``$(optenv ...)``) are never cached.
 
-Entries are written atomically; a cache that cannot be read or written only costs time. ``ROBOTDYN_CACHE`` moves
+Entries are written atomically, at most :data:`MAX_ENTRIES` are kept; a cache that cannot be read or written only
+costs time. ``ROBOTDYN_CACHE`` moves
 the cache (default ``~/.cache/robotdyn``); ``ROBOTDYN_CACHE=off`` switches it off.
 """
 
@@ -26,6 +27,10 @@ from ..errors import RobotDynError
 
 REVISION = 1
 """Revision of the entry format (raise it when the format or what a key covers changes)."""
+
+MAX_ENTRIES = 256
+"""Entries kept (the least recently written are removed beyond it: a parameter sweep expands a new variant per
+run and must not fill the disk)."""
 
 
 def cache_dir() -> Path | None:
@@ -99,8 +104,28 @@ def store(path: Path, mappings: dict[str, str], index, files: list[str], urdf: s
         entry.parent.mkdir(parents=True, exist_ok=True)
         with atomic_output(entry, "cache") as tmp:
             tmp.write_text(json.dumps(data))
+        _prune(entry.parent)
     except (OSError, RobotDynError):
         pass
+
+
+def _prune(folder: Path) -> None:
+    """Remove the least recently written entries beyond :data:`MAX_ENTRIES` (another process may remove them
+    first: a missing file is not an error)."""
+    entries = list(folder.glob("*.json"))
+    if len(entries) <= MAX_ENTRIES:
+        return
+    by_age = []
+    for e in entries:
+        try:
+            by_age.append((e.stat().st_mtime_ns, e))
+        except OSError:
+            pass
+    for _, e in sorted(by_age)[: len(by_age) - MAX_ENTRIES]:
+        try:
+            e.unlink()
+        except OSError:
+            pass
 
 
 __all__ = ["cache_dir", "package_stamp", "lookup", "store"]

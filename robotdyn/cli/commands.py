@@ -307,24 +307,25 @@ def cmd_simulate(args) -> int:
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
             f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
             + ("; ..." if len(switches) > 10 else ""))
-    if "offsets" in traj.stats:  # holonomic residuals no coordinate can change (robotdyn.reduction.pull_back)
-        out["constant_offsets"] = traj.stats["offsets"]
-    if "event" in traj.stats:
-        out["stopped"] = traj.stats["event"]
-        text.append(f"stopped early: {traj.stats['event']}")
-    if args.csv:
-        text.append(f"wrote {args.csv}")
-    if args.plot:
-        text.append(f"wrote {args.plot}")
-    if args.traction_plot:
-        text.append(f"wrote {args.traction_plot}")
+    return _finish_run(args, out, text, traj.stats, partial, [args.csv, args.plot, args.traction_plot])
+
+
+def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | None, written: list) -> int:
+    """The end of ``simulate``'s report, in memory or streamed: constant offsets, an event that stopped the run, the
+    files written and a partial run's note (stderr, exit status 130)."""
+    if "offsets" in stats:  # holonomic residuals no coordinate can change (robotdyn.reduction.pull_back)
+        out["constant_offsets"] = stats["offsets"]
+    if "event" in stats:
+        out["stopped"] = stats["event"]
+        text.append(f"stopped early: {stats['event']}")
+    written = [w for w in written if w]
+    text += [f"wrote {w}" for w in written]
     if partial:
         out["partial"] = partial
         text.append(f"partial: {partial}")
     _emit(args, out, "\n".join(text))
     if partial:
-        written = ", ".join(p for p in (args.csv, args.plot, args.traction_plot) if p) or "nothing"
-        print(f"robotdyn: {partial}; wrote the partial results: {written}", file=sys.stderr)
+        print(f"robotdyn: {partial}; wrote the partial results: {', '.join(written) or 'nothing'}", file=sys.stderr)
         return 130
     return 0
 
@@ -373,20 +374,7 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
                            "events": [vars(e) for e in first]}
         text.append(f"loads {min(p[0] for p in peaks.values()):.4g} N minimum"
                     + (f"; first: {first[0]}" if first else "; no lift-off or slip"))
-    if "offsets" in res.stats:
-        out["constant_offsets"] = res.stats["offsets"]
-    if "event" in res.stats:
-        out["stopped"] = res.stats["event"]
-        text.append(f"stopped early: {res.stats['event']}")
-    text.append(f"wrote {args.csv}")
-    if partial:
-        out["partial"] = partial
-        text.append(f"partial: {partial}")
-    _emit(args, out, "\n".join(text))
-    if partial:
-        print(f"robotdyn: {partial}; wrote the partial results: {args.csv}", file=sys.stderr)
-        return 130
-    return 0
+    return _finish_run(args, out, text, res.stats, partial, [args.csv])
 
 
 def _nonnegative(text: str) -> float:

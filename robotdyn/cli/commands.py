@@ -251,10 +251,11 @@ def cmd_simulate(args) -> int:
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops the run like Ctrl-C: results kept
         signal.signal(signal.SIGTERM, _interrupt)
     extra = {} if args.stabilisation is None else {"stabilisation": args.stabilisation}
+    from ..contact.stick_slip_wheel import stick_slip_wheels
     from ..simulation.streaming import SEGMENT
 
     if args.csv and not (args.plot or args.traction_plot) and sc.span(args.t_end, None, streamed=True)[1] > SEGMENT \
-            and not any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):
+            and not stick_slip_wheels(robot):
         return _simulate_streamed(args, robot, sc, extra)  # more samples than a segment: to disk as they come
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")

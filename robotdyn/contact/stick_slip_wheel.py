@@ -58,3 +58,8 @@ class StickSlipWheel(RollingWheel):
 
     def jacobian(self, kin):  # an override keeps the wheel off the compiled path (its rows change)
         return super().jacobian(kin)
+
+
+def stick_slip_wheels(robot) -> list[StickSlipWheel]:
+    """The robot's stick-slip wheels (a robot with any is simulated by the exact switching engine only)."""
+    return [c for c in robot.constraints if isinstance(c, StickSlipWheel)]

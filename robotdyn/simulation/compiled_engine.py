@@ -41,7 +41,7 @@ from ..fast.dispatch import compiled_model
 from ..errors import NonFiniteError, RobotDynError
 from ..reduction.pull_back import failure_note
 from ..contact.sliding import slipping_wheels
-from ..contact.stick_slip_wheel import StickSlipWheel
+from ..contact.stick_slip_wheel import stick_slip_wheels
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
 
@@ -134,7 +134,7 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     if engine == "scipy" or (method is not None and engine == "auto"):
         return False
     reason = None
-    if any(isinstance(c, StickSlipWheel) for c in robot.constraints):
+    if stick_slip_wheels(robot):
         reason = "stick-slip wheels (exact switching) are simulated on the Python path"
     elif compiled_model(robot) is None:
         from ..fast.dispatch import enabled

@@ -29,7 +29,7 @@ from ..reduction.pull_back import failure_note, position_rate, start_offsets
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import lift_off_message, slipping_wheels
-from ..contact.stick_slip_wheel import StickSlipWheel
+from ..contact.stick_slip_wheel import stick_slip_wheels
 from .progress import Progress
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
@@ -130,7 +130,7 @@ def simulate(
         robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
-    if any(isinstance(c, StickSlipWheel) for c in robot.constraints):  # exact switching: segment by segment
+    if stick_slip_wheels(robot):  # exact switching: segment by segment
         if t0 or times is not None:
             raise RobotDynError("t0/times: stick-slip wheels are simulated from t = 0 on n_out samples only")
         from .stick_slip import simulate as simulate_stick_slip

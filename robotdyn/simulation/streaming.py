@@ -111,6 +111,7 @@ def stream(robot, t_end: float, q0, nu0, torque, n_out: int, sink: CsvSink, prog
     Raises:
         RobotDynError: Bad arguments, or a segment's integration failed (the file is then not written).
     """
+    from ..contact.stick_slip_wheel import stick_slip_wheels
     from ..output import atomic_output, check_target
     from .engine import simulate
 
@@ -122,7 +123,7 @@ def stream(robot, t_end: float, q0, nu0, torque, n_out: int, sink: CsvSink, prog
     n_out = int(n_out)
     if not (np.isfinite(t_end) and t_end > 0):
         raise RobotDynError(f"t_end = {t_end} s; expected a positive duration")
-    if any(type(c).__name__ == "StickSlipWheel" for c in robot.constraints):
+    if stick_slip_wheels(robot):
         raise RobotDynError("sink: a run with stick-slip wheels cannot be streamed (its phases switch over the whole "
                             "run); simulate it in memory")
     check_target(sink.path, "CSV file")

@@ -320,9 +320,10 @@ def climbing_robot(slope: float, robot: Robot | None = None) -> Robot:
 
     if not np.isfinite(slope) or abs(slope) >= np.pi / 2:
         raise InputError(f"slope = {slope} rad; expected |slope| < pi/2")
+    base = robot.spec if robot is not None else SPEC
     spec = dataclasses.replace(
-        robot.spec if robot is not None else SPEC, name=f"{SPEC.name}_climbing", root="floating", independent=None,
-        wheels=[*SPEC.wheels, *(Wheel(f"CS{i}", "r", axis=(0.0, 0.0, 1.0), kind="support", name=f"tip{i}")
+        base, name=f"{base.name}_climbing", root="floating", independent=None,
+        wheels=[*base.wheels, *(Wheel(f"CS{i}", "r", axis=(0.0, 0.0, 1.0), kind="support", name=f"tip{i}")
                                 for i in (3, 4))])
     return Robot(spec, robot.params if robot is not None else None, RampTerrain(float(np.tan(slope))))
 

@@ -40,6 +40,7 @@
 #include <thread>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -796,7 +797,8 @@ class Evaluator {
                          const Eigen::Ref<const RowMat>& models, const std::vector<robotdyn::TorqueProfile*>& profiles,
                          const std::vector<std::vector<double>>& breaks, double t_end,
                          const std::vector<double>& samples, double rtol, double atol, double alpha,
-                         const std::string& method, int threads, py::object progress, py::object rechoose) {
+                         const std::string& method, int threads, py::object progress, py::object rechoose,
+                         double time_limit) {
     if (!slips_.empty()) throw std::invalid_argument("simulate_many does not run robots with slipping wheels");
     const long N = static_cast<long>(Q0.rows());
     const int k = mobility(), dim = nv_ + k;
@@ -813,6 +815,9 @@ class Evaluator {
     py::array_t<double> Y({N, S, static_cast<long>(dim)}), E({N, S}), R({N, S});
     py::array_t<long> emitted(N), nfev(N), steps(N);
     py::array_t<int> status(N);
+    py::array_t<double> walls(N);
+    double* wall_out = walls.mutable_data();
+    std::fill(wall_out, wall_out + N, 0.0);
     std::vector<std::string> messages(N);
     double* y_out = Y.mutable_data();
     double* e_out = E.mutable_data();
@@ -840,6 +845,8 @@ class Evaluator {
         double* ei = e_out + i * S;
         double* ri = r_out + i * S;
         long count = 0, evals = 0;
+        const auto started = std::chrono::steady_clock::now();
+        bool timed_out = false;
         try {
           robotdyn::State y0(dim);
           Eigen::Map<VectorXd>(y0.data(), nv_) = Q0.row(i).transpose();
@@ -853,13 +860,24 @@ class Evaluator {
             std::copy(x.begin(), x.end(), yi + count * dim);
             ++count;
           };
-          auto poll = [&](double) { return !stop.load(); };
+          auto poll = [&](double) {  // time_limit <= 0: none; past it the run stops as failed, named so
+            if (time_limit > 0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() >
+                                      time_limit)
+              timed_out = true;
+            return !stop.load() && !timed_out;
+          };
           size_t next = 0;
           robotdyn::Outcome out = robotdyn::integrate(method, system, y0, 0.0, t_end, samples, next, breaks[i], rtol,
                                                       atol, observer, poll);
           for (long j = 0; j < count; ++j) ev.observe(yi + j * dim, ei[j], ri[j], rechoose);
           status_out[i] = out.status;
-          if (out.status == robotdyn::FAILED)
+          if (timed_out && out.status == robotdyn::INTERRUPTED) {
+            status_out[i] = robotdyn::FAILED;
+            std::ostringstream text;
+            text << "the run exceeded its time limit of " << time_limit << " s at t = " << out.t << " s of " << t_end
+                 << " s";
+            messages[i] = text.str();
+          } else if (out.status == robotdyn::FAILED)
             messages[i] = "integration failed at t = " + std::to_string(out.t) + " s: " + out.message;
           else if (out.status == robotdyn::INTERRUPTED)
             messages[i] = "interrupted at t = " + std::to_string(out.t) + " s";
@@ -874,6 +892,7 @@ class Evaluator {
         }
         emitted_out[i] = count;
         nfev_out[i] = evals;
+        wall_out[i] = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         ++done;
       }
     };
@@ -918,6 +937,7 @@ class Evaluator {
     result["steps"] = steps;
     result["status"] = status;
     result["messages"] = messages;
+    result["walls"] = walls;
     result["interrupted"] = interrupted;
     return result;
   }

@@ -149,3 +149,32 @@ def test_ctrl_c_keeps_the_finished_runs():
     assert proc.returncode == 0, err
     done, total, *partial = out.split()
     assert 0 < int(done) < int(total) == 4000 and "interrupted" in " ".join(partial)
+
+
+def test_model_vectors_per_run_are_the_params_runs(quasimoro):
+    """Model vectors given directly (as a sweep's chunk sends them) give the runs that params give, bit for bit;
+    each run's integration wall time is reported."""
+    params = _params(4, seed=3)
+    by_params = simulate_many(quasimoro, 2.0, torque=PULSE, params=params, n_out=21, threads=1)
+    by_models = simulate_many(quasimoro, 2.0, torque=PULSE, models=by_params.models, n_out=21, threads=2)
+    assert np.array_equal(by_params.q, by_models.q) and np.array_equal(by_params.nu, by_models.nu)
+    assert np.array_equal(by_models.models, by_params.models)
+    assert by_models.walls.shape == (4,) and np.all(by_models.walls > 0)
+    with pytest.raises(RobotDynError, match=r"models has shape \(4, 3\); expected \(N, \d+\)"):
+        simulate_many(quasimoro, 2.0, torque=PULSE, models=np.zeros((4, 3)))
+    with pytest.raises(RobotDynError, match="not more than one"):
+        simulate_many(quasimoro, 2.0, params=params, models=by_params.models)
+
+
+def test_a_run_past_its_time_limit_is_flagged_and_named(quasimoro):
+    """A wall-clock limit per run: the long run stops (checked about every 50 ms) with a message naming the limit
+    and the time reached; the short one finishes."""
+    runs = simulate_many(quasimoro, 5000.0, torque=[PULSE, PULSE], q0=quasimoro.neutral(),
+                         nu0=[[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]], n_out=3, threads=1, time_limit=0.1)
+    assert not runs.ok.any()
+    assert all(m.startswith("the run exceeded its time limit of 0.1 s at t = ") and m.endswith("s of 5000 s")
+               for m in runs.messages)
+    assert np.all(runs.walls < 1.0)
+    assert simulate_many(quasimoro, 1.0, torque=PULSE, n_out=3, time_limit=5.0).ok.all()
+    with pytest.raises(RobotDynError, match="time_limit = -1 s"):
+        simulate_many(quasimoro, 1.0, time_limit=-1)

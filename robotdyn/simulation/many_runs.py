@@ -37,6 +37,7 @@ class ManyRuns:
         nfev: (N,) right-hand-side evaluations per run.
         models: (N, L) the model vector of each run (:mod:`robotdyn.simulation.model_variants`; ``None`` when the runs share
             the robot's): ``simulate(variant(robot, models[i]), ...)`` repeats run i alone, bit for bit.
+        walls: (N,) wall-clock time of each run's integration [s] (0 for runs not started).
         stats: Wall time [s], threads, integrator, runs per second, ``partial`` after an interruption.
     """
 
@@ -52,6 +53,7 @@ class ManyRuns:
     coordinates: list[str]
     velocity_names: list[str]
     models: np.ndarray | None = None
+    walls: np.ndarray | None = None
     stats: dict = field(default_factory=dict)
 
     def __len__(self) -> int:
@@ -77,7 +79,8 @@ def _per_run(x, N: int | None, width: int, what: str, names) -> tuple[np.ndarray
 def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: dict | None = None,
                   robots: list | None = None, bounds: dict | None = None, n_out: int = 101, rtol: float = 1e-10,
                   atol: float = 1e-12, method: str = "adams", stabilisation: float = 10.0,
-                  threads: int | None = None, progress: bool = False) -> ManyRuns:
+                  threads: int | None = None, progress: bool = False, *, models=None,
+                  time_limit: float | None = None) -> ManyRuns:
     """N simulations of one robot's variants in one call, spread over threads (compiled engine only).
 
     Every run is what :func:`robotdyn.simulation.engine.simulate` would compute alone on the compiled engine with the
@@ -90,7 +93,10 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
       inertias, lengths, radii, g): the model vector comes from a :class:`~robotdyn.simulation.model_variants.ParameterModel`
       fitted once over ``bounds`` (default: the values' range) and cached, so a sweep split in chunks should pass
       the whole sweep's ``bounds`` to share one fit;
-    - ``robots``: N built robots of the same structure as ``robot`` (any parameters, at the cost of a build each).
+    - ``robots``: N built robots of the same structure as ``robot`` (any parameters, at the cost of a build each);
+    - ``models``: N model vectors (N, L) of ``robot``'s layout, e.g. from one
+      :class:`~robotdyn.simulation.model_variants.ParameterModel` fitted for a whole sweep and sent in chunks (a
+      sweep's worker computes no fit and its runs do not depend on which chunk holds them).
 
     All inputs are plain data that pickle (a Dask worker may call this per chunk).
 
@@ -105,6 +111,9 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
         rtol, atol, method, stabilisation: As :func:`~robotdyn.simulation.engine.simulate` (compiled methods).
         threads: Worker threads (default: one per CPU).
         progress: Print the runs done to stderr (about once a second).
+        models: Per-run model vectors (instead of ``params`` or ``robots``).
+        time_limit: Wall-clock limit of each run [s] (None: none): a run past it is flagged failed with a message
+            saying so (the others go on).
 
     Returns:
         The :class:`ManyRuns` (failed runs are flagged with their message, never raised; Ctrl-C keeps the finished
@@ -132,8 +141,19 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
         if N is not None and len(torque) != N:
             raise RobotDynError(f"{len(torque)} torque profiles for {N} runs; expected one per run or one for all")
         N = len(torque)
-    if params and robots is not None:
-        raise RobotDynError("give per-run params or per-run robots, not both")
+    if sum(x is not None and (not isinstance(x, dict) or bool(x)) for x in (params, robots, models)) > 1:
+        raise RobotDynError("give per-run params, robots or models, not more than one of them")
+    if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
+        raise RobotDynError(f"time_limit = {time_limit} s; expected a positive wall-clock duration or None")
+    if models is not None:
+        models = np.asarray(models, float)
+        width = model_vector(robot).size
+        if models.ndim != 2 or models.shape[1] != width or (N is not None and models.shape[0] != N):
+            raise RobotDynError(f"models has shape {models.shape}; expected ({N if N is not None else 'N'}, {width}) "
+                                "(one model vector of the robot's layout per run)")
+        if not np.all(np.isfinite(models)):
+            raise RobotDynError("models must be finite (found NaN or inf)")
+        N = models.shape[0]
     if params:
         values = {}
         for k, v in params.items():
@@ -178,9 +198,11 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
         raise RobotDynError("simulate_many does not run robots with slipping wheels (their friction and lift-off "
                             "are on robotdyn.simulation.simulate); expected wheels that roll without slipping")
     robot.reduced(Q0[0], NU0[0])  # the projection's rows (the Python path chooses them)
-    models = np.zeros((0, 0))
+    given, models = models, np.zeros((0, 0))
     variants: dict[int, object] = {}
-    if params:
+    if given is not None:
+        models = given
+    elif params:
         names = list(values)
         box = {n: tuple(bounds[n]) if bounds and n in bounds else (float(values[n].min()), float(values[n].max()))
                for n in names}
@@ -214,13 +236,14 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
     sub = idx.tolist()
     out = fast.ev.simulate_many(Q0[idx], NU0[idx], models[idx] if models.size else models, [natives[i] for i in sub],
                                 [breaks[i] for i in sub], float(t_end), samples, rtol, atol, stabilisation, method,
-                                threads, report, lambda i, q, nu: rechoose(sub[i], q, nu))
+                                threads, report, lambda i, q, nu: rechoose(sub[i], q, nu),
+                                float(time_limit) if time_limit is not None else 0.0)
     wall = time.perf_counter() - start
     if len(idx) < N:  # the refused runs: no samples, their reason
         full = {"y": np.zeros((N,) + out["y"].shape[1:]), "energy": np.zeros((N, n_out)),
                 "residual": np.zeros((N, n_out)), "emitted": np.zeros(N, int), "nfev": np.zeros(N, int),
-                "status": np.full(N, 3), "messages": list(refused)}
-        for key in ("y", "energy", "residual", "emitted", "nfev", "status"):
+                "status": np.full(N, 3), "messages": list(refused), "walls": np.zeros(N)}
+        for key in ("y", "energy", "residual", "emitted", "nfev", "status", "walls"):
             full[key][idx] = out[key]
         for j, i in enumerate(sub):
             full["messages"][i] = out["messages"][j]
@@ -243,7 +266,7 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
     n = robot.nq
     return ManyRuns(samples, Y[:, :, :n], Y[:, :, n:], out["energy"], out["residual"], status == 0, emitted,
                     messages, out["nfev"], list(robot.coordinates), list(robot.velocity_names),
-                    models if models.size else None, stats)
+                    models if models.size else None, out["walls"], stats)
 
 
 def _refuse_callable(p):

@@ -1,7 +1,8 @@
 """make bench, side by side in one run (issue 17): Quasimoro's 'rectilinear' manoeuvre by robotdyn's scipy path,
 by the compiled simulation (where ``robotdyn.simulation.engine.simulate`` offers it) and by MuJoCo, with the cost per
 simulated second and the accuracy against robotdyn's exact trajectory; then the throughput of a 2,000-run sweep
-on 1 and 2 Dask workers, with the identity of their results. Ratios matter here, not absolute times: the machine
+on 1 and 2 Dask workers (its runs as model variants, robotdyn.sweep.batched), with the identity of their results,
+and the same sweep built run by run for scale. Ratios matter here, not absolute times: the machine
 has 2 cores and may be shared. This is a benchmark, not a test: it asserts nothing.
 
 ``ROBOTDYN_BENCH_SWEEP_RUNS`` sets the sweep's size (default 2000).
@@ -100,38 +101,55 @@ def manoeuvre(t_ends=(20.0, 90.0)) -> None:
           "by construction in robotdyn; psi drift: |psi - rho (theta2 - theta1)|, eq 11)")
 
 
-def sweep_throughput(n: int | None = None, t_end: float = 2.0) -> None:
-    """A Latin-hypercube sweep of n Quasimoro runs (M, d, J1, torque scale) on 1 and 2 Dask workers: runs per
-    second of the whole ``robotdyn.sweep.runner.run`` call (cluster start included) and whether the results agree."""
+def _sweep(spec, workers: int, batch: str):
+    """One whole ``robotdyn.sweep.runner.run`` call on a new local cluster, with an empty description cache (every
+    run of this sweep is a new variant, and a cache an earlier measurement filled would favour the later one)."""
     from robotdyn.sweep import runner as sweep
+
+    before = os.times()
+    with tempfile.TemporaryDirectory() as out, tempfile.TemporaryDirectory() as cache:
+        saved, os.environ["ROBOTDYN_CACHE"] = os.environ.get("ROBOTDYN_CACHE"), cache
+        try:
+            res = sweep.run(spec, out, workers=workers, progress=False, plot=False, batch=batch)
+        finally:
+            os.environ.pop("ROBOTDYN_CACHE") if saved is None else os.environ.__setitem__("ROBOTDYN_CACHE", saved)
+    after = os.times()  # the workers' CPU time: they are this process's (reaped) descendants
+    cpu = after.children_user + after.children_system - before.children_user - before.children_system
+    return res, cpu
+
+
+def sweep_throughput(n: int | None = None, t_end: float = 2.0) -> None:
+    """A Latin-hypercube sweep of n Quasimoro runs (M, d, J1, torque scale) on 1 and 2 Dask workers: the whole
+    ``robotdyn.sweep.runner.run`` call (planning, the one-time fit of the model variants, cluster start, runs,
+    Parquet) and its runs phase (first submission to last result), and whether the results agree bit for bit; then
+    the same sweep with every run built from its parameters (``batch="never"``, the way before model variants) on 2
+    workers, for scale."""
     from robotdyn.sweep.spec import SweepSpec, parse_axis
 
     n = n or int(os.environ.get("ROBOTDYN_BENCH_SWEEP_RUNS", 2000))
     spec = SweepSpec(robot="quasimoro", sample="lhs", n=n, seed=0, t_end=t_end, columns=["theta3"],
                      axes=[parse_axis(a) for a in ("M=4:6", "d=0.1:0.2", "J1=0.15:0.25", "torque_scale=0.5:2")])
     print(f"\nsweep throughput: {n} Quasimoro runs of {t_end:g} s (LHS over M, d, J1, torque scale), "
-          f"robotdyn.sweep.runner.run on a local Dask cluster (cluster start included)")
-    tables, rates = {}, {}
+          f"robotdyn.sweep.runner.run on a new local Dask cluster each time")
+    tables, whole, runs = {}, {}, {}
     for workers in (1, 2):
-        before = os.times()
-        with tempfile.TemporaryDirectory() as out, tempfile.TemporaryDirectory() as cache:
-            # each measurement starts with an empty description cache (robotdyn.description.cache): every run of
-            # this sweep is a new variant, and a cache the first measurement filled would favour the second
-            saved, os.environ["ROBOTDYN_CACHE"] = os.environ.get("ROBOTDYN_CACHE"), cache
-            try:
-                res = sweep.run(spec, out, workers=workers, progress=False, plot=False)
-            finally:
-                os.environ.pop("ROBOTDYN_CACHE") if saved is None else os.environ.__setitem__("ROBOTDYN_CACHE", saved)
-        after = os.times()  # the workers' CPU time: they are this process's (reaped) descendants
-        cpu = after.children_user + after.children_system - before.children_user - before.children_system
-        rates[workers] = res.computed / res.wall
+        res, cpu = _sweep(spec, workers, "auto")
+        ph = res.phases
+        whole[workers], runs[workers] = res.computed / res.wall, res.computed / ph["runs"]
         tables[workers] = {k: v for k, v in res.table.to_pydict().items() if k not in ("wall", "run_wall")}
-        print(f"  {workers} worker(s): {res.wall:7.1f} s wall, {rates[workers]:7.1f} runs/s, workers' CPU {cpu:.1f} s "
-              f"({cpu / res.wall:.2f} cores busy on average; {res.statuses})")
+        print(f"  {workers} worker(s): {res.wall:6.1f} s whole call ({whole[workers]:6.1f} runs/s): plan "
+              f"{ph['plan']:.2f} s, fit {ph['fit']:.2f} s, cluster start {ph.get('connect', 0):.2f} s, runs "
+              f"{ph['runs']:.2f} s ({runs[workers]:6.1f} runs/s); {res.batched} batched; workers' CPU {cpu:.1f} s; "
+              f"{res.statuses}")
     same = tables[1] == tables[2]
-    print(f"  2 workers / 1 worker: {rates[2] / rates[1]:.2f}x (target >= 1.8x); results bit-for-bit identical: "
-          f"{'yes' if same else 'NO'}  (machine load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores: "
-          "fewer cores busy than workers means other processes took them)")
+    print(f"  2 workers / 1 worker: runs phase {runs[2] / runs[1]:.2f}x (target >= 1.8x), whole call "
+          f"{whole[2] / whole[1]:.2f}x (the plan, the fit and the cluster start do not shrink with workers); "
+          f"results bit-for-bit identical: {'yes' if same else 'NO'}  (machine load average "
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
+    res, cpu = _sweep(spec, 2, "never")
+    print(f"  every run built from its parameters (batch = never), 2 workers: {res.wall:6.1f} s whole call "
+          f"({res.computed / res.wall:6.1f} runs/s), runs {res.phases['runs']:.2f} s; batched sweep "
+          f"{res.wall / (res.computed / whole[2]):.1f}x faster on the whole call")
 
 
 def side_by_side() -> None:

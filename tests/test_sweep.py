@@ -121,11 +121,11 @@ def test_on_a_running_cluster_by_its_address(reference, tmp_path):
 def test_interrupted_sweep_resumes_without_recomputing(reference, tmp_path, monkeypatch):
     calls = []
 
-    def interrupting(ctx, runs):
+    def interrupting(ctx, runs, vectors=None):
         calls.append(len(runs))
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return sweep_chunk.run_chunk(ctx, runs)
+        return sweep_chunk.run_chunk(ctx, runs, vectors)
 
     monkeypatch.setattr(sweep, "run_chunk", interrupting)
     first = sweep.run(small_spec(), tmp_path, workers=0, progress=False, chunk_size=3, plot=False)

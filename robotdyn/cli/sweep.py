@@ -53,6 +53,9 @@ def register(sub, parents) -> None:
     p.add_argument("--time-limit", type=float, metavar="SECONDS",
                    help="wall-clock limit of one run (default 600; 0: none): beyond it the run is an error row")
     p.add_argument("--retry-errors", action="store_true", help="compute again the runs that ended in an error")
+    p.add_argument("--batch", choices=("auto", "always", "never"), default="auto",
+                   help="simulate runs that vary only masses, inertias, lengths as variants of one compiled model "
+                        "(auto: where the sweep is large enough to pay for the fit; never: build every run)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(func=cmd_sweep)
 
@@ -94,7 +97,7 @@ def cmd_sweep(args) -> int:
         signal.signal(signal.SIGTERM, _interrupt)
     workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
     res = run(spec, args.out, workers=workers, scheduler=args.scheduler, chunk_size=args.chunk_size,
-              progress=not args.quiet, retry_errors=args.retry_errors, plot=not args.no_plot)
+              progress=not args.quiet, retry_errors=args.retry_errors, plot=not args.no_plot, batch=args.batch)
     rows = res.table.to_pydict() if res.table.num_rows else {"run_id": [], "status": [], "error": []}
     varied = [a.name for a in spec.axes] + ["scenario"] + (["terrain"] if spec.terrains else [])
     errors = [{"run_id": rows["run_id"][i], "inputs": {k: rows[k][i] for k in varied if k in rows},
@@ -103,11 +106,15 @@ def cmd_sweep(args) -> int:
                                                            "in this process")
     out = {"out": str(res.out), "results": str(res.out / "results.parquet"), "runs": res.total,
            "computed": res.computed, "resumed": res.resumed, "statuses": res.statuses, "wall_time_s": res.wall,
-           "plot": str(res.plot) if res.plot else None, "errors": errors, "interrupted": res.interrupted}
+           "plot": str(res.plot) if res.plot else None, "errors": errors, "interrupted": res.interrupted,
+           "batched": res.batched, "notes": res.notes}
     text = [f"sweep of {spec.robot or spec.constraints}: {res.total} run(s) "
             f"({res.computed} computed, {res.resumed} resumed) in {res.wall:.1f} s {where}: "
             + (", ".join(f"{n} {s}" for s, n in res.statuses.items() if n) or "nothing finished"),
             f"wrote {out['results']} ({res.table.num_rows} rows)" + (f" and {out['plot']}" if res.plot else "")]
+    if res.computed:
+        text.append(f"{res.batched} of {res.computed} computed run(s) simulated as variants of one compiled model "
+                    "(robotdyn.sweep.batched)" + "".join(f"\n  {n}" for n in res.notes))
     text += [f"  error in run {e['run_id']} ({', '.join(f'{k}={v}' for k, v in e['inputs'].items())}): {e['error']}"
              for e in errors[:5]]
     if len(errors) > 5:

@@ -72,6 +72,26 @@ class TorqueProfile:
                 out = out + _interpolate(par, coef, t)
         return out
 
+    def at(self, times) -> np.ndarray:
+        """The motor torques at many times (T,) [s] at once: (T, motors), row i the value of ``self(times[i])``
+        (the same formulas, vectorised)."""
+        t = np.asarray(times, float).reshape(-1)
+        terms = self._all()
+        out = np.zeros((t.size, terms[0][1].shape[-1]))
+        for kind, coef, par in terms:
+            if kind == CONSTANT:
+                out = out + coef
+            elif kind == SINE:
+                inside = (par[2] <= t) & (t <= par[3])
+                out = out + np.where(inside[:, None], coef * np.sin(par[0] * t + par[1])[:, None], 0.0)
+            else:
+                i = np.clip(np.searchsorted(par, t, side="right") - 1, 0, len(par) - 2)
+                s = (t - par[i]) / (par[i + 1] - par[i])
+                inner = coef[i] + s[:, None] * (coef[i + 1] - coef[i])
+                out = out + np.where((t <= par[0])[:, None], coef[0], np.where((t >= par[-1])[:, None], coef[-1],
+                                                                                inner))
+        return out
+
     def breakpoints(self) -> np.ndarray:
         """Sorted times [s] where the profile or its derivative jumps (window edges, table knots)."""
         points = []

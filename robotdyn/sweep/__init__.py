@@ -1,6 +1,7 @@
 """Stage 10, sweep: parameter sweeps on Dask into Parquet.
 
-Owns ``spec`` (the sweep TOML), ``plan`` (runs and their identity), ``chunk`` (what a worker runs), ``store``
+Owns ``spec`` (the sweep TOML), ``plan`` (runs and their identity), ``chunk`` (what a worker runs), ``batched``
+(runs as variants of one compiled model), ``store``
 (Parquet), ``plot`` and ``runner`` (:func:`run`, :func:`load`). Imports every earlier stage (robots included),
 never robotdyn.cli. ``robotdyn.sweep.run`` and ``robotdyn.sweep.load`` still work (re-exported lazily).
 

@@ -1,13 +1,12 @@
 """One chunk of a sweep's runs, computed where it is sent (a Dask worker, or this process): :func:`run_chunk`.
 
-Each run builds its robot afresh (parameters, terrain), takes its scenario's initial state and torque profile
-(times the run's torque scale) and integrates them with :func:`robotdyn.simulation.engine.simulate`; it returns one
-summary row (and optionally the trajectory). A run that raises, or whose numbers are not finite, gives an error row
-naming why; the other runs of the chunk go on. Nothing depends on which process computes a run or what it computed
-before, so a run's numbers are the same bits on one worker, on two, or in this process.
-
-:func:`run_chunk` is the one place to change when the runs of a chunk go to a batch simulation API instead (one
-call for the chunk's (robot, q0, nu0, torque) tuples, built by :func:`prepare`).
+Runs that come with a model vector are simulated together as variants of one compiled model
+(:mod:`robotdyn.sweep.batched`). Every other run builds its robot afresh (parameters, terrain), takes its scenario's
+initial state and torque law (times the run's torque scale) and integrates them with
+:func:`robotdyn.simulation.engine.simulate`. Each run gives one summary row (and optionally the trajectory). A
+run that raises, or whose numbers are not finite, gives an error row naming why; the other runs of the chunk go on.
+Nothing depends on which process computes a run or what it computed before, so a run's numbers are the same bits
+on one worker, on two, or in this process.
 """
 
 from __future__ import annotations
@@ -152,8 +151,11 @@ def energy_drift(traj, torque) -> float | None:
     if torque is None:
         start = 0
     else:
-        active = [bool(np.any(np.asarray(torque(t, q, nu), float) != 0.0))
-                  for t, q, nu in zip(traj.t, traj.q, traj.nu)]
+        if isinstance(torque, TorqueProfile):  # a function of time alone: all samples at once
+            active = np.any(torque.at(traj.t) != 0.0, axis=1).tolist()
+        else:
+            active = [bool(np.any(np.asarray(torque(t, q, nu), float) != 0.0))
+                      for t, q, nu in zip(traj.t, traj.q, traj.nu)]
         if active[-1]:
             return None
         start = len(active) - int(np.argmax(active[::-1])) if any(active) else 0
@@ -183,6 +185,22 @@ def summary(mod, robot, traj, torque, columns) -> dict:
     return row
 
 
+def trajectory_columns(traj) -> dict:
+    """A run's trajectory as the columns a sweep stores (t, q, nu, energy, residual)."""
+    return {"t": traj.t, **{c: traj.q[:, i] for i, c in enumerate(traj.coordinates)},
+            **{c: traj.nu[:, i] for i, c in enumerate(traj.velocity_names)},
+            "energy": traj.energy, "residual": traj.residual}
+
+
+def error_message(exc: Exception) -> str:
+    """The error row's message of a failed run: the first line (with the exception's type unless it is one of
+    robotdyn's), at most 1000 characters."""
+    message = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+    if not isinstance(exc, RobotDynError):
+        message = f"{type(exc).__name__}: {message}"
+    return message[:1000]
+
+
 def _one(ctx: RunContext, run: RunInput) -> tuple[dict, dict | None]:
     start = time.perf_counter()
     row = {"run_id": run.run_id, "status": "ok", "error": None}
@@ -198,26 +216,43 @@ def _one(ctx: RunContext, run: RunInput) -> tuple[dict, dict | None]:
         if "event" in traj.stats:  # e.g. a slipping wheel lifting off: the run ends there by the model's rules
             row["status"], row["error"] = "stopped", str(traj.stats["event"])
         if ctx.trajectories:
-            traj_out = {"t": traj.t, **{c: traj.q[:, i] for i, c in enumerate(traj.coordinates)},
-                        **{c: traj.nu[:, i] for i, c in enumerate(traj.velocity_names)},
-                        "energy": traj.energy, "residual": traj.residual}
+            traj_out = trajectory_columns(traj)
     except Exception as exc:  # one failed run is an error row, never the end of the sweep
-        message = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-        if not isinstance(exc, RobotDynError):
-            message = f"{type(exc).__name__}: {message}"
-        row = {"run_id": run.run_id, "status": "error", "error": message[:1000]}
+        row = {"run_id": run.run_id, "status": "error", "error": error_message(exc)}
         traj_out = None
     row["run_wall"] = time.perf_counter() - start
     return row, traj_out
 
 
-def run_chunk(ctx: RunContext, runs: list[RunInput]) -> list[tuple[dict, dict | None]]:
-    """Compute a chunk of runs, one after the other: for each, its summary row (``status`` ok, stopped or
-    error, with the message) and its trajectory columns (``None`` unless ``ctx.trajectories``)."""
+def run_chunk(ctx: RunContext, runs: list[RunInput], vectors: dict | None = None) -> list[tuple[dict, dict | None]]:
+    """Compute a chunk of runs: for each, its summary row (``status`` ok, stopped or error, with the message) and
+    its trajectory columns (``None`` unless ``ctx.trajectories``). Runs with a model vector in ``vectors`` (run id
+    -> vector, :func:`robotdyn.sweep.batched.model_vectors`) are simulated together as variants of one compiled
+    model (:func:`robotdyn.sweep.batched.run_batched`), the others one after the other, each built afresh."""
     from ..fast.dispatch import use_compiled
 
+    vectors = vectors or {}
+    batched = [i for i, r in enumerate(runs) if r.run_id in vectors]
+    out: list = [None] * len(runs)
     with use_compiled(ctx.compiled), np.errstate(all="ignore"):
-        return [_one(ctx, run) for run in runs]
+        if batched:
+            from .batched import run_batched
+
+            try:
+                results = run_batched(ctx, [runs[i] for i in batched], [vectors[runs[i].run_id] for i in batched])
+            except (KeyboardInterrupt, MemoryError):
+                raise
+            except Exception as exc:  # the batch itself failed (not one run): each of its runs says why
+                message = error_message(exc)
+                results = [({"run_id": runs[i].run_id, "status": "error", "error": message, "run_wall": 0.0}, None)
+                           for i in batched]
+            for i, result in zip(batched, results):
+                out[i] = result
+        for i, run in enumerate(runs):
+            if out[i] is None:
+                out[i] = _one(ctx, run)
+    return out
 
 
-__all__ = ["RunContext", "run_chunk", "simulate_run", "prepare", "load_source", "energy_drift", "overrides_run"]
+__all__ = ["RunContext", "run_chunk", "simulate_run", "prepare", "load_source", "energy_drift", "overrides_run",
+           "trajectory_columns", "error_message"]

@@ -30,6 +30,7 @@ from pathlib import Path
 
 from . import store as sweep_store
 from ..errors import RobotDynError
+from .batched import MODES, Batching, model_vectors
 from .chunk import RunContext, load_source, run_chunk
 from .plan import Plan, plan
 from .spec import RunInput, SweepSpec, from_toml
@@ -53,10 +54,13 @@ class SweepResult:
     plot: Path | None = None
     interrupted: str | None = None
     statuses: dict[str, int] = field(default_factory=dict)
+    batched: int = 0
+    notes: list[str] = field(default_factory=list)
+    phases: dict[str, float] = field(default_factory=dict)
 
     def __repr__(self) -> str:
         return (f"SweepResult({str(self.out)!r}, runs={self.total}, computed={self.computed}, "
-                f"resumed={self.resumed}, {self.statuses}, wall={self.wall:.3g} s"
+                f"resumed={self.resumed}, batched={self.batched}, {self.statuses}, wall={self.wall:.3g} s"
                 + (", interrupted" if self.interrupted else "") + ")")
 
     def frame(self):
@@ -136,21 +140,33 @@ def _connect(stack: ExitStack, workers: int, scheduler: str | None):
     return stack.enter_context(Client(cluster))
 
 
-def _execute(chunks, ctx: RunContext, workers: int, scheduler: str | None, client, on_chunk) -> None:
-    """Run the chunks (in this process, or on Dask) and hand each finished one to ``on_chunk(runs, results)``."""
+def _execute(chunks, ctx: RunContext, vectors: dict, workers: int, scheduler: str | None, client,
+             on_chunk, phases: dict) -> None:
+    """Run the chunks (in this process, or on Dask) and hand each finished one to ``on_chunk(runs, results)``;
+    each chunk carries the model vectors of its batched runs (``vectors``: run id -> vector). ``phases`` gets the
+    wall times [s] of starting or reaching the cluster (``connect``) and of the runs (``runs``: first
+    submission to last result)."""
+    def mine(chunk):
+        return {r.run_id: vectors[r.run_id] for r in chunk if r.run_id in vectors}
+
     if client is None and scheduler is None and workers == 0:
+        begin = time.perf_counter()
         for chunk in chunks:
-            on_chunk(chunk, run_chunk(ctx, chunk))
+            on_chunk(chunk, run_chunk(ctx, chunk, mine(chunk)))
+        phases["runs"] = time.perf_counter() - begin
         return
     from dask.distributed import as_completed
     from distributed.scheduler import KilledWorker
 
     with ExitStack() as stack:
         if client is None:
+            begin = time.perf_counter()
             client = _connect(stack, workers, scheduler)
+            phases["connect"] = time.perf_counter() - begin
+        begin = time.perf_counter()
         futures = {}
         for chunk in chunks:
-            futures[client.submit(run_chunk, ctx, chunk, pure=False)] = chunk
+            futures[client.submit(run_chunk, ctx, chunk, mine(chunk), pure=False)] = chunk
         pending = as_completed(list(futures))
         try:
             for fut in pending:
@@ -160,7 +176,7 @@ def _execute(chunks, ctx: RunContext, workers: int, scheduler: str | None, clien
                 except KilledWorker as exc:  # a run took its worker process down: isolate it
                     if len(chunk) > 1:
                         for run in chunk:
-                            single = client.submit(run_chunk, ctx, [run], pure=False)
+                            single = client.submit(run_chunk, ctx, [run], mine([run]), pure=False)
                             futures[single] = [run]
                             pending.add(single)
                         continue
@@ -168,12 +184,13 @@ def _execute(chunks, ctx: RunContext, workers: int, scheduler: str | None, clien
                                  "error": f"the worker process died during this run ({exc})"}, None)]
                 on_chunk(chunk, results)
         finally:
+            phases["runs"] = time.perf_counter() - begin
             client.cancel(list(futures))
 
 
 def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: str | None = None,
         chunk_size: int | None = None, progress: bool = True, retry_errors: bool = False, plot: bool = True,
-        client=None) -> SweepResult:
+        client=None, batch: str = "auto") -> SweepResult:
     """Run a sweep and write its results to the directory ``out`` (see the module docstring).
 
     Args:
@@ -181,20 +198,27 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
         out: The sweep directory (created; a rerun there resumes: finished runs are not computed again).
         workers: Worker processes of the local Dask cluster (0: in this process, without Dask).
         scheduler: Address of a running Dask scheduler (e.g. ``tcp://host:8786``) instead of a local cluster.
-        chunk_size: Runs per Dask task (default: about 32 tasks per worker, at most 32 runs each,
-            so that the last tasks leave no worker idle for long).
+        chunk_size: Runs per Dask task (default: about 32 tasks per worker, at most 32 runs each, so that the
+            last tasks leave no worker idle for long; where most runs are batched, about 8 tasks per worker of at
+            most 256 runs).
         progress: Progress lines on stderr.
         retry_errors: Compute the runs again whose rows on disk are errors (others are kept).
         plot: Write ``summary.png`` (the plot column against each varied parameter).
         client: An existing ``dask.distributed.Client`` to use.
+        batch: ``auto``, ``always`` or ``never``: whether runs that vary only numbers of the model are simulated
+            together as variants of one compiled model (:mod:`robotdyn.sweep.batched`; ``never``: each run built
+            from its parameters).
 
     Returns:
         A :class:`SweepResult`; after an interruption (Ctrl-C) it holds what was finished, with ``interrupted``
         saying so: running the same sweep again resumes.
     """
+    if batch not in MODES:
+        raise RobotDynError(f"batch = {batch!r}; expected one of {', '.join(MODES)}")
     spec = from_toml(spec) if isinstance(spec, (str, Path)) else spec
     start = time.perf_counter()
     p = plan(spec)
+    phases = {"plan": time.perf_counter() - start}
     out = sweep_store.prepare(out)
     done = sweep_store.finished(out)
     todo = [r for r in p.runs if r.run_id not in done or (retry_errors and done[r.run_id] == "error")]
@@ -203,7 +227,13 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     n_workers = workers
     if client is not None:
         n_workers = len(client.scheduler_info()["workers"]) or 1
-    size = chunk_size or max(1, min(32, math.ceil(len(todo) / (32 * max(n_workers, 1)))))
+    begin = time.perf_counter()
+    batching = model_vectors(p.context, p.runs, batch) if todo else Batching({}, [])  # all runs: resumes fit alike
+    phases["fit"] = time.perf_counter() - begin
+    # batched runs cost a few ms each: bigger chunks, fewer tasks and Parquet files (still 8 tasks per worker)
+    mostly_batched = 2 * sum(r.run_id in batching.vectors for r in todo) > len(todo)
+    tasks, cap = (8, 256) if mostly_batched else (32, 32)
+    size = chunk_size or max(1, min(cap, math.ceil(len(todo) / (tasks * max(n_workers, 1)))))
     if size < 1:
         raise RobotDynError(f"chunk_size = {chunk_size}; expected at least 1 run per chunk")
     report = _Progress(len(p.runs), resumed, progress)
@@ -217,7 +247,7 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     interrupted = None
     try:
         if todo:
-            _execute(_chunks(todo, size), p.context, workers, scheduler, client, on_chunk)
+            _execute(_chunks(todo, size), p.context, batching.vectors, workers, scheduler, client, on_chunk, phases)
     except KeyboardInterrupt:
         interrupted = (f"interrupted after {resumed + report.done} of {len(p.runs)} runs; run the same sweep again "
                        "to resume")
@@ -232,7 +262,8 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
 
         image = plot_summary(table, p, out / "summary.png")
     return SweepResult(out, table, len(p.runs), report.done, resumed, time.perf_counter() - start, image,
-                       interrupted, statuses)
+                       interrupted, statuses, sum(r.run_id in batching.vectors for r in todo), batching.reasons,
+                       phases)
 
 
 __all__ = ["run", "plan", "load", "load_trajectory", "SweepResult", "SweepSpec", "Plan", "load_source"]

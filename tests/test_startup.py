@@ -38,3 +38,82 @@ def test_cache_never_admits_an_invalid_description(tmp_path, monkeypatch):
     for _ in range(2):
         with pytest.raises(DescriptionError):
             validate_urdf(bad)
+
+
+DUMP_PROBE = ("import sys, io, contextlib, robotdyn.cli.commands as c\n"
+              "with contextlib.redirect_stdout(io.StringIO()):\n"
+              "    rc = c.main('dump quasimoro --q 0 0 0 0 0 0.3 --v 1 0.5 0.2'.split())\n"
+              "print(rc, sorted(m for m in sys.modules if m.split('.')[0] in ('scipy', 'yourdfpy', 'trimesh', "
+              "'matplotlib') or m.split('.')[:2] == ['numpy', 'ma']))")
+
+
+def test_dump_imports_no_scipy_package_nor_numpy_ma(tmp_path):
+    """`robotdyn dump` takes its pivoted QR and solves from scipy's compiled LAPACK module alone (not the ~0.3 s
+    scipy.linalg package), and its index complements without np.unique (whose first call imports numpy.ma)."""
+    env = {**os.environ, "ROBOTDYN_CACHE": str(tmp_path)}
+    subprocess.run([sys.executable, "-c", DUMP_PROBE], capture_output=True, text=True, env=env, check=True)
+    again = subprocess.run([sys.executable, "-c", DUMP_PROBE], capture_output=True, text=True, env=env, check=True)
+    assert again.stdout.strip() == "0 []"
+
+
+LAPACK_PROBE = """
+import sys
+import numpy as np
+from robotdyn.reduction import projection as P
+
+lapack = P._lapack()
+assert not [m for m in sys.modules if m.split('.')[0] == 'scipy'], 'scipy imported'
+rng = np.random.default_rng(7)
+mats = [rng.standard_normal(shape) for shape in ((3, 6), (6, 3), (5, 9), (9, 9), (1, 4))]
+low = rng.standard_normal((7, 3)) @ rng.standard_normal((3, 8))  # rank 3
+mats += [low, low.T, np.vstack([low[:2], low[:2], 2 * low[:1]]), np.round(rng.standard_normal((6, 6)))]
+mats += [np.array([[1.0, 0, 0, 1, 0, 0], [0, 1, 0, 0, 1, 0], [1, 0, 0, 1, 0, 0]])]
+ours = [P._pivoted_qr(a) for a in mats]
+B = rng.standard_normal((4, 2))
+A = rng.standard_normal((4, 4))
+x = P.solve(A, B)
+
+import scipy.linalg
+import scipy.linalg.lapack
+
+assert lapack.dgeqp3 is scipy.linalg.lapack.dgeqp3 and lapack.dgesv is scipy.linalg.lapack.dgesv
+for a, (diag, piv) in zip(mats, ours):
+    _, R, ref = scipy.linalg.qr(a, mode='economic', pivoting=True)
+    assert np.array_equal(np.diag(R), diag) and np.array_equal(ref, piv), a
+assert np.array_equal(x, scipy.linalg.solve(A, B)) or np.array_equal(x, np.linalg.solve(A, B))
+print('ok')
+"""
+
+
+def test_lapack_loaded_alone_is_scipys_own():
+    """The LAPACK module loaded without the scipy.linalg package holds scipy.linalg.lapack's very functions: the
+    same pivots and numbers as scipy.linalg.qr(pivoting=True), bit for bit."""
+    out = subprocess.run([sys.executable, "-c", LAPACK_PROBE], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "ok"
+
+
+def test_lapack_falls_back_to_scipy_linalg(monkeypatch):
+    """Where scipy's compiled LAPACK module cannot be loaded alone, scipy.linalg.lapack is imported."""
+    import importlib.util
+
+    import scipy.linalg.lapack
+
+    from robotdyn.reduction import projection
+
+    monkeypatch.delitem(sys.modules, "scipy.linalg._flapack", raising=False)
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, package=None: None)
+    assert projection._flapack() is scipy.linalg.lapack
+
+
+def test_complement_without_unique_matches_setdiff1d():
+    import numpy as np
+
+    from robotdyn.reduction.projection import _others
+
+    rng = np.random.default_rng(0)
+    for _ in range(2000):
+        n = int(rng.integers(0, 10))
+        idx = rng.integers(-3, 13, size=int(rng.integers(0, 8)))
+        ref = np.setdiff1d(np.arange(n), idx)
+        got = _others(n, idx)
+        assert got.dtype == ref.dtype and np.array_equal(got, ref)

@@ -63,7 +63,9 @@ def violations(red, nudot=None, tol: float = TOL) -> list[RowViolation]:
     rows = red.jacobian_rows
     m = rows.A.shape[0]
     kept = np.asarray(getattr(red.projection, "rows", np.arange(m)), dtype=int)
-    dropped = np.setdiff1d(np.arange(m), kept)
+    keep = np.ones(m, dtype=bool)  # np.setdiff1d(np.arange(m), kept) without importing numpy.ma (np.unique)
+    keep[kept[(kept >= 0) & (kept < m)]] = False
+    dropped = np.flatnonzero(keep)
     if dropped.size == 0:
         return []
     A = rows.A[dropped]

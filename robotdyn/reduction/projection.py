@@ -22,13 +22,51 @@ _LAPACK = None
 
 
 def _lapack():
-    """scipy.linalg.lapack, imported on first use (keeps ``robotdyn info`` free of scipy's import cost)."""
+    """scipy's LAPACK wrappers (``dgeqp3``, ``dgesv``), loaded on first use: the very functions of
+    ``scipy.linalg.lapack``, so the same numbers and the same pivots.
+
+    ``import scipy.linalg.lapack`` costs about 0.3 s (the whole of ``scipy.linalg`` and scipy's array-API layer, a
+    large part of ``robotdyn dump``'s start-up); the compiled module behind it, ``scipy.linalg._flapack`` (an f2py
+    extension needing only numpy), loads from its file in ~5 ms. It is not left in ``sys.modules`` (its package is
+    not imported): a later ``import scipy.linalg`` gets its own module object holding the same functions. Where it
+    cannot be loaded alone (another scipy layout, a platform whose DLLs scipy's ``__init__`` locates first),
+    ``scipy.linalg.lapack`` is imported as before.
+    """
     global _LAPACK
     if _LAPACK is None:
+        _LAPACK = _flapack()
+    return _LAPACK
+
+
+def _flapack():
+    """``scipy.linalg._flapack`` without importing the ``scipy`` and ``scipy.linalg`` packages (see
+    :func:`_lapack`); ``scipy.linalg.lapack`` if that fails."""
+    import sys
+
+    mod = sys.modules.get("scipy.linalg._flapack")
+    if mod is None:
+        try:
+            import os
+            from importlib.machinery import EXTENSION_SUFFIXES
+            from importlib.util import find_spec, module_from_spec, spec_from_file_location
+
+            spec = find_spec("scipy")  # locates the package without importing it
+            folder = os.path.join(spec.submodule_search_locations[0], "linalg")
+            path = next(p for p in (os.path.join(folder, "_flapack" + s) for s in EXTENSION_SUFFIXES)
+                        if os.path.isfile(p))
+            spec = spec_from_file_location("scipy.linalg._flapack", path)
+            mod = module_from_spec(spec)
+            spec.loader.exec_module(mod)
+            if sys.modules.get(spec.name) is mod:  # Python registers it (single-phase init) without its package:
+                del sys.modules[spec.name]  # a later import of scipy.linalg loads it anew (the same functions)
+        except (ImportError, OSError, AttributeError, TypeError, IndexError, StopIteration):
+            mod = None
+    if mod is None or not all(hasattr(mod, f) for f in ("dgeqp3", "dgesv")):
         import scipy.linalg.lapack
 
-        _LAPACK = scipy.linalg.lapack
-    return _LAPACK
+        mod = scipy.linalg.lapack
+    return mod
+
 
 RANK_TOL = 1e-9
 """Relative tolerance on QR diagonal entries below which rows are counted as redundant."""
@@ -145,6 +183,14 @@ class Projection:
         return w
 
 
+def _others(n: int, indices: np.ndarray) -> np.ndarray:
+    """``np.setdiff1d(np.arange(n), indices)`` (the indices below n that ``indices`` does not name, ascending),
+    without ``np.unique``, whose first call imports ``numpy.ma`` (~50 ms of a command's start-up)."""
+    keep = np.ones(n, dtype=bool)
+    keep[indices[(indices >= 0) & (indices < n)]] = False
+    return np.flatnonzero(keep)
+
+
 def _layout(n: int, independent: np.ndarray, dependent: np.ndarray, rows: np.ndarray) -> tuple:
     """Index helpers of a choice of independent velocities and rows (reused by projections built from a hint):
     S with its identity block set, and the index tuples of the dependent and independent blocks of A."""
@@ -208,7 +254,7 @@ def project(
     if independent is None:
         independent = auto_independent(A)
     independent = np.asarray(independent, dtype=int)
-    dependent = np.setdiff1d(np.arange(n), independent)
+    dependent = _others(n, independent)
     if dependent.size != rows.size:
         raise SingularConstraintError(
             f"{independent.size} independent velocities chosen ({', '.join(names[i] for i in independent)}) but the "

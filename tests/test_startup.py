@@ -117,3 +117,36 @@ def test_complement_without_unique_matches_setdiff1d():
         ref = np.setdiff1d(np.arange(n), idx)
         got = _others(n, idx)
         assert got.dtype == ref.dtype and np.array_equal(got, ref)
+
+
+SAMPLES = {
+    "list": ["list", "--json"],
+    "info": ["info", "quasimoro", "--param", "M=6"],
+    "dump": ["dump", "quasimoro", "--q", "0", "0", "0", "0", "0", "0.3", "--v", "1", "0.5", "0.2", "--tau", "1", "2"],
+    "simulate": ["simulate", "quasimoro", "--scenario", "rectilinear", "--t-end", "1e-2", "--quiet"],
+    "compare": ["compare", "quasimoro"],
+    "view": ["view", "quasimoro", "--html", "x.html"],
+    "sweep": ["sweep", "quasimoro", "--vary", "M=4,6", "--out", "d"],
+}
+
+
+def test_a_command_parsed_alone_parses_as_with_all_commands():
+    """`robotdyn CMD ...` builds CMD's parser alone (the others cost start-up time): the same arguments, help and
+    errors as with the whole parser."""
+    from robotdyn.cli.commands import BUILT_IN, build_parser
+    from robotdyn.errors import RobotDynError
+
+    full = build_parser()
+    assert set(full.commands) == set(BUILT_IN) == set(SAMPLES)
+    for name, argv in SAMPLES.items():
+        alone = build_parser(name)
+        assert list(alone.commands) == [name]
+        assert alone.commands[name].format_help() == full.commands[name].format_help()
+        assert vars(alone.parse_args(argv)) == vars(full.parse_args(argv))
+        for bad in (argv + ["--no-such-option"], [name, "--json", "--json=1"]):
+            errors = []
+            for parser in (alone, full):
+                with pytest.raises(RobotDynError) as exc:
+                    parser.parse_args(bad)
+                errors.append(str(exc.value))
+            assert errors[0] == errors[1]

@@ -469,7 +469,20 @@ class _Parser(argparse.ArgumentParser):
                             "--help)")
 
 
-def build_parser() -> argparse.ArgumentParser:
+BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep")
+"""The built-in commands (robot modules add theirs, see :func:`_add_robot_commands`)."""
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The ``robotdyn`` parser; with ``only`` (one of :data:`BUILT_IN`), a parser holding that command alone (what
+    :func:`main` needs to parse it: the others' parsers cost start-up time and change nothing of its parsing, help
+    or errors)."""
+    if only is not None and only not in BUILT_IN:
+        raise ValueError(f"only = {only!r}; expected one of {', '.join(BUILT_IN)}")
+
+    def wanted(name: str) -> bool:
+        return only is None or only == name
+
     parser = _Parser(prog="robotdyn", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     common = _Parser(add_help=False)
@@ -492,11 +505,32 @@ def build_parser() -> argparse.ArgumentParser:
                             help="independent velocities that are FRAME's twist in its own axes (default components "
                                  "vx vy wz: a base's body twist) instead of joint velocities")
 
-    p = sub.add_parser("list", parents=[common], help="list the robots")
-    p.set_defaults(func=cmd_list)
-    p = sub.add_parser("info", parents=[common, robot_args], help="coordinates, parameters, actuators")
-    p.set_defaults(func=cmd_info)
-    p = sub.add_parser("dump", parents=[common, robot_args],
+    if wanted("list"):
+        p = sub.add_parser("list", parents=[common], help="list the robots")
+        p.set_defaults(func=cmd_list)
+    if wanted("info"):
+        p = sub.add_parser("info", parents=[common, robot_args], help="coordinates, parameters, actuators")
+        p.set_defaults(func=cmd_info)
+    if wanted("dump"):
+        _add_dump(sub, [common, robot_args])
+    if wanted("simulate"):
+        _add_simulate(sub, [common, robot_args])
+    if wanted("compare"):
+        p = sub.add_parser("compare", parents=[common, robot_args], help="the paper comparison table")
+        p.set_defaults(func=cmd_compare)
+    if wanted("view"):
+        _add_view(sub, [common, robot_args])
+    if wanted("sweep"):
+        from .sweep import register as register_sweep  # the command imports Dask only when it runs
+
+        register_sweep(sub, [common, robot_args])
+    parser.commands = sub.choices  # name -> subparser (the built-in ones until robot_commands() adds theirs)
+    parser.robot_commands = lambda: _add_robot_commands(sub, [common, robot_args])
+    return parser
+
+
+def _add_dump(sub, parents) -> None:
+    p = sub.add_parser("dump", parents=parents,
                        help="minimal-coordinate M, C, g and torques (or accelerations) at a state")
     p.add_argument("--q", nargs="+", help="natural coordinates, in the order info lists them (default: the neutral "
                                           "configuration)")
@@ -512,7 +546,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--forces", action="store_true",
                    help="also the wheel-ground contact forces and loop-closure forces (needs --tau or --a)")
     p.set_defaults(func=cmd_dump)
-    p = sub.add_parser("simulate", parents=[common, robot_args], help="run a scenario")
+
+
+def _add_simulate(sub, parents) -> None:
+    p = sub.add_parser("simulate", parents=parents, help="run a scenario")
     p.add_argument("--scenario", required=True, help="scenario name (robotdyn info ROBOT lists them)")
     p.add_argument("--t-end", type=_duration, default=None, help="duration [s] (default: the scenario's)")
     p.add_argument("--csv", help="write t, q columns, velocity columns to this CSV file (a run of more than "
@@ -526,9 +563,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--traction-plot", metavar="FILE",
                    help="save the wheel loads and required friction against time to this image file")
     p.set_defaults(func=cmd_simulate)
-    p = sub.add_parser("compare", parents=[common, robot_args], help="the paper comparison table")
-    p.set_defaults(func=cmd_compare)
-    p = sub.add_parser("view", parents=[common, robot_args],
+
+
+def _add_view(sub, parents) -> None:
+    p = sub.add_parser("view", parents=parents,
                        help="meshcat viewer (live on localhost, or a standalone HTML file with --html)")
     p.add_argument("--scenario", help="animate this scenario (robotdyn info ROBOT lists them)")
     p.add_argument("--t-end", type=_duration, default=None,
@@ -538,12 +576,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--open", action="store_true", help="open the live viewer in the default web browser")
     p.add_argument("--quiet", action="store_true", help="no simulation progress on stderr")
     p.set_defaults(func=cmd_view)
-    from .sweep import register as register_sweep  # the command imports Dask only when it runs
-
-    register_sweep(sub, [common, robot_args])
-    parser.commands = sub.choices  # name -> subparser (the built-in ones until robot_commands() adds theirs)
-    parser.robot_commands = lambda: _add_robot_commands(sub, [common, robot_args])
-    return parser
 
 
 def _add_robot_commands(sub, parents) -> None:
@@ -585,8 +617,8 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``robotdyn`` console script."""
     _one_line_warnings()
     try:
-        parser = build_parser()
         argv = sys.argv[1:] if argv is None else list(argv)
+        parser = build_parser(argv[0] if argv and argv[0] in BUILT_IN else None)  # `robotdyn CMD ...`: CMD alone
         command = next((a for a in argv if not a.startswith("-")), None)
         if command is None or command not in parser.commands:
             parser.robot_commands()  # a robot module's command, or --help listing them all

@@ -382,11 +382,11 @@ class Robot:
         rows = self.rows_at(q)
         return rows.residual[rows.holonomic]
 
-    def check_constraints(self, q, tol: float = 1e-6) -> None:
+    def check_constraints(self, q, tol: float = 1e-6, rows: ConstraintRows | None = None) -> None:
         """Raise :class:`ConstraintError` if q violates a holonomic constraint by more than ``tol``, with the advice
         that fits: a root at the wrong height when every wheel misses the ground by the same amount, else the
-        wheels or closures that do not close."""
-        rows = self.rows_at(q)
+        wheels or closures that do not close (``rows``: :meth:`rows_at` of q, when the caller has them)."""
+        rows = self.rows_at(q) if rows is None else rows
         if not (rows.residual.size and np.max(np.abs(rows.residual)) > tol):
             return
         i = int(np.argmax(np.abs(rows.residual)))

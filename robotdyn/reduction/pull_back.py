@@ -129,10 +129,11 @@ def weakest(A_h: np.ndarray, labels) -> tuple[float, str]:
     return float(s[rank - 1] / max(s[0], 1.0)), ", ".join(heavy)
 
 
-def start_offsets(robot, q0: np.ndarray, stabilisation: float) -> dict[str, float]:
+def start_offsets(robot, q0: np.ndarray, stabilisation: float, rows=None) -> dict[str, float]:
     """The holonomic residuals at q0 that no coordinate can change (reported once on stderr, kept as constant
-    offsets); raises where the pull-back cannot work (:func:`robotdyn.reduction.pull_back.check_start`)."""
-    rows = robot.rows_at(q0)
+    offsets); raises where the pull-back cannot work (:func:`robotdyn.reduction.pull_back.check_start`).
+    ``rows``: ``robot.rows_at(q0)``, when the caller has them."""
+    rows = robot.rows_at(q0) if rows is None else rows
     hol = rows.holonomic
     found = check_start(rows.A[hol], rows.residual[hol], [lab for lab, h in zip(rows.labels, hol) if h],
                         stabilisation)

@@ -30,6 +30,9 @@ from ..errors import RobotDynError
 from .chunk import (RunContext, _robot, _scaled, build_terrain, error_message, load_source, overrides_run, summary,
                     trajectory_columns)
 from .spec import RunInput
+from ..reduction.pull_back import start_offsets
+from ..simulation.engine import simulate
+from ..simulation.many_runs import simulate_many
 from ..simulation.trajectory import Trajectory
 
 
@@ -188,10 +191,6 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
     run whose start holds residuals that no coordinate can change (constant offsets,
     :func:`robotdyn.reduction.pull_back.start_offsets`) is simulated alone by ``simulate`` on its variant.
     """
-    from ..reduction.pull_back import start_offsets
-    from ..simulation.engine import simulate
-    from ..simulation.many_runs import simulate_many
-
     mod = load_source(ctx.source)
     out: list = [None] * len(runs)
     groups: dict[tuple, list[int]] = {}
@@ -211,8 +210,9 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
                 q0, nu0 = scenario.initial_state(robot)
                 torque = _scaled(scenario.torque, run.torque_scale)
                 q0, nu0 = robot.check_q(q0), robot.check_nu(nu0)
-                robot.check_constraints(q0)
-                if start_offsets(robot, q0, stabilisation):  # simulate keeps them as constant offsets
+                rows = robot.rows_at(q0)
+                robot.check_constraints(q0, rows=rows)
+                if start_offsets(robot, q0, stabilisation, rows):  # simulate keeps them as constant offsets
                     traj = simulate(robot, t_end, q0, nu0, torque, n_out=n_out, progress=False,
                                     time_limit=ctx.time_limit, **ctx.tolerances)
                     out[i] = _result(ctx, mod, run, robot, traj, torque, time.perf_counter() - begin)

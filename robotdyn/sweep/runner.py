@@ -136,7 +136,7 @@ def _connect(stack: ExitStack, workers: int, scheduler: str | None):
     cluster = stack.enter_context(LocalCluster(
         n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
         dashboard_address="127.0.0.1:0",  # the scheduler's HTTP server on a free local port, never a fixed one
-        silence_logs=logging.ERROR, preload=["robotdyn.sweep.chunk"]))  # each worker imports robotdyn once
+        silence_logs=logging.ERROR, preload=["robotdyn.sweep.batched"]))  # each worker imports robotdyn once
     return stack.enter_context(Client(cluster))
 
 

@@ -19,7 +19,6 @@ polynomially (e.g. a ratio inside the coupling law).
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 import time
@@ -27,8 +26,8 @@ import time
 import numpy as np
 
 from ..errors import RobotDynError
-from .chunk import (RunContext, _robot, _scaled, build_terrain, error_message, load_source, overrides_run, summary,
-                    trajectory_columns)
+from .chunk import (RunContext, build_robot, build_terrain, error_message, load_source, overrides_run, scaled_torque,
+                    scenario_of, summary, trajectory_columns)
 from .spec import RunInput
 from ..reduction.pull_back import start_offsets
 from ..simulation.engine import simulate
@@ -69,18 +68,11 @@ def base_robot(ctx: RunContext, terrain: str | None):
     if robot is None:
         mod = load_source(ctx.source)
         terrain_obj = build_terrain(mod, ctx.terrains[terrain]) if terrain is not None else None
-        robot = _robot(mod, dict(ctx.fixed), terrain_obj)
+        robot = build_robot(mod, dict(ctx.fixed), terrain_obj)
         while len(_BASES) >= 8:
             _BASES.pop(next(iter(_BASES)))
         _BASES[key] = robot
     return robot
-
-
-def _scenario(ctx: RunContext, mod, run: RunInput):
-    scenario = copy.copy(mod.SCENARIOS[run.scenario])
-    if run.terrain is not None and dataclasses.is_dataclass(scenario) and hasattr(scenario, "terrain"):
-        scenario = dataclasses.replace(scenario, terrain=ctx.terrains[run.terrain][1])
-    return scenario
 
 
 MODES = ("auto", "always", "never")
@@ -129,7 +121,7 @@ def model_vectors(ctx: RunContext, runs: list[RunInput], mode: str = "auto") -> 
                 continue
             ok = []
             for name in dict.fromkeys(r.scenario for r in group):
-                scenario = _scenario(ctx, mod, next(r for r in group if r.scenario == name))
+                scenario = scenario_of(ctx, mod, next(r for r in group if r.scenario == name))
                 if overrides_run(scenario):
                     reasons.append(f"scenario {name}{where}: builds its own torque law, so its runs are built one "
                                    "at a time")
@@ -199,16 +191,16 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
     stabilisation = 10.0  # simulate's and simulate_many's default
     for (terrain, name), index in groups.items():
         base = base_robot(ctx, terrain)
-        t_end, n_out = _scenario(ctx, mod, runs[index[0]]).span(ctx.t_end, ctx.n_out)
+        t_end, n_out = scenario_of(ctx, mod, runs[index[0]]).span(ctx.t_end, ctx.n_out)
         batch = []  # (i, robot, q0, nu0, torque, prep wall)
         for i in index:
             begin = time.perf_counter()
             run = runs[i]
             try:
                 robot = _variant(base, vectors[i], _params(base, run.params))
-                scenario = _scenario(ctx, mod, run)
+                scenario = scenario_of(ctx, mod, run)
                 q0, nu0 = scenario.initial_state(robot)
-                torque = _scaled(scenario.torque, run.torque_scale)
+                torque = scaled_torque(scenario.torque, run.torque_scale)
                 q0, nu0 = robot.check_q(q0), robot.check_nu(nu0)
                 rows = robot.rows_at(q0)
                 robot.check_constraints(q0, rows=rows)

@@ -97,15 +97,21 @@ def prepare(ctx: RunContext, run: RunInput):
     mod = load_source(ctx.source)
     params = {**ctx.fixed, **{k: v for k, v in run.params if k != "torque_scale"}}
     terrain = build_terrain(mod, ctx.terrains[run.terrain]) if run.terrain is not None else None
-    robot = _robot(mod, params, terrain)
-    scenario = copy.copy(mod.SCENARIOS[run.scenario])
-    if run.terrain is not None and dataclasses.is_dataclass(scenario) and hasattr(scenario, "terrain"):
-        scenario = dataclasses.replace(scenario, terrain=ctx.terrains[run.terrain][1])  # it picks its own by name
+    robot = build_robot(mod, params, terrain)
+    scenario = scenario_of(ctx, mod, run)
     t_end, n_out = scenario.span(ctx.t_end, ctx.n_out)
     return robot, scenario, t_end, n_out
 
 
-def _robot(mod, params: dict, terrain):
+def scenario_of(ctx: RunContext, mod, run: RunInput):
+    """A copy of the run's scenario, on the run's terrain (a scenario that picks its terrain by name gets it)."""
+    scenario = copy.copy(mod.SCENARIOS[run.scenario])
+    if run.terrain is not None and dataclasses.is_dataclass(scenario) and hasattr(scenario, "terrain"):
+        scenario = dataclasses.replace(scenario, terrain=ctx.terrains[run.terrain][1])
+    return scenario
+
+
+def build_robot(mod, params: dict, terrain):
     """A robot module's robot, or a constraint file's (which also checks its scenarios against the robot)."""
     from ..interfaces.constraint_file import ConstraintFile
     from ..robot import Robot
@@ -113,7 +119,7 @@ def _robot(mod, params: dict, terrain):
     return mod.robot(params, terrain) if isinstance(mod, ConstraintFile) else Robot(mod.SPEC, params, terrain)
 
 
-def _scaled(torque, scale: float):
+def scaled_torque(torque, scale: float):
     """The torques times the run's scale: a profile stays a profile (the compiled engine runs it)."""
     if torque is None or scale == 1.0:
         return torque
@@ -136,7 +142,7 @@ def simulate_run(ctx: RunContext, run: RunInput):
         traj = scenario.run(robot, t_end=t_end, n_out=n_out, progress=False, **ctx.tolerances)
         return robot, traj, SCENARIO_LAW
     q0, nu0 = scenario.initial_state(robot)  # may set the scenario's torque law (it is a copy)
-    torque = _scaled(scenario.torque, run.torque_scale)
+    torque = scaled_torque(scenario.torque, run.torque_scale)
     traj = simulate(robot, t_end, q0, nu0, torque, n_out=n_out, progress=False, time_limit=ctx.time_limit,
                     **ctx.tolerances)
     return robot, traj, torque
@@ -255,4 +261,4 @@ def run_chunk(ctx: RunContext, runs: list[RunInput], vectors: dict | None = None
 
 
 __all__ = ["RunContext", "run_chunk", "simulate_run", "prepare", "load_source", "energy_drift", "overrides_run",
-           "trajectory_columns", "error_message"]
+           "trajectory_columns", "error_message", "scenario_of", "build_robot", "scaled_torque", "build_terrain"]

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError, RobotDynError
-from .chunk import RunContext, _robot, build_terrain, load_source, overrides_run
+from .chunk import RunContext, build_robot, build_terrain, load_source, overrides_run
 from .spec import (MAX_RUNS, RESERVED, TORQUE_SCALE, Axis, RunInput, SweepSpec, SweepSpecError, points,
                          resolve_axis, run_id)
 
@@ -121,7 +121,7 @@ def plan(spec: SweepSpec) -> Plan:
     if not spec.fixed.keys().isdisjoint(a.name for a in spec.axes):
         both = sorted(set(spec.fixed) & {a.name for a in spec.axes})
         raise SweepSpecError(f"parameter {both[0]!r} is both fixed and varied; expected one or the other")
-    robot = _robot(mod, dict(spec.fixed), None)
+    robot = build_robot(mod, dict(spec.fixed), None)
     axes = []
     for axis in spec.axes:
         if axis.name in RESERVED:

@@ -118,3 +118,17 @@ def test_a_large_enough_sweep_is_batched_by_default(tmp_path):
     """60 runs of a 3-parameter sweep (twice the fit's 30 builds): batched under auto, every run ok."""
     res = sweep.run(lhs(n=60, t_end=0.3), tmp_path, workers=0, progress=False, plot=False)
     assert res.batched == 60 and res.statuses["ok"] == 60 and res.notes == []
+
+
+def test_guided_chunks_cover_the_runs_in_order_large_first():
+    """Batched sweeps go out in guided chunks: every run once, in order, sizes non-increasing from at most the
+    cap down to 8 (the last may be smaller), a quarter of what is left per worker."""
+    from robotdyn.sweep.runner import _chunks
+
+    runs = list(range(2000))
+    chunks = _chunks(runs, 250, 2)
+    assert [r for c in chunks for r in c] == runs
+    sizes = [len(c) for c in chunks]
+    assert sizes[0] == 250 and sizes[1] == 219 and all(a >= b for a, b in zip(sizes, sizes[1:]))
+    assert min(sizes[:-1]) == 8 and sizes[-1] <= 8
+    assert [len(c) for c in _chunks(runs[:10], 4)] == [4, 4, 2]  # without workers: fixed size

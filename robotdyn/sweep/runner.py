@@ -98,8 +98,18 @@ def _duration(s: float) -> str:
     return f"{s:.0f} s" if s < 120 else f"{s / 60:.0f} min"
 
 
-def _chunks(runs: list[RunInput], size: int) -> list[list[RunInput]]:
-    return [runs[i:i + size] for i in range(0, len(runs), size)]
+def _chunks(runs: list[RunInput], size: int, workers: int = 0) -> list[list[RunInput]]:
+    """Runs in chunks of ``size``; with ``workers`` > 0, guided: each chunk a quarter of the runs left per worker
+    (at most ``size``, at least 8), so that the first chunks are large and the last small and no worker waits long
+    for another's last chunk."""
+    if workers <= 0:
+        return [runs[i:i + size] for i in range(0, len(runs), size)]
+    out, i = [], 0
+    while i < len(runs):
+        step = min(size, max(8, math.ceil((len(runs) - i) / (4 * workers))))
+        out.append(runs[i:i + step])
+        i += step
+    return out
 
 
 def _worker_info() -> str:
@@ -199,8 +209,8 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
         workers: Worker processes of the local Dask cluster (0: in this process, without Dask).
         scheduler: Address of a running Dask scheduler (e.g. ``tcp://host:8786``) instead of a local cluster.
         chunk_size: Runs per Dask task (default: about 32 tasks per worker, at most 32 runs each, so that the
-            last tasks leave no worker idle for long; where most runs are batched, about 8 tasks per worker of at
-            most 256 runs).
+            last tasks leave no worker idle for long; where most runs are batched, guided chunks of at most 256
+            runs, each a quarter of the runs left per worker, at least 8).
         progress: Progress lines on stderr.
         retry_errors: Compute the runs again whose rows on disk are errors (others are kept).
         plot: Write ``summary.png`` (the plot column against each varied parameter).
@@ -232,8 +242,9 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     phases["fit"] = time.perf_counter() - begin
     # batched runs cost a few ms each: bigger chunks, fewer tasks and Parquet files (still 8 tasks per worker)
     mostly_batched = 2 * sum(r.run_id in batching.vectors for r in todo) > len(todo)
-    tasks, cap = (8, 256) if mostly_batched else (32, 32)
+    tasks, cap = (4, 256) if mostly_batched else (32, 32)
     size = chunk_size or max(1, min(cap, math.ceil(len(todo) / (tasks * max(n_workers, 1)))))
+    guided = max(n_workers, 1) if mostly_batched and not chunk_size else 0
     if size < 1:
         raise RobotDynError(f"chunk_size = {chunk_size}; expected at least 1 run per chunk")
     report = _Progress(len(p.runs), resumed, progress)
@@ -247,7 +258,7 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     interrupted = None
     try:
         if todo:
-            _execute(_chunks(todo, size), p.context, batching.vectors, workers, scheduler, client, on_chunk, phases)
+            _execute(_chunks(todo, size, guided), p.context, batching.vectors, workers, scheduler, client, on_chunk, phases)
     except KeyboardInterrupt:
         interrupted = (f"interrupted after {resumed + report.done} of {len(p.runs)} runs; run the same sweep again "
                        "to resume")

@@ -41,8 +41,9 @@ from ..inputs import MAX_FORCE, MAX_POSITION, MAX_VELOCITY
 from .contact_forces import DETERMINED_TOL, TWIN_RESIDUAL, cone_minimum, constraint_forces, floating_twin
 from .sliding import sliding_now
 
-BLOCK = 2048
-"""Samples evaluated together (bounds the memory of the stacked rows and SVDs to a few MB)."""
+BLOCK = 512
+"""Samples evaluated together: bounds the working set of the stacked rows and SVDs (~2 MB on Quasimoro; larger
+blocks are no faster)."""
 
 DIRECTION_TOL = 1e-12
 """Singular value (relative to 1, the null space being orthonormal) below which a direction of the undetermined

@@ -146,6 +146,7 @@ def main() -> None:
     startup_bench()
     compiled_engine_bench()
     compiled_forces_bench()
+    traction_bench()
     simulate_many_bench()
 
 
@@ -268,6 +269,38 @@ def compiled_forces_bench() -> None:
         t_f = statistics.median(p[1] for p in pairs)
         t_api = timeit(lambda: robot.contact_forces(q, nu, tau=tau), number=50)
         print(f"{name:<20} {t_c * 1e6:>13.2f} {t_f * 1e6:>12.2f} {100 * (t_f / t_c - 1):>6.0f}%   {t_api * 1e6:>8.0f}")
+
+
+def traction_bench() -> None:
+    """The traction post-pass of ``robotdyn simulate`` (robotdyn.contact.traction.traction: per-sample wheel loads,
+    required and minimum mu, events) on long runs, the fast pass (robotdyn.contact.traction_fast) next to the
+    per-sample reference (constraint_forces at every sample): wall time of the traction() call alone (best of 3,
+    reference: 1, after a warm-up), per sample, the ratio and the largest differences of the loads [N] and the
+    minimum mu."""
+    from robotdyn.contact.traction import traction
+
+    print(f"\n{'traction post-pass':<40} {'samples':>8} {'fast [s]':>9} {'ref [s]':>8} {'us/sample':>10} "
+          f"{'speed-up':>9} {'max|dN| [N]':>12} {'max|dmu_min|':>13}")
+    for name, sc_name, t_end in (("quasimoro", "rectilinear", 200.0), ("linkage_suspension", "straight_line", 6.0),
+                                 ("omni_caster", "circle", 20.0)):
+        robot = robotdyn.load(name)
+        sc = module(name).SCENARIOS[sc_name]
+        traj = sc.run(robot, t_end=t_end, progress=False)
+        traction(robot, traj, sc.torque)  # warm: imports, the floating twin, its compiled model
+        walls = []
+        for _ in range(3):
+            start = time.perf_counter()
+            fast = traction(robot, traj, sc.torque)
+            walls.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        ref = traction(robot, traj, sc.torque, method="reference")
+        t_ref, t_fast = time.perf_counter() - start, min(walls)
+        d_mu = (float(np.max(np.abs(fast.minimum_mu - ref.minimum_mu))) if ref.minimum_mu is not None
+                else float("nan"))
+        print(f"{name + ' / ' + sc_name + f' {t_end:g} s':<40} {len(traj.t):>8} {t_fast:>9.3f} {t_ref:>8.2f} "
+              f"{1e6 * t_fast / len(traj.t):>10.1f} {t_ref / t_fast:>8.0f}x "
+              f"{float(np.max(np.abs(fast.normal - ref.normal), initial=0.0)):>12.1e} {d_mu:>13.1e}"
+              + ("" if fast.method == "fast" else f"   (fast pass not used: {fast.method})"))
 
 
 def simulate_many_bench(runs: int = 10_000) -> None:

@@ -158,25 +158,7 @@ class ConstraintForces:
                 maps.append((np.asarray(friction, float), np.zeros((2, self.null_space.shape[1]))))
             else:
                 maps.append((D.T[:2] @ self.lam[idx], D.T[:2] @ self.null_space[idx]))
-        ratio = lambda z: max(float(np.linalg.norm(b + T @ z)) / f for (b, T), f in zip(maps, fn))  # noqa: E731
-        d = self.null_space.shape[1]
-        if d == 0 or all(not np.any(T) for _, T in maps):
-            return ratio(np.zeros(d))
-        if d == 1:  # one undetermined combination (two wheels on one axle, ...): a bounded scalar search
-            from scipy.optimize import minimize_scalar
-
-            scale = 10.0 * (1.0 + max(float(np.linalg.norm(b)) for b, _ in maps))
-            res = minimize_scalar(lambda z: ratio(np.array([z])), bounds=(-scale, scale), method="bounded",
-                                  options={"xatol": 1e-12 * scale})
-            return min(float(res.fun), ratio(np.zeros(1)))
-        from scipy.optimize import minimize
-
-        cons = [{"type": "ineq", "fun": (lambda x, b=b, T=T, f=f: (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2))}
-                for (b, T), f in zip(maps, fn)]
-        x0 = np.append(np.zeros(d), ratio(np.zeros(d)))
-        res = minimize(lambda x: x[-1], x0, constraints=cons, bounds=[(None, None)] * d + [(0, None)],
-                       method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
-        return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
+        return cone_minimum(maps, fn, self.null_space.shape[1])
 
     def wheel(self, name: str) -> WheelForce:
         """The force on the wheel called ``name``."""
@@ -242,6 +224,40 @@ class ConstraintForces:
         und = int((~self.determined).sum())
         return (f"ConstraintForces(rows={len(self.labels)}, rank={self.rank}, undetermined={und}, "
                 f"wheels={[w.name for w in self.wheels]}, closures={list(self.closures)})")
+
+
+def cone_minimum(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: int) -> float:
+    """The smallest friction coefficient over the undetermined combinations z (d of them):
+    :math:`\\min_z \\max_i \\|b_i + T_i z\\| / f_{n,i}` (the algorithm of :meth:`ConstraintForces.minimum_mu`).
+
+    Args:
+        maps: Per wheel ``(b_i, T_i)``: its tangential force (t1, t2) [N] at z = 0 (2,) and how it changes with z
+            (2, d), in its contact frame.
+        fn: (W,) the wheels' normal loads [N], all positive.
+        d: Number of undetermined combinations.
+
+    Returns:
+        The smallest ratio found: exact for d = 0 (or no T_i), a bounded scalar search for d = 1, SLSQP in epigraph
+        form above.
+    """
+    ratio = lambda z: max(float(np.linalg.norm(b + T @ z)) / f for (b, T), f in zip(maps, fn))  # noqa: E731
+    if d == 0 or all(not np.any(T) for _, T in maps):
+        return ratio(np.zeros(d))
+    if d == 1:  # one undetermined combination (two wheels on one axle, ...): a bounded scalar search
+        from scipy.optimize import minimize_scalar
+
+        scale = 10.0 * (1.0 + max(float(np.linalg.norm(b)) for b, _ in maps))
+        res = minimize_scalar(lambda z: ratio(np.array([z])), bounds=(-scale, scale), method="bounded",
+                              options={"xatol": 1e-12 * scale})
+        return min(float(res.fun), ratio(np.zeros(1)))
+    from scipy.optimize import minimize
+
+    cons = [{"type": "ineq", "fun": (lambda x, b=b, T=T, f=f: (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2))}
+            for (b, T), f in zip(maps, fn)]
+    x0 = np.append(np.zeros(d), ratio(np.zeros(d)))
+    res = minimize(lambda x: x[-1], x0, constraints=cons, bounds=[(None, None)] * d + [(0, None)],
+                   method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
+    return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
 
 
 def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> ConstraintForces:
@@ -352,6 +368,25 @@ TWIN_RESIDUAL = 1e-8
 """Relative residual above which the wheels cannot hold a planar model's out-of-plane equilibrium."""
 
 
+def floating_twin(robot) -> tuple:
+    """A planar-root robot's floating twin and where its coordinates go in the twin's.
+
+    Returns:
+        ``(twin, index)``: the same description on a floating root (x, y, z, yaw, pitch, roll), built once per
+        robot and terrain (kept as ``robot._floating_twin``), and for each of the planar model's coordinates (and
+        velocities) its index in the twin's (``psi`` is the twin's ``yaw``; z, pitch and roll are the twin's own).
+    """
+    from dataclasses import replace
+
+    twin = getattr(robot, "_floating_twin", None)
+    if twin is None or twin.terrain is not robot.terrain:  # (re)built for the robot's current terrain
+        spec = replace(robot.spec, root="floating", independent=None, operational=None)
+        twin = type(robot)(spec, robot.params, robot.terrain)  # a Robot (robotdyn.robot, the layer above)
+        robot._floating_twin = twin
+    names = twin.description.joint_names
+    return twin, [names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]
+
+
 def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) -> ConstraintForces:
     """The loads of a planar-root model from its floating twin.
 
@@ -361,15 +396,7 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
     equations of motion (vertical force, roll and pitch moments of the whole robot) then determine the normal
     loads. If the wheels cannot hold that equilibrium (e.g. a robot on two wheels with no other support) the
     residual says so and the planar result is kept, with the reason."""
-    from dataclasses import replace
-
-    twin = getattr(robot, "_floating_twin", None)
-    if twin is None or twin.terrain is not robot.terrain:  # (re)built for the robot's current terrain
-        spec = replace(robot.spec, root="floating", independent=None, operational=None)
-        twin = type(robot)(spec, robot.params, robot.terrain)  # a Robot (robotdyn.robot, the layer above)
-        robot._floating_twin = twin
-    names = twin.description.joint_names
-    index = [names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]
+    twin, index = floating_twin(robot)
 
     def lift(x):
         out = np.zeros(twin.nq)

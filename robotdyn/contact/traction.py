@@ -1,8 +1,11 @@
 """Traction along a simulated motion: each wheel's normal load, the friction the motion requires, and where the
 no-slip assumption breaks.
 
-The forces come from :func:`robotdyn.contact.contact_forces.constraint_forces` at every output sample of a
-:class:`~robotdyn.simulation.trajectory.Trajectory` (a post-pass: the integrator is not slowed down). Per wheel:
+The forces are those of :func:`robotdyn.contact.contact_forces.constraint_forces` at every output sample of a
+:class:`~robotdyn.simulation.trajectory.Trajectory` (a post-pass: the integrator is not slowed down), computed by the
+fast pass of :mod:`robotdyn.contact.traction_fast` (compiled calls and stacked linear algebra over blocks of samples,
+no force object per sample: ~40 us a sample on Quasimoro against ~1.5 ms) wherever it serves the robot, else by
+``constraint_forces`` itself sample by sample (``method="reference"`` forces that). Per wheel:
 
 - the normal load :math:`f_n` [N] (positive: pressed on the ground);
 - the required friction coefficient :math:`\\mu_{req} = \\|f_t\\| / f_n` (``inf`` where :math:`f_n \\le 0`);
@@ -23,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .contact_forces import constraint_forces
+from .traction_fast import WheelLoads, sample_loads, wheel_loads
 from ..errors import InputError
 
 
@@ -65,6 +69,9 @@ class Traction:
         mu: (W,) the wheels' friction coefficients (``nan``: not given, no slip check).
         undetermined: Wheels whose loads rigid-body dynamics do not determine, with the reason.
         events: The first lift-off and slip of each wheel, in time order.
+        method: Which pass computed the loads: ``fast`` (:mod:`robotdyn.contact.traction_fast`, a few samples
+            possibly by the reference) or ``reference`` (:func:`~robotdyn.contact.contact_forces.constraint_forces`
+            at every sample).
     """
 
     t: np.ndarray
@@ -77,6 +84,7 @@ class Traction:
     undetermined: dict[str, str] = field(default_factory=dict)
     minimum_mu: np.ndarray | None = None
     events: list[TractionEvent] = field(default_factory=list)
+    method: str = "reference"
 
     def broken(self) -> np.ndarray:
         """(N, W) where the no-slip assumption is broken: load <= 0, or required friction above mu."""
@@ -125,7 +133,14 @@ class Traction:
         return f"Traction(wheels={self.wheels}, N={len(self.t)}, events={len(self.events)})"
 
 
-def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, float] | None = None) -> Traction:
+METHODS = ("auto", "reference")
+"""How :func:`traction` computes the loads: ``auto`` by the fast pass (:func:`robotdyn.contact.traction_fast.
+wheel_loads`) where it serves the robot, else sample by sample; ``reference`` sample by sample
+(:func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample)."""
+
+
+def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, float] | None = None,
+             method: str = "auto") -> Traction:
     """Wheel loads, required friction and no-slip events along a trajectory.
 
     Args:
@@ -134,35 +149,65 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
         torque: The motor torques ``tau(t, q, nu)`` it was simulated with (``None``: unactuated).
         mu: Friction coefficient of every wheel, or by wheel name; default each wheel's own ``mu`` (its spec),
             else no slip check.
+        method: ``auto`` (default): the fast pass of :mod:`robotdyn.contact.traction_fast` (compiled calls and
+            stacked linear algebra over blocks of samples, the same numbers) where it serves the robot, the
+            per-sample reference elsewhere (slipping wheels, no compiled model) and at the samples it cannot
+            serve; ``reference``: :func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample.
 
     Returns:
-        The :class:`Traction`.
+        The :class:`Traction` (``method`` says which pass computed it: ``fast`` or ``reference``).
     """
-    zero = np.zeros(len(robot.motors))
-    samples, minimum = [], []
-    for i, t in enumerate(traj.t):
-        tau = zero if torque is None else np.asarray(torque(t, traj.q[i], traj.nu[i]), float)
-        forces = constraint_forces(robot, traj.q[i], traj.nu[i], tau=tau)
-        samples.append(forces.wheels)
-        if not all(w.load_determined for w in forces.wheels):
-            minimum.append(forces.minimum_mu())
-    names = [w.name for w in samples[0]] if samples else []
+    if method not in METHODS:
+        raise InputError(f"method = {method!r}; expected one of {', '.join(METHODS)}")
+    loads = wheel_loads(robot, traj.t, traj.q, traj.nu, torque) if method == "auto" else None
+    used = "reference" if loads is None else "fast"
+    if loads is None:
+        loads = _reference_loads(robot, traj, torque)
+    names = loads.names
     undetermined = {}
     for j, name in enumerate(names):
-        if not all(s[j].determined[2] for s in samples):
+        if not loads.normal_determined[:, j].all():
             undetermined[name] = "normal load not determined (see robotdyn.contact.contact_forces)"
     keep = [j for j, name in enumerate(names) if name not in undetermined]
-    friction_known = np.array([all(s[j].load_determined for s in samples) for j in keep], bool)
-    normal = np.array([[s[j].normal for j in keep] for s in samples]).reshape(len(samples), len(keep))
-    tangential = np.array([[s[j].tangential for j in keep] for s in samples]).reshape(len(samples), len(keep))
+    friction_known = loads.load_determined[:, keep].all(axis=0)
+    normal = loads.normal[:, keep]
+    tangential = loads.tangential[:, keep]
     with np.errstate(divide="ignore", invalid="ignore"):
         required = np.where(normal > 0, tangential / np.where(normal > 0, normal, 1.0), np.inf)
     wheels = [names[j] for j in keep]
     out = Traction(np.asarray(traj.t, float), wheels, normal, tangential, required,
                    _friction_coefficients(robot, wheels, mu), friction_known, undetermined)
-    if minimum and len(minimum) == len(samples) and all(m is not None for m in minimum):
-        out.minimum_mu = np.array(minimum, float)
+    out.minimum_mu = loads.minimum_mu
+    out.method = used
     out.events = _events(out)
+    return out
+
+
+def _reference_loads(robot, traj, torque) -> WheelLoads:
+    """The :class:`~robotdyn.contact.traction_fast.WheelLoads` of a trajectory by
+    :func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample (only the loads are kept), with
+    ``minimum_mu`` where every sample has a wheel whose load is not all determined and it is never ``None``."""
+    zero = np.zeros(len(robot.motors))
+    N = len(traj.t)
+    names: list[str] = []
+    normal = tangential = determined = None
+    minimum = []
+    for i, t in enumerate(traj.t):
+        tau = zero if torque is None else np.asarray(torque(t, traj.q[i], traj.nu[i]), float)
+        forces = constraint_forces(robot, traj.q[i], traj.nu[i], tau=tau)
+        names_i, fn, ft, det = sample_loads(forces)
+        if normal is None:
+            names = names_i
+            normal, tangential = np.zeros((N, len(names))), np.zeros((N, len(names)))
+            determined = np.zeros((N, len(names), 3), bool)
+        normal[i], tangential[i], determined[i] = fn, ft, det
+        if not det.all():
+            minimum.append(forces.minimum_mu())
+    if normal is None:
+        normal, tangential, determined = np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0, 3), bool)
+    out = WheelLoads(names, normal, tangential, determined[:, :, 2], determined.all(axis=2))
+    if minimum and len(minimum) == N and all(m is not None for m in minimum):
+        out.minimum_mu = np.array(minimum, float)
     return out
 
 

@@ -96,3 +96,27 @@ def test_cli_dump_forces(capsys):
     assert data["forces"]["wheels"]["wheel_A"]["required_mu"] is None
     assert main(["dump", "quasimoro", "--q", *q, "--v", "1", "0.5", "0.2", "--forces"]) == 2
     assert "--forces needs --tau" in capsys.readouterr().err
+
+
+def test_cli_loads_use_the_torques_the_scenario_applied(tmp_path):
+    """A scenario that builds its own torque law (omni caster's feed-forward path torques): the CSV's wheel loads
+    and required friction are those of the torques simulated, not of an unactuated robot (which differ here)."""
+    from robotdyn.robots import module
+    import robotdyn
+
+    csv = tmp_path / "circle.csv"
+    assert main(["simulate", "omni_caster", "--scenario", "circle", "--t-end", "0.5", "--quiet", "--csv",
+                 str(csv)]) == 0
+    header = csv.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    robot = robotdyn.load("omni_caster")
+    sc = module("omni_caster").SCENARIOS["circle"]
+    traj = sc.run(robot, t_end=0.5, progress=False)
+    applied = traction(robot, traj, sc.torque_law(robot), method="reference")
+    idle = traction(robot, traj, None, method="reference")
+    for name, col in applied.columns().items():
+        got = data[:, header.index(name)]
+        assert np.allclose(got, col, rtol=1e-9, atol=1e-9), name
+    for c in applied.columns():  # the friction the path needs comes from its torques: unactuated, it is ~0
+        if "mu" in c:
+            assert np.max(np.abs(applied.columns()[c] - idle.columns()[c])) > 0.5 * np.max(applied.columns()[c]), c

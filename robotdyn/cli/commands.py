@@ -270,7 +270,7 @@ def cmd_simulate(args) -> int:
         from ..contact.traction import traction
 
         try:
-            tr = traction(robot, traj, sc.torque, args.mu)
+            tr = traction(traj.robot or robot, traj, traj.torque, args.mu)  # the robot and torques simulated
         except KeyboardInterrupt:  # the trajectory is kept; only its traction columns are lost
             partial = traj.stats["partial"] = (partial + "; " if partial else "") + "traction not computed (interrupted)"
             tr = None
@@ -345,7 +345,7 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
     def columns(traj) -> dict:
         from ..contact.traction import traction
 
-        tr = traction(robot, traj, sc.torque, args.mu)
+        tr = traction(traj.robot or robot, traj, traj.torque, args.mu)  # the segment's robot and torque law
         for j, w in enumerate(tr.wheels):
             lo, hi = peaks.setdefault(w, [np.inf, -np.inf])
             mus = tr.required_mu[:, j] if tr.friction_determined[j] else np.array([-np.inf])

@@ -135,11 +135,13 @@ def simulate(
             raise RobotDynError("t0/times: stick-slip wheels are simulated from t = 0 on n_out samples only")
         from .stick_slip import simulate as simulate_stick_slip
 
-        return simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
-                                   method or "DOP853", stabilisation, progress, time_limit=time_limit)
+        return _applied(simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
+                                            method or "DOP853", stabilisation, progress, time_limit=time_limit),
+                        robot, torque)
     if compiled_engine:
-        return simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
-                                 stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times)
+        return _applied(simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
+                                          stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times),
+                        robot, torque)
     method = method or "DOP853"
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
@@ -231,7 +233,13 @@ def simulate(
     if offsets:
         stats["offsets"] = offsets
     return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
-                      robot.units, sol.y[n + k][: len(times)] if slipping else None)
+                      robot.units, sol.y[n + k][: len(times)] if slipping else None, robot, torque)
+
+
+def _applied(traj: Trajectory, robot, torque) -> Trajectory:
+    """The trajectory with the robot and the torque law it was simulated with (:attr:`Trajectory.robot`)."""
+    traj.robot, traj.torque = robot, torque
+    return traj
 
 
 def _integrate(rhs, t_end: float, y0: np.ndarray, method: str, t_eval: np.ndarray, rtol: float, atol: float,

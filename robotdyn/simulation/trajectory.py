@@ -26,6 +26,10 @@ class Trajectory:
         units: Unit of each column by name (m, rad, m/s, rad/s).
         friction_work: Work done by the slipping wheels' friction forces since t = 0 (N,) [J] (<= 0; ``None``
             without slipping wheels): energy balance E(t) - E(0) = motor work + friction_work.
+        robot, torque: The robot simulated and the torque law applied (``None``: unactuated), as
+            :func:`~robotdyn.simulation.engine.simulate` received them: what a post-pass (wheel loads,
+            :func:`robotdyn.contact.traction.traction`) must use, also where a scenario built its own controller
+            or robot. Not part of comparisons or the CSV.
     """
 
     t: np.ndarray
@@ -38,6 +42,8 @@ class Trajectory:
     stats: dict = field(default_factory=dict)
     units: dict[str, str] = field(default_factory=dict)
     friction_work: np.ndarray | None = None
+    robot: object | None = field(default=None, repr=False, compare=False)
+    torque: object | None = field(default=None, repr=False, compare=False)
 
     def __repr__(self) -> str:
         return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"

@@ -229,7 +229,8 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
                 continue
             traj = Trajectory(many.t, many.q[pos], many.nu[pos], many.energy[pos], many.residual[pos],
                               many.coordinates, many.velocity_names,
-                              {"nfev": int(many.nfev[pos]), "wall": float(many.walls[pos])}, base.units)
+                              {"nfev": int(many.nfev[pos]), "wall": float(many.walls[pos])}, base.units, None,
+                              robot, torque)
             out[i] = _result(ctx, mod, run, robot, traj, torque, prep + float(many.walls[pos]))
     return out
 

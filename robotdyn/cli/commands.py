@@ -505,25 +505,24 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                             help="independent velocities that are FRAME's twist in its own axes (default components "
                                  "vx vy wz: a base's body twist) instead of joint velocities")
 
-    if wanted("list"):
-        p = sub.add_parser("list", parents=[common], help="list the robots")
-        p.set_defaults(func=cmd_list)
-    if wanted("info"):
-        p = sub.add_parser("info", parents=[common, robot_args], help="coordinates, parameters, actuators")
-        p.set_defaults(func=cmd_info)
-    if wanted("dump"):
-        _add_dump(sub, [common, robot_args])
-    if wanted("simulate"):
-        _add_simulate(sub, [common, robot_args])
-    if wanted("compare"):
-        p = sub.add_parser("compare", parents=[common, robot_args], help="the paper comparison table")
-        p.set_defaults(func=cmd_compare)
-    if wanted("view"):
-        _add_view(sub, [common, robot_args])
-    if wanted("sweep"):
-        from .sweep import register as register_sweep  # the command imports Dask only when it runs
+    plain = {"list": ([common], "list the robots", cmd_list),
+             "info": ([common, robot_args], "coordinates, parameters, actuators", cmd_info),
+             "compare": ([common, robot_args], "the paper comparison table", cmd_compare)}
 
-        register_sweep(sub, [common, robot_args])
+    def _add_sweep(sub, parents) -> None:
+        from .sweep import register  # the command imports Dask only when it runs
+
+        register(sub, parents)
+
+    added = {"dump": _add_dump, "simulate": _add_simulate, "view": _add_view, "sweep": _add_sweep}
+    for name in ("list", "info", "dump", "simulate", "compare", "view", "sweep"):  # the order of --help
+        if not wanted(name):
+            continue
+        if name in plain:
+            parents, text, func = plain[name]
+            sub.add_parser(name, parents=parents, help=text).set_defaults(func=func)
+        else:
+            added[name](sub, [common, robot_args])
     parser.commands = sub.choices  # name -> subparser (the built-in ones until robot_commands() adds theirs)
     parser.robot_commands = lambda: _add_robot_commands(sub, [common, robot_args])
     return parser

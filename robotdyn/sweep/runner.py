@@ -5,8 +5,9 @@ hypercube sample, in the parameters' units), scenarios, terrains and a torque sc
 against the robot and lists the runs, each with an id derived from its inputs; :func:`run` sends them in chunks
 (:func:`robotdyn.sweep.chunk.run_chunk`) to Dask: an in-process ``LocalCluster`` of ``workers`` single-threaded
 worker processes by default, the cluster of a ``scheduler`` address, or a given ``client`` (``workers=0``: no
-Dask, in this process). Each finished chunk is written to Parquet at once (:mod:`robotdyn.sweep.store`), so a
-sweep that is interrupted and run again computes only the runs it has not finished.
+Dask, in this process). Finished runs are written to Parquet about once a second (:data:`FLUSH_EVERY`,
+:mod:`robotdyn.sweep.store`) and at the end, also after Ctrl-C or SIGTERM, so a sweep that is interrupted and run
+again computes only the runs it has not finished.
 
 Results (``results.parquet``, :func:`load`): one row per run with its inputs (``run_id``, ``run_index``,
 ``robot``, ``scenario``, ``terrain``, ``torque_scale``, ``t_end`` and the varied parameters, units in each
@@ -35,6 +36,10 @@ from .chunk import RunContext, load_source, run_chunk
 from .plan import Plan, plan
 from .spec import RunInput, SweepSpec, from_toml
 
+FLUSH_EVERY = 1.0
+"""Finished runs are written to ``OUT/runs/`` at most this often [s] (and at the end, after an interruption too):
+one Parquet file per second rather than per chunk keeps the client's work small beside the workers; a process
+killed outright (SIGKILL, power loss) loses at most this much of finished runs, which a rerun computes again."""
 CONNECT_TIMEOUT = "20s"
 """How long to try reaching a Dask scheduler given by address."""
 load = sweep_store.load
@@ -250,19 +255,32 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     report = _Progress(len(p.runs), resumed, progress)
     inputs = {r.run_id: p.inputs(r) for r in p.runs}
 
+    pending: list = []  # finished runs not yet on disk: (row, trajectory)
+    flushed = [-math.inf]  # the first finished chunk is written at once, later ones at most every FLUSH_EVERY
+
+    def flush() -> None:
+        if pending:
+            sweep_store.write_chunk(out, [r for r, _ in pending], [t for _, t in pending], p.schema)
+            pending.clear()
+        flushed[0] = time.perf_counter()
+
     def on_chunk(chunk: list[RunInput], results) -> None:
         rows = [{**inputs[row["run_id"]], **row} for row, _ in results]
-        sweep_store.write_chunk(out, rows, [traj for _, traj in results], p.schema)
+        pending.extend(zip(rows, [traj for _, traj in results]))
+        if time.perf_counter() - flushed[0] >= FLUSH_EVERY:
+            flush()
         report(rows)
 
     interrupted = None
     try:
         if todo:
-            _execute(_chunks(todo, size, guided), p.context, batching.vectors, workers, scheduler, client, on_chunk, phases)
+            _execute(_chunks(todo, size, guided), p.context, batching.vectors, workers, scheduler, client,
+                     on_chunk, phases)
     except KeyboardInterrupt:
         interrupted = (f"interrupted after {resumed + report.done} of {len(p.runs)} runs; run the same sweep again "
                        "to resume")
     finally:
+        flush()  # also after Ctrl-C or SIGTERM: every finished run is kept
         if todo and progress:
             report([], final=True)
     table = sweep_store.consolidate(out, {r.run_id: r.index for r in p.runs}, p.schema)

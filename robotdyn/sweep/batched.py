@@ -26,10 +26,10 @@ import time
 import numpy as np
 
 from ..errors import RobotDynError
-from .chunk import (RunContext, build_robot, build_terrain, error_message, load_source, overrides_run, scaled_torque,
-                    scenario_of, summary, trajectory_columns)
+from .chunk import (RunContext, build_robot, build_terrain, error_message, finished_row, load_source, overrides_run,
+                    scaled_torque, scenario_of)
 from .spec import RunInput
-from ..reduction.pull_back import start_offsets
+from ..reduction.pull_back import STABILISATION, start_offsets
 from ..simulation.engine import simulate
 from ..simulation.many_runs import simulate_many
 from ..simulation.trajectory import Trajectory
@@ -188,7 +188,6 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
     groups: dict[tuple, list[int]] = {}
     for i, r in enumerate(runs):
         groups.setdefault((r.terrain, r.scenario), []).append(i)
-    stabilisation = 10.0  # simulate's and simulate_many's default
     for (terrain, name), index in groups.items():
         base = base_robot(ctx, terrain)
         t_end, n_out = scenario_of(ctx, mod, runs[index[0]]).span(ctx.t_end, ctx.n_out)
@@ -204,10 +203,12 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
                 q0, nu0 = robot.check_q(q0), robot.check_nu(nu0)
                 rows = robot.rows_at(q0)
                 robot.check_constraints(q0, rows=rows)
-                if start_offsets(robot, q0, stabilisation, rows):  # simulate keeps them as constant offsets
+                if start_offsets(robot, q0, STABILISATION, rows):  # simulate keeps them as constant offsets
                     traj = simulate(robot, t_end, q0, nu0, torque, n_out=n_out, progress=False,
                                     time_limit=ctx.time_limit, **ctx.tolerances)
-                    out[i] = _result(ctx, mod, run, robot, traj, torque, time.perf_counter() - begin)
+                    if "partial" in traj.stats:  # interrupted (as run_chunk's per-run path): the sweep stops
+                        raise KeyboardInterrupt
+                    out[i] = _result(ctx, run, robot, traj, torque, time.perf_counter() - begin)
                     continue
             except Exception as exc:  # an error row, as the run built alone gives
                 out[i] = ({"run_id": run.run_id, "status": "error", "error": error_message(exc),
@@ -218,7 +219,7 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
             continue
         many = simulate_many(base, t_end, np.array([b[2] for b in batch]), np.array([b[3] for b in batch]),
                              [b[4] for b in batch], models=np.array([vectors[b[0]] for b in batch]), n_out=n_out,
-                             threads=1, time_limit=ctx.time_limit, stabilisation=stabilisation, **ctx.tolerances)
+                             threads=1, time_limit=ctx.time_limit, **ctx.tolerances)
         if "partial" in many.stats:
             raise KeyboardInterrupt
         for pos, (i, robot, _, _, torque, prep) in enumerate(batch):
@@ -231,21 +232,14 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
                               many.coordinates, many.velocity_names,
                               {"nfev": int(many.nfev[pos]), "wall": float(many.walls[pos])}, base.units, None,
                               robot, torque)
-            out[i] = _result(ctx, mod, run, robot, traj, torque, prep + float(many.walls[pos]))
+            out[i] = _result(ctx, run, robot, traj, torque, prep + float(many.walls[pos]))
     return out
 
 
-def _result(ctx: RunContext, mod, run: RunInput, robot, traj, torque, wall: float) -> tuple[dict, dict | None]:
-    """A run's summary row and trajectory columns (an error row where a summarised number is not finite)."""
+def _result(ctx: RunContext, run: RunInput, robot, traj, torque, wall: float) -> tuple[dict, dict | None]:
+    """:func:`robotdyn.sweep.chunk.finished_row` with ``run_wall``: ``wall`` [s] plus the summary's own time."""
     begin = time.perf_counter()
-    row = {"run_id": run.run_id, "status": "ok", "error": None, **summary(mod, robot, traj, torque, ctx.columns)}
-    bad = [k for k, v in row.items() if isinstance(v, float) and not np.isfinite(v) and k != "wall"]
-    traj_out = None
-    if bad:
-        row = {"run_id": run.run_id, "status": "error",
-               "error": f"non-finite result ({', '.join(bad[:3])}): the dynamics blew up"}
-    elif ctx.trajectories:
-        traj_out = trajectory_columns(traj)
+    row, traj_out = finished_row(ctx, run, robot, traj, torque)
     row["run_wall"] = wall + time.perf_counter() - begin
     return row, traj_out
 

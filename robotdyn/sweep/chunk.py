@@ -207,25 +207,32 @@ def error_message(exc: Exception) -> str:
     return message[:1000]
 
 
+def finished_row(ctx: RunContext, run: RunInput, robot, traj, torque) -> tuple[dict, dict | None]:
+    """The row (``ok``, or ``stopped`` where an event ended the run) and trajectory columns (``None`` unless
+    ``ctx.trajectories``) of a simulated run, whichever engine ran it; an error row where a summarised number is
+    not finite or the summary fails. ``run_wall`` is the caller's to add."""
+    try:
+        row = {"run_id": run.run_id, "status": "ok", "error": None,
+               **summary(load_source(ctx.source), robot, traj, torque, ctx.columns)}
+        bad = [k for k, v in row.items() if isinstance(v, float) and not np.isfinite(v) and k != "wall"]
+        if bad:
+            raise RobotDynError(f"non-finite result ({', '.join(bad[:3])}): the dynamics blew up")
+    except Exception as exc:  # one failed run is an error row, never the end of the sweep
+        return {"run_id": run.run_id, "status": "error", "error": error_message(exc)}, None
+    if "event" in traj.stats:  # e.g. a slipping wheel lifting off: the run ends there by the model's rules
+        row["status"], row["error"] = "stopped", str(traj.stats["event"])
+    return row, trajectory_columns(traj) if ctx.trajectories else None
+
+
 def _one(ctx: RunContext, run: RunInput) -> tuple[dict, dict | None]:
     start = time.perf_counter()
-    row = {"run_id": run.run_id, "status": "ok", "error": None}
-    traj_out = None
     try:
         robot, traj, torque = simulate_run(ctx, run)
         if "partial" in traj.stats:  # simulate() kept what it had when interrupted: the sweep stops, not the run
             raise KeyboardInterrupt
-        row.update(summary(load_source(ctx.source), robot, traj, torque, ctx.columns))
-        bad = [k for k, v in row.items() if isinstance(v, float) and not np.isfinite(v) and k != "wall"]
-        if bad:
-            raise RobotDynError(f"non-finite result ({', '.join(bad[:3])}): the dynamics blew up")
-        if "event" in traj.stats:  # e.g. a slipping wheel lifting off: the run ends there by the model's rules
-            row["status"], row["error"] = "stopped", str(traj.stats["event"])
-        if ctx.trajectories:
-            traj_out = trajectory_columns(traj)
+        row, traj_out = finished_row(ctx, run, robot, traj, torque)
     except Exception as exc:  # one failed run is an error row, never the end of the sweep
-        row = {"run_id": run.run_id, "status": "error", "error": error_message(exc)}
-        traj_out = None
+        row, traj_out = {"run_id": run.run_id, "status": "error", "error": error_message(exc)}, None
     row["run_wall"] = time.perf_counter() - start
     return row, traj_out
 
@@ -261,4 +268,5 @@ def run_chunk(ctx: RunContext, runs: list[RunInput], vectors: dict | None = None
 
 
 __all__ = ["RunContext", "run_chunk", "simulate_run", "prepare", "load_source", "energy_drift", "overrides_run",
-           "trajectory_columns", "error_message", "scenario_of", "build_robot", "scaled_torque", "build_terrain"]
+           "trajectory_columns", "error_message", "scenario_of", "build_robot", "scaled_torque", "build_terrain",
+           "finished_row"]

@@ -26,6 +26,8 @@ import numpy as np
 from ..errors import ConstraintError, RobotDynError
 from .projection import RANK_TOL
 
+STABILISATION = 10.0
+"""Default gain :math:`\\alpha` [1/s] of the pull-back (every simulation engine's ``stabilisation``)."""
 OFFSET_TOL = 1e-12
 """Residuals [m or rad] in directions no coordinate can change are reported as offsets above this size."""
 
@@ -159,4 +161,5 @@ def failure_note(robot, q: np.ndarray, stabilisation: float) -> str:
             f"{s:.3g}; stabilisation = 0 turns it off)")
 
 
-__all__ = ["correction", "offsets", "check_start", "start_offsets", "failure_note", "MAX_CORRECTION", "describe_offsets", "weakest", "RANK_TOL", "OFFSET_TOL"]
+__all__ = ["correction", "offsets", "check_start", "start_offsets", "failure_note", "MAX_CORRECTION", "describe_offsets", "weakest", "RANK_TOL", "OFFSET_TOL",
+           "STABILISATION"]

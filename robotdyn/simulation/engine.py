@@ -25,7 +25,7 @@ from ..fast.dispatch import compiled_model
 from .compiled_engine import METHODS, choose_engine, simulate_compiled
 from ..errors import NonFiniteError, RobotDynError
 from ..reduction.projection import solve
-from ..reduction.pull_back import failure_note, position_rate, start_offsets
+from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import lift_off_message, slipping_wheels
@@ -52,7 +52,7 @@ def simulate(
     rtol: float = 1e-10,
     atol: float = 1e-12,
     method: str | None = None,
-    stabilisation: float = 10.0,
+    stabilisation: float = STABILISATION,
     progress: bool = True,
     engine: str = "auto",
     time_limit: float | None = None,

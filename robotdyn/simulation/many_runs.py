@@ -19,6 +19,7 @@ import numpy as np
 
 from ..fast.dispatch import compiled_model
 from ..errors import InputError, RobotDynError
+from ..reduction.pull_back import STABILISATION
 
 
 @dataclass
@@ -78,7 +79,7 @@ def _per_run(x, N: int | None, width: int, what: str, names) -> tuple[np.ndarray
 
 def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: dict | None = None,
                   robots: list | None = None, bounds: dict | None = None, n_out: int = 101, rtol: float = 1e-10,
-                  atol: float = 1e-12, method: str = "adams", stabilisation: float = 10.0,
+                  atol: float = 1e-12, method: str = "adams", stabilisation: float = STABILISATION,
                   threads: int | None = None, progress: bool = False, *, models=None,
                   time_limit: float | None = None) -> ManyRuns:
     """N simulations of one robot's variants in one call, spread over threads (compiled engine only).
@@ -141,7 +142,7 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
         if N is not None and len(torque) != N:
             raise RobotDynError(f"{len(torque)} torque profiles for {N} runs; expected one per run or one for all")
         N = len(torque)
-    if sum(x is not None and (not isinstance(x, dict) or bool(x)) for x in (params, robots, models)) > 1:
+    if sum((bool(params), robots is not None, models is not None)) > 1:
         raise RobotDynError("give per-run params, robots or models, not more than one of them")
     if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
         raise RobotDynError(f"time_limit = {time_limit} s; expected a positive wall-clock duration or None")
@@ -198,17 +199,14 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
         raise RobotDynError("simulate_many does not run robots with slipping wheels (their friction and lift-off "
                             "are on robotdyn.simulation.simulate); expected wheels that roll without slipping")
     robot.reduced(Q0[0], NU0[0])  # the projection's rows (the Python path chooses them)
-    given, models = models, np.zeros((0, 0))
     variants: dict[int, object] = {}
-    if given is not None:
-        models = given
-    elif params:
+    if models is None and params:
         names = list(values)
         box = {n: tuple(bounds[n]) if bounds and n in bounds else (float(values[n].min()), float(values[n].max()))
                for n in names}
         points = np.column_stack([values[n] for n in names])
         models = _parameter_model(robot, box, points).vectors(points)
-    elif robots is not None:
+    elif models is None and robots is not None:
         base = structure(robot)
         rows = []
         for i, r in enumerate(robots):
@@ -217,7 +215,7 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
                                     "expected variants of one description")
             rows.append(model_vector(r))
         models = np.array(rows)
-    models = np.ascontiguousarray(models, float)
+    models = np.ascontiguousarray(np.zeros((0, 0)) if models is None else models, float)
     refused = physical(models, robot) if models.size else [""] * N
     run = np.array([not r for r in refused])  # the runs whose model is physical
 

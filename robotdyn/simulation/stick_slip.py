@@ -29,6 +29,7 @@ import numpy as np
 from ..contact.contact_forces import constraint_forces
 from ..errors import RobotDynError
 from ..reduction.projection import auto_independent
+from ..reduction.pull_back import STABILISATION
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import sliding_now
 from ..contact.sliding import tangential as slip
@@ -59,8 +60,8 @@ def _forces(robot, q, nu, tau):
 
 
 def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: float = 1e-10,
-             atol: float = 1e-12, method: str = "DOP853", stabilisation: float = 10.0, progress: bool = True,
-             max_switches: int = 10_000, time_limit: float | None = None):
+             atol: float = 1e-12, method: str = "DOP853", stabilisation: float = STABILISATION,
+             progress: bool = True, max_switches: int = 10_000, time_limit: float | None = None):
     """Integrate a robot with stick-slip wheels over [0, t_end] from (q0, v0), switching phases exactly.
 
     Args:

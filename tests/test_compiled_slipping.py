@@ -47,6 +47,16 @@ ROVERS = {
 }
 
 
+def _tilted_states(robot, count: int = 5, seed: int = 3):
+    """Random states of a rover: (q: rolled by up to 0.05 rad, any yaw; nu; tau), seeded."""
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        q = robot.neutral()
+        q[robot.coordinate_index("roll")] = rng.uniform(-0.05, 0.05)
+        q[robot.coordinate_index("yaw")] = rng.uniform(-np.pi, np.pi)
+        yield q, rng.uniform(-1.0, 1.0, robot.mobility), rng.uniform(-1.0, 1.0, 4)
+
+
 @pytest.mark.parametrize("kind", ROVERS)
 def test_one_state_equals_the_python_path(kind):
     """Accelerations, normal loads, slip velocities, friction forces and power of Evaluator.slip_rhs equal
@@ -54,13 +64,8 @@ def test_one_state_equals_the_python_path(kind):
     robot = _rover(**ROVERS[kind])
     fast = compiled_model(robot)
     assert fast.slip_refusal is None and fast.ev.slipping == 4
-    rng = np.random.default_rng(3)
     n, k = robot.nq, robot.mobility
-    for _ in range(5):
-        q = robot.neutral()
-        q[robot.coordinate_index("roll")] = rng.uniform(-0.05, 0.05)
-        q[robot.coordinate_index("yaw")] = rng.uniform(-np.pi, np.pi)
-        nu, tau = rng.uniform(-1.0, 1.0, k), rng.uniform(-1.0, 1.0, 4)
+    for q, nu, tau in _tilted_states(robot):
         ref = forward(robot, q, nu, tau)
         fast.select(ref.reduced.projection)
         out, normal, slip, force = fast.ev.slip_rhs(q, nu, tau, 0.0)
@@ -252,13 +257,7 @@ def test_painleve_test_clears_regular_states_from_the_estimate(kind, monkeypatch
     seen = _python_condition(monkeypatch)
     robot = _rover(**ROVERS[kind])
     fast = compiled_model(robot)
-    rng = np.random.default_rng(3)
-    k = robot.mobility
-    for _ in range(5):
-        q = robot.neutral()
-        q[robot.coordinate_index("roll")] = rng.uniform(-0.05, 0.05)
-        q[robot.coordinate_index("yaw")] = rng.uniform(-np.pi, np.pi)
-        nu, tau = rng.uniform(-1.0, 1.0, k), rng.uniform(-1.0, 1.0, 4)
+    for q, nu, tau in _tilted_states(robot):
         ref = forward(robot, q, nu, tau)
         K = seen["K"]
         assert np.linalg.cond(K) <= 1e12  # regular on the Python path

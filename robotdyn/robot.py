@@ -475,6 +475,15 @@ class Robot:
             self._warn_dropped(red, out)
         return out
 
+    def dynamics_derivatives(self, q, nu, tau):
+        """:math:`\\dot\\nu` and its derivatives in q (natural coordinates, and along the holonomic manifold in
+        independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
+        :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (Python path; see
+        :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`)."""
+        from .reduction.dynamics_derivatives import dynamics_derivatives
+
+        return dynamics_derivatives(self, q, nu, tau)
+
     def redundant_row_violations(self, q, nu, nudot=None) -> list:
         """The constraint rows dropped as redundant at q that the velocities ``nu`` (and the accelerations
         ``nudot``, if given) violate: a list of :class:`~robotdyn.constraints.redundancy.RowViolation` (empty where the state is

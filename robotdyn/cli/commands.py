@@ -1,4 +1,4 @@
-"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep`` plus robot-specific commands
+"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep | linearize`` plus robot-specific commands
 (every command has ``--json``).
 
 Robot modules may add their own subcommands by defining ``register_cli(subparsers, parents)``; each such
@@ -469,7 +469,7 @@ class _Parser(argparse.ArgumentParser):
                             "--help)")
 
 
-BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep")
+BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep", "linearize")
 """The built-in commands (robot modules add theirs, see :func:`_add_robot_commands`)."""
 
 
@@ -514,8 +514,14 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
         register(sub, parents)
 
-    added = {"dump": _add_dump, "simulate": _add_simulate, "view": _add_view, "sweep": _add_sweep}
-    for name in ("list", "info", "dump", "simulate", "compare", "view", "sweep"):  # the order of --help
+    def _add_linearize(sub, parents) -> None:
+        from .linearize import register
+
+        register(sub, parents)
+
+    added = {"dump": _add_dump, "simulate": _add_simulate, "view": _add_view, "sweep": _add_sweep,
+             "linearize": _add_linearize}
+    for name in BUILT_IN:  # the order of --help
         if not wanted(name):
             continue
         if name in plain:

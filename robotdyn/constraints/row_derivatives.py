@@ -17,8 +17,10 @@ times a fixed velocity, which is what the rows need). Per constraint kind:
 - rolling wheels (standard, omni, support; flat or curved terrain, constant or joint-driven radius):
   :math:`\\partial(Ax)/\\partial q` analytic (the contact geometry's configuration derivatives are the rate
   formulas of :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact` with the velocity replaced by the
-  identity); :math:`\\partial\\gamma/\\partial q` by Richardson-extrapolated central differences of the drift
-  (a kinematics-only function), reported as numerical;
+  identity); :math:`\\partial\\gamma/\\partial q` analytic on planes (flat or sloped terrain,
+  :func:`wheel_drift_dq`), and on curved terrain (whose normal's derivative would need the terrain's third
+  derivatives) by Richardson-extrapolated central differences of the drift (a kinematics-only function),
+  reported as numerical;
 - loop closures: :math:`\\partial(Ax)/\\partial q` and :math:`\\partial\\gamma/\\partial q` analytic;
 - joint couplings: both analytic (a :class:`~robotdyn.constraints.joint_coupling.CosineLaw` gives
   :math:`f'''`; another law's :math:`f'''` is a central difference of its :math:`f''`, reported as numerical).
@@ -169,6 +171,58 @@ def wheel_velocity_dq(wheel: RollingWheel, fpass: FramePass) -> np.ndarray:
     return wheel._directions @ dEs
 
 
+def wheel_drift_dq(wheel: RollingWheel, fpass: FramePass) -> np.ndarray:
+    """:math:`\\partial\\gamma/\\partial q` at fixed v = ``fpass.x`` of a rolling wheel on a plane (flat or
+    sloped terrain: constant normal), analytic: the drift of
+    :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.drift`,
+    :math:`D(\\dot E^T s + E^T(a_c^0 + \\dot\\omega^0\\times r + \\omega\\times\\dot r - \\dot u\\dot R))`,
+    differentiated term by term: the geometry through :func:`wheel_geometry_dq`, the frame's velocity and classical
+    acceleration through Pinocchio's derivatives, and the rates :math:`\\dot u = P(-(n\\cdot\\dot a)a - (n\\cdot a)
+    \\dot a)`, :math:`P = (I - uu^T)/\\|n - (n\\cdot a)a\\|`, :math:`\\dot t_1 = (I - t_1t_1^T)(\\dot a\\times n)
+    /\\|a\\times n\\|`, :math:`\\dot t_2 = n\\times\\dot t_1` by the product rule."""
+    kin0 = fpass.kin0
+    c, a, R, n, u, p, nw, phi, N, E, nc1 = wheel._geometry(kin0)
+    assert N is None
+    g = wheel_geometry_dq(wheel, kin0)
+    v = fpass.x
+    V, dV = fpass.velocity(wheel.fid)
+    al, dal, _ = fpass.acceleration(wheel.fid)
+    w, dw = V[3:], dV[3:]
+    Rd = 0.0 if wheel.radius_index is None else v[wheel.radius_index]
+    r, dr, du, da = -R * u, g["r"], g["u"], g["a"]
+    # rates at (q, v)
+    adot = np.cross(w, a)
+    dadot = _cross_d(w, dw, a, da)
+    na, nad = n @ a, n @ adot
+    rc = -nad * a - na * adot
+    drc = -np.outer(a, n @ dadot) - nad * da - np.outer(adot, n @ da) - na * dadot
+    dnw = -na * (n @ da) / nw
+    Prc = (rc - u * (u @ rc)) / nw
+    udot = Prc
+    dudot = (drc - np.outer(u, u @ drc) - np.outer(u, rc @ du) - du * (u @ rc)) / nw - np.outer(Prc, dnw) / nw
+    rdot = -R * udot - Rd * u
+    drdot = -np.outer(udot, g["R"]) - R * dudot - Rd * du
+    t1, dt1 = E[:, 0], g["t1"]
+    c1d = np.cross(adot, n)
+    dc1d = -skew(n) @ dadot
+    dnc1 = t1 @ (-skew(n) @ da)
+    y = c1d - t1 * (t1 @ c1d)
+    dy = dc1d - dt1 * (t1 @ c1d) - np.outer(t1, c1d @ dt1 + t1 @ dc1d)
+    t1d = y / nc1
+    dt1d = dy / nc1 - np.outer(y, dnc1) / nc1 ** 2
+    t2d = np.cross(n, t1d)
+    dt2d = skew(n) @ dt1d
+    # s and acc
+    s = V[:3] + np.cross(w, r) - u * Rd
+    ds = dV[:3] + _cross_d(w, dw, r, dr) - Rd * du
+    acc = al[:3] + np.cross(al[3:], r) + np.cross(w, rdot) - udot * Rd
+    dacc = dal[:3] + _cross_d(al[3:], dal[3:], r, dr) + _cross_d(w, dw, rdot, drdot) - Rd * dudot
+    Ed = (t1d, t2d, np.zeros(3))
+    dEd = (dt1d, dt2d, np.zeros_like(dt1d))
+    rows = [Ed[i] @ ds + s @ dEd[i] + E[:, i] @ dacc + acc @ g["E"][i] for i in range(3)]
+    return wheel._directions @ np.vstack(rows)
+
+
 # -------------------------------------------------------------------------------------------- loop closures
 def closure_velocity_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
     """:math:`\\partial(A x)/\\partial q` of a loop closure at fixed x (see the formulas of
@@ -279,9 +333,9 @@ def velocity_dq(constraints, fpass: FramePass) -> np.ndarray:
 def drift_dq(constraints, fpass: FramePass, numerical: set[str], step: float = 1e-3) -> np.ndarray:
     """All rows' :math:`\\partial\\gamma/\\partial q` (m x n) at fixed v = ``fpass.x``, stacked in constraint order.
 
-    Rolling wheels: Richardson-extrapolated central differences of their drift (steps ``step`` and ``step``/2,
-    kinematics only; error ~1e-11 relative); their names go into ``numerical``. Loop closures and couplings:
-    analytic."""
+    Rolling wheels on planes, loop closures and couplings: analytic. Rolling wheels on curved terrain:
+    Richardson-extrapolated central differences of their drift (steps ``step`` and ``step``/2, kinematics only;
+    error ~1e-11 relative); their names go into ``numerical``."""
     kin0, v = fpass.kin0, fpass.x
     model, q = kin0.model, kin0.q
     n = model.nv
@@ -298,7 +352,9 @@ def drift_dq(constraints, fpass: FramePass, numerical: set[str], step: float = 1
             if not exact:
                 numerical.add(f"{c.name}: f''' (central difference of the law's f'')")
             parts.append(row)
-        else:
+        elif c._geometry(kin0)[8] is None:  # a plane: analytic
+            parts.append(wheel_drift_dq(c, fpass))
+        else:  # curved terrain: the normal's derivative would need the terrain's third derivatives
             parts.append(None)
             wheels.append(i)
     if wheels:
@@ -323,9 +379,10 @@ def drift_dq(constraints, fpass: FramePass, numerical: set[str], step: float = 1
             m = len(constraints[i]._directions)
             parts[i] = D[start:start + m]
             start += m
-            numerical.add(f"{constraints[i].name}: drift q-derivative (Richardson central differences)")
+            numerical.add(f"{constraints[i].name}: drift q-derivative on curved terrain (Richardson central "
+                          "differences)")
     return np.vstack(parts) if parts else np.zeros((0, n))
 
 
-__all__ = ["FramePass", "wheel_geometry_dq", "wheel_velocity_dq", "closure_velocity_dq", "closure_drift_dq",
+__all__ = ["FramePass", "wheel_geometry_dq", "wheel_velocity_dq", "wheel_drift_dq", "closure_velocity_dq", "closure_drift_dq",
            "coupling_velocity_dq", "velocity_dq", "drift_dq", "kind"]

@@ -28,9 +28,9 @@ coordinates (a subset of q, the others being solved from the holonomic rows, cho
 velocities where possible), :attr:`~DynamicsDerivatives.tangent` is :math:`\\partial q/\\partial q_P` and
 ``dq_manifold = dq @ tangent`` the derivative in those coordinates.
 
-What is analytic: everything except the q-derivative of rolling wheels' drift terms
+What is analytic: everything except the q-derivative of the drift terms of rolling wheels on curved terrain
 (:func:`robotdyn.constraints.row_derivatives.drift_dq`: Richardson-extrapolated central differences of a
-kinematics-only function) and the third derivative of a coupling law that is not a
+kinematics-only function; on planes it is analytic) and the third derivative of a coupling law that is not a
 :class:`~robotdyn.constraints.joint_coupling.CosineLaw`; :attr:`DynamicsDerivatives.numerical` lists the pieces so
 computed at each call. Slipping wheels (friction laws) are refused in one line.
 """

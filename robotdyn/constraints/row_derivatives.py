@@ -155,9 +155,10 @@ def wheel_geometry_dq(wheel: RollingWheel, kin0: KinematicState) -> dict:
     return out
 
 
-def wheel_velocity_dq(wheel: RollingWheel, fpass: FramePass) -> np.ndarray:
+def wheel_velocity_dq(wheel: RollingWheel, fpass: FramePass, directions: np.ndarray | None = None) -> np.ndarray:
     """:math:`\\partial(A x)/\\partial q` (rows x n) of a rolling wheel at fixed x = ``fpass.x``:
-    :math:`A x = D E^T s`, :math:`s = v_c(x) + \\omega(x)\\times r - u\\,x_R`."""
+    :math:`A x = D E^T s`, :math:`s = v_c(x) + \\omega(x)\\times r - u\\,x_R` (``directions``: D, default the
+    wheel's own rows; e.g. the tangential rows (t1, t2) of a slipping wheel)."""
     kin0 = fpass.kin0
     geo = wheel._geometry(kin0)
     E, R, u = geo[9], geo[2], geo[4]
@@ -168,7 +169,7 @@ def wheel_velocity_dq(wheel: RollingWheel, fpass: FramePass) -> np.ndarray:
     s = V[:3] + np.cross(V[3:], r) - u * xR
     ds = dV[:3] + _cross_d(V[3:], dV[3:], r, g["r"]) - xR * g["u"]
     dEs = np.vstack([E[:, i] @ ds + s @ g["E"][i] for i in range(3)])
-    return wheel._directions @ dEs
+    return (wheel._directions if directions is None else directions) @ dEs
 
 
 def wheel_drift_dq(wheel: RollingWheel, fpass: FramePass) -> np.ndarray:
@@ -293,18 +294,21 @@ def coupling_velocity_dq(coupling: JointCoupling, kin0: KinematicState, x: np.nd
 
 
 # ------------------------------------------------------------------------------------------------ dispatch
-def kind(constraint) -> str:
+def kind(constraint, sliding: bool = False) -> str:
     """The derivative rule that serves a constraint: ``wheel``, ``closure`` or ``coupling``.
 
+    Args:
+        sliding: Accept wheels under a friction law (their rows are the normal row only; the caller adds the
+            friction, :mod:`robotdyn.contact.sliding_derivatives`).
+
     Raises:
-        InputError: A constraint without derivatives here (slipping wheels under a friction law, a user's own
-            constraint class): one line naming it.
+        InputError: A constraint without derivatives here (a wheel under a friction law unless ``sliding``, a
+            user's own constraint class): one line naming it.
     """
-    if getattr(constraint, "law", None) is not None and not isinstance(constraint, JointCoupling) or hasattr(
-            constraint, "sliding"):
+    if hasattr(constraint, "sliding") and not sliding:
         raise InputError(f"dynamics derivatives: constraint {constraint.name!r} is a wheel under a friction law; "
-                         "expected rolling wheels, loop closures and joint couplings (slipping wheels have no "
-                         "derivatives yet)")
+                         "expected rolling wheels, loop closures and joint couplings here (slipping wheels: "
+                         "Robot.dynamics_derivatives)")
     if isinstance(constraint, RollingWheel):
         return "wheel"
     if isinstance(constraint, LoopClosure):
@@ -319,7 +323,7 @@ def velocity_dq(constraints, fpass: FramePass) -> np.ndarray:
     """All rows' :math:`\\partial(A x)/\\partial q` (m x n) at fixed x = ``fpass.x``, stacked in constraint order."""
     parts = []
     for c in constraints:
-        k = kind(c)
+        k = kind(c, sliding=True)
         if k == "wheel":
             parts.append(wheel_velocity_dq(c, fpass))
         elif k == "closure":
@@ -342,7 +346,7 @@ def drift_dq(constraints, fpass: FramePass, numerical: set[str], step: float = 1
     parts: list[np.ndarray | None] = []
     wheels = []
     for i, c in enumerate(constraints):
-        k = kind(c)
+        k = kind(c, sliding=True)
         if k == "closure":
             parts.append(closure_drift_dq(c, fpass))
         elif k == "coupling":

@@ -38,6 +38,7 @@ computed at each call. Slipping wheels (friction laws) are refused in one line.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 import pinocchio as pin
@@ -173,7 +174,7 @@ class _Projection:
         return dA[t.select]
 
 
-def _motor_rows(robot, kin0: KinematicState, passes: list[FramePass], tau: np.ndarray) -> np.ndarray:
+def motor_rows(robot, kin0: KinematicState, passes: list[FramePass], tau: np.ndarray) -> np.ndarray:
     """:math:`S^T\\,\\partial(B(q)\\tau)/\\partial q` at fixed S (k, n): row l is the q-derivative of
     :math:`s_l^T B\\tau = \\sum_j \\tau_j(\\omega_{\\text{child}}(s_l) - \\omega_{\\text{reaction}}(s_l))\\cdot\\hat a_j`
     (:mod:`robotdyn.reduction.actuation`), :math:`\\partial\\hat a/\\partial q = -[\\hat a]_\\times J_\\omega`.
@@ -194,36 +195,36 @@ def _motor_rows(robot, kin0: KinematicState, passes: list[FramePass], tau: np.nd
     return out
 
 
-def dynamics_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
-    """:math:`\\dot\\nu` and its derivatives in q, :math:`\\nu` and :math:`\\tau` at one state (Python path).
+class Pieces(SimpleNamespace):
+    """The derivative pieces shared by every reduction at one state (q, nu), before the dynamics is solved:
+    kinematics (``kin0``, ``kin``), the projection ``P`` (``S``, ``v``, ``w``), the full rows ``full`` (with
+    Adot) and ``rows0``, the input matrix ``B``, the mass matrix ``M``, the frame passes at the columns of S, w and v
+    with the rows' derivatives (``dA_cols``, ``dA_w``, ``dA_v``; ``dJ_*`` for a twist), ``Vq`` =
+    :math:`\\partial(S\\nu)/\\partial q`, the drift's total q-derivative ``dgA`` (``dgJ``), ``Wnu`` =
+    :math:`\\partial w/\\partial\\nu`, and ``numerical``."""
 
-    Args:
-        robot: A :class:`~robotdyn.robot.Robot` whose constraints are rolling wheels (standard, omni, support),
-            loop closures and joint couplings; operational-space velocities are supported.
-        q: Natural coordinates (n,) [m, rad], on the holonomic constraint manifold for ``dq_manifold`` to be
-            the derivative along it.
-        nu: Independent velocities (k,) in the order of ``robot.velocity_names``.
-        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+    def Aq(self, nudot: np.ndarray) -> np.ndarray:
+        """:math:`\\partial a/\\partial q` at fixed :math:`\\dot\\nu`, :math:`a = S\\dot\\nu + w`:
+        :math:`-K^{-1}(\\partial(Ka)/\\partial q + dg)` (n, n)."""
+        k = len(nudot)
+        dKa_A = self.dA_w + sum(nudot[l] * self.dA_cols[l] for l in range(k))
+        if self.P.twist is None:
+            return self.P.solve_neg(dKa_A + self.dgA, None)
+        dKa_J = self.dJ_w + sum(nudot[l] * self.dJ_cols[l] for l in range(k))
+        return self.P.solve_neg(dKa_A + self.dgA, dKa_J + self.dgJ)
 
-    Returns:
-        A :class:`DynamicsDerivatives`.
 
-    Raises:
-        InputError: A constraint without derivatives (slipping wheels), or wrong sizes.
-        NonFiniteError: A non-finite result.
-    """
+def pieces(robot, q: np.ndarray, nu: np.ndarray) -> Pieces:
+    """The :class:`Pieces` at (q, nu) (q, nu already validated; slipping wheels' normal rows are ordinary rows
+    here: :mod:`robotdyn.contact.sliding_derivatives` adds their friction)."""
     model = robot.model
     n = model.nv
-    q = robot.check_q(q)
-    nu = robot.check_nu(nu)
-    tau = robot.check_tau(tau)
     constraints = list(robot.constraints)
     for c in constraints:
-        kind(c)
+        kind(c, sliding=True)
     data = model.createData()
     kin0 = KinematicState(model, data, q, np.zeros(n))
-    cset = constraint_set(robot)
-    rows0 = cset.jacobian(kin0)
+    rows0 = constraint_set(robot).jacobian(kin0)
     P = _Projection(robot, kin0, rows0.A)
     S = P.S
     k = S.shape[1]
@@ -242,13 +243,6 @@ def dynamics_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
     tree = model.createData()  # kept alive: Pinocchio returns views into its data
     M = pin.crba(model, tree, q).copy()
     M = np.triu(M) + np.triu(M, 1).T
-    Mr = S.T @ M @ S
-    bias = S.T @ pin.rnea(model, tree, q, v, w)
-    Br = S.T @ B
-    nudot = solve_mass(Mr, Br @ tau - bias)
-    a = S @ nudot + w
-    rho = pin.rnea(model, tree, q, v, a) - B @ tau
-    dtau_dq, dtau_dv, _ = (x.copy() for x in pin.computeRNEADerivatives(model, tree, q, v, a))
 
     numerical: set[str] = set()
     cols = [FramePass(kin0, S[:, l]) for l in range(k)]
@@ -265,41 +259,82 @@ def dynamics_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
         dJd_v = Jodot + dJ_v
     else:
         dJd_q = dJd_v = None
-
     # v = S(q) nu: dv/dq = -K^{-1} d(K v)/dq
     Vq = P.solve_neg(dA_v, dJ_v)
     # the drift terms along the motion: d g / dq with v = S(q) nu
     dgA = dgam_q + dgam_v @ Vq
     dgJ = None if dJd_q is None else dJd_q + dJd_v @ Vq
-    # a = S nudot + w at fixed nudot: da/dq = -K^{-1}(d(K a)/dq + dg)
-    dKa_A = dA_w + sum(nudot[l] * dA_cols[l] for l in range(k))
-    dKa_J = None if dJ_w is None else dJ_w + sum(nudot[l] * dJ_cols[l] for l in range(k))
-    Aq = P.solve_neg(dKa_A + dgA, None if dKa_J is None else dKa_J + dgJ)
+    # nu-derivative of w: dv = S dnu, dw/dnu = -K^{-1} dg/dv S
+    Wnu = P.solve_neg(dgam_v @ S, None if dJd_v is None else dJd_v @ S)
+    return Pieces(model=model, n=n, k=k, q=q, nu=nu, kin0=kin0, kin=kin, rows0=rows0, P=P, S=S, v=v, w=w,
+                  full=full, B=B, M=M, tree=tree, cols=cols, fv=fv, dA_cols=dA_cols, dJ_cols=dJ_cols, dA_w=dA_w,
+                  dJ_w=dJ_w, dA_v=dA_v, dJ_v=dJ_v, Vq=Vq, dgA=dgA, dgJ=dgJ, Wnu=Wnu, numerical=numerical,
+                  constraints=constraints)
+
+
+def result(robot, pc: Pieces, nudot, dq, dnu, dtau) -> DynamicsDerivatives:
+    """Assemble a :class:`DynamicsDerivatives` (independent position coordinates, the tangent, finiteness)."""
+    hol = pc.rows0.holonomic
+    prefer = pc.P.dep if pc.P.twist is None else None
+    positions, T = position_coordinates(pc.rows0.A[hol], prefer)
+    out = DynamicsDerivatives(nudot, dq, dnu, dtau, pc.v, pc.Vq, pc.S, positions, T, dq @ T,
+                              tuple(sorted(pc.numerical)), list(robot.coordinates), list(robot.velocity_names),
+                              [m.name for m in robot.motors])
+    for name in ("nudot", "dq", "dnu", "dtau", "dqdot_dq"):
+        if not np.all(np.isfinite(getattr(out, name))):
+            raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
+                                 f"{np.max(np.abs(pc.q)):.3g}, |nu| up to {np.max(np.abs(pc.nu), initial=0):.3g})")
+    return out
+
+
+def dynamics_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
+    """:math:`\\dot\\nu` and its derivatives in q, :math:`\\nu` and :math:`\\tau` at one state (Python path).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` whose constraints are rolling wheels (standard, omni, support),
+            loop closures and joint couplings; operational-space velocities are supported (slipping wheels:
+            :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`, which
+            :meth:`robotdyn.robot.Robot.dynamics_derivatives` chooses).
+        q: Natural coordinates (n,) [m, rad], on the holonomic constraint manifold for ``dq_manifold`` to be
+            the derivative along it.
+        nu: Independent velocities (k,) in the order of ``robot.velocity_names``.
+        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+
+    Returns:
+        A :class:`DynamicsDerivatives`.
+
+    Raises:
+        InputError: A constraint without derivatives here (slipping wheels), or wrong sizes.
+        NonFiniteError: A non-finite result.
+    """
+    q, nu, tau = robot.check_q(q), robot.check_nu(nu), robot.check_tau(tau)
+    for c in robot.constraints:
+        kind(c)
+    pc = pieces(robot, q, nu)
+    S, M, k, n = pc.S, pc.M, pc.k, pc.n
+    model, tree, v, w, B = pc.model, pc.tree, pc.v, pc.w, pc.B
+    Mr = S.T @ M @ S
+    Br = S.T @ B
+    nudot = solve_mass(Mr, Br @ tau - S.T @ pin.rnea(model, tree, q, v, w))
+    a = S @ nudot + w
+    rho = pin.rnea(model, tree, q, v, a) - B @ tau
+    dtau_dq, dtau_dv, _ = (x.copy() for x in pin.computeRNEADerivatives(model, tree, q, v, a))
     # dS^T rho = -S^T dK^T mu
+    P = pc.P
     muA, muJ = P.multiplier(rho)
     L = np.zeros((k, n))
     for l in range(k):
         if muA.size:
-            L[l] += muA @ dA_cols[l][P.rows]
+            L[l] += muA @ pc.dA_cols[l][P.rows]
         if muJ is not None:
-            L[l] += muJ @ dJ_cols[l]
-    G = -L + S.T @ (dtau_dq + dtau_dv @ Vq + M @ Aq) - _motor_rows(robot, kin0, cols, tau)
+            L[l] += muJ @ pc.dJ_cols[l]
+    G = -L + S.T @ (dtau_dq + dtau_dv @ pc.Vq + M @ pc.Aq(nudot)) - motor_rows(robot, pc.kin0, pc.cols, tau)
     Mr_inv = solve_mass(Mr, np.eye(k))
     dq = -Mr_inv @ G
-    # nu-derivative: dv = S dnu, dw/dnu = -K^{-1} dg/dv S
-    Wnu = P.solve_neg(dgam_v @ S, None if dJd_v is None else dJd_v @ S)
-    dnu = -Mr_inv @ (S.T @ (dtau_dv @ S + M @ Wnu))
+    dnu = -Mr_inv @ (S.T @ (dtau_dv @ S + M @ pc.Wnu))
     dtau = Mr_inv @ Br
-    hol = rows0.holonomic
-    prefer = P.dep if P.twist is None else None
-    positions, T = position_coordinates(rows0.A[hol], prefer)
-    out = DynamicsDerivatives(nudot, dq, dnu, dtau, v, Vq, S, positions, T, dq @ T, tuple(sorted(numerical)),
-                              list(robot.coordinates), list(robot.velocity_names), [m.name for m in robot.motors])
-    for name in ("nudot", "dq", "dnu", "dtau", "dqdot_dq"):
-        if not np.all(np.isfinite(getattr(out, name))):
-            raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
-                                 f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g})")
-    return out
+    return result(robot, pc, nudot, dq, dnu, dtau)
 
 
-__all__ = ["DynamicsDerivatives", "dynamics_derivatives", "position_coordinates"]
+__all__ = ["DynamicsDerivatives", "dynamics_derivatives", "position_coordinates", "pieces", "Pieces", "result",
+           "motor_rows"]

@@ -479,7 +479,12 @@ class Robot:
         """:math:`\\dot\\nu` and its derivatives in q (natural coordinates, and along the holonomic manifold in
         independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
         :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (Python path; see
-        :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`)."""
+        :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`, and with slipping wheels
+        :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`)."""
+        if sliding_now(self):
+            from .contact.sliding_derivatives import sliding_derivatives
+
+            return sliding_derivatives(self, q, nu, tau)
         from .reduction.dynamics_derivatives import dynamics_derivatives
 
         return dynamics_derivatives(self, q, nu, tau)

@@ -24,6 +24,7 @@ from oracles import diff_drive_sympy as dd_oracle
 from oracles import quasimoro_sympy as qo
 
 from robotdyn.constraints.posture import solve_posture
+from robotdyn.contact.sliding import forward, sliding_now
 from robotdyn.errors import InputError
 from robotdyn.interfaces.constraint_file import read
 from robotdyn.reduction.dynamics_derivatives import dynamics_derivatives
@@ -41,6 +42,8 @@ otherwise)."""
 
 
 def nudot(robot, q, nu, tau):
+    if sliding_now(robot):
+        return forward(robot, q, nu, tau).nudot
     red = reference(robot, q, nu)
     return solve_mass(red.M, red.B @ tau - red.h)
 
@@ -79,7 +82,7 @@ def admissible_state(robot, start, rng):
 
 
 def check_against_differences(robot, q, nu, tau):
-    D = dynamics_derivatives(robot, q, nu, tau)
+    D = robot.dynamics_derivatives(q, nu, tau)
     np.testing.assert_allclose(D.nudot, nudot(robot, q, nu, tau), rtol=1e-12, atol=1e-12)
     names = [robot.coordinates[i] for i in D.positions]
     if len(D.positions) == robot.nq:
@@ -95,6 +98,8 @@ def check_against_differences(robot, q, nu, tau):
     for name, ref in refs.items():
         got = getattr(D, name)
         assert np.abs(got - ref).max() <= 1e-7 * max(1.0, np.abs(ref).max()), (name, np.abs(got - ref).max())
+    if robot.terrain.is_flat:  # on planes every piece is analytic
+        assert D.numerical == (), D.numerical
     return D
 
 
@@ -187,10 +192,56 @@ def test_differential_drive_derivatives_equal_symbolic_ones(tmp_path):
         assert np.abs(D.dtau - np.linalg.inv(M)).max() < 1e-10
 
 
-def test_slipping_wheels_are_refused_in_one_line():
+def skid_steer(tmp_path, law: dict | None = None, lateral: bool = False):
+    """examples/skid_steer.toml, its wheels' friction law replaced by ``law`` (keys of a [[wheels]] table), the
+    rear pair slipping only sideways with ``lateral``."""
+    import tomllib
+
+    import tomli_w
+
+    data = tomllib.loads((EXAMPLES / "skid_steer.toml").read_text())
+    data["urdf"] = str(EXAMPLES / "skid_steer.urdf.xacro")
+    for wheel in data["wheels"]:
+        if law is not None:
+            for key in ("friction", "stiffness", "mu", "slip_velocity"):
+                wheel.pop(key, None)
+            wheel.update(law)
+        if lateral and wheel["name"].startswith("rear"):
+            wheel["slip"] = "lateral"
+    if lateral:
+        data["independent"] = data["independent"][:5]  # the rear wheels' rolling rows take two velocities
+    if law is not None and law["friction"] == "stick_slip":
+        data["independent"] = ["front_left_spin"]  # sticking, the four wheels roll: mobility 1
+    path = tmp_path / "skid.toml"
+    path.write_text(tomli_w.dumps(data))
+    return read(path).robot()
+
+
+@pytest.mark.parametrize("variant", ["linear", "coulomb", "lateral"])
+def test_derivatives_with_slipping_wheels_on_the_skid_steer(variant, tmp_path):
+    """The skid-steer example (linear tyre law, as shipped), with regularised Coulomb friction, and with its rear
+    wheels slipping sideways only: the coupled accelerations-and-loads solve differentiated."""
+    if variant == "linear":
+        robot = read(EXAMPLES / "skid_steer.toml").robot()
+    elif variant == "coulomb":
+        robot = skid_steer(tmp_path, {"friction": "coulomb", "mu": 0.8, "slip_velocity": 0.05})
+    else:
+        robot = skid_steer(tmp_path, lateral=True)
+    rng = np.random.default_rng(9)
+    q = robot.neutral()
+    for c in ("x", "y", "yaw", "front_left_spin", "rear_right_spin"):
+        q[robot.coordinate_index(c)] = rng.uniform(-1, 1)
+    D = check_against_differences(robot, q, rng.normal(size=robot.mobility) * 0.5, rng.normal(size=4) * 3)
+    assert np.abs(D.dnu).max() > 1.0  # the friction forces depend on the slip velocities
+
+
+def test_slipping_wheels_need_their_own_rule_and_a_smooth_law(tmp_path):
     robot = read(EXAMPLES / "skid_steer.toml").robot()
-    with pytest.raises(InputError, match="friction law"):
+    with pytest.raises(InputError, match="friction law"):  # the rolling-only rule refuses them in one line
         dynamics_derivatives(robot, robot.neutral(), np.zeros(robot.mobility), np.zeros(len(robot.motors)))
+    exact = skid_steer(tmp_path, {"friction": "stick_slip", "mu": 0.8})  # exact Coulomb: sticking, then sliding
+    with pytest.raises(InputError, match="friction law"):
+        exact.dynamics_derivatives(exact.neutral(), np.ones(exact.mobility), np.zeros(4))
 
 
 # ------------------------------------------------------------------------------------------- linearisation

@@ -307,8 +307,8 @@ def kind(constraint, sliding: bool = False) -> str:
     """
     if hasattr(constraint, "sliding") and not sliding:
         raise InputError(f"dynamics derivatives: constraint {constraint.name!r} is a wheel under a friction law; "
-                         "expected rolling wheels, loop closures and joint couplings here (slipping wheels: "
-                         "Robot.dynamics_derivatives)")
+                         "expected rolling wheels, loop closures and joint couplings here (smoothly slipping wheels: "
+                         "Robot.dynamics_derivatives; exact stick-slip friction has no derivative)")
     if isinstance(constraint, RollingWheel):
         return "wheel"
     if isinstance(constraint, LoopClosure):

@@ -32,7 +32,9 @@ What is analytic: everything except the q-derivative of the drift terms of rolli
 (:func:`robotdyn.constraints.row_derivatives.drift_dq`: Richardson-extrapolated central differences of a
 kinematics-only function; on planes it is analytic) and the third derivative of a coupling law that is not a
 :class:`~robotdyn.constraints.joint_coupling.CosineLaw`; :attr:`DynamicsDerivatives.numerical` lists the pieces so
-computed at each call. Slipping wheels (friction laws) are refused in one line.
+computed at each call. Slipping wheels (friction laws) are refused here in one line: their derivatives are
+:mod:`robotdyn.contact.sliding_derivatives` (a later stage), which reuses :func:`pieces`;
+:meth:`robotdyn.robot.Robot.dynamics_derivatives` chooses.
 """
 
 from __future__ import annotations

@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .dynamics_derivatives import dynamics_derivatives
 
 
 @dataclass
@@ -94,14 +93,15 @@ def linearize(robot, q, nu, tau) -> LinearModel:
     """The linearised model of ``robot``'s reduced dynamics about (q, nu, tau).
 
     Args:
-        robot: A :class:`~robotdyn.robot.Robot` (rolling wheels, loop closures, couplings, operational velocities).
+        robot: A :class:`~robotdyn.robot.Robot` (rolling and slipping wheels, loop closures, couplings, operational
+            velocities): its :meth:`~robotdyn.robot.Robot.dynamics_derivatives`.
         q: Natural coordinates (n,) on the holonomic manifold [m, rad].
         nu: Independent velocities (k,). tau: Motor torques (n_motors,) [N m or N].
 
     Returns:
         A :class:`LinearModel` in the state (independent positions, independent velocities).
     """
-    D = dynamics_derivatives(robot, q, nu, tau)
+    D = robot.dynamics_derivatives(q, nu, tau)
     P, T = D.positions, D.tangent
     A = np.block([[(D.dqdot_dq @ T)[P], D.S[P]], [D.dq_manifold, D.dnu]])
     B = np.vstack([np.zeros((len(P), D.dtau.shape[1])), D.dtau])

@@ -98,8 +98,7 @@ def check_against_differences(robot, q, nu, tau):
     for name, ref in refs.items():
         got = getattr(D, name)
         assert np.abs(got - ref).max() <= 1e-7 * max(1.0, np.abs(ref).max()), (name, np.abs(got - ref).max())
-    if robot.terrain.is_flat:  # on planes every piece is analytic
-        assert D.numerical == (), D.numerical
+    assert D.numerical == (), D.numerical  # every piece analytic (the built-in terrains give third derivatives)
     return D
 
 
@@ -124,6 +123,22 @@ def test_derivatives_on_the_linkage_rover_on_a_ramp():
     D = check_against_differences(robot, q, rng.normal(size=2) * 0.5, rng.normal(size=6))
     assert np.abs(D.dq_manifold).max() > 1.0
     assert len(D.positions) == 9 and np.abs(robot.rows_at(q).A[robot.rows_at(q).holonomic] @ D.tangent).max() < 1e-12
+
+
+def test_terrain_third_derivatives_equal_differences_of_the_hessian():
+    """Terrain.third of the built-in curved terrains against Richardson differences of their normal's derivative;
+    a terrain without third derivatives (FunctionTerrain) falls back to those differences and says so."""
+    from robotdyn.constraints.row_derivatives import terrain_normal_dp
+    from robotdyn.constraints.terrain import BumpTerrain, FunctionTerrain, SineTerrain
+
+    for terrain in (SineTerrain(0.1, 0.5, 0.7, 0.3), BumpTerrain(0.05, 0.2, 0.1, 0.3)):
+        plain = FunctionTerrain(terrain.height, terrain.gradient, terrain.hessian)
+        for p in ([0.23, 0.1, 0.0], [0.41, -0.3, 0.0]):
+            said = set()
+            ref = terrain_normal_dp(plain, np.array(p), said, "w")
+            assert said and "third derivatives" in said.pop()
+            got = terrain_normal_dp(terrain, np.array(p))
+            assert np.abs(got - ref).max() < 1e-8 * np.abs(ref).max()
 
 
 def test_derivatives_on_tiago():
@@ -313,3 +328,31 @@ def test_linear_model_predicts_a_steady_motion():
     pred = scipy.linalg.expm(model.A * 0.3) @ dx
     assert np.abs(got - pred).max() < 1e-3 * np.abs(dx).max(), np.abs(got - pred).max()
     assert np.abs(got - dx).max() > 1e-2 * np.abs(dx).max()  # the motion does change the deviation
+
+
+def test_linear_model_of_the_omni_platform_on_its_path():
+    """The omni-caster platform (operational-space velocities) at the start of its circle, under the path's
+    feed-forward torques held constant: the difference of two nonlinear runs 1e-6 apart follows expm(A t) over a
+    time short enough that A itself (which turns with the heading) stays put: error O(dx t^2)."""
+    import scipy.linalg
+
+    mod = module("omni_caster")
+    robot = Robot(mod.SPEC)
+    scenario = mod.SCENARIOS["circle"]
+    q, _ = scenario.initial_state(robot)
+    nu = np.array([0.0, 0.5, 0.1])
+    tau = scenario.torque_law(robot)(0.0, q, nu)
+    model = linearize(robot, q, nu, tau)
+    assert model.states[:3] == ["x", "y", "psi"] and model.B.shape == (12, 6)
+    rng = np.random.default_rng(8)
+    dx = rng.normal(size=12) * 1e-6
+    q1, nu1 = q.copy(), nu + dx[9:]
+    q1[model.position_index] += dx[:9]
+    const = lambda t, q, nu: tau  # noqa: E731
+    kw = dict(n_out=2, rtol=1e-12, atol=1e-14, progress=False)
+    base = simulate(robot, 0.02, q, nu, const, **kw)
+    pert = simulate(robot, 0.02, q1, nu1, const, **kw)
+    got = np.concatenate([(pert.q[-1] - base.q[-1])[model.position_index], pert.nu[-1] - base.nu[-1]])
+    pred = scipy.linalg.expm(model.A * 0.02) @ dx
+    assert np.abs(got - pred).max() < 1e-4 * np.abs(dx).max(), np.abs(got - pred).max()
+    assert np.abs(got - dx).max() > 1e-2 * np.abs(dx).max()

@@ -14,13 +14,12 @@ Frame kinematics derivatives come from Pinocchio's own algorithms (``computeForw
 Pinocchio 4.1's LOCAL_WORLD_ALIGNED velocity derivative is not the derivative of the LOCAL_WORLD_ALIGNED Jacobian
 times a fixed velocity, which is what the rows need). Per constraint kind:
 
-- rolling wheels (standard, omni, support; flat or curved terrain, constant or joint-driven radius):
-  :math:`\\partial(Ax)/\\partial q` analytic (the contact geometry's configuration derivatives are the rate
-  formulas of :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact` with the velocity replaced by the
-  identity); :math:`\\partial\\gamma/\\partial q` analytic on planes (flat or sloped terrain,
-  :func:`wheel_drift_dq`), and on curved terrain (whose normal's derivative would need the terrain's third
-  derivatives) by Richardson-extrapolated central differences of the drift (a kinematics-only function),
-  reported as numerical;
+- rolling wheels (standard, omni, support, and the normal row of slipping ones; flat or curved terrain, constant
+  or joint-driven radius): both analytic. The contact geometry's configuration derivatives are the rate formulas
+  of :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact` with the velocity replaced by the identity
+  (every rate there is linear in v); the drift's q-derivative differentiates those rates once more, which on
+  curved terrain needs the terrain's third derivatives (:attr:`~robotdyn.constraints.terrain.Terrain.third`; a
+  terrain without them: central differences of its Hessian, reported as numerical);
 - loop closures: :math:`\\partial(Ax)/\\partial q` and :math:`\\partial\\gamma/\\partial q` analytic;
 - joint couplings: both analytic (a :class:`~robotdyn.constraints.joint_coupling.CosineLaw` gives
   :math:`f'''`; another law's :math:`f'''` is a central difference of its :math:`f''`, reported as numerical).
@@ -172,54 +171,136 @@ def wheel_velocity_dq(wheel: RollingWheel, fpass: FramePass, directions: np.ndar
     return (wheel._directions if directions is None else directions) @ dEs
 
 
-def wheel_drift_dq(wheel: RollingWheel, fpass: FramePass) -> np.ndarray:
-    """:math:`\\partial\\gamma/\\partial q` at fixed v = ``fpass.x`` of a rolling wheel on a plane (flat or
-    sloped terrain: constant normal), analytic: the drift of
+def terrain_normal_dp(terrain, p: np.ndarray, numerical: set[str] | None = None, name: str = "") -> np.ndarray:
+    """:math:`\\partial N/\\partial p_x`, :math:`\\partial N/\\partial p_y` (2, 3, 3) of the terrain normal's
+    derivative :math:`N = \\partial n/\\partial p = (I - nn^T)D/\\|m\\|` (:math:`m = (-f_x, -f_y, 1)`,
+    :math:`D = \\partial m/\\partial p`) at the ground point p, from the terrain's third derivatives
+    (:attr:`~robotdyn.constraints.terrain.Terrain.third`):
+    :math:`\\partial_\\alpha N = [-(N_\\alpha n^T + nN_\\alpha^T)D + (I - nn^T)\\partial_\\alpha D]/\\|m\\| -
+    N\\,(n^TD_\\alpha)/\\|m\\|`; a terrain without them: Richardson-extrapolated central differences of its
+    ``normal_derivative`` (reported in ``numerical``)."""
+    x, y = float(p[0]), float(p[1])
+    if terrain.third is not None:
+        fx, fy = terrain.gradient(x, y)
+        H = terrain.hessian(x, y)
+        F3 = np.asarray(terrain.third(x, y), float)
+        m = np.array([-fx, -fy, 1.0])
+        norm = np.linalg.norm(m)
+        n = m / norm
+        D = np.zeros((3, 3))
+        D[:2, :2] = -H
+        Pn = np.eye(3) - np.outer(n, n)
+        N = Pn @ D / norm
+        out = np.zeros((2, 3, 3))
+        for al in range(2):
+            dD = np.zeros((3, 3))
+            dD[:2, :2] = -F3[:, :, al]
+            Na = N[:, al]
+            out[al] = (-(np.outer(Na, n) + np.outer(n, Na)) @ D + Pn @ dD) / norm - N * (n @ D[:, al]) / norm
+        return out
+    if numerical is not None:
+        numerical.add(f"{name}: the terrain's third derivatives (Richardson central differences of its Hessian)")
+    out = np.zeros((2, 3, 3))
+    for i in range(2):
+        h = 1e-4 * max(1.0, abs(p[i]))
+        e = np.zeros(2)
+        e[i] = h
+        f = lambda d: terrain.normal_derivative(x + d[0], y + d[1])  # noqa: E731
+        d1 = (f(e) - f(-e)) / (2 * h)
+        d2 = (f(e / 2) - f(-e / 2)) / h
+        out[i] = (4 * d2 - d1) / 3
+    return out
+
+
+def wheel_drift_dq(wheel: RollingWheel, fpass: FramePass, numerical: set[str] | None = None) -> np.ndarray:
+    """:math:`\\\\partial\\\\gamma/\\\\partial q` at fixed v = ``fpass.x`` of a rolling wheel, analytic: the drift of
     :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.drift`,
-    :math:`D(\\dot E^T s + E^T(a_c^0 + \\dot\\omega^0\\times r + \\omega\\times\\dot r - \\dot u\\dot R))`,
+    :math:`D(\\\\dot E^T s + E^T(a_c^0 + \\\\dot\\\\omega^0\\\\times r + \\\\omega\\\\times\\\\dot r - \\\\dot u\\\\dot R))`,
     differentiated term by term: the geometry through :func:`wheel_geometry_dq`, the frame's velocity and classical
-    acceleration through Pinocchio's derivatives, and the rates :math:`\\dot u = P(-(n\\cdot\\dot a)a - (n\\cdot a)
-    \\dot a)`, :math:`P = (I - uu^T)/\\|n - (n\\cdot a)a\\|`, :math:`\\dot t_1 = (I - t_1t_1^T)(\\dot a\\times n)
-    /\\|a\\times n\\|`, :math:`\\dot t_2 = n\\times\\dot t_1` by the product rule."""
+    acceleration through Pinocchio's derivatives, and the rates of
+    :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact` (:math:`K\\\\dot u = P(Q_aN(\\\\dot c - \\\\dot R u)
+    + r_c)`, :math:`K = I + RPQ_aN`, :math:`\\\\dot n = N(\\\\dot c - R\\\\dot u - \\\\dot R u)`, :math:`\\\\dot t_1`,
+    :math:`\\\\dot t_2`) by the product rule. On curved terrain :math:`\\\\partial N/\\\\partial q` needs the terrain's
+    third derivatives (:func:`terrain_normal_dp`); on planes N = 0."""
     kin0 = fpass.kin0
     c, a, R, n, u, p, nw, phi, N, E, nc1 = wheel._geometry(kin0)
-    assert N is None
     g = wheel_geometry_dq(wheel, kin0)
+    nv = kin0.model.nv
+    _, jac = kin0.pose(wheel.fid)
     v = fpass.x
     V, dV = fpass.velocity(wheel.fid)
     al, dal, _ = fpass.acceleration(wheel.fid)
     w, dw = V[3:], dV[3:]
     Rd = 0.0 if wheel.radius_index is None else v[wheel.radius_index]
-    r, dr, du, da = -R * u, g["r"], g["u"], g["a"]
+    eR = g["R"]
+    r, dr, du, da, dn = -R * u, g["r"], g["u"], g["a"], g["n"]
+    curved = N is not None
+    if curved:
+        dNdp = terrain_normal_dp(wheel.terrain, p, numerical, wheel.name)
+        dp = jac[:3] - np.outer(u, eR) - R * du  # p = c - R u
+        dN = np.einsum("aij,ap->ijp", dNdp, dp[:2])  # (3, 3, n)
+    else:
+        N = np.zeros((3, 3))
+        dN = np.zeros((3, 3, nv))
+
+    def dN_times(y):  # d(N y)/dq at fixed y
+        return np.einsum("ijp,j->ip", dN, y)
+
+    def dP_times(y):  # d(P y)/dq at fixed y, P = (I - u u^T)/nw
+        return -(np.outer(u, y @ du) + du * (u @ y)) / nw - np.outer(P @ y, dnw) / nw
+
+    def dQ_times(y):  # d(Qa y)/dq at fixed y, Qa = I - a a^T
+        return -(da * (a @ y) + np.outer(a, y @ da))
+
+    P = (np.eye(3) - np.outer(u, u)) / nw
+    Qa = np.eye(3) - np.outer(a, a)
+    na = n @ a
+    dna = a @ dn + n @ da
+    dnw = -na * dna / nw
     # rates at (q, v)
+    cd, dcd = V[:3], dV[:3]
     adot = np.cross(w, a)
     dadot = _cross_d(w, dw, a, da)
-    na, nad = n @ a, n @ adot
+    nad = n @ adot
     rc = -nad * a - na * adot
-    drc = -np.outer(a, n @ dadot) - nad * da - np.outer(adot, n @ da) - na * dadot
-    dnw = -na * (n @ da) / nw
-    Prc = (rc - u * (u @ rc)) / nw
-    udot = Prc
-    dudot = (drc - np.outer(u, u @ drc) - np.outer(u, rc @ du) - du * (u @ rc)) / nw - np.outer(Prc, dnw) / nw
+    drc = -np.outer(a, adot @ dn + n @ dadot) - nad * da - np.outer(adot, dna) - na * dadot
+    e = cd - Rd * u
+    de = dcd - Rd * du
+    m1 = N @ e
+    dm1 = dN_times(e) + N @ de
+    m2 = Qa @ m1 + rc
+    dm2 = dQ_times(m1) + Qa @ dm1 + drc
+    z = P @ m2
+    dz = dP_times(m2) + P @ dm2
+    K = np.eye(3) + R * P @ Qa @ N
+    udot = np.linalg.solve(K, z)
+    x1 = N @ udot
+    x2 = Qa @ x1
+    dK_udot = np.outer(P @ x2, eR) + R * (dP_times(x2) + P @ (dQ_times(x1) + Qa @ dN_times(udot)))
+    dudot = np.linalg.solve(K, dz - dK_udot)
+    hh = cd - R * udot - Rd * u
+    dhh = dcd - np.outer(udot, eR) - R * dudot - Rd * du
+    ndot = N @ hh
+    dndot = dN_times(hh) + N @ dhh
     rdot = -R * udot - Rd * u
-    drdot = -np.outer(udot, g["R"]) - R * dudot - Rd * du
+    drdot = -np.outer(udot, eR) - R * dudot - Rd * du
     t1, dt1 = E[:, 0], g["t1"]
-    c1d = np.cross(adot, n)
-    dc1d = -skew(n) @ dadot
-    dnc1 = t1 @ (-skew(n) @ da)
+    c1d = np.cross(adot, n) + np.cross(a, ndot)
+    dc1d = _cross_d(adot, dadot, n, dn) + _cross_d(a, da, ndot, dndot)
+    dnc1 = t1 @ _cross_d(a, da, n, dn)
     y = c1d - t1 * (t1 @ c1d)
     dy = dc1d - dt1 * (t1 @ c1d) - np.outer(t1, c1d @ dt1 + t1 @ dc1d)
     t1d = y / nc1
     dt1d = dy / nc1 - np.outer(y, dnc1) / nc1 ** 2
-    t2d = np.cross(n, t1d)
-    dt2d = skew(n) @ dt1d
+    t2d = np.cross(ndot, t1) + np.cross(n, t1d)
+    dt2d = _cross_d(ndot, dndot, t1, dt1) + _cross_d(n, dn, t1d, dt1d)
     # s and acc
     s = V[:3] + np.cross(w, r) - u * Rd
     ds = dV[:3] + _cross_d(w, dw, r, dr) - Rd * du
     acc = al[:3] + np.cross(al[3:], r) + np.cross(w, rdot) - udot * Rd
     dacc = dal[:3] + _cross_d(al[3:], dal[3:], r, dr) + _cross_d(w, dw, rdot, drdot) - Rd * dudot
-    Ed = (t1d, t2d, np.zeros(3))
-    dEd = (dt1d, dt2d, np.zeros_like(dt1d))
+    Ed = (t1d, t2d, ndot)
+    dEd = (dt1d, dt2d, dndot)
     rows = [Ed[i] @ ds + s @ dEd[i] + E[:, i] @ dacc + acc @ g["E"][i] for i in range(3)]
     return wheel._directions @ np.vstack(rows)
 
@@ -334,18 +415,14 @@ def velocity_dq(constraints, fpass: FramePass) -> np.ndarray:
     return np.vstack(parts) if parts else np.zeros((0, n))
 
 
-def drift_dq(constraints, fpass: FramePass, numerical: set[str], step: float = 1e-3) -> np.ndarray:
-    """All rows' :math:`\\partial\\gamma/\\partial q` (m x n) at fixed v = ``fpass.x``, stacked in constraint order.
-
-    Rolling wheels on planes, loop closures and couplings: analytic. Rolling wheels on curved terrain:
-    Richardson-extrapolated central differences of their drift (steps ``step`` and ``step``/2, kinematics only;
-    error ~1e-11 relative); their names go into ``numerical``."""
-    kin0, v = fpass.kin0, fpass.x
-    model, q = kin0.model, kin0.q
-    n = model.nv
-    parts: list[np.ndarray | None] = []
-    wheels = []
-    for i, c in enumerate(constraints):
+def drift_dq(constraints, fpass: FramePass, numerical: set[str]) -> np.ndarray:
+    """All rows' :math:`\\partial\\gamma/\\partial q` (m x n) at fixed v = ``fpass.x``, stacked in constraint order,
+    analytic (the pieces that are not, a terrain without third derivatives or a coupling law other than a
+    :class:`~robotdyn.constraints.joint_coupling.CosineLaw`, are named in ``numerical``)."""
+    q, v = fpass.kin0.q, fpass.x
+    n = fpass.model.nv
+    parts = []
+    for c in constraints:
         k = kind(c, sliding=True)
         if k == "closure":
             parts.append(closure_drift_dq(c, fpass))
@@ -356,37 +433,10 @@ def drift_dq(constraints, fpass: FramePass, numerical: set[str], step: float = 1
             if not exact:
                 numerical.add(f"{c.name}: f''' (central difference of the law's f'')")
             parts.append(row)
-        elif c._geometry(kin0)[8] is None:  # a plane: analytic
-            parts.append(wheel_drift_dq(c, fpass))
-        else:  # curved terrain: the normal's derivative would need the terrain's third derivatives
-            parts.append(None)
-            wheels.append(i)
-    if wheels:
-        data = model.createData()
-        sel = [constraints[i] for i in wheels]
-
-        def drift(qq):
-            kin = KinematicState(model, data, qq, v)
-            return np.concatenate([c.drift(kin) for c in sel])
-
-        cols = []
-        for j in range(n):
-            e = np.zeros(n)
-            e[j] = 1.0
-            h = step * max(1.0, abs(q[j]))
-            d1 = (drift(q + h * e) - drift(q - h * e)) / (2 * h)
-            d2 = (drift(q + h / 2 * e) - drift(q - h / 2 * e)) / h
-            cols.append((4 * d2 - d1) / 3)
-        D = np.column_stack(cols)
-        start = 0
-        for i in wheels:
-            m = len(constraints[i]._directions)
-            parts[i] = D[start:start + m]
-            start += m
-            numerical.add(f"{constraints[i].name}: drift q-derivative on curved terrain (Richardson central "
-                          "differences)")
+        else:
+            parts.append(wheel_drift_dq(c, fpass, numerical))
     return np.vstack(parts) if parts else np.zeros((0, n))
 
 
-__all__ = ["FramePass", "wheel_geometry_dq", "wheel_velocity_dq", "wheel_drift_dq", "closure_velocity_dq", "closure_drift_dq",
-           "coupling_velocity_dq", "velocity_dq", "drift_dq", "kind"]
+__all__ = ["FramePass", "wheel_geometry_dq", "wheel_velocity_dq", "wheel_drift_dq", "terrain_normal_dp",
+           "closure_velocity_dq", "closure_drift_dq", "coupling_velocity_dq", "velocity_dq", "drift_dq", "kind"]

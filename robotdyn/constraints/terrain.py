@@ -27,6 +27,11 @@ class Terrain:
         """:math:`[[f_{xx}, f_{xy}], [f_{xy}, f_{yy}]]` [1/m]."""
         raise NotImplementedError
 
+    third = None
+    """Optional ``third(x, y)``: the third derivatives :math:`f_{ijk}` (2, 2, 2) [1/m^2], used by the dynamics
+    derivatives (:mod:`robotdyn.constraints.row_derivatives`) on curved terrain; without it they take central
+    differences of the Hessian (and say so)."""
+
     @property
     def is_flat(self) -> bool:
         """True when the normal is constant (a plane): the contact point then needs no iteration."""
@@ -73,6 +78,9 @@ class RampTerrain(Terrain):
     def hessian(self, x: float, y: float) -> np.ndarray:
         return np.zeros((2, 2))
 
+    def third(self, x: float, y: float) -> np.ndarray:
+        return np.zeros((2, 2, 2))
+
     @property
     def is_flat(self) -> bool:
         return True
@@ -103,6 +111,16 @@ class BumpTerrain(Terrain):
         t = np.tanh((x - x0) / self.w)
         s = 1.0 - t * t
         return 0.5 * self.h * (1 + t), 0.5 * self.h * s / self.w, -self.h * t * s / self.w**2
+
+    def _step3(self, x: float, x0: float) -> float:
+        """The step's third derivative :math:`-h(1 - t^2)(1 - 3t^2)/w^3`, :math:`t = \\tanh((x - x_0)/w)`."""
+        t = np.tanh((x - x0) / self.w)
+        return -self.h * (1.0 - t * t) * (1.0 - 3.0 * t * t) / self.w**3
+
+    def third(self, x: float, y: float) -> np.ndarray:
+        out = np.zeros((2, 2, 2))
+        out[0, 0, 0] = self._step3(x, self.x0) - (0.0 if self.length is None else self._step3(x, self.x0 + self.length))
+        return out
 
     def _parts(self, x: float) -> tuple[float, float, float]:
         f, fx, fxx = self._step(x, self.x0)
@@ -144,6 +162,10 @@ class SineTerrain(Terrain):
         s = -self.a * np.sin(self._arg(x, y))
         k = np.array([self.kx, self.ky])
         return s * np.outer(k, k)
+
+    def third(self, x: float, y: float) -> np.ndarray:
+        k = np.array([self.kx, self.ky])
+        return -self.a * np.cos(self._arg(x, y)) * np.einsum("i,j,k->ijk", k, k, k)
 
     def __repr__(self) -> str:
         return f"SineTerrain(amplitude={self.a}, kx={self.kx}, ky={self.ky}, phase={self.phase})"

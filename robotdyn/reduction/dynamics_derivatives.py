@@ -28,10 +28,10 @@ coordinates (a subset of q, the others being solved from the holonomic rows, cho
 velocities where possible), :attr:`~DynamicsDerivatives.tangent` is :math:`\\partial q/\\partial q_P` and
 ``dq_manifold = dq @ tangent`` the derivative in those coordinates.
 
-What is analytic: everything except the q-derivative of the drift terms of rolling wheels on curved terrain
-(:func:`robotdyn.constraints.row_derivatives.drift_dq`: Richardson-extrapolated central differences of a
-kinematics-only function; on planes it is analytic) and the third derivative of a coupling law that is not a
-:class:`~robotdyn.constraints.joint_coupling.CosineLaw`; :attr:`DynamicsDerivatives.numerical` lists the pieces so
+What is analytic: everything, except on a terrain that does not give its third derivatives
+(:attr:`~robotdyn.constraints.terrain.Terrain.third`: a user's ``FunctionTerrain``; the built-in terrains give
+them) and for a coupling law that is not a :class:`~robotdyn.constraints.joint_coupling.CosineLaw` (its
+:math:`f'''`), where central differences are taken; :attr:`DynamicsDerivatives.numerical` lists the pieces so
 computed at each call. Slipping wheels (friction laws) are refused here in one line: their derivatives are
 :mod:`robotdyn.contact.sliding_derivatives` (a later stage), which reuses :func:`pieces`;
 :meth:`robotdyn.robot.Robot.dynamics_derivatives` chooses.
@@ -132,7 +132,9 @@ class _Projection:
         n = A.shape[1]
         self.n = n
         if self.op is None:
-            proj = project(A, robot.independent_indices, robot.velocity_labels)
+            # the row choice of the robot's own reduction (its hint: the last projection's rows while they still
+            # span the row space), so that S, and hence every number, is the one reduce() gives
+            proj = project(A, robot.independent_indices, robot.velocity_labels, hint=robot._projection_hint)
             self.rows, self.dep, self.Ad_inv = proj.rows, proj.dependent, proj.Ad_inv
             self.S = proj.S
             self.twist = None

@@ -356,3 +356,27 @@ def test_linear_model_of_the_omni_platform_on_its_path():
     pred = scipy.linalg.expm(model.A * 0.02) @ dx
     assert np.abs(got - pred).max() < 1e-4 * np.abs(dx).max(), np.abs(got - pred).max()
     assert np.abs(got - dx).max() > 1e-2 * np.abs(dx).max()
+
+
+def test_linearize_command_prints_the_api_model(capsys):
+    """`robotdyn linearize ... --json` gives the API's A, B, eigenvalues and LQR gain (one story through both
+    doors)."""
+    import json
+
+    from robotdyn.cli import main
+
+    argv = ["linearize", "quasimoro", "--set", "theta3=3.141592653589793", "--states", *UPRIGHT,
+            "--lqr-q", *map(str, WEIGHTS[0]), "--lqr-r", *map(str, WEIGHTS[1]), "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    robot = Robot(module("quasimoro").SPEC)
+    q = robot.neutral()
+    q[5] = np.pi
+    model = linearize(robot, q, np.zeros(3), np.zeros(2)).restrict(UPRIGHT)
+    K, closed = lqr(model, *WEIGHTS)
+    assert out["states"] == UPRIGHT and out["inputs"] == ["m1", "m2"]
+    np.testing.assert_allclose(out["A"], model.A, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(out["B"], model.B, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(out["K"], K, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(out["eigenvalues_real"], model.eigenvalues.real, atol=1e-10)
+    np.testing.assert_allclose(out["closed_loop_real"], closed.real, rtol=1e-10)

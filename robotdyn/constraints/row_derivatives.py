@@ -99,7 +99,6 @@ class FramePass:
         """World-axes classical acceleration at :math:`\\dot v = 0` (6,: origin's linear acceleration and angular
         acceleration, :math:`\\dot J x` of the LOCAL_WORLD_ALIGNED Jacobian) and its derivatives in q and in x."""
         if fid not in self._acc:
-            n = self.model.nv
             vdq, vdv = pin.getFrameVelocityDerivatives(self.model, self.data, fid, LOCAL)[:2]
             vl = pin.getFrameVelocity(self.model, self.data, fid, LOCAL).vector
             al, a_dq, a_dv = self.local_acceleration(fid)
@@ -112,7 +111,6 @@ class FramePass:
             out = np.concatenate([R @ lin, R @ al[3:]])
             dq = np.vstack([R @ lin_dq + _rot_dq(R, lin, Jw), R @ a_dq[3:] + _rot_dq(R, al[3:], Jw)])
             dv = np.vstack([R @ lin_dv, R @ a_dv[3:]])
-            assert dq.shape == (6, n)
             self._acc[fid] = (out, dq, dv)
         return self._acc[fid]
 

@@ -135,6 +135,7 @@ class _Projection:
             # the row choice of the robot's own reduction (its hint: the last projection's rows while they still
             # span the row space), so that S, and hence every number, is the one reduce() gives
             proj = project(A, robot.independent_indices, robot.velocity_labels, hint=robot._projection_hint)
+            robot._projection_hint = proj
             self.rows, self.dep, self.Ad_inv = proj.rows, proj.dependent, proj.Ad_inv
             self.S = proj.S
             self.twist = None

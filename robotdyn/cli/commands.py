@@ -275,16 +275,17 @@ def cmd_simulate(args) -> int:
             partial = traj.stats["partial"] = (partial + "; " if partial else "") + "traction not computed (interrupted)"
             tr = None
         if tr is not None and args.traction_plot:
-            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction")
+            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction",
+                          traj.robot or robot)
     elif args.mu is not None or args.traction_plot:
         raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
     if args.csv:
         traj.to_csv(args.csv, tr.columns() if tr is not None else None)
     if args.plot:
-        from ..interfaces.plotting import plot_trajectory
+        from ..interfaces.plotting import plot_trajectory, pose_columns
 
         plot_trajectory(traj, sc.plot or traj.velocity_names, args.plot, f"{args.robot}: {sc.name}", sc.zoom,
-                        sc.references)
+                        sc.references, pose_columns(traj.robot or robot, traj))
     drift = float(np.max(traj.residual)) if traj.residual.size else 0.0
     final = dict(zip(traj.coordinates + traj.velocity_names, np.concatenate([traj.q[-1], traj.nu[-1]])))
     out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,

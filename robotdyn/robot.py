@@ -173,11 +173,31 @@ class RobotSpec:
     root_height: float | None = 0.0
 
     def parameter(self, name: str) -> Parameter:
+        """The declared parameter called ``name``.
+
+        Args:
+            name: A parameter name (``robotdyn info ROBOT`` lists them).
+
+        Returns:
+            The :class:`Parameter`.
+
+        Raises:
+            InputError: No parameter has that name; the message names the declared ones or, where there are none,
+                how to declare them.
+        """
         for p in self.parameters:
             if p.name == name:
                 return p
+        if not self.parameters:
+            raise InputError(
+                f"unknown parameter {name!r}: {self.name} has no parameters to set or sweep; declare them in its "
+                "constraint file as [[parameters]] (name, default, unit) and use them by name (e.g. a wheel's "
+                "radius = \"r\"); a number of the URDF itself (a link mass, a length) must be a <xacro:arg> of a "
+                ".urdf.xacro description, declared with xacro = true")
         raise InputError(
             f"unknown parameter {name!r} for {self.name}; expected one of {', '.join(p.name for p in self.parameters)}"
+            " (to vary another number of the description, make it a <xacro:arg> and declare it under [[parameters]] "
+            "with xacro = true)"
         )
 
 

@@ -133,7 +133,14 @@ def _suggest(name: str, candidates) -> str:
 def package_search_dirs(extra=()) -> list[Path]:
     """Directories where ``package://NAME/...`` is looked up: ``extra``, ``ROS_PACKAGE_PATH``, and the
     ``cmeel.prefix/share`` directory of pip-installed robot data (e.g. example-robot-data), if present.
-    (:class:`robotdyn.description.ros_packages.PackageIndex` is the lookup itself.)"""
+    (:class:`robotdyn.description.ros_packages.PackageIndex` is the lookup itself.)
+
+    Args:
+        extra: Directories searched first (paths or strings).
+
+    Returns:
+        The directories, in search order.
+    """
     dirs = [Path(d) for d in extra]
     dirs += [Path(d) for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
     share = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
@@ -144,8 +151,21 @@ def package_search_dirs(extra=()) -> list[Path]:
 
 def resolve_path(text: str, base: Path, package_dirs=(), packages: PackageIndex | None = None) -> Path:
     """Resolve a description path: ``package://PKG/rest`` with a :class:`~robotdyn.description.ros_packages.PackageIndex`
-    (default: one of ``package_dirs`` and the environment), a relative path against ``base``. Raises
-    :class:`ConstraintFileError` if the file does not exist."""
+    (default: one of ``package_dirs`` and the environment), a relative path against ``base``.
+
+    Args:
+        text: The path as written: ``package://PKG/rest``, absolute, relative, or starting with ``~``.
+        base: The directory a relative path is relative to (the constraint file's).
+        package_dirs: Directories searched for packages when ``packages`` is not given.
+        packages: The package index to resolve ``package://`` with (default ``None``: one built from
+            ``package_dirs`` and the environment).
+
+    Returns:
+        The absolute path of an existing file.
+
+    Raises:
+        ConstraintFileError: The package or the file is not found.
+    """
     if text.startswith("package://"):
         index = packages if packages is not None else PackageIndex.create(dirs=package_dirs)
         path, missing = index.resolve_uri(text)
@@ -283,14 +303,36 @@ class _Reader:
 @dataclass
 class ConstraintFile:
     """A validated constraint file: the robot's :class:`RobotSpec` and scenarios (module-like: ``SPEC``,
-    ``SCENARIOS``), plus where they came from."""
+    ``SCENARIOS``), plus where they came from.
+
+    Attributes:
+        path: The constraint file.
+        SPEC: The robot's :class:`~robotdyn.robot.RobotSpec` (what ``Robot(spec)`` builds).
+        SCENARIOS: The file's ``[[scenarios]]`` by name (:class:`~robotdyn.simulation.scenario.Scenario`).
+    """
 
     path: Path
     SPEC: RobotSpec
     SCENARIOS: dict[str, Scenario] = field(default_factory=dict)
 
     def robot(self, params: dict | None = None, terrain: Terrain | None = None) -> Robot:
-        """Build the robot; core errors are prefixed with the file name."""
+        """Build the robot; core errors are prefixed with the file name.
+
+        Without ``independent`` in the file (and no ``[twist]``) the independent velocities are chosen
+        automatically; a :class:`~robotdyn.errors.RobotDynWarning` names them and the line that chooses them, unless
+        they are the motor joints.
+
+        Args:
+            params: Parameter values by name (default ``None``: the file's defaults).
+            terrain: A terrain replacing the file's ``[terrain]`` (default ``None``).
+
+        Returns:
+            The :class:`~robotdyn.robot.Robot`.
+
+        Raises:
+            ConstraintFileError: The robot cannot be built, or ``independent`` or a scenario's ``nu0`` does not fit it
+                (one line naming the file).
+        """
         try:
             robot = Robot(self.SPEC, params, terrain)
         except ConstraintFileError:
@@ -373,8 +415,19 @@ def read(
         twist: Independent velocities that are a body twist instead (overrides the file's ``independent`` and
             ``twist``): ``FRAME`` (components vx vy wz) or ``FRAME:vx,vy,wz``.
 
+    Returns:
+        The :class:`ConstraintFile` (its ``SPEC`` and ``SCENARIOS``; :meth:`ConstraintFile.robot` builds it).
+
     Raises:
         ConstraintFileError: one line naming the file, the entry and what was expected.
+
+    Example:
+        >>> from pathlib import Path
+        >>> import robotdyn
+        >>> from robotdyn.interfaces.constraint_file import read
+        >>> cf = read(Path(robotdyn.__file__).parents[1] / "examples" / "quasimoro.toml")
+        >>> [w.name for w in cf.SPEC.wheels], [m.name for m in cf.SPEC.motors]
+        (['wheel_A', 'wheel_B'], ['m1', 'm2'])
     """
     path = Path(path)
     r = _Reader(path)
@@ -937,7 +990,31 @@ def load_robot(
     terrain: Terrain | None = None,
     package_dirs=(),
 ) -> Robot:
-    """Read a constraint file (see :func:`read`) and build its :class:`~robotdyn.robot.Robot`."""
+    """Read a constraint file (see :func:`read`) and build its :class:`~robotdyn.robot.Robot`.
+
+    Args:
+        path: The TOML constraint file.
+        urdf: The URDF/Xacro description, overriding the file's ``urdf`` (default ``None``).
+        xacro_args: Xacro arguments by name (strings), overriding the file's ``xacro_args``.
+        params: Parameter values by name (the file's ``[[parameters]]``; default ``None``: their defaults).
+        terrain: A :class:`~robotdyn.constraints.terrain.Terrain` replacing the file's (default ``None``).
+        package_dirs: Extra directories searched for ROS packages.
+
+    Returns:
+        The :class:`~robotdyn.robot.Robot`, the same object :func:`robotdyn.load` returns for a built-in robot.
+
+    Raises:
+        ConstraintFileError: One line naming the file, the entry and what was expected.
+
+    Example:
+        >>> from pathlib import Path
+        >>> import robotdyn
+        >>> from robotdyn.interfaces.constraint_file import load_robot
+        >>> examples = Path(robotdyn.__file__).parents[1] / "examples"
+        >>> robot = load_robot(examples / "quasimoro.toml")
+        >>> robot.velocity_names
+        ['theta1_dot', 'theta2_dot', 'theta3_dot']
+    """
     return read(path, urdf, xacro_args, package_dirs).robot(params, terrain)
 
 

@@ -306,7 +306,16 @@ def _velocity(robot, fast, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, n
 
 
 def power(robot, traj: Trajectory, torque: TorqueFunction | None) -> np.ndarray:
-    """Motor power :math:`\\tau^T B_r^T \\nu` [W] along a trajectory (dE/dt must equal it without friction)."""
+    """Motor power :math:`\\tau^T B_r^T \\nu` [W] along a trajectory (dE/dt must equal it without friction).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` simulated.
+        traj: Its :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        torque: The torque law ``tau(t, q, nu)`` it was simulated with (``None``: unactuated, zero power).
+
+    Returns:
+        The power at each sample (N,) [W].
+    """
     out = np.zeros(len(traj.t))
     if torque is None:
         return out

@@ -276,6 +276,14 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
 
     Returns:
         The :class:`ConstraintForces`.
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.contact.contact_forces import constraint_forces
+        >>> robot = robotdyn.load("quasimoro")
+        >>> forces = constraint_forces(robot, robot.neutral(), [0.0, 0.0, 0.0], tau=[0.0, 0.0])
+        >>> round(sum(w.normal for w in forces.wheels), 2)  # the weight (2 m + M) g [N]
+        58.86
     """
     q = robot.check_q(q)
     nu = robot.check_nu(nu, "v")

@@ -151,6 +151,16 @@ class Viewer:
         tile: Edge [m] of the ground's checker tiles (about 0.4 times the robot's size, rounded to 1, 2 or 5).
         camera_position: Where :meth:`set_camera` put the camera (world frame, m); it looks at the origin with
             meshcat's default perspective (75 degrees vertical field of view, z up on screen).
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.interfaces.viewer import Viewer
+        >>> robot = robotdyn.load("quasimoro")
+        >>> viewer = Viewer(robot)             # live=True also serves it at viewer.url
+        >>> viewer.display(robot.neutral())
+        >>> viewer.save("quasimoro.html").name  # a page that works offline
+        'quasimoro.html'
+        >>> viewer.close()
     """
 
     def __init__(self, robot, live: bool = False, contacts: bool = True, frames: bool = False,

@@ -96,6 +96,18 @@ def simulate(
             ``sink.segment`` samples (memory bounded whatever the duration; any ``n_out`` >= 2) and returns a
             :class:`robotdyn.simulation.streaming.StreamResult` instead of a Trajectory (see
             :func:`robotdyn.simulation.streaming.stream`: the integrator restarts at each segment boundary).
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.simulation.engine import simulate
+        >>> from robotdyn.simulation.torque_profile import Constant
+        >>> robot = robotdyn.load("quasimoro")
+        >>> traj = simulate(robot, 1.0, robot.neutral(), [0.0, 0.0, 0.0], Constant([0.1, 0.1]), n_out=11,
+        ...                 progress=False)
+        >>> traj.q.shape, traj.nu.shape
+        ((11, 6), (11, 3))
+        >>> bool(abs(traj.energy[-1] - traj.energy[0]) > 0)  # the motors did work
+        True
     """
     if sink is not None:
         from .streaming import stream

@@ -227,6 +227,16 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     Returns:
         A :class:`SweepResult`; after an interruption (Ctrl-C) it holds what was finished, with ``interrupted``
         saying so: running the same sweep again resumes.
+
+    Example:
+        >>> from robotdyn.sweep import load, run
+        >>> from robotdyn.sweep.spec import SweepSpec, parse_axis
+        >>> spec = SweepSpec(robot="quasimoro", axes=[parse_axis("M=4:6:3")], t_end=0.2)
+        >>> result = run(spec, "sweep_out", workers=0, progress=False, plot=False)
+        >>> result.total, result.statuses
+        (3, {'ok': 3, 'stopped': 0, 'error': 0})
+        >>> load("sweep_out").sort_values("M")["M"].tolist()
+        [4.0, 5.0, 6.0]
     """
     if batch not in MODES:
         raise RobotDynError(f"batch = {batch!r}; expected one of {', '.join(MODES)}")

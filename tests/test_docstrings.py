@@ -7,7 +7,8 @@ constructor arguments are documented in the class docstring (``autodoc_class_sig
 test walks the same set and fails, naming each, for any parameter without a description: under ``Args:`` (or
 ``Arguments:``, ``Keyword Args:``, ``Other Parameters:``), or for a class's constructor also under
 ``Attributes:`` (a dataclass's fields), as ``name: text``, ``name (type): text``, or ``a, b: text`` for several.
-``self``, ``cls`` and ``*``/``**`` collectors documented as ``*args``/``args`` are handled alike.
+``self``, ``cls`` and ``*``/``**`` collectors documented as ``*args``/``args`` are handled alike; an overriding
+method without a docstring of its own is checked against the docstring it inherits (as autodoc shows it).
 
 The docstring examples (``Example:`` blocks, doctest format) of the entry points a user meets first are run by
 ``test_docstring_examples`` so that they cannot rot.
@@ -95,7 +96,7 @@ def missing_descriptions() -> list[str]:
                         continue
                     func = member.__func__ if isinstance(member, (staticmethod, classmethod)) else member
                     if inspect.isfunction(func):
-                        doc = described(func.__doc__)
+                        doc = described(inspect.getdoc(getattr(obj, mname)))  # inherited, as autodoc shows it
                         missing += [f"{where}.{mname}({p})" for p in parameters(func) if p not in doc]
     return missing
 

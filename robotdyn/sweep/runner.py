@@ -48,7 +48,22 @@ load_trajectory = sweep_store.load_trajectory
 
 @dataclass
 class SweepResult:
-    """What a sweep did: its directory, the results table (pyarrow; :meth:`frame` for pandas), counts."""
+    """What a sweep did: its directory, the results table (pyarrow; :meth:`frame` for pandas), counts.
+
+    Attributes:
+        out: The sweep directory.
+        table: The results (pyarrow table, one row per run in run order).
+        total: Number of runs of the sweep.
+        computed: Runs computed by this call.
+        resumed: Runs found finished on disk.
+        wall: Wall time [s].
+        plot: The summary plot's path (``None``: not written).
+        interrupted: Why the sweep stopped early (``None``: it finished).
+        statuses: Number of runs by status (ok, stopped, error).
+        batched: Runs simulated as variants of one compiled model.
+        notes: Lines on which runs were built one at a time and why.
+        phases: Wall time [s] of each phase (plan, compute, ...).
+    """
 
     out: Path
     table: object

@@ -127,7 +127,13 @@ def plot_path(traj, x: str, y: str, heading: str, ax=None):
 
 def finish(fig, path=None, title: str = ""):
     """Title and lay out a figure, then save it atomically (:func:`robotdyn.output.save_figure`) and close it when
-    ``path`` is given; returns the figure."""
+    ``path`` is given; returns the figure.
+
+    Args:
+        fig: The matplotlib figure.
+        path: The image file (default ``None``: not saved, the figure stays open).
+        title: The figure's title (default: none).
+    """
     if title:
         fig.suptitle(title)
     fig.tight_layout()

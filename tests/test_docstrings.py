@@ -91,8 +91,9 @@ def missing_descriptions() -> list[str]:
                         getattr(ctor, "__doc__", None))
                     names = parameters(ctor) if ctor is not None else parameters(obj)
                     missing += [f"{where}({p})" for p in names if p not in doc]
+                fields = getattr(obj, "__dataclass_fields__", {})
                 for mname, member in obj.__dict__.items():
-                    if mname.startswith("_"):
+                    if mname.startswith("_") or mname in fields:  # a field's default (e.g. a lambda) is data
                         continue
                     func = member.__func__ if isinstance(member, (staticmethod, classmethod)) else member
                     if inspect.isfunction(func):

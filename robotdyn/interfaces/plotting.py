@@ -181,7 +181,7 @@ def plot_traction(tr, path=None, title: str = "", robot=None):
     per wheel against time, shaded where the no-slip assumption is broken (load <= 0, or required friction above
     the wheel's mu, drawn dashed).
 
-    Drive wheels come first. Every wheel that can slip has its required friction |f_t|/f_n drawn where it is
+    Drive wheels come first. Every wheel that can slip has its required friction ``|f_t|/f_n`` drawn where it is
     determined; where rigid-body dynamics split a force between wheels only as a sum (e.g. two wheels on one
     axle share a lateral force), the smallest mu with which some split lies inside every friction cone
     (:attr:`~robotdyn.contact.traction.Traction.minimum_mu`) is drawn for them instead. Support wheels

@@ -359,7 +359,7 @@ def climbing_balance(robot: Robot, slope: float, mu: float | None = None) -> dic
 
     Args:
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
-        slope: Slope angle psi [rad] (|slope| < pi/2).
+        slope: Slope angle psi [rad] (abs(slope) < pi/2).
         mu: Rolling-resistance coefficient (default ``None``: the robot's parameter ``mu``).
 
     Returns:
@@ -398,7 +398,7 @@ def climbing_robot(slope: float, robot: Robot | None = None) -> Robot:
     description).
 
     Args:
-        slope: Ramp angle [rad] (|slope| < pi/2).
+        slope: Ramp angle [rad] (abs(slope) < pi/2).
         robot: The robot whose parameters are kept (default ``None``: the defaults).
 
     Returns:
@@ -439,7 +439,7 @@ def climbing_forces(slope: float, robot: Robot | None = None):
     loads, tip loads, ``minimum_mu``: the smallest friction coefficient that holds the robot there).
 
     Args:
-        slope: Ramp angle [rad] (|slope| < pi/2).
+        slope: Ramp angle [rad] (abs(slope) < pi/2).
         robot: The robot whose parameters are kept (default ``None``: the defaults).
     """
     climber = climbing_robot(slope, robot)

@@ -23,7 +23,17 @@ IMAGE_FORMATS = ("png", "pdf", "svg", "jpg", "jpeg", "eps", "ps", "tif", "tiff",
 
 def check_target(path, what: str = "output file", suffixes: tuple[str, ...] | None = None) -> Path:
     """Validate an output path before any work is done: its directory exists and is writable, it is not a
-    directory, and (with ``suffixes``) its extension is one of them."""
+    directory, and (with ``suffixes``) its extension is one of them.
+
+    Args:
+        path: The output file.
+        what: What it is, for messages.
+        suffixes: Allowed extensions (e.g. ``(".png", ".pdf")``; default ``None``: any).
+
+    Raises:
+        OutputError: The path is a directory, its directory is missing or not writable, or its extension is not
+            allowed.
+    """
     p = Path(path)
     if p.is_dir():
         raise OutputError(f"{what} {str(path)!r} is a directory; expected a file name")
@@ -44,7 +54,12 @@ def check_target(path, what: str = "output file", suffixes: tuple[str, ...] | No
 @contextlib.contextmanager
 def atomic_output(path, what: str = "output file") -> Iterator[Path]:
     """Yield a temporary path next to ``path``; on success it replaces ``path`` atomically, on any error it is
-    removed and ``path`` is left as it was. OS errors become one-line :class:`OutputError`."""
+    removed and ``path`` is left as it was. OS errors become one-line :class:`OutputError`.
+
+    Args:
+        path: The output file.
+        what: What it is, for messages.
+    """
     target = check_target(path, what)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".tmp{target.suffix}", dir=target.parent or ".")
     os.close(fd)
@@ -59,7 +74,13 @@ def atomic_output(path, what: str = "output file") -> Iterator[Path]:
 
 
 def save_figure(fig, path, dpi: int = 110) -> None:
-    """Save a matplotlib figure atomically, in the format its extension names."""
+    """Save a matplotlib figure atomically, in the format its extension names.
+
+    Args:
+        fig: The matplotlib figure.
+        path: The image file (PNG, PDF, SVG, ... by its extension).
+        dpi: Resolution of raster formats [dots per inch].
+    """
     target = check_target(path, "plot", IMAGE_FORMATS)
     with atomic_output(target, "plot") as tmp:
         fig.savefig(tmp, dpi=dpi, format=target.suffix.lower().lstrip("."))

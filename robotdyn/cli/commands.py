@@ -102,6 +102,15 @@ def _vector_text(name: str, rows: list[str], x: np.ndarray) -> str:
 
 # --------------------------------------------------------------------------------------------- commands
 def cmd_list(args) -> int:
+    """``robotdyn list``: the registered robots and their titles.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     from ..robots import module, names
 
     data = {n: module(n).SPEC.title for n in names()}
@@ -110,6 +119,15 @@ def cmd_list(args) -> int:
 
 
 def cmd_info(args) -> int:
+    """``robotdyn info ROBOT``: coordinates, independent velocities, mobility, parameters, actuators, constraints and scenarios.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     mod, robot = _load(args)
     info = robot.info()
     info["scenarios"] = {k: s.description for k, s in getattr(mod, "SCENARIOS", {}).items()}
@@ -141,6 +159,15 @@ def cmd_info(args) -> int:
 
 
 def cmd_dump(args) -> int:
+    """``robotdyn dump ROBOT``: the reduced model (M_r, h, g_r, B_r, S) at a state, and with ``--a``/``--tau`` the inverse or forward dynamics and the constraint forces.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     _, robot = _load(args)
     q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates, MAX_POSITION)
     for name, x in _numbers(args.set, "--set", "a value in m or rad").items():
@@ -230,6 +257,16 @@ def _numbers(items, option: str, expected: str) -> dict[str, float]:
 
 
 def cmd_simulate(args) -> int:
+    """``robotdyn simulate ROBOT --scenario NAME``: run a scenario; summary, CSV, plots and the traction check.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status (0 on success; 130 after an interruption whose partial results were kept). Errors raise
+        :class:`~robotdyn.errors.RobotDynError`, which :func:`~robotdyn.cli.commands.main` prints in one line with
+        status 2.
+    """
     from ..output import IMAGE_FORMATS, check_target
 
     # output paths checked before the run, so that a typo does not cost a simulation
@@ -275,16 +312,17 @@ def cmd_simulate(args) -> int:
             partial = traj.stats["partial"] = (partial + "; " if partial else "") + "traction not computed (interrupted)"
             tr = None
         if tr is not None and args.traction_plot:
-            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction")
+            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction",
+                          traj.robot or robot)
     elif args.mu is not None or args.traction_plot:
         raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
     if args.csv:
         traj.to_csv(args.csv, tr.columns() if tr is not None else None)
     if args.plot:
-        from ..interfaces.plotting import plot_trajectory
+        from ..interfaces.plotting import plot_trajectory, pose_columns
 
         plot_trajectory(traj, sc.plot or traj.velocity_names, args.plot, f"{args.robot}: {sc.name}", sc.zoom,
-                        sc.references)
+                        sc.references, pose_columns(traj.robot or robot, traj))
     drift = float(np.max(traj.residual)) if traj.residual.size else 0.0
     final = dict(zip(traj.coordinates + traj.velocity_names, np.concatenate([traj.q[-1], traj.nu[-1]])))
     out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,
@@ -405,6 +443,15 @@ def _interrupt(signum, frame):
 
 
 def cmd_compare(args) -> int:
+    """``robotdyn compare ROBOT``: the paper comparison table of a built-in robot.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     mod, robot = _load(args)
     if not hasattr(mod, "compare"):
         raise RobotDynError(f"robot {args.robot!r} has no paper comparison")
@@ -414,7 +461,16 @@ def cmd_compare(args) -> int:
 
 
 def cmd_view(args) -> int:
-    """The meshcat viewer: the robot (and a scenario's animation); a standalone HTML file or a live server."""
+    """The meshcat viewer: the robot (and a scenario's animation); a standalone HTML file or a live server.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0 (also when Ctrl-C stops the live server). Errors raise
+        :class:`~robotdyn.errors.RobotDynError`, which :func:`~robotdyn.cli.commands.main` prints in one line with
+        status 2.
+    """
     from ..interfaces.viewer import Viewer
 
     mod, robot = _load(args)
@@ -476,7 +532,11 @@ BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep", "lin
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The ``robotdyn`` parser; with ``only`` (one of :data:`BUILT_IN`), a parser holding that command alone (what
     :func:`main` needs to parse it: the others' parsers cost start-up time and change nothing of its parsing, help
-    or errors)."""
+    or errors).
+
+    Args:
+        only: One of :data:`BUILT_IN` (default ``None``: every command).
+    """
     if only is not None and only not in BUILT_IN:
         raise ValueError(f"only = {only!r}; expected one of {', '.join(BUILT_IN)}")
 
@@ -619,7 +679,14 @@ def _one_line_warnings() -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``robotdyn`` console script."""
+    """Entry point of the ``robotdyn`` console script.
+
+    Args:
+        argv: The arguments after the program name (default ``None``: ``sys.argv[1:]``).
+
+    Returns:
+        The exit status: 0 on success, 2 on a one-line error, 130 after Ctrl-C.
+    """
     _one_line_warnings()
     try:
         argv = sys.argv[1:] if argv is None else list(argv)

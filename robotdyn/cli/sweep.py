@@ -16,7 +16,12 @@ EXAMPLES = """examples:
 
 
 def register(sub, parents) -> None:
-    """Add ``sweep`` to the CLI's subparsers (``parents``: the common and robot arguments)."""
+    """Add ``sweep`` to the CLI's subparsers (``parents``: the common and robot arguments).
+
+    Args:
+        sub: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     import argparse
 
     p = sub.add_parser("sweep", parents=parents, help="parameter sweep on Dask, results in Parquet",
@@ -61,7 +66,11 @@ def register(sub, parents) -> None:
 
 
 def spec_from_args(args):
-    """The sweep spec of the command line: the ``--spec`` file, then the flags on top."""
+    """The sweep spec of the command line: the ``--spec`` file, then the flags on top.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+    """
     from ..inputs import parse_assignments
     from ..sweep.spec import SweepSpec, from_toml, parse_axis
 
@@ -80,6 +89,16 @@ def spec_from_args(args):
 
 
 def cmd_sweep(args) -> int:
+    """``robotdyn sweep``: run a parameter sweep and print its summary.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status (0 on success; 130 after an interruption whose partial results were kept). Errors raise
+        :class:`~robotdyn.errors.RobotDynError`, which :func:`~robotdyn.cli.commands.main` prints in one line with
+        status 2.
+    """
     import signal
     import threading
 

@@ -85,7 +85,11 @@ def _compiled_formulas(constraint, base: type) -> bool:
 
 
 def why_not(robot) -> str | None:
-    """Why ``robot`` cannot use the compiled path (``None``: it can)."""
+    """Why ``robot`` cannot use the compiled path (``None``: it can).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+    """
     if _compiled is None:
         return "the compiled extension robotdyn._compiled was not built"
     for i in range(1, robot.model.njoints):
@@ -261,7 +265,12 @@ class CompiledModel:
         self.select(checked(reference(self.robot, q, nu), q, nu).projection)
 
     def select(self, proj) -> None:
-        """Use the row choice (and independent velocities) of a Python projection from now on."""
+        """Use the row choice (and independent velocities) of a Python projection from now on.
+
+        Args:
+            proj: A projection of the Python path (:class:`~robotdyn.reduction.projection.Projection` or the
+                operational one).
+        """
         if proj is self._hint:
             return
         if self.operational is not None:
@@ -277,6 +286,10 @@ class CompiledModel:
         ``condition`` and ``inverse`` :math:`K^{-1}` for operational velocities, ``None`` otherwise (the exact
         condition number and :math:`A_d^{-1}` then come from :class:`LazyProjection`, on request).
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
         """
@@ -287,6 +300,10 @@ class CompiledModel:
     def compute(self, q: np.ndarray, nu: np.ndarray) -> tuple:
         """``(M_r, h, g_r, B_r, S, w, v)`` at (q, nu) without copies: read-only views of the evaluator's buffers,
         overwritten by the next call (copy what must be kept). The cheapest evaluation, e.g. inside an integrator.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
@@ -303,7 +320,13 @@ class CompiledModel:
     def reduced(self, q: np.ndarray, nu: np.ndarray, independent: np.ndarray | None = None):
         """The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu), or ``None`` where the Python path
         must decide (then call :meth:`select` with its projection): no projection chosen yet, other
-        ``independent`` velocity indices than the chosen ones, or a :meth:`evaluate` fallback."""
+        ``independent`` velocity indices than the chosen ones, or a :meth:`evaluate` fallback.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+            independent: Indices of the independent velocities in v (default ``None``: the chosen ones).
+        """
         hint = self._hint
         if hint is None or (independent is not None and independent is not getattr(hint, "independent", None)
                             and not np.array_equal(independent, hint.independent)):
@@ -324,6 +347,12 @@ class CompiledModel:
     def rhs(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray, stabilisation: float) -> np.ndarray:
         """:math:`(\\dot q, \\dot\\nu)` of :func:`robotdyn.simulation.engine.simulate`'s ODE in one call.
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+            tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+            stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
@@ -339,6 +368,11 @@ class CompiledModel:
         :math:`A_d` (the projection's own factorisation; operational velocities: its :math:`K^{-1}`) and zero on
         redundant rows (the basic solution: equal to any other on the rows rigid-body dynamics determine;
         :mod:`robotdyn.contact.contact_forces` reports the others).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+            tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
@@ -358,6 +392,12 @@ class CompiledModel:
         ``(lambda, e, (wheel forces, world forces, frames, points), A)`` as :meth:`forces` (copies), with the
         constraint rows A (rows in :attr:`labels`' order).
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            v: Full velocities (n,) [m/s, rad/s].
+            a: Full accelerations (n,) [m/s^2, rad/s^2].
+            tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
@@ -367,7 +407,12 @@ class CompiledModel:
 
     def evaluate_many(self, Q: np.ndarray, NU: np.ndarray) -> tuple:
         """Many states in one call: ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n),
-        B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path."""
+        B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path.
+
+        Args:
+            Q: Coordinates (N, n) [m, rad].
+            NU: Independent velocities (N, k).
+        """
         N, n = Q.shape
         k = NU.shape[1]
         Q, NU = np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float)

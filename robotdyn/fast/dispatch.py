@@ -28,7 +28,11 @@ def enabled() -> bool:
 
 @contextmanager
 def use_compiled(flag: bool):
-    """Turn the fast path on or off inside a ``with`` block (e.g. to compare it with the Python path)."""
+    """Turn the fast path on or off inside a ``with`` block (e.g. to compare it with the Python path).
+
+    Args:
+        flag: True: the compiled path where it serves; False: always the Python path.
+    """
     global _ENABLED
     old, _ENABLED = _ENABLED, bool(flag)
     try:
@@ -41,7 +45,11 @@ def compiled_model(robot) -> CompiledModel | None:
     """The robot's :class:`CompiledModel` for the calling thread (built once per thread; rebuilt when its
     constraints, their terrain, radius or friction law, or the model's gravity change), or ``None`` when the fast
     path is off or :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated
-    from several threads at once."""
+    from several threads at once.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+    """
     if not enabled():
         return None
     # one compiled model per thread: compute() returns views of its buffers, which another thread's call would
@@ -69,7 +77,15 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     """The reduced model of ``robot`` at (q, nu) (in its operational velocities if it has them): by the robot's
     compiled model where it serves, else (and to choose the projection's rows) by the Python reference
     (:func:`robotdyn.reduction.reduced_dynamics.reference`). ``coriolis`` (the matrix :math:`C_r`) is the Python
-    path's; ``independent`` overrides the independent velocity indices (not with operational velocities)."""
+    path's; ``independent`` overrides the independent velocity indices (not with operational velocities).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+        coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
+        independent: Indices of the independent velocities in v (default ``None``: the robot's).
+    """
     op = getattr(robot, "operational", None)
     fast = None if coriolis else compiled_model(robot)
     if fast is not None:

@@ -54,7 +54,11 @@ DONE, INTERRUPTED, FAILED = 0, 1, 3
 
 
 def native_profile(profile: TorqueProfile):
-    """The C++ object of a :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (``robotdyn._compiled.TorqueProfile``)."""
+    """The C++ object of a :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (``robotdyn._compiled.TorqueProfile``).
+
+    Args:
+        profile: The :class:`~robotdyn.simulation.torque_profile.TorqueProfile`.
+    """
     from .._compiled import TorqueProfile as Native
 
     kinds, coefs, pars = profile.encode()
@@ -121,6 +125,15 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
 def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     """Whether :func:`robotdyn.simulation.engine.simulate` runs on the compiled engine (see its docstring).
 
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        torque: The torque law (``None``, a profile, or a Python callable).
+        method: The integrator method asked for (``None``: the engine's default).
+        engine: ``auto``, ``compiled`` or ``scipy``.
+
+    Returns:
+        True for the compiled engine, False for scipy's.
+
     Raises:
         RobotDynError: An unknown engine or method, or ``engine="compiled"`` where it cannot run (naming why).
     """
@@ -156,7 +169,25 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
     """:func:`robotdyn.simulation.engine.simulate` on the compiled engine (:func:`run`), after its checks: a
     :class:`~robotdyn.simulation.trajectory.Trajectory` with ``stats["engine"]``. ``progress`` is the run's reporter
     (:class:`robotdyn.simulation.progress.Progress`: prints, and raises past the run's time limit). The run
-    starts at ``t0`` [s] and samples ``times`` (default ``n_out`` evenly spaced from t0 to t_end)."""
+    starts at ``t0`` [s] and samples ``times`` (default ``n_out`` evenly spaced from t0 to t_end).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        t_end: Final time [s].
+        q0: Initial coordinates (n,) [m, rad].
+        nu0: Initial independent velocities (k,).
+        torque: ``None`` or a :class:`~robotdyn.simulation.torque_profile.TorqueProfile`.
+        n_out: Number of evenly spaced output samples (unless ``times``).
+        rtol: Relative error tolerance.
+        atol: Absolute error tolerance per component.
+        method: One of :data:`METHODS` (``None``: adams).
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+        progress: The run's :class:`~robotdyn.simulation.progress.Progress` reporter.
+        offsets: Holonomic residuals kept as constant offsets, by row label [m or rad]
+            (:func:`robotdyn.reduction.pull_back.start_offsets`).
+        t0: Start time [s].
+        times: Output times [s] (increasing, t0 to t_end; default ``None``: ``n_out`` evenly spaced).
+    """
 
     profile = as_profile(torque, len(robot.motors))
     robot.forward_dynamics(q0, nu0, profile(t0))  # regular where the run starts (raises the Python path's error)
@@ -190,7 +221,12 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
 def rechooser(robot, fast=None):
     """The callback with which the C++ integrator asks the Python path for a new row choice at (q, nu), where the
     compiled one stops working: returns ``(rows, independent, dependent)`` of the Python projection there (and
-    makes ``fast``, if given, use it), or raises the Python path's error (e.g. a singular configuration)."""
+    makes ``fast``, if given, use it), or raises the Python path's error (e.g. a singular configuration).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        fast: The robot's compiled model, told to use the new choice (default ``None``).
+    """
     from ..fast.dispatch import use_compiled
 
     def rechoose(q: np.ndarray, nu: np.ndarray) -> tuple[list[int], list[int], list[int]]:

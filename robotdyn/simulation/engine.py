@@ -96,6 +96,18 @@ def simulate(
             ``sink.segment`` samples (memory bounded whatever the duration; any ``n_out`` >= 2) and returns a
             :class:`robotdyn.simulation.streaming.StreamResult` instead of a Trajectory (see
             :func:`robotdyn.simulation.streaming.stream`: the integrator restarts at each segment boundary).
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.simulation.engine import simulate
+        >>> from robotdyn.simulation.torque_profile import Constant
+        >>> robot = robotdyn.load("quasimoro")
+        >>> traj = simulate(robot, 1.0, robot.neutral(), [0.0, 0.0, 0.0], Constant([0.1, 0.1]), n_out=11,
+        ...                 progress=False)
+        >>> traj.q.shape, traj.nu.shape
+        ((11, 6), (11, 3))
+        >>> bool(abs(traj.energy[-1] - traj.energy[0]) > 0)  # the motors did work
+        True
     """
     if sink is not None:
         from .streaming import stream
@@ -306,7 +318,16 @@ def _velocity(robot, fast, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, n
 
 
 def power(robot, traj: Trajectory, torque: TorqueFunction | None) -> np.ndarray:
-    """Motor power :math:`\\tau^T B_r^T \\nu` [W] along a trajectory (dE/dt must equal it without friction)."""
+    """Motor power :math:`\\tau^T B_r^T \\nu` [W] along a trajectory (dE/dt must equal it without friction).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` simulated.
+        traj: Its :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        torque: The torque law ``tau(t, q, nu)`` it was simulated with (``None``: unactuated, zero power).
+
+    Returns:
+        The power at each sample (N,) [W].
+    """
     out = np.zeros(len(traj.t))
     if torque is None:
         return out

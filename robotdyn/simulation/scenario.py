@@ -41,7 +41,15 @@ class Scenario:
     references: dict[str, list[tuple[float, str]]] = field(default_factory=dict)
 
     def initial_state(self, robot) -> tuple[np.ndarray, np.ndarray]:
-        """(q0, nu0) as vectors for ``robot``."""
+        """(q0, nu0) as vectors for ``robot``.
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot` to run the scenario on.
+
+        Returns:
+            ``(q0, nu0)``: the neutral configuration with the scenario's ``q0`` entries set (n,) [m, rad], and the
+            independent velocities (k,) [m/s, rad/s], zero except the scenario's ``nu0`` entries.
+        """
         q0 = robot.neutral()
         for label, value in self.q0.items():
             q0[robot.coordinate_index(label)] = value
@@ -51,9 +59,21 @@ class Scenario:
         return q0, nu0
 
     def span(self, t_end: float | None = None, n_out: int | None = None, streamed: bool = False) -> tuple[float, int]:
-        """The duration [s] (default the scenario's; checked finite and positive) and the number of output samples
-        (default: the scenario's sampling rate over that duration), at most MAX_SAMPLES unless ``streamed`` (a run
-        written to a file in segments, :mod:`robotdyn.simulation.streaming`)."""
+        """The duration and the number of output samples of a run.
+
+        Args:
+            t_end: Duration [s] (default ``None``: the scenario's); must be finite and at least
+                :data:`~robotdyn.simulation.engine.MIN_DURATION`.
+            n_out: Number of output samples (default ``None``: the scenario's sampling rate over that duration).
+            streamed: The run is written to a file in segments (:mod:`robotdyn.simulation.streaming`): no upper bound
+                on the samples (else at most :data:`~robotdyn.simulation.engine.MAX_SAMPLES`).
+
+        Returns:
+            ``(t_end [s], n_out)``.
+
+        Raises:
+            RobotDynError: A duration or a number of samples out of range.
+        """
         from .engine import MAX_SAMPLES, MIN_DURATION
 
         t_end = self.t_end if t_end is None else float(t_end)
@@ -69,8 +89,32 @@ class Scenario:
         return t_end, int(n)
 
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs) -> Trajectory:
-        """Simulate the scenario on ``robot`` (keyword arguments go to :func:`~robotdyn.simulation.engine.simulate`;
-        with ``sink=`` the run streams to a file and returns a :class:`~robotdyn.simulation.streaming.StreamResult`)."""
+        """Simulate the scenario on ``robot`` from its initial state with its torques.
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot` (its motors in the order the scenario's torques use).
+            t_end: Duration [s] (default ``None``: the scenario's).
+            n_out: Number of output samples (default ``None``: the scenario's rate).
+            **kwargs: Passed to :func:`~robotdyn.simulation.engine.simulate` (``rtol``, ``engine``, ``progress``, ...);
+                with ``sink=`` the run streams to a file and returns a
+                :class:`~robotdyn.simulation.streaming.StreamResult`.
+
+        Returns:
+            The :class:`~robotdyn.simulation.trajectory.Trajectory`.
+
+        Raises:
+            RobotDynError: A duration or number of samples out of range, or a failing integration.
+
+        Example:
+            >>> import robotdyn
+            >>> from robotdyn.robots.quasimoro import model
+            >>> robot = robotdyn.load("quasimoro")
+            >>> traj = model.SCENARIOS["rectilinear"].run(robot, t_end=0.5, progress=False)
+            >>> float(traj.t[-1]), traj.q.shape[1], traj.velocity_names
+            (0.5, 6, ['theta1_dot', 'theta2_dot', 'theta3_dot'])
+            >>> bool(traj.column("x")[-1] > 0)  # it drove forward
+            True
+        """
         t_end, n_out = self.span(t_end, n_out, streamed=kwargs.get("sink") is not None)
         q0, nu0 = self.initial_state(robot)
         return simulate(robot, t_end, q0, nu0, self.torque, n_out=n_out, **kwargs)

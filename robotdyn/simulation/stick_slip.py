@@ -67,12 +67,19 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` with :class:`StickSlipWheel` constraints.
         t_end: Duration [s] (> 0).
-        q0: Initial natural coordinates; v0: initial full velocities (n,) (each wheel starts sliding where its
-            slip speed exceeds 1e-9 m/s, else sticking; a sticking wheel outside its cone starts sliding).
+        q0: Initial natural coordinates (n,) [m, rad].
+        v0: Initial full velocities (n,) [m/s, rad/s] (each wheel starts sliding where its slip speed exceeds
+            1e-9 m/s, else sticking; a sticking wheel outside its cone starts sliding).
         torque: Motor torques ``tau(t, q, nu)`` (None: unactuated); nu are the current phase's independent
             velocities, so torque laws should use q (or the returned full velocities) only.
         max_switches: Bound on the number of phase switches (Zeno behaviour stops the run with a message).
         time_limit: Wall-clock limit [s] (None: none), as in :func:`robotdyn.simulation.engine.simulate`.
+        n_out: Number of output samples.
+        rtol: Relative error tolerance of the integrator.
+        atol: Absolute error tolerance per component.
+        method: The ``scipy.integrate.solve_ivp`` method.
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+        progress: Print progress to stderr on long runs.
 
     Returns:
         A :class:`~robotdyn.simulation.trajectory.Trajectory` whose velocity columns are the full velocities v (named

@@ -27,7 +27,18 @@ OUTPUT_UNITS = {"t_reached": "s", "energy.start": "J", "energy.end": "J", "energ
 @dataclass
 class Plan:
     """A checked sweep: the runs, their shared :class:`~robotdyn.sweep.chunk.RunContext`, the resolved axes,
-    the results' pyarrow schema, units by column and each scenario's (duration, samples)."""
+    the results' pyarrow schema, units by column and each scenario's (duration, samples).
+
+    Attributes:
+        spec: The :class:`~robotdyn.sweep.spec.SweepSpec`.
+        robot: The robot's name.
+        context: The :class:`~robotdyn.sweep.chunk.RunContext` every run shares.
+        axes: The resolved axes (plain values in the parameters' units).
+        runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
+        schema: The results' pyarrow schema.
+        units: Unit of each result column by name.
+        spans: (duration [s], samples) of each scenario by name.
+    """
 
     spec: SweepSpec
     robot: str
@@ -42,7 +53,11 @@ class Plan:
         return f"Plan({self.robot!r}, runs={len(self.runs)}, axes={[a.name for a in self.axes]})"
 
     def inputs(self, run: RunInput) -> dict:
-        """The input columns of a run's row."""
+        """The input columns of a run's row.
+
+        Args:
+            run: The :class:`~robotdyn.sweep.spec.RunInput`.
+        """
         return {"run_id": run.run_id, "run_index": run.index, "robot": self.robot, "scenario": run.scenario,
                 "terrain": run.terrain, "torque_scale": run.torque_scale, "t_end": self.spans[run.scenario][0],
                 **{k: v for k, v in run.params if k != TORQUE_SCALE}}
@@ -111,7 +126,14 @@ def _terrain(mod, item, scenarios) -> tuple[str, tuple]:
 
 
 def plan(spec: SweepSpec) -> Plan:
-    """Check ``spec`` against its robot and list its runs (see the module docstring)."""
+    """Check ``spec`` against its robot and list its runs (see the module docstring).
+
+    Args:
+        spec: The :class:`~robotdyn.sweep.spec.SweepSpec`.
+
+    Returns:
+        The :class:`Plan`.
+    """
     from ..fast.dispatch import enabled
 
     import robotdyn

@@ -48,7 +48,22 @@ load_trajectory = sweep_store.load_trajectory
 
 @dataclass
 class SweepResult:
-    """What a sweep did: its directory, the results table (pyarrow; :meth:`frame` for pandas), counts."""
+    """What a sweep did: its directory, the results table (pyarrow; :meth:`frame` for pandas), counts.
+
+    Attributes:
+        out: The sweep directory.
+        table: The results (pyarrow table, one row per run in run order).
+        total: Number of runs of the sweep.
+        computed: Runs computed by this call.
+        resumed: Runs found finished on disk.
+        wall: Wall time [s].
+        plot: The summary plot's path (``None``: not written).
+        interrupted: Why the sweep stopped early (``None``: it finished).
+        statuses: Number of runs by status (ok, stopped, error).
+        batched: Runs simulated as variants of one compiled model.
+        notes: Lines on which runs were built one at a time and why.
+        phases: Wall time [s] of each phase (plan, compute, ...).
+    """
 
     out: Path
     table: object
@@ -227,6 +242,16 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     Returns:
         A :class:`SweepResult`; after an interruption (Ctrl-C) it holds what was finished, with ``interrupted``
         saying so: running the same sweep again resumes.
+
+    Example:
+        >>> from robotdyn.sweep import load, run
+        >>> from robotdyn.sweep.spec import SweepSpec, parse_axis
+        >>> spec = SweepSpec(robot="quasimoro", axes=[parse_axis("M=4:6:3")], t_end=0.2)
+        >>> result = run(spec, "sweep_out", workers=0, progress=False, plot=False)
+        >>> result.total, result.statuses
+        (3, {'ok': 3, 'stopped': 0, 'error': 0})
+        >>> load("sweep_out").sort_values("M")["M"].tolist()
+        [4.0, 5.0, 6.0]
     """
     if batch not in MODES:
         raise RobotDynError(f"batch = {batch!r}; expected one of {', '.join(MODES)}")

@@ -28,7 +28,12 @@ RESULTS = "results.parquet"
 
 def schema(fields: list[tuple[str, str, str]], metadata: dict | None = None):
     """A pyarrow schema from (column, type, unit) triples, type one of ``float``, ``int``, ``str``; each field
-    carries its unit in its metadata (``unit``)."""
+    carries its unit in its metadata (``unit``).
+
+    Args:
+        fields: (column, type, unit) triples.
+        metadata: Schema-level metadata (default ``None``).
+    """
     import pyarrow as pa
 
     types = {"float": pa.float64(), "int": pa.int64(), "str": pa.string()}
@@ -37,7 +42,11 @@ def schema(fields: list[tuple[str, str, str]], metadata: dict | None = None):
 
 
 def prepare(out) -> Path:
-    """Create the sweep directory (and ``runs/``); an existing file in the way is a one-line error."""
+    """Create the sweep directory (and ``runs/``); an existing file in the way is a one-line error.
+
+    Args:
+        out: The sweep directory.
+    """
     out = Path(out)
     try:
         (out / RUNS).mkdir(parents=True, exist_ok=True)
@@ -54,7 +63,14 @@ def _write(table, path: Path, what: str) -> None:
 
 
 def write_chunk(out: Path, rows: list[dict], trajectories: list[dict | None], schema) -> Path:
-    """Write a finished chunk: its trajectories (if any), then its row file; returns the row file's path."""
+    """Write a finished chunk: its trajectories (if any), then its row file; returns the row file's path.
+
+    Args:
+        out: The sweep directory.
+        rows: The chunk's result rows.
+        trajectories: Each row's trajectory columns (``None``: not kept).
+        schema: The results' pyarrow schema (:func:`schema`).
+    """
     import pyarrow as pa
 
     for row, traj in zip(rows, trajectories):
@@ -74,7 +90,11 @@ def _parts(out: Path) -> list[Path]:
 
 
 def finished(out: Path) -> dict[str, str]:
-    """The runs with a row on disk: run_id -> status (``ok``, ``stopped`` or ``error``)."""
+    """The runs with a row on disk: run_id -> status (``ok``, ``stopped`` or ``error``).
+
+    Args:
+        out: The sweep directory.
+    """
     import pyarrow.parquet as pq
 
     done: dict[str, str] = {}
@@ -90,7 +110,13 @@ def finished(out: Path) -> dict[str, str]:
 
 def consolidate(out: Path, order: dict[str, int], schema):
     """Gather this sweep's rows (the run ids in ``order``) from the row files, sorted by run order, and write
-    them to ``results.parquet``; returns the table."""
+    them to ``results.parquet``; returns the table.
+
+    Args:
+        out: The sweep directory.
+        order: Run index by run id (the runs of this sweep).
+        schema: The results' pyarrow schema (:func:`schema`).
+    """
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
@@ -112,12 +138,25 @@ def consolidate(out: Path, order: dict[str, int], schema):
 
 
 def write_json(path: Path, data: dict) -> None:
+    """Write ``data`` as indented JSON to ``path``, atomically.
+
+    Args:
+        path: The JSON file.
+        data: The data (non-JSON values written as strings).
+    """
     with atomic_output(path, "sweep description") as tmp:
         tmp.write_text(json.dumps(data, indent=2, default=str))
 
 
 def load(out):
-    """A sweep's results as a pandas DataFrame (one row per run, in run order)."""
+    """A sweep's results as a pandas DataFrame (one row per run, in run order).
+
+    Args:
+        out: A sweep directory written by ``robotdyn sweep`` (or :func:`robotdyn.sweep.runner.run`).
+
+    Returns:
+        A pandas DataFrame.
+    """
     import pyarrow.parquet as pq
 
     path = Path(out) / RESULTS
@@ -127,7 +166,12 @@ def load(out):
 
 
 def load_trajectory(out, run_id: str):
-    """One run's trajectory (t, coordinates, velocities, energy, residual) as a pandas DataFrame."""
+    """One run's trajectory (t, coordinates, velocities, energy, residual) as a pandas DataFrame.
+
+    Args:
+        out: A sweep directory run with ``--trajectories``.
+        run_id: The run's id (``run_id`` column).
+    """
     import pyarrow.parquet as pq
 
     path = Path(out) / TRAJECTORIES / f"run_id={run_id}" / "part-0.parquet"

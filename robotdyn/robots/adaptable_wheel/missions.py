@@ -58,9 +58,17 @@ class IKRun:
     """Inverse kinematics along a mission (one row per time step).
 
     Attributes:
-        t: Times [s]. beta, q: (N, 3) eq 16's unknowns per wheel (fr, fl, r) [rad]. RT: (N, 3) radii [m].
-        error: (N,) ||C|| (eq 24). yaw: (N,) q_zd [rad]. cg: (N, 3) CG position [m].
-        contacts: (N, 3, 3) contact points [m]. nfev: (N,) residual evaluations of the root finder.
+        mission: The :class:`Mission` solved.
+        t: Times (N,) [s].
+        beta: (N, 3) eq 16's contact angles per wheel (fr, fl, r) [rad].
+        q: (N, 3) eq 16's adjustment angles per wheel (fr, fl, r) [rad].
+        RT: (N, 3) total wheel radii [m].
+        error: (N,) ||C|| (eq 24).
+        yaw: (N,) q_zd [rad].
+        cg: (N, 3) CG position [m], world frame.
+        contacts: (N, 3, 3) contact points [m], world frame.
+        nfev: (N,) residual evaluations of the root finder.
+        commands: The :class:`~robotdyn.robots.adaptable_wheel.paper.Commands` of each step.
     """
 
     mission: Mission
@@ -80,6 +88,14 @@ def run_mission(mission: Mission | str, params: dict | None = None, tol: float =
     """Inverse kinematics at every step of a mission (the flowchart of Fig. 8).
 
     Each step solves eq 15 by :func:`solve_ik` from the previous step's solution and updates q_zd by eqs 18-23.
+
+    Args:
+        mission: A :class:`Mission` or its name (:data:`MISSIONS`).
+        params: Parameter overrides (default ``None``).
+        tol: Required ||C|| of each step's IK (eq 24).
+
+    Returns:
+        The :class:`IKRun`.
 
     Raises:
         MechanismRangeError, ConstraintError: as :func:`solve_ik`, with the time of the failing step.

@@ -134,15 +134,17 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     if engine == "scipy" or (method is not None and engine == "auto"):
         return False
     reason = None
+    fast = None if stick_slip_wheels(robot) else compiled_model(robot)
     if stick_slip_wheels(robot):
         reason = "stick-slip wheels (exact switching) are simulated on the Python path"
-    elif compiled_model(robot) is None:
+    elif fast is None:
         from ..fast.dispatch import enabled
         from ..fast.compiled import why_not
 
-        reason = why_not(robot) if enabled() else "the compiled fast path is turned off (ROBOTDYN_COMPILED=0)"
-    elif compiled_model(robot).slip_refusal is not None:
-        reason = compiled_model(robot).slip_refusal
+        reason = why_not(robot) if enabled() else ("the compiled fast path is turned off (ROBOTDYN_COMPILED=0 or "
+                                                   "use_compiled(False))")
+    elif fast.slip_refusal is not None:
+        reason = fast.slip_refusal
     elif torque is not None and not isinstance(torque, TorqueProfile):
         reason = ("the torques are a Python function; give a robotdyn.simulation.torque_profile.TorqueProfile (constant, sine, "
                   "table) to run them compiled")

@@ -230,6 +230,13 @@ def _numbers(items, option: str, expected: str) -> dict[str, float]:
 
 
 def cmd_simulate(args) -> int:
+    from .time_limit import wall_clock_limit
+
+    with wall_clock_limit(getattr(args, "time_limit", None)) as limit:  # robotdyn.cli.time_limit: a partial run past it
+        return _simulate(args, limit)
+
+
+def _simulate(args, limit) -> int:
     from ..output import IMAGE_FORMATS, check_target
 
     # output paths checked before the run, so that a typo does not cost a simulation
@@ -256,7 +263,8 @@ def cmd_simulate(args) -> int:
 
     if args.csv and not (args.plot or args.traction_plot) and sc.span(args.t_end, None, streamed=True)[1] > SEGMENT \
             and not stick_slip_wheels(robot):
-        return _simulate_streamed(args, robot, sc, extra)  # more samples than a segment: to disk as they come
+        return _simulate_streamed(args, robot, sc, extra, limit)  # more samples than a segment: to disk as they come
+    limit.start()
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")
     tr = None
@@ -278,6 +286,10 @@ def cmd_simulate(args) -> int:
             plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction")
     elif args.mu is not None or args.traction_plot:
         raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
+    limit.stop()
+    partial = limit.reason(partial)
+    if partial:  # the CSV file's marker says why the run stopped
+        traj.stats["partial"] = partial
     if args.csv:
         traj.to_csv(args.csv, tr.columns() if tr is not None else None)
     if args.plot:
@@ -308,12 +320,12 @@ def cmd_simulate(args) -> int:
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
             f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
             + ("; ..." if len(switches) > 10 else ""))
-    return _finish_run(args, out, text, traj.stats, partial, [args.csv, args.plot, args.traction_plot])
+    return _finish_run(args, out, text, traj.stats, partial, [args.csv, args.plot, args.traction_plot], limit)
 
 
-def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | None, written: list) -> int:
+def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | None, written: list, limit) -> int:
     """The end of ``simulate``'s report, in memory or streamed: constant offsets, an event that stopped the run, the
-    files written and a partial run's note (stderr, exit status 130)."""
+    files written and a partial run's note (stderr, exit status 130; 124 past ``--time-limit``)."""
     if "offsets" in stats:  # holonomic residuals no coordinate can change (robotdyn.reduction.pull_back)
         out["constant_offsets"] = stats["offsets"]
     if "event" in stats:
@@ -327,11 +339,11 @@ def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | No
     _emit(args, out, "\n".join(text))
     if partial:
         print(f"robotdyn: {partial}; wrote the partial results: {', '.join(written) or 'nothing'}", file=sys.stderr)
-        return 130
+        return limit.status
     return 0
 
 
-def _simulate_streamed(args, robot, sc, extra: dict) -> int:
+def _simulate_streamed(args, robot, sc, extra: dict, limit) -> int:
     """``simulate --csv`` of a run longer than one segment (robotdyn.simulation.streaming): the samples go to the
     CSV file segment by segment, with the wheel-load columns; only the ends and extremes stay in memory."""
     from ..simulation.streaming import SEGMENT, CsvSink
@@ -354,9 +366,11 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
             events.setdefault((e.kind, e.wheel), e)
         return tr.columns()
 
+    limit.start()
     res = sc.run(robot, t_end=args.t_end, progress=not args.quiet,
                  sink=CsvSink(args.csv, columns if has_wheels else None, SEGMENT), **extra)
-    partial = res.stats.get("partial")
+    limit.stop()
+    partial = limit.reason(res.stats.get("partial"))
     final = dict(zip(res.coordinates + res.velocity_names, np.concatenate([res.q, res.nu])))
     out = {"scenario": sc.name, "t_end": res.t, "samples": res.samples, "final": final, "streamed": True,
            "segments": res.stats["segments"], "energy_start": res.energy_start, "energy_end": res.energy_end,
@@ -375,7 +389,7 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
                            "events": [vars(e) for e in first]}
         text.append(f"loads {min(p[0] for p in peaks.values()):.4g} N minimum"
                     + (f"; first: {first[0]}" if first else "; no lift-off or slip"))
-    return _finish_run(args, out, text, res.stats, partial, [args.csv])
+    return _finish_run(args, out, text, res.stats, partial, [args.csv], limit)
 
 
 def _nonnegative(text: str) -> float:
@@ -561,6 +575,9 @@ def _add_simulate(sub, parents) -> None:
                    help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
     p.add_argument("--traction-plot", metavar="FILE",
                    help="save the wheel loads and required friction against time to this image file")
+    p.add_argument("--time-limit", type=_duration, default=None, metavar="SECONDS",
+                   help="wall-clock limit of the run: past it the run stops, the samples so far are written as a "
+                        "marked partial file, and the exit status is 124 (Ctrl-C/SIGTERM: 130)")
     p.set_defaults(func=cmd_simulate)
 
 

@@ -137,6 +137,7 @@ def simulate(
     if not t0:  # a continuation starts where the earlier run ended (its drift is reported, not refused)
         robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
+    stiff_slip_warning(robot, t_end - t0)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
     if stick_slip_wheels(robot):  # exact switching: segment by segment
         if t0 or times is not None:
@@ -244,6 +245,41 @@ def simulate(
         stats["offsets"] = offsets
     return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
                       robot.units, sol.y[n + k][: len(times)] if slipping else None, robot, torque)
+
+
+MAX_STEPS = 1e8
+"""Integration steps beyond which :func:`stiff_slip_warning` warns (hours of wall time on either engine)."""
+
+
+def stiff_slip_warning(robot, duration: float) -> None:
+    """Warn (:class:`~robotdyn.errors.RobotDynWarning`) where a slipping wheel's friction law is so stiff that the
+    run needs more than :data:`MAX_STEPS` steps. Near zero slip a law's force per unit load grows as :math:`k s`
+    (:class:`~robotdyn.contact.friction.LinearTyre`: k its stiffness [s/m];
+    :class:`~robotdyn.contact.friction.RegularisedCoulomb`: :math:`k = \\mu / v_s`), so a wheel carrying its share
+    m of the weight (load m g) relaxes its slip at the rate :math:`k g` [1/s] at least (its own spin inertia only
+    makes the mode faster). An explicit (or Adams) stepper needs steps of about :math:`1/(k g)`: a run of T seconds
+    at least :math:`k g T` of them (e.g. k = 1e12 s/m: 1e13 steps a second, a run that never ends)."""
+    import warnings
+
+    from ..errors import RobotDynWarning
+
+    g = float(np.linalg.norm(robot.model.gravity.linear))
+    stiff = {}
+    for wheel in slipping_wheels(robot):
+        law = getattr(wheel, "law", None)
+        k = getattr(law, "stiffness", None)
+        if k is None and getattr(law, "slip_velocity", None):
+            k = law.mu / law.slip_velocity
+        if k and k * g * duration > MAX_STEPS:
+            stiff[wheel.name] = k
+    if stiff:
+        k = max(stiff.values())
+        warnings.warn(RobotDynWarning(
+            f"wheel(s) {', '.join(stiff)}: a friction law's slope up to k = {k:.3g} s/m relaxes slip at k g = "
+            f"{k * g:.3g} 1/s, so a run of {duration:g} s needs at least {k * g * duration:.2g} integration steps "
+            f"and will not end in a useful time (simulate --time-limit bounds it); expected k <= "
+            f"{MAX_STEPS / (g * duration):.3g} s/m for this duration (a lower stiffness, a larger slip_velocity) or "
+            "friction = 'rolling'"), stacklevel=3)
 
 
 def _timed(rhs):

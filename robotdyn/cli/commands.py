@@ -263,10 +263,18 @@ def cmd_simulate(args) -> int:
         args: The parsed command line (``argparse.Namespace``).
 
     Returns:
-        The exit status (0 on success; 130 after an interruption whose partial results were kept). Errors raise
+        The exit status (0 on success; 130 after an interruption, 124 past ``--time-limit``, whose partial results were kept). Errors raise
         :class:`~robotdyn.errors.RobotDynError`, which :func:`~robotdyn.cli.commands.main` prints in one line with
         status 2.
     """
+    from .time_limit import wall_clock_limit
+
+    with wall_clock_limit(getattr(args, "time_limit", None)) as limit:  # robotdyn.cli.time_limit: a partial run past it
+        return _simulate(args, limit)
+
+
+def _simulate(args, limit) -> int:
+    """:func:`cmd_simulate` inside its wall-clock ``limit`` (:mod:`robotdyn.cli.time_limit`)."""
     from ..output import IMAGE_FORMATS, check_target
 
     # output paths checked before the run, so that a typo does not cost a simulation
@@ -293,7 +301,8 @@ def cmd_simulate(args) -> int:
 
     if args.csv and not (args.plot or args.traction_plot) and sc.span(args.t_end, None, streamed=True)[1] > SEGMENT \
             and not stick_slip_wheels(robot):
-        return _simulate_streamed(args, robot, sc, extra)  # more samples than a segment: to disk as they come
+        return _simulate_streamed(args, robot, sc, extra, limit)  # more samples than a segment: to disk as they come
+    limit.start()
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")
     tr = None
@@ -316,6 +325,10 @@ def cmd_simulate(args) -> int:
                           traj.robot or robot)
     elif args.mu is not None or args.traction_plot:
         raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
+    limit.stop()
+    partial = limit.reason(partial)
+    if partial:  # the CSV file's marker says why the run stopped
+        traj.stats["partial"] = partial
     if args.csv:
         traj.to_csv(args.csv, tr.columns() if tr is not None else None)
     if args.plot:
@@ -346,12 +359,12 @@ def cmd_simulate(args) -> int:
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
             f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
             + ("; ..." if len(switches) > 10 else ""))
-    return _finish_run(args, out, text, traj.stats, partial, [args.csv, args.plot, args.traction_plot])
+    return _finish_run(args, out, text, traj.stats, partial, [args.csv, args.plot, args.traction_plot], limit)
 
 
-def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | None, written: list) -> int:
+def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | None, written: list, limit) -> int:
     """The end of ``simulate``'s report, in memory or streamed: constant offsets, an event that stopped the run, the
-    files written and a partial run's note (stderr, exit status 130)."""
+    files written and a partial run's note (stderr, exit status 130; 124 past ``--time-limit``)."""
     if "offsets" in stats:  # holonomic residuals no coordinate can change (robotdyn.reduction.pull_back)
         out["constant_offsets"] = stats["offsets"]
     if "event" in stats:
@@ -365,11 +378,11 @@ def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | No
     _emit(args, out, "\n".join(text))
     if partial:
         print(f"robotdyn: {partial}; wrote the partial results: {', '.join(written) or 'nothing'}", file=sys.stderr)
-        return 130
+        return limit.status
     return 0
 
 
-def _simulate_streamed(args, robot, sc, extra: dict) -> int:
+def _simulate_streamed(args, robot, sc, extra: dict, limit) -> int:
     """``simulate --csv`` of a run longer than one segment (robotdyn.simulation.streaming): the samples go to the
     CSV file segment by segment, with the wheel-load columns; only the ends and extremes stay in memory."""
     from ..simulation.streaming import SEGMENT, CsvSink
@@ -392,9 +405,11 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
             events.setdefault((e.kind, e.wheel), e)
         return tr.columns()
 
+    limit.start()
     res = sc.run(robot, t_end=args.t_end, progress=not args.quiet,
                  sink=CsvSink(args.csv, columns if has_wheels else None, SEGMENT), **extra)
-    partial = res.stats.get("partial")
+    limit.stop()
+    partial = limit.reason(res.stats.get("partial"))
     final = dict(zip(res.coordinates + res.velocity_names, np.concatenate([res.q, res.nu])))
     out = {"scenario": sc.name, "t_end": res.t, "samples": res.samples, "final": final, "streamed": True,
            "segments": res.stats["segments"], "energy_start": res.energy_start, "energy_end": res.energy_end,
@@ -413,7 +428,7 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
                            "events": [vars(e) for e in first]}
         text.append(f"loads {min(p[0] for p in peaks.values()):.4g} N minimum"
                     + (f"; first: {first[0]}" if first else "; no lift-off or slip"))
-    return _finish_run(args, out, text, res.stats, partial, [args.csv])
+    return _finish_run(args, out, text, res.stats, partial, [args.csv], limit)
 
 
 def _nonnegative(text: str) -> float:
@@ -627,6 +642,9 @@ def _add_simulate(sub, parents) -> None:
                    help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
     p.add_argument("--traction-plot", metavar="FILE",
                    help="save the wheel loads and required friction against time to this image file")
+    p.add_argument("--time-limit", type=_duration, default=None, metavar="SECONDS",
+                   help="wall-clock limit of the run: past it the run stops, the samples so far are written as a "
+                        "marked partial file, and the exit status is 124 (Ctrl-C/SIGTERM: 130)")
     p.set_defaults(func=cmd_simulate)
 
 

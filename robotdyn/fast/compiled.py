@@ -27,9 +27,12 @@ the Python path on every robot.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from ..constraints.constraint import ConstraintRows, KinematicState
+from ..errors import RobotDynError
 from ..constraints.joint_coupling import CosineLaw, JointCoupling
 from ..constraints.loop_closure import LoopClosure
 from ..reduction.operational_space import OperationalProjection
@@ -152,8 +155,18 @@ def _placement(M) -> np.ndarray:
     return np.hstack([M.rotation, M.translation[:, None]])
 
 
+class ThreadError(RobotDynError):
+    """A :class:`CompiledModel` used from a thread other than the one that built it."""
+
+
 class CompiledModel:
     """A robot's reduced model as one C++ object (build with :func:`compiled_model`).
+
+    A compiled model belongs to the thread that built it: its evaluations write into the evaluator's own buffers and
+    :meth:`compute` and :meth:`forces` return views of them, which a call from another thread would overwrite while
+    the first still reads them (a lock could not protect views that outlive the call). Every evaluation from
+    another thread therefore raises :class:`ThreadError` in one line; each thread gets its own model from
+    :func:`robotdyn.fast.dispatch.compiled_model`.
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` for which :func:`why_not` is ``None``.
@@ -165,6 +178,7 @@ class CompiledModel:
     def __init__(self, robot) -> None:
         model = robot.model
         self.robot = robot
+        self.owner = threading.get_ident()  # the thread that may evaluate it (see the class docstring)
         self.constraints = list(robot.constraints)
         kinds, parents, placements, axes, inertias = [], [], [], [], []
         for i in range(1, model.njoints):
@@ -236,6 +250,13 @@ class CompiledModel:
     def __repr__(self) -> str:
         return f"CompiledModel({self.robot.spec.name!r}, nv={self.ev.nv}, rows={self.ev.nrows})"
 
+    def _mine(self) -> None:
+        """Refuse a call from a thread that does not own the model (:class:`ThreadError`)."""
+        if threading.get_ident() != self.owner:
+            raise ThreadError(f"compiled model of {self.robot.spec.name} used from a thread that did not build it "
+                              "(its buffers are the building thread's); expected one model per thread: call "
+                              "robotdyn.fast.dispatch.compiled_model(robot) in each thread")
+
     def _check_model(self) -> None:
         """The rebuilt model must give Pinocchio's M, g and RNEA of the robot's model at a random state."""
         import pinocchio as pin
@@ -271,6 +292,7 @@ class CompiledModel:
             proj: A projection of the Python path (:class:`~robotdyn.reduction.projection.Projection` or the
                 operational one).
         """
+        self._mine()
         if proj is self._hint:
             return
         if self.operational is not None:
@@ -293,6 +315,7 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         return self.ev.evaluate(q, nu)
@@ -308,6 +331,7 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         generation = self._compute(q, nu)
@@ -327,6 +351,7 @@ class CompiledModel:
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
             independent: Indices of the independent velocities in v (default ``None``: the chosen ones).
         """
+        self._mine()
         hint = self._hint
         if hint is None or (independent is not None and independent is not getattr(hint, "independent", None)
                             and not np.array_equal(independent, hint.independent)):
@@ -356,6 +381,7 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         return self.ev.rhs(q, nu, tau, stabilisation)
@@ -377,6 +403,7 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         generation = self.ev.forces(q, nu, tau)
@@ -401,6 +428,7 @@ class CompiledModel:
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, np.zeros(self.robot.mobility))
         return self.ev.forces_at(q, v, a, tau)
@@ -413,6 +441,7 @@ class CompiledModel:
             Q: Coordinates (N, n) [m, rad].
             NU: Independent velocities (N, k).
         """
+        self._mine()
         N, n = Q.shape
         k = NU.shape[1]
         Q, NU = np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float)
@@ -420,4 +449,4 @@ class CompiledModel:
         return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
 
 
-__all__ = ["Fallback", "CompiledModel", "LazyProjection", "why_not", "available"]
+__all__ = ["Fallback", "CompiledModel", "ThreadError", "LazyProjection", "why_not", "available"]

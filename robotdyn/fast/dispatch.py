@@ -5,40 +5,47 @@ Every evaluation that has a compiled form asks this module: :func:`reduce` (the 
 back to the Python reference of :mod:`robotdyn.reduction` (which also chooses the projection's rows the compiled
 model then uses); the simulation engines, the constraint forces and the many-run/batch evaluators ask
 :func:`compiled_model` for the robot's compiled model (``None``: take the Python path). ``ROBOTDYN_COMPILED=0`` in
-the environment, or :func:`use_compiled` ``(False)`` in a ``with`` block, turns the fast path off everywhere.
+the environment turns the fast path off everywhere; :func:`use_compiled` ``(False)`` in a ``with`` block turns it off
+for the calls made inside that block only: the switch is a :class:`contextvars.ContextVar`, so it belongs to the
+calling thread (or asyncio task), and a block in one thread never changes what another thread evaluates.
 """
 
 from __future__ import annotations
 
 import os
+import threading
 from contextlib import contextmanager
+from contextvars import ContextVar
 
 import numpy as np
 
 from ..reduction.reduced_dynamics import ReducedDynamics, reference
 from .compiled import CompiledModel, available, why_not
 
-_ENABLED = os.environ.get("ROBOTDYN_COMPILED", "1") != "0"
+_DEFAULT = os.environ.get("ROBOTDYN_COMPILED", "1") != "0"
+"""Whether the fast path is on where no :func:`use_compiled` block says otherwise (``ROBOTDYN_COMPILED``)."""
+_ENABLED: ContextVar[bool] = ContextVar("robotdyn_compiled", default=_DEFAULT)
+"""The switch of :func:`use_compiled`: context-local (a new thread starts from :data:`_DEFAULT`)."""
 
 
 def enabled() -> bool:
-    """Whether the fast path is used where a robot allows it (built, and not turned off)."""
-    return _ENABLED and available()
+    """Whether the fast path is used where a robot allows it (built, and not turned off in this thread's context)."""
+    return _ENABLED.get() and available()
 
 
 @contextmanager
 def use_compiled(flag: bool):
-    """Turn the fast path on or off inside a ``with`` block (e.g. to compare it with the Python path).
+    """Turn the fast path on or off for the calls made inside a ``with`` block (e.g. to compare it with the Python
+    path). Context-local: other threads, and code after the block, are unaffected.
 
     Args:
         flag: True: the compiled path where it serves; False: always the Python path.
     """
-    global _ENABLED
-    old, _ENABLED = _ENABLED, bool(flag)
+    token = _ENABLED.set(bool(flag))
     try:
         yield
     finally:
-        _ENABLED = old
+        _ENABLED.reset(token)
 
 
 def compiled_model(robot) -> CompiledModel | None:
@@ -57,7 +64,8 @@ def compiled_model(robot) -> CompiledModel | None:
     local = getattr(robot, "_local", None)
     cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
     gravity = robot.model.gravity.linear
-    if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
+    if cached is not None and (cached[3] is None or cached[3].owner == threading.get_ident()) \
+            and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
         getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r and getattr(c, "law", None) is law
         for c, (t, r, law) in zip(robot.constraints, cached[2])
     ):

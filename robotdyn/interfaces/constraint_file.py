@@ -344,6 +344,7 @@ class ConstraintFile:
             message = automatic_independent_message(robot, self.path)
             if message:
                 warnings.warn(message, RobotDynWarning, stacklevel=2)
+        held = _sliding_rows(robot)  # stick-slip wheels: counted sliding, their freest phase
         if independent:  # more independent velocities than the constraints leave free cannot be independent
             A = robot.rows_at(robot.neutral()).A
             free = robot.nq - (int(np.linalg.matrix_rank(A)) if A.size else 0)
@@ -352,9 +353,10 @@ class ConstraintFile:
                     f"{self.path}: independent: {len(independent)} coordinates ({', '.join(independent)}) but the "
                     f"constraints leave {free} velocities free at the neutral configuration (n = {robot.nq}, rank A = "
                     f"{robot.nq - free}); expected at most {free}")
+        held.restore()
         for i, sc in enumerate(self.SCENARIOS.values()):
             for name in sc.nu0:
-                if name not in robot.velocity_names:
+                if name not in robot.velocity_names and not (held.wheels and name in robot.velocity_labels):
                     raise ConstraintFileError(
                         f"{self.path}: scenarios[{i}] ({sc.name}): nu0 {name.removesuffix('_dot')!r} is not an "
                         "independent velocity; expected one of "
@@ -393,6 +395,24 @@ def automatic_independent_message(robot: Robot, path: str | Path) -> str:
             "automatically: best conditioned at the neutral configuration); to choose them, add independent = "
             f"[{', '.join(repr(c) for c in (suggestion or chosen))}]")
     return text + (" (the motor joints)" if suggestion else "") + " to the file"
+
+
+class _sliding_rows:  # noqa: N801 (used as a statement: held = _sliding_rows(robot) ... held.restore())
+    """Put a robot's stick-slip wheels in their sliding phase (only the normal row constrains) until
+    :meth:`restore`: the freest phase, which bounds the independent velocities a stick-slip vehicle may be given
+    (all sticking it may be held, with none free)."""
+
+    def __init__(self, robot) -> None:
+        from ..contact.stick_slip_wheel import stick_slip_wheels
+
+        self.wheels = stick_slip_wheels(robot)
+        self.phases = [(w.phase, getattr(w, "direction", None)) for w in self.wheels]
+        for w in self.wheels:
+            w.set_phase("slide", np.array([1.0, 0.0]))
+
+    def restore(self) -> None:
+        for w, (phase, direction) in zip(self.wheels, self.phases):
+            w.set_phase(phase, direction)
 
 
 def read(

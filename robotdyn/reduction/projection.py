@@ -274,7 +274,9 @@ def project(
         except SingularConstraintError:
             proj = None
         scale = max(1.0, float(abs(A).max())) if A.size else 1.0
-        if proj is not None and (A.size == 0 or abs(A @ proj.S).max() <= 1e-10 * scale):
+        # no independent velocity (S has no columns, e.g. every wheel of a vehicle at rest sticking): A S is empty,
+        # and the hint's rows, n of them with a regular block, span every row
+        if proj is not None and (A.size == 0 or proj.S.shape[1] == 0 or abs(A @ proj.S).max() <= 1e-10 * scale):
             return proj
     rows = independent_rows(A)
     if independent is None:

@@ -22,7 +22,9 @@ class Scenario:
         t_end: Default duration [s].
         torque: Motor torques: a :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (simulated by the compiled engine)
             or any ``tau(t, q, nu)`` (the scipy engine); None: unactuated.
-        q0, nu0: Initial coordinates and independent velocities by name (missing entries are zero).
+        q0, nu0: Initial coordinates and independent velocities by name (missing entries are zero); with
+            stick-slip wheels nu0 may name any coordinate's velocity (the full velocities v, see
+            :meth:`initial_state`).
         n_out: Default number of output samples.
         plot: Columns to plot (the paper's figures); default all independent velocities.
         zoom: Length [s] of the zoomed transient window in plots (``None``: no zoom column).
@@ -41,22 +43,40 @@ class Scenario:
     references: dict[str, list[tuple[float, str]]] = field(default_factory=dict)
 
     def initial_state(self, robot) -> tuple[np.ndarray, np.ndarray]:
-        """(q0, nu0) as vectors for ``robot``.
+        """(q0, nu0) as vectors for ``robot`` (nu0: the full velocities v (n,) where :meth:`_full_velocities`).
 
         Args:
             robot: The :class:`~robotdyn.robot.Robot` to run the scenario on.
 
         Returns:
             ``(q0, nu0)``: the neutral configuration with the scenario's ``q0`` entries set (n,) [m, rad], and the
-            independent velocities (k,) [m/s, rad/s], zero except the scenario's ``nu0`` entries.
+            independent velocities (k,) [m/s, rad/s] (or the full velocities (n,), see above), zero except the scenario's ``nu0`` entries.
         """
         q0 = robot.neutral()
         for label, value in self.q0.items():
             q0[robot.coordinate_index(label)] = value
+        if self._full_velocities(robot, q0):  # stick-slip wheels: v by coordinate (robotdyn.simulation.engine.simulate)
+            v0 = np.zeros(robot.nq)
+            for label, value in self.nu0.items():
+                v0[robot.velocity_labels.index(label)] = value
+            return q0, v0
         nu0 = np.zeros(robot.mobility)
         for label, value in self.nu0.items():
             nu0[robot.velocity_names.index(label)] = value
         return q0, nu0
+
+    def _full_velocities(self, robot, q0: np.ndarray) -> bool:
+        """Whether nu0 gives the full velocities v by coordinate: on a robot with stick-slip wheels, where it names
+        a velocity that is not independent when every wheel sticks, or the robot's independent velocities do not fit
+        that phase (e.g. a vehicle that every sticking wheel holds: none is free)."""
+        from ..contact.stick_slip_wheel import stick_slip_wheels
+
+        if not stick_slip_wheels(robot):
+            return False
+        if any(label not in robot.velocity_names for label in self.nu0):
+            return True
+        A = robot.rows_at(q0).A
+        return robot.nq - (int(np.linalg.matrix_rank(A)) if A.size else 0) != robot.mobility
 
     def span(self, t_end: float | None = None, n_out: int | None = None, streamed: bool = False) -> tuple[float, int]:
         """The duration and the number of output samples of a run.

@@ -4,9 +4,10 @@
 :class:`~robotdyn.sweep.spec.SweepSpec` against it (parameters and their units, scenarios, terrains, columns,
 durations, tolerances) and lists the runs in order: every parameter point (grid or sample), then every scenario,
 then every terrain. Each run's id hashes everything its result depends on: the robot (its name, or the bytes of
-its constraint file and description), robotdyn's version, the fixed and varied parameters, scenario, terrain,
-torque scale, duration, samples, tolerances, summarised columns, whether trajectories are kept and whether the
-compiled fast path is on.
+its constraint file and description), the expanded description at the fixed parameters (the URDF text: the
+content of every file the description includes, so a changed Xacro include is a new run), robotdyn's version, the
+fixed and varied parameters, scenario, terrain, torque scale, duration, samples, tolerances, summarised columns,
+whether trajectories are kept and whether the compiled fast path is on.
 """
 
 from __future__ import annotations
@@ -204,7 +205,9 @@ def plan(spec: SweepSpec) -> Plan:
         raise SweepSpecError(f"{total:,} runs; expected at most {MAX_RUNS:,}: fewer points or samples")
     ctx = RunContext(source, dict(spec.fixed), terrains, spec.t_end, spec.n_out, tolerances, tuple(columns),
                      bool(spec.trajectories), enabled(), limit)
-    base = {"robot": identity, "version": robotdyn.__version__, "fixed": dict(spec.fixed), "tolerances": tolerances,
+    expanded = hashlib.sha256(robot.description.urdf.encode()).hexdigest()  # every included file's content
+    base = {"robot": {**identity, "expanded": expanded}, "version": robotdyn.__version__, "fixed": dict(spec.fixed),
+            "tolerances": tolerances,
             "columns": list(columns), "trajectories": bool(spec.trajectories), "compiled": ctx.compiled}
     runs = []
     for point in pts:

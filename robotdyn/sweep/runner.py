@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import store as sweep_store
-from ..errors import RobotDynError
+from ..errors import OutputError, RobotDynError
 from .batched import MODES, Batching, model_vectors
 from .chunk import RunContext, load_source, run_chunk
 from .plan import Plan, plan
@@ -220,7 +220,7 @@ def _execute(chunks, ctx: RunContext, vectors: dict, workers: int, scheduler: st
 
 def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: str | None = None,
         chunk_size: int | None = None, progress: bool = True, retry_errors: bool = False, plot: bool = True,
-        client=None, batch: str = "auto") -> SweepResult:
+        client=None, batch: str = "auto", replace: bool = False) -> SweepResult:
     """Run a sweep and write its results to the directory ``out`` (see the module docstring).
 
     Args:
@@ -238,6 +238,12 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
         batch: ``auto``, ``always`` or ``never``: whether runs that vary only numbers of the model are simulated
             together as variants of one compiled model (:mod:`robotdyn.sweep.batched`; ``never``: each run built
             from its parameters).
+        replace: Delete the results of another sweep found in ``out`` (else that is an error: a directory whose
+            rows are not all runs of this sweep, e.g. another specification, or this one after an input changed).
+
+    Raises:
+        OutputError: ``out`` is being written by another sweep (locked), or holds another sweep's results and
+            ``replace`` is false.
 
     Returns:
         A :class:`SweepResult`; after an interruption (Ctrl-C) it holds what was finished, with ``interrupted``
@@ -260,7 +266,25 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     p = plan(spec)
     phases = {"plan": time.perf_counter() - start}
     out = sweep_store.prepare(out)
+    held = sweep_store.lock(out)  # one sweep at a time per directory
+    try:
+        return _run_locked(spec, p, out, start, phases, workers, scheduler, chunk_size, progress, retry_errors, plot,
+                           client, batch, replace)
+    finally:
+        held.release()
+
+
+def _run_locked(spec, p, out, start, phases, workers, scheduler, chunk_size, progress, retry_errors, plot, client,
+                batch, replace) -> SweepResult:
+    """:func:`run` once the sweep directory ``out`` is locked."""
     done = sweep_store.finished(out)
+    other = sweep_store.foreign(out, done, {r.run_id for r in p.runs}, spec.to_dict())
+    if other is not None:
+        if not replace:
+            raise OutputError(f"sweep directory {str(out)!r} holds another sweep ({other}); expected a new directory, "
+                              "or --replace (run(..., replace=True)) to delete its results")
+        sweep_store.clear(out)
+        done = {}
     todo = [r for r in p.runs if r.run_id not in done or (retry_errors and done[r.run_id] == "error")]
     resumed = len(p.runs) - len(todo)
     sweep_store.write_json(out / "sweep.json", {"spec": spec.to_dict(), "runs": len(p.runs)})

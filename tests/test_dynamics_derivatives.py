@@ -380,3 +380,13 @@ def test_linearize_command_prints_the_api_model(capsys):
     np.testing.assert_allclose(out["K"], K, rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(out["eigenvalues_real"], model.eigenvalues.real, atol=1e-10)
     np.testing.assert_allclose(out["closed_loop_real"], closed.real, rtol=1e-10)
+
+
+def test_quasimoro_lqr_example_balances_the_body():
+    """examples/quasimoro_lqr.py runs and holds the inverted body (0.2 rad off at the start)."""
+    import runpy
+
+    example = runpy.run_path(str(EXAMPLES / "quasimoro_lqr.py"))
+    out = example["main"](["--t-end", "4"])
+    assert abs(out["error"][0] - 0.2) < 1e-12 and abs(out["error"][-1]) < 1e-3
+    assert np.all(out["closed"].real < 0)

@@ -93,7 +93,8 @@ SPEC = RobotSpec(
     title="Tricycle with adaptable-radius wheels on rough terrain (Mardani & Ebrahimi 2016)",
     xacro="adaptable_wheel.urdf.xacro",
     root="floating",
-    paper="mardani_ebrahimi_2016_adaptable_wheel_robot.txt",
+    paper=("Mardani & Ebrahimi 2016, "
+           "A novel multimode mobile robot with adaptable wheel geometry for maneuverability improvement"),
     parameters=[
         Parameter("m", 10.0, "kg", "total mass (Table 1)", positive=True),
         Parameter("m_wheel", 0.0, "kg", "mass of each wheel hub (paper: all mass lumped in the body)"),

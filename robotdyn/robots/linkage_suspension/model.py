@@ -45,7 +45,8 @@ SPEC = RobotSpec(
     title="Six-wheel robot with linkage suspension on uneven terrain (Chen et al., wheel-centre kinematics)",
     xacro="linkage_suspension.urdf.xacro",
     root="floating",
-    paper="chen_linkage_suspension_six_wheel.txt",
+    paper=("Chen, Wang, Zhong, Zhu & Wang, "
+           "Kinematics analysis and simulation of mobile robot based on linkage suspension"),
     parameters=[
         Parameter("a1", 0.05, "m", "Table 1: rocker pivot D ahead of the body frame R (an offset: 0 or < 0, behind R, are valid geometries)"),
         Parameter("d1", 0.10, "m", "Table 1: rocker pivot D below R (an offset: any sign)"),

@@ -40,7 +40,8 @@ SPEC = RobotSpec(
     title="MMR12-EOD: differential-drive mobile manipulator, 4 lifting arms, RPRR arm (Zuniga-Aviles, HTG)",
     xacro="mmr12_eod.urdf.xacro",
     root="planar",
-    paper="zuniga_aviles_2014_mmr12_eod_htg.txt",
+    paper=("Zúñiga-Avilés et al. 2014, "
+           "HTG-based kinematic modeling for positioning of a multi-articulated wheeled mobile manipulator"),
     parameters=[
         Parameter("lambda_C0", 0.15, "m", "height of C over the ground = drive-wheel radius (sec 3, conclusion)",
                   positive=True),

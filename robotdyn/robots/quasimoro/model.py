@@ -26,7 +26,7 @@ SPEC = RobotSpec(
     title="Quasimoro: two wheels plus a pendulum body (Staicu, virtual powers)",
     xacro="quasimoro.urdf.xacro",
     root="planar",
-    paper="staicu_quasimoro_virtual_powers.txt",
+    paper="Staicu, Dynamics of Angeles's Quasimoro mobile robot using principle of virtual powers",
     parameters=[
         Parameter("m", 0.5, "kg", "mass of each wheel"),
         Parameter("M", 5.0, "kg", "mass of the intermediate body", positive=True),

@@ -2,7 +2,7 @@
 
 Description: ``urdf/adaptable_wheel.urdf.xacro``. Paper the parameters come from: A. Mardani, S. Ebrahimi, "A Novel
 Multimode Mobile Robot with Adaptable Wheel Geometry for Maneuverability Improvement"
-(``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``), Table 1.
+(Mardani & Ebrahimi 2016, ``docs/bibliography.md``), Table 1.
 
 Model (derived by Pinocchio from the description): floating body (x, y, z, yaw, pitch, roll; Z-Y-X Euler) with
 three wheels fr, fl, r at the eq-8 positions, each with a spin joint ``theta_<i>`` (wheel motor), an adjustment

@@ -1,7 +1,7 @@
 """Six-wheel mobile robot with linkage suspension (Chen, Wang, Zhong, Zhu, Wang): the model side.
 
 Paper: "Kinematics Analysis and Simulation of Mobile Robot Based on Linkage Suspension"
-(``shared/papers/chen_linkage_suspension_six_wheel.txt``). Description: ``urdf/linkage_suspension.urdf.xacro``
+(Chen et al., ``docs/bibliography.md``). Description: ``urdf/linkage_suspension.urdf.xacro``
 (the mechanism, our reading of Figs. 1-3, and the dimensions, our own: the paper prints none).
 
 Coordinates: floating root (x, y, z, yaw, pitch, roll) of the body frame R (origin at the body's centre of gravity,

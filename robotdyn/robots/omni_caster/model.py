@@ -3,7 +3,7 @@
 Description: ``urdf/omni_caster.urdf.xacro`` (Fig. 2, Tables 1-2); Pinocchio derives the dynamics from it.
 Paper the parameters and manoeuvres come from: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free
 dynamic modeling including wheel dynamics for an omni-directional mobile robot with three caster wheels"
-(``shared/papers/chung_yi_omni_caster_dynamics.txt``).
+(Chung, Yi, Kim & Han, ``docs/bibliography.md``).
 
 Coordinates: (x, y, psi) of the platform centre C and heading (world, m and rad), the steering angles phi_i
 (platform relative to offset link i, eq 9-11: omega = eta_i' + phi_i') and the wheel angles theta_i.

@@ -28,8 +28,11 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 REPO = Path(__file__).resolve().parent.parent
-SCREENSHOT_PAGES = ("docs/index.html", "notebooks/your_own_robot.html", "docs/concepts.html")
-"""Pages rendered in the browser: the landing page, the tutorial and a concepts page."""
+SCREENSHOT_PAGES = ("docs/index.html", "notebooks/your_own_robot.html", "docs/concepts.html",
+                    "docs/getting-started.html")
+"""Pages rendered in the browser: the landing page, the tutorial, the concepts page and getting started."""
+RAW_TEX = re.compile(r"\\\(|\\\[|\$\$|\$[A-Za-z\\{]")
+"""TeX left unrendered in a page's text: ``\\(``, ``\\[``, ``$$``, or ``$`` before a letter, ``\\`` or ``{``."""
 
 
 def machine_paths() -> re.Pattern:
@@ -151,10 +154,8 @@ def check_browser(root: Path, shots: Path) -> list[str]:
         text = "".join(rendered.text)
         if "<mjx-container" not in dom:
             problems.append(f"{name}: no math typeset by MathJax in the browser")
-        for raw in ("\\(", "\\[", "$$"):
-            if raw in text:
-                i = text.index(raw)
-                problems.append(f"{name}: raw TeX {raw!r} in the rendered page: {text[i:i + 60]!r}")
+        for m in RAW_TEX.finditer(text):
+            problems.append(f"{name}: raw TeX in the rendered page: {text[m.start():m.start() + 60]!r}")
         if not rendered.images:
             problems.append(f"{name}: no figure in the rendered page")
         if not png.is_file() or png.stat().st_size < 10_000:

@@ -180,16 +180,16 @@ def rows() -> list[KeyRow]:
 
 
 def markdown_table() -> str:
-    """The reference as one Markdown table (key, type, expected with units and ranges, default, example)."""
+    """The reference as one Markdown table: key and type, what it is and what it accepts (units, ranges), default,
+    example."""
 
     def cell(text: str) -> str:
         return text.replace("|", "\\|").replace("\n", "<br>")
 
-    lines = ["| key | type | what it is | accepts (units, range) | default | example |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| key (type) | what it is; what it accepts (units, range) | default | example |", "|---|---|---|---|"]
     for r in rows():
         default = "**required**" if r.required else cell(r.default)
-        lines.append(f"| `{r.key}` | {cell(r.type)} | {cell(r.description)} | {cell(r.expected)} | {default} | "
+        lines.append(f"| `{r.key}`<br>({cell(r.type)}) | {cell(r.description)}; accepts {cell(r.expected)} | {default} | "
                      f"<code>{cell(r.example)}</code> |")
     return "\n".join(lines)
 

@@ -138,3 +138,6 @@ def test_site_checker_raw_tex_pattern():
     raw = _check_site().RAW_TEX
     assert raw.search(r"the map \(S(q)\)") and raw.search("$M_r$") and raw.search("$$x$$")
     assert not raw.search("$ robotdyn list") and not raw.search("$(arg chassis_mass)")
+    page = _check_site().Page()
+    page.feed("<p>prose $x$</p><pre>${side}</pre><code>$y</code><script>var a='$b'</script>")
+    assert "".join(page.text) == "prose $x$"  # code and scripts are not searched for raw TeX

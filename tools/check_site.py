@@ -51,7 +51,7 @@ class Page(HTMLParser):
         self.links: list[str] = []
         self.images: list[tuple[str, str | None]] = []
         self.remote: list[str] = []
-        self.text: list[str] = []
+        self.text: list[str] = []  # prose: outside script, style, pre and code (code may hold "$" legitimately)
         self._skip = 0
 
     def handle_starttag(self, tag, attrs):
@@ -71,11 +71,11 @@ class Page(HTMLParser):
                     self.remote.append(url)
                 elif tag != "link" or "stylesheet" in (a.get("rel") or ""):
                     self.links.append(url)
-        if tag in ("script", "style"):
+        if tag in ("script", "style", "pre", "code"):
             self._skip += 1
 
     def handle_endtag(self, tag):
-        if tag in ("script", "style") and self._skip:
+        if tag in ("script", "style", "pre", "code") and self._skip:
             self._skip -= 1
 
     def handle_data(self, data):

@@ -187,7 +187,7 @@ class RobotSpec:
         labels: Display name of a coordinate for a joint name (e.g. ``wheel_left_joint -> theta_L``).
         independent: Coordinate labels whose velocities are the independent ones (``None``: automatic).
         terrain: A terrain, or a function of the parameter values returning one (default: flat z = 0).
-        paper: The paper's file name in ``shared/papers``.
+        paper: A short reference of the robot's paper (authors, title; full references: ``docs/bibliography.md``).
         neutral: Coordinate values of a valid configuration (default all zero), used e.g. by ``info``.
         xacro_args: Fixed xacro arguments (name -> string) that are not parameters (e.g. from ``--xacro-arg``).
         package_dirs: Directories where ``package://`` URIs (meshes) are resolved.

@@ -16,6 +16,7 @@ import sys
 
 import numpy as np
 
+from .. import __version__
 from ..errors import RobotDynError
 from ..inputs import MAX_ACCELERATION, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector, parse_assignments
 from ..reduction.reduced_dynamics import solve_mass
@@ -133,7 +134,7 @@ def cmd_info(args) -> int:
     info["scenarios"] = {k: s.description for k, s in getattr(mod, "SCENARIOS", {}).items()}
     lines = [
         f"{info['robot']}: {info['title']}",
-        *([f"paper: shared/papers/{info['paper']}"] if info["paper"] else []),
+        *([f"paper: {info['paper']} (full reference: docs/bibliography.md)"] if info["paper"] else []),
         f"coordinates q ({len(info['coordinates'])}): {', '.join(info['coordinates'])}   [m, rad]",
         f"independent velocities ({info['mobility']}): {', '.join(info['independent_velocities'])}",
         f"mobility at the neutral configuration: {info['mobility_at_neutral']} (n - rank A)"
@@ -540,6 +541,10 @@ class _Parser(argparse.ArgumentParser):
                             "--help)")
 
 
+HELP_EPILOG = ("file formats (constraint TOML, sweep spec, simulate CSV, sweep Parquet): docs/reference/file-formats.md "
+               "(the documentation site: make docs)")
+"""The last line of ``robotdyn --help``: where the file formats are documented."""
+
 BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep", "linearize")
 """The built-in commands (robot modules add theirs, see :func:`_add_robot_commands`)."""
 
@@ -558,7 +563,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     def wanted(name: str) -> bool:
         return only is None or only == name
 
-    parser = _Parser(prog="robotdyn", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="robotdyn", description=__doc__.splitlines()[0], epilog=HELP_EPILOG)
+    parser.add_argument("--version", action="version", version=f"robotdyn {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     common = _Parser(add_help=False)
     common.add_argument("--json", action="store_true", help="machine-readable output")
@@ -570,7 +576,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     robot_args.add_argument("--xacro-arg", action="append", default=[], metavar="NAME=VALUE",
                             help="a xacro argument of --urdf (repeatable)")
     robot_args.add_argument("--constraints", metavar="FILE",
-                            help="TOML constraint file: root, wheels, closures, motors (see examples/*.toml)")
+                            help="TOML constraint file: root, wheels, closures, motors (format: docs/reference/file-formats.md; "
+                                 "examples/*.toml)")
     robot_args.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                             help="override a parameter (repeatable; robotdyn info ROBOT lists them)")
     robot_args.add_argument("--package", action="append", default=[], metavar="NAME=DIR|DIR",

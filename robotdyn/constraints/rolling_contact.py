@@ -13,7 +13,7 @@ vector ``axis`` in that frame. With terrain normal n at the contact point p and 
 - the time derivative follows the contact point as it moves around the rim (not a body-fixed point):
   :math:`\\dot A_w v = a_c^0 + \\dot\\omega^0 \\times r + \\omega \\times \\dot r - \\dot u \\dot R`,
   :math:`r = p - c`, :math:`\\dot r = -(R\\dot u + \\dot R u)`, with :math:`\\dot u` from a 3x3 implicit solve on
-  curved terrain (see ``shared/notes/rolling-contact-and-projection.md``).
+  curved terrain (see the concepts page, ``docs/concepts.md``).
 
 An omni (Swedish) wheel keeps the normal row and one tangential row along its rollers' axis, at ``roller_angle``
 from t1 towards t2 (0 for a 90-degree omni wheel whose rollers leave the lateral motion free).

@@ -6,7 +6,7 @@ With the constraint rows :math:`A(q)v = 0` (m rows, rank r) the full equations o
 
 so once :math:`\\dot\\nu` is known (forward dynamics from motor torques) or given (inverse dynamics), the residual
 :math:`e = M a + h - B\\tau = \\mathrm{RNEA}(q, v, a) - B\\tau` lies in the range of :math:`A^T` and
-:math:`A^T\\lambda = e` gives the constraint forces (``shared/notes/contact-forces-and-friction.md``).
+:math:`A^T\\lambda = e` gives the constraint forces (the concepts page ``docs/concepts.md``).
 
 Units and frames. Each row's multiplier is the force along that row:
 

@@ -6,7 +6,7 @@ are replaced by the force of its :class:`~robotdyn.contact.friction.FrictionLaw`
 :math:`s = J_t v`) and :math:`F_t = -f_n c(s)`. The normal load :math:`f_n` is a constraint force, so it depends on
 the accelerations; with the friction direction fixed by the current slip, the system in
 :math:`(\\dot\\nu, \\lambda)` stays linear and is solved exactly at each evaluation (no lagged load,
-``shared/notes/contact-forces-and-friction.md``):
+the concepts page ``docs/concepts.md``):
 
 .. math:: M S\\dot\\nu - \\Big(A_R^T - \\sum_i J_{t,i}^T c_i e_{n_i}^T\\Big)\\lambda = B\\tau - \\mathrm{RNEA}(q, v, w),
 

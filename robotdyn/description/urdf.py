@@ -27,7 +27,10 @@ import pinocchio as pin
 from ..errors import DescriptionError, InputError, RobotDynError
 
 URDF_DIR = Path(__file__).resolve().parents[2] / "urdf"
-"""Directory of the Xacro descriptions shipped with robotdyn."""
+"""Directory of the Xacro descriptions shipped with robotdyn (``urdf/`` of the repository).
+
+:meta hide-value:
+"""
 
 ROOT_KINDS = ("fixed", "planar", "floating")
 _UNBOUNDED = 1.0e9

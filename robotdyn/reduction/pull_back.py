@@ -4,7 +4,7 @@ The velocity constraints hold exactly along a simulation (v = S nu), but the pos
 :math:`\\phi(q)` of holonomic rows (a wheel's normal row, loop closures, joint couplings) drift by the integrator's
 error. :func:`robotdyn.simulation.engine.simulate` adds :math:`-\\alpha\\,\\delta q` to :math:`\\dot q`, with
 :math:`\\delta q` the minimum-norm solution of :math:`A_h\\,\\delta q = \\phi`
-(``shared/notes/rolling-contact-and-projection.md``, "Loop closures"), so that :math:`\\dot\\phi = -\\alpha\\phi`
+(the concepts page ``docs/concepts.md``, "The projection"), so that :math:`\\dot\\phi = -\\alpha\\phi`
 on every residual the model's coordinates can change.
 
 Rows whose Jacobian has no rank relative to its scale cannot be corrected by any coordinate. The textbook case is

@@ -12,7 +12,7 @@ A :class:`~robotdyn.contact.stick_slip_wheel.StickSlipWheel` is in one of two ph
   :math:`\\hat s = s/\\|s\\|` (:math:`\\hat s_0` while :math:`\\|s\\|` is below 1e-12 m/s), the normal load solved
   together with the accelerations (:func:`robotdyn.contact.sliding.forward`). Event: :math:`s\\cdot\\hat s_0 = 0`
   (decreasing) tries sticking: the wheel sticks if the sticking solution's force lies inside the cone, else it
-  keeps sliding in the direction of that force (``shared/notes/contact-forces-and-friction.md``).
+  keeps sliding in the direction of that force (the concepts page ``docs/concepts.md``).
 
 Lift-off (a normal load reaching zero, decreasing) stops the run with a message naming the wheel, time and load.
 The independent velocities change with the phases, so :func:`simulate` integrates segment by segment and reports

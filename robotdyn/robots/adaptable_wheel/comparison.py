@@ -1,7 +1,7 @@
 """Adaptable-wheel tricycle: the model against the paper (:func:`compare`) and the functions that bring both together.
 
 Model: :mod:`robotdyn.robots.adaptable_wheel.model` (Pinocchio, ``urdf/adaptable_wheel.urdf.xacro``). Paper: :mod:`robotdyn.robots.adaptable_wheel.paper` (eqs 1, 3-35, Table 2 of
-``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``) and its missions (:mod:`robotdyn.robots.adaptable_wheel.missions`, section 7).
+Mardani & Ebrahimi 2016, ``docs/bibliography.md``) and its missions (:mod:`robotdyn.robots.adaptable_wheel.missions`, section 7).
 :func:`model_configuration` puts an IK solution of the paper into the model's coordinates,
 :func:`model_static_check` tests eqs 25-34 against the model's generalised equilibrium, :func:`compare` the printed
 numbers of section 7 and Table 2. The ``ik`` CLI subcommand shows the paper's IK and statics beside the model's

@@ -5,7 +5,7 @@ The paper stops at kinematics and statics; here the model of :mod:`robotdyn.robo
 torques with inertia (:func:`mission_dynamics`, contact forces chosen as in eqs 28-30), or the wheels slide sideways
 under a friction law (:func:`mission_friction`). Both report the paper's eq 35 and eqs 25-34 beside the model's
 torques. Discussion: ``docs/errata/adaptable_wheel.md``
-(``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``).
+(Mardani & Ebrahimi 2016, ``docs/bibliography.md``).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Adaptable-wheel tricycle: the kinematic missions of section 7, solved by the paper's inverse kinematics.
 
-Paper: ``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``, section 7 and Table 1 (mission 1: a circle
+Paper: Mardani & Ebrahimi 2016, ``docs/bibliography.md``, section 7 and Table 1 (mission 1: a circle
 on the rough terrain; mission 2: a straight run across a ramp, path and heading not printed: ours) and the
 flowchart of Fig. 8 (:func:`run_mission`: eqs 15-24 at every step, the yaw by eqs 18-23). The computation is the
 paper's (:mod:`robotdyn.robots.adaptable_wheel.paper`); only the parameter defaults and the terrain come from the model's ``SPEC``.

@@ -1,7 +1,7 @@
 """Adaptable-wheel tricycle: the paper's closed forms and printed values, transcribed (no robotdyn model here).
 
 Paper: A. Mardani, S. Ebrahimi, "A Novel Multimode Mobile Robot with Adaptable Wheel Geometry for Maneuverability
-Improvement" (``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``): the radius law of eq 1 and its
+Improvement" (Mardani & Ebrahimi 2016, ``docs/bibliography.md``): the radius law of eq 1 and its
 derivative (eq 33), the wheel offsets of eq 8, the inverse kinematics of eqs 3-17 and 24 (:func:`solve_ik`, eq 24's
 Newton-Raphson replaced by scipy's hybrid root finder), the yaw update of eqs 18-23, the statics of eqs 25-34
 (:func:`static_torques`; the free contact-force components of eqs 28-30 are chosen by the generic

@@ -2,7 +2,7 @@
 
 Model: :mod:`robotdyn.robots.linkage_suspension.model` (Pinocchio, ``urdf/linkage_suspension.urdf.xacro``) -- its frames, wheel-centre velocities,
 contact angles (the ``model_*`` helpers here) and kinematic runs. Paper: :mod:`robotdyn.robots.linkage_suspension.paper` (Table 1, eqs 1-4, 10 and
-section 3 of ``shared/papers/chen_linkage_suspension_six_wheel.txt``); eq 9 (rolling) is checked against the model's
+section 3 of Chen et al., ``docs/bibliography.md``); eq 9 (rolling) is checked against the model's
 rolling constraints. Verdicts and evidence: ``docs/errata/linkage_suspension.md``.
 """
 

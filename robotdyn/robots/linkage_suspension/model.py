@@ -1,7 +1,7 @@
 """Six-wheel mobile robot with linkage suspension (Chen, Wang, Zhong, Zhu, Wang): the model side.
 
 Paper: "Kinematics Analysis and Simulation of Mobile Robot Based on Linkage Suspension"
-(``shared/papers/chen_linkage_suspension_six_wheel.txt``). Description: ``urdf/linkage_suspension.urdf.xacro``
+(Chen et al., ``docs/bibliography.md``). Description: ``urdf/linkage_suspension.urdf.xacro``
 (the mechanism, our reading of Figs. 1-3, and the dimensions, our own: the paper prints none).
 
 Coordinates: floating root (x, y, z, yaw, pitch, roll) of the body frame R (origin at the body's centre of gravity,
@@ -45,7 +45,8 @@ SPEC = RobotSpec(
     title="Six-wheel robot with linkage suspension on uneven terrain (Chen et al., wheel-centre kinematics)",
     xacro="linkage_suspension.urdf.xacro",
     root="floating",
-    paper="chen_linkage_suspension_six_wheel.txt",
+    paper=("Chen, Wang, Zhong, Zhu & Wang, "
+           "Kinematics analysis and simulation of mobile robot based on linkage suspension"),
     parameters=[
         Parameter("a1", 0.05, "m", "Table 1: rocker pivot D ahead of the body frame R (an offset: 0 or < 0, behind R, are valid geometries)"),
         Parameter("d1", 0.10, "m", "Table 1: rocker pivot D below R (an offset: any sign)"),

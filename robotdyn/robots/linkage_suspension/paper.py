@@ -1,7 +1,7 @@
 """Linkage-suspension six-wheel robot: the paper's closed forms and printed values, transcribed (no model here).
 
 Paper: Chen, Wang, Zhong, Zhu, Wang, "Kinematics Analysis and Simulation of Mobile Robot Based on Linkage
-Suspension" (``shared/papers/chen_linkage_suspension_six_wheel.txt``): the D-H rows of Table 1 (eq 3's product
+Suspension" (Chen et al., ``docs/bibliography.md``): the D-H rows of Table 1 (eq 3's product
 R -> A3), the contact rotation of eq 1, the omni-wheel attitude of eq 2, the entries of eq 4 exactly as printed
 (with single-typo readings, :func:`eq4_readings`), the left-hand side of eq 10 as printed (and eq 5 evaluated with
 Table 1's own axes, :func:`corrected_eq10_joint_terms`), and the numbers section 3 prints (Figs. 7, 8, 12).

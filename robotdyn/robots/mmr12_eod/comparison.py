@@ -3,7 +3,7 @@
 Model: :mod:`robotdyn.robots.mmr12_eod.model` (Pinocchio, ``urdf/mmr12_eod.urdf.xacro``) -- the lift, frame poses and numerical IK computed
 on it (``model_*``, :func:`ik_cases`), and the model states matching each printed transform
 (:func:`printed_states`). Paper: :mod:`robotdyn.robots.mmr12_eod.paper` (eqs 1-2, 3-5, 10-14, 26-31 of
-``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``). Verdicts and evidence: ``docs/errata/mmr12_eod.md``.
+Zúñiga-Avilés et al. 2014, ``docs/bibliography.md``). Verdicts and evidence: ``docs/errata/mmr12_eod.md``.
 """
 
 from __future__ import annotations

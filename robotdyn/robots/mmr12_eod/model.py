@@ -2,7 +2,7 @@
 
 Paper: L. A. Zuniga-Aviles, J. C. Pedraza-Ortega et al., "HTG-Based Kinematic Modeling for Positioning of a
 Multi-Articulated Wheeled Mobile Manipulator", J. Intell. Robot. Syst. (2014)
-(``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``). Description: ``urdf/mmr12_eod.urdf.xacro``, built from
+(Zúñiga-Avilés et al. 2014, ``docs/bibliography.md``). Description: ``urdf/mmr12_eod.urdf.xacro``, built from
 Table 2's Denavit-Hartenberg rows (Paul's convention) so that every HTG frame of eq (2) is a named frame.
 
 Coordinates (natural, m and rad): the planar root (x, y, psi) of the ground footprint under the platform frame C,
@@ -40,7 +40,8 @@ SPEC = RobotSpec(
     title="MMR12-EOD: differential-drive mobile manipulator, 4 lifting arms, RPRR arm (Zuniga-Aviles, HTG)",
     xacro="mmr12_eod.urdf.xacro",
     root="planar",
-    paper="zuniga_aviles_2014_mmr12_eod_htg.txt",
+    paper=("Zúñiga-Avilés et al. 2014, "
+           "HTG-based kinematic modeling for positioning of a multi-articulated wheeled mobile manipulator"),
     parameters=[
         Parameter("lambda_C0", 0.15, "m", "height of C over the ground = drive-wheel radius (sec 3, conclusion)",
                   positive=True),

@@ -2,7 +2,7 @@
 
 Paper: L. A. Zuniga-Aviles, J. C. Pedraza-Ortega et al., "HTG-Based Kinematic Modeling for Positioning of a
 Multi-Articulated Wheeled Mobile Manipulator", J. Intell. Robot. Syst. (2014)
-(``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``): Paul's link transform of Table 2, the lift of eqs 1/26,
+(Zúñiga-Avilés et al. 2014, ``docs/bibliography.md``): Paul's link transform of Table 2, the lift of eqs 1/26,
 A_C and the HTG product of sec 2.7.1, X_M of eq 2 as printed, the platform rates of eqs 12-14, the inverse
 kinematics of eqs 3-5, 10-11 (eqs 6-9 use undefined symbols: not transcribed) and the matrices printed as
 eqs 27-31. Each function takes the parameters as a plain dict (Table 2 names of :data:`.model.SPEC`).

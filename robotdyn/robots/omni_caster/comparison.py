@@ -1,7 +1,7 @@
 """Omni caster platform: the model against the paper (:func:`compare`) and the functions that bring both together.
 
 Model: :mod:`robotdyn.robots.omni_caster.model` (Pinocchio, ``urdf/omni_caster.urdf.xacro``). Paper: :mod:`robotdyn.robots.omni_caster.paper` (eqs 12-19, 43, 48-51, 60,
-A7-A9 and the printed matrices of section 5 of ``shared/papers/chung_yi_omni_caster_dynamics.txt``). Here too:
+A7-A9 and the printed matrices of section 5 of Chung, Yi, Kim & Han, ``docs/bibliography.md``). Here too:
 :func:`offset_link_correction`, the velocity terms eq 43 leaves out, derived by us (not printed in the paper), and
 the least-squares search for a configuration reproducing the printed I_uu* (:func:`fit_printed_matrix`).
 Verdicts and evidence: ``docs/errata/omni_caster.md``.

@@ -3,7 +3,7 @@
 Description: ``urdf/omni_caster.urdf.xacro`` (Fig. 2, Tables 1-2); Pinocchio derives the dynamics from it.
 Paper the parameters and manoeuvres come from: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free
 dynamic modeling including wheel dynamics for an omni-directional mobile robot with three caster wheels"
-(``shared/papers/chung_yi_omni_caster_dynamics.txt``).
+(Chung, Yi, Kim & Han, ``docs/bibliography.md``).
 
 Coordinates: (x, y, psi) of the platform centre C and heading (world, m and rad), the steering angles phi_i
 (platform relative to offset link i, eq 9-11: omega = eta_i' + phi_i') and the wheel angles theta_i.
@@ -39,7 +39,8 @@ SPEC = RobotSpec(
     title="Omnidirectional platform on three active caster wheels (Chung, Yi, Kim, Han)",
     xacro="omni_caster.urdf.xacro",
     root="planar",
-    paper="chung_yi_omni_caster_dynamics.txt",
+    paper=("Chung, Yi, Kim & Han, Singularity-free dynamic modeling including wheel dynamics "
+           "for an omni-directional mobile robot with three caster wheels"),
     parameters=[
         Parameter("l", 0.173, "m", "distance A1A2 between the front steering axes (Table 1)", positive=True),
         Parameter("a", 0.05, "m", "A1, A2 lie a behind C along -j (Table 1, eq 6-7; an offset: 0 or < 0 valid)"),

@@ -1,7 +1,7 @@
 """Omni caster platform: the paper's closed forms and printed numbers, transcribed (no robotdyn model here).
 
 Paper: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free dynamic modeling including wheel dynamics
-for an omni-directional mobile robot with three caster wheels" (``shared/papers/chung_yi_omni_caster_dynamics.txt``):
+for an omni-directional mobile robot with three caster wheels" (Chung, Yi, Kim & Han, ``docs/bibliography.md``):
 the chain Jacobians [iG_phi^u] of eqs 12-14 and their inverses [iG_u^phi] of eqs 15-17 (with the erratum of
 eq 16 as an option), the Hessian of eqs 18-19, the chain inertia of eq 43, the platform inertia of eq 50, the
 operational-space inertia I_uu* of eqs 48/51 and bias of eq 49, the impulse of eq 60, the NOC Jacobians of

@@ -1,7 +1,7 @@
 """Quasimoro: the model against the paper (:func:`compare`) and the model-side helper it needs.
 
 Brings :mod:`robotdyn.robots.quasimoro.model` (Pinocchio's reduced dynamics of ``urdf/quasimoro.urdf.xacro``) and :mod:`robotdyn.robots.quasimoro.paper` (eqs 23-31
-of ``shared/papers/staicu_quasimoro_virtual_powers.txt``) together; disagreements are discussed in
+of Staicu, ``docs/bibliography.md``) together; disagreements are discussed in
 ``docs/errata/quasimoro.md``.
 """
 

@@ -2,7 +2,7 @@
 
 Description: ``urdf/quasimoro.urdf.xacro``; Pinocchio derives the dynamics from it (nothing here is a closed form).
 Paper the parameters and manoeuvres come from: Şt. Staicu, "Dynamics of Angeles's Quasimoro mobile robot using
-principle of virtual powers" (``shared/papers/staicu_quasimoro_virtual_powers.txt``): parameter values of
+principle of virtual powers" (Staicu, ``docs/bibliography.md``): parameter values of
 section 3, the torque pulse of eq 19, the two manoeuvres of section 3 (1° rectilinear, 2° pure rotation).
 
 Coordinates (x, y, psi) of the axle midpoint C2 and yaw; theta1, theta2 the wheel angles relative to the axle
@@ -26,7 +26,7 @@ SPEC = RobotSpec(
     title="Quasimoro: two wheels plus a pendulum body (Staicu, virtual powers)",
     xacro="quasimoro.urdf.xacro",
     root="planar",
-    paper="staicu_quasimoro_virtual_powers.txt",
+    paper="Staicu, Dynamics of Angeles's Quasimoro mobile robot using principle of virtual powers",
     parameters=[
         Parameter("m", 0.5, "kg", "mass of each wheel"),
         Parameter("M", 5.0, "kg", "mass of the intermediate body", positive=True),

@@ -1,7 +1,7 @@
 """Quasimoro: the paper's closed forms, transcribed as printed (no robotdyn model computation here).
 
 Paper: Şt. Staicu, "Dynamics of Angeles's Quasimoro mobile robot using principle of virtual powers"
-(``shared/papers/staicu_quasimoro_virtual_powers.txt``): the coefficients A11..A19 of eq 24 with the symmetries of
+(Staicu, ``docs/bibliography.md``): the coefficients A11..A19 of eq 24 with the symmetries of
 eq 26, the rows of eqs 23, 25, 28, the rectilinear torque of eq 29, the pure-rotation inertia of eq 31 and the
 steady inclination amplitude read off Fig. 5 (section 3). Each function takes the parameters as a plain dict
 (m, M, J1, J2, r, d, rho, g), so it can be read line by line against the paper.

@@ -473,7 +473,32 @@ class Robot:
                                  "what double precision holds)")
         if check:
             self._warn_dropped(red, out)
+            self.warn_conditioning(red, out)
         return out
+
+    def conditioning(self, q, nu, tau=None) -> list:
+        """The ill-conditioned parts of the reduced solve at (q, nu) (the projection's :math:`A_d`, the reduced
+        mass matrix :math:`S^TMS`) that make its results (with motor torques ``tau``: the accelerations they
+        give) beyond what the state can produce, as data: a list of
+        :class:`~robotdyn.reduction.conditioning.IllConditioned`, empty where they are within it
+        (:mod:`robotdyn.reduction.conditioning`)."""
+        from .reduction.conditioning import ill_conditioned
+
+        red = self.reduced(q, nu)
+        nudot = None if tau is None else solve_mass(red.M, red.B @ np.asarray(tau, float) - red.h)
+        return ill_conditioned(red, self.velocity_names, nudot)
+
+    def warn_conditioning(self, red, nudot=None, extra: list | None = None) -> list:
+        """Warn (one :class:`~robotdyn.errors.RobotDynWarning`) when the results of ``red`` (with the accelerations
+        ``nudot`` computed from it) are beyond what the state can produce (:mod:`robotdyn.reduction.conditioning`),
+        with ``extra`` parts found by the caller (e.g. the force system); returns the parts found."""
+        from .reduction.conditioning import ill_conditioned, message
+
+        found = ill_conditioned(red, self.velocity_names, nudot)
+        found += [e for e in (extra or []) if e.part not in {f.part for f in found}]
+        if found:
+            warnings.warn(message(found), RobotDynWarning, stacklevel=3)
+        return found
 
     def redundant_row_violations(self, q, nu, nudot=None) -> list:
         """The constraint rows dropped as redundant at q that the velocities ``nu`` (and the accelerations

@@ -183,6 +183,7 @@ def cmd_dump(args) -> int:
         tau = _torques(robot, args.tau, args.tau_set)
         nudot = solve_mass(red.M, red.B @ tau - red.h)
         out["a"] = nudot
+        out["ill_conditioned"] = [vars(f) for f in robot.warn_conditioning(red, nudot)]
         text.append(_vector_text("a (independent accelerations)", names, nudot))
     from ..constraints.redundancy import message, violations
 
@@ -602,9 +603,13 @@ def _one_line_warnings() -> None:
 
     default = warnings.showwarning
 
+    shown = set()
+
     def show(message, category, filename, lineno, file=None, line=None):
         if issubclass(category, RobotDynWarning):
-            print(f"robotdyn: warning: {message}", file=sys.stderr)
+            if str(message) not in shown:  # once per run, wherever it was raised from (e.g. a robot built twice)
+                shown.add(str(message))
+                print(f"robotdyn: warning: {message}", file=sys.stderr)
         else:
             default(message, category, filename, lineno, file, line)
 

@@ -195,6 +195,8 @@ class Robot:
         params: Resolved parameter values.
         model, data: The Pinocchio model and data (natural coordinates, nq == nv).
         constraints, motors: The constraint and motor objects.
+        implausible_inertias: Links whose inertia is implausible for their mass and size, with their share of the
+            effective mass (:mod:`robotdyn.description.inertia_check`; a warning names them on load).
     """
 
     def __init__(self, spec: RobotSpec, params: dict | None = None, terrain: Terrain | None = None) -> None:
@@ -251,6 +253,11 @@ class Robot:
         self.operational = spec.operational.build(self.description) if spec.operational is not None else None
         if self.operational is not None:
             self.velocity_names = list(self.operational.names)
+        from .description.inertia_check import implausible_inertias, message
+
+        self.implausible_inertias = implausible_inertias(self)  # placeholder inertias (issue 24): data, and a warning
+        if self.implausible_inertias:
+            warnings.warn(message(self.implausible_inertias), RobotDynWarning, stacklevel=2)
 
     def __getstate__(self) -> dict:
         """Pickle without the per-thread caches (Pinocchio data and compiled models are rebuilt on use)."""
@@ -617,6 +624,7 @@ class Robot:
             "root_height": self.description.root_height,
             "root_height_source": self.root_height_source,
             "visual_warnings": report.warnings if report is not None else [],
+            "implausible_inertias": [vars(f) for f in self.implausible_inertias],  # warned on load, not repeated
             "robot": self.spec.name,
             "title": self.spec.title,
             "paper": self.spec.paper,

@@ -557,8 +557,11 @@ class Robot:
 
     def mobility_check(self) -> tuple[int, list[str]]:
         """The mobility n - rank A at the neutral configuration, and plain-language notes where the wheels lock
-        the base (no admissible motion turns it, or moves it at all), e.g. a skid-steer base whose non-steering
-        wheels roll without slipping."""
+        the base (no admissible motion turns it, or moves it at all, at the neutral configuration and at the other
+        admissible ones :func:`~robotdyn.constraints.base_mobility.reachable_motion` finds), e.g. a skid-steer base
+        whose non-steering wheels roll without slipping, or where that holds only at the neutral configuration
+        (steerable wheels parallel there); and joint-origin angles that look like a rounded multiple of pi/2
+        (:mod:`robotdyn.description.rounded_angles`)."""
         A = self.rows_at(self.neutral()).A
         rank = int(np.linalg.matrix_rank(A)) if A.size else 0
         notes = []
@@ -568,12 +571,32 @@ class Robot:
             names = self.description.joint_names
             yaw = names.index("psi" if "psi" in names else "yaw")
             xy = [names.index("x"), names.index("y")]
+            from .constraints.base_mobility import reachable_motion
+
             if not np.any(np.abs(null[:, yaw]) > 1e-9):
-                notes.append("the base cannot turn: in every motion its wheels allow (rolling without slipping) the "
-                             "yaw rate is zero, so turning requires slip; give the wheels a friction law "
-                             "(friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and friction')")
+                elsewhere = reachable_motion(self, names[yaw])
+                if elsewhere is None:
+                    notes.append("the base cannot turn: in every motion its wheels allow (rolling without slipping) "
+                                 "the yaw rate is zero, at the neutral configuration and at the other admissible "
+                                 "ones searched (steering moved), so turning requires slip; give the wheels a "
+                                 "friction law (friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and "
+                                 "friction')")
+                else:
+                    moved = self._moved(elsewhere)
+                    notes.append("the base cannot turn at the neutral configuration (e.g. its steerable wheels are "
+                                 f"parallel there), but it can without slip at other admissible ones, e.g. {moved}: "
+                                 "steer the wheels first")
             if not np.any(np.abs(null[:, xy]) > 1e-9):
-                notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+                if all(reachable_motion(self, names[i]) is None for i in xy):
+                    notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+                else:
+                    notes.append("the base cannot translate at the neutral configuration, but it can at other "
+                                 "admissible ones (steer the wheels first)")
+        from .description.rounded_angles import hint, rounded_angles
+
+        rounded = rounded_angles(self.description.urdf)
+        if rounded:
+            notes.append(hint(rounded))
         nearby = self._nearby_rank(rank)
         if nearby > rank:
             notes.append(f"the mobility changes at the neutral configuration: {self.nq - rank} here, "
@@ -582,6 +605,11 @@ class Robot:
                          "and velocities or accelerations that leave this configuration violate them (robotdyn warns, "
                          "naming the row: Robot.redundant_row_violations)")
         return self.nq - rank, notes
+
+    def _moved(self, q) -> str:
+        """The coordinates of q that differ from the neutral configuration, as text (name = value rad/m)."""
+        q0 = self.neutral()
+        return ", ".join(f"{c} = {x:.3g}" for c, x, x0 in zip(self.coordinates, q, q0) if abs(x - x0) > 1e-3)
 
     def _nearby_rank(self, rank: int, samples: int = 3, step: float = 0.1) -> int:
         """The largest rank of the constraint rows at a few valid configurations near the neutral one, to tell a

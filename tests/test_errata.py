@@ -125,6 +125,34 @@ def test_table2_angles_with_heading_and_Ly_both_free():
     np.testing.assert_allclose(fit.fun, [2.41, 1.15, 4.21], atol=0.02)
 
 
+def test_mission1_friction_need_is_no_threshold():
+    """Issue 24: 'requires mu >= 20' is not a friction threshold. With the same lateral Coulomb law at mu from 0.25
+    to 20, no sample of mission 1 (first second, every 50 ms) is inside the friction cone: the law makes each
+    lateral force mu f_n (checked), so |f_t| / f_n >= mu with equality only without traction, and the mission needs
+    traction at every sample; for mu <= 1 that traction scales as 1/mu (the sideways force the path needs comes only
+    from the tilt differences of the contact planes: a nearly singular force system)."""
+    from dataclasses import replace
+
+    from robotdyn.robots.adaptable_wheel import dynamics as aw_dyn
+    from robotdyn.robots.adaptable_wheel import missions as aw_missions
+
+    run = aw_missions.run_mission(replace(aw_missions.MISSIONS["mission1"], t_end=1.0))
+    traction = {}
+    for mu in (0.25, 1.0, 4.0, 20.0):
+        fr = aw_dyn.mission_friction(run, params={"mu": mu}, every=5)
+        assert np.all(fr.rank == 15) and fr.residual.max() < 1e-8  # regular, solved exactly
+        np.testing.assert_allclose(np.abs(fr.lateral), mu * np.abs(fr.normal), rtol=1e-5)  # the law, saturated
+        with np.errstate(invalid="ignore"):
+            assert np.all(fr.required_mu >= mu * (1 - 1e-9))  # never inside the cone ...
+        assert not np.any(np.all(fr.required_mu <= mu * (1 + 1e-6), axis=1))  # ... at any sample, at any mu
+        assert np.all(np.abs(fr.longitudinal).max(axis=1) > 50.0)  # traction everywhere (weight: 98 N)
+        traction[mu] = np.median(np.abs(fr.longitudinal))
+        if mu == 1.0:
+            assert fr.required_mu.min() == pytest.approx(20.15, abs=0.01)  # the errata's old "mu >= 20"
+            assert fr.condition.min() > 900
+    assert traction[0.25] * 0.25 == pytest.approx(traction[1.0], rel=0.2)  # traction roughly ~ 1 / mu (0.84)
+
+
 # --------------------------------------------------------------- Zuniga-Aviles et al.: eq 28 and eq 31
 @pytest.mark.parametrize("radius, turns_of_pi", [(0.15, 0.75), (0.08, 0.4), (0.05, 0.25)])
 def test_eq28_wheel_angles_through_eq14(radius, turns_of_pi):

@@ -193,6 +193,49 @@ def test_eq31_rotation_is_the_modified_dh_product_of_table2():
     # the position is neither: modified order (l_cs cos phi, l_cs sin phi, lambda_C - l_cs1) = (0.233, 0.233, 0.10)
     np.testing.assert_allclose(out["modified"][:3, 3], [0.33 / np.sqrt(2), 0.33 / np.sqrt(2), 0.10], atol=1e-12)
     assert np.abs(out["modified"][:3, 3] - printed[:3, 3]).max() > 0.2
+    # Paul's order: ((l_cs + l_cs1 cos theta_CS1) cos(phi + theta_C1), ... sin(...), lambda_C - l_cs1 sin theta_CS1)
+    np.testing.assert_allclose(out["paul"][:3, 3], [-0.33 / np.sqrt(2), 0.33 / np.sqrt(2), 0.54 + 0.44], atol=1e-12)
+    assert np.abs(out["paul"][:3, 3] - printed[:3, 3]).max() > 0.2
+
+
+def test_mmr12_printed_numbers_classified():
+    """Issue 24: |J1| = -1 (sympy, and the model's projection block at every heading), Table 5's climbing error
+    against Tables 7 and 8, Tables 6-8's arithmetic, Table 7's CAE row, and the manipulation range."""
+    phi, b = sp.symbols("phi b", real=True)
+    J1 = sp.Matrix([[-sp.sin(phi), sp.cos(phi), 0], [-sp.cos(phi), -sp.sin(phi), -b], [0, 0, -1]])  # eq 16, x y phi
+    assert sp.simplify(J1.det()) == -1  # for every heading and half-track: a fact about the platform only
+    robot = robotdyn.load("mmr12_eod")
+    conds = []
+    for psi in (0.0, 0.7, 2.0, -2.5):  # the model's dependent block: regular, its 2-norm condition heading-invariant
+        red = robot.reduced(mm.state(robot, psi=psi), np.zeros(robot.mobility))
+        proj = red.projection
+        conds.append(np.linalg.cond(red.jacobian_rows.A[np.ix_(proj.rows, proj.dependent)]))
+    assert np.ptp(conds) < 1e-9 * conds[0] and conds[0] < 10
+    # Table 7 (simulation, real) means and RMS [mm], Table 8 differences, Table 6 ranges; order: orientation,
+    # approaching, manipulation, lifting, climbing
+    sim = np.array([[40, 40.16], [2.37, 2.38], [0.05, 0.05], [0.02, 0.02], [0.04, 0.041]])
+    real = np.array([[60, 60.09], [6.5, 6.52], [4.25, 4.25], [5, 5.04], [6.3, 6.31]])
+    table8 = np.array([[20, 19.95], [4.13, 4.15], [4.2, 4.2], [4.98, 5.02], [6.26, 6.28]])
+    table6 = np.array([[40, 80], [0.5, 8], [0.5, 8], [4, 6], [4.6, 8]])
+    np.testing.assert_allclose((real - sim)[:, 0], table8[:, 0], atol=1e-9)  # means: to the printed digits
+    assert np.abs(real - sim - table8)[:, 1].max() <= 0.021  # RMS: within 0.02 mm
+    assert real[4, 0] - 40.0 < 0 < table8[4, 0]  # Table 5's 40 mm climbing error would make Table 8's negative
+    midrange = table6.mean(axis=1)
+    np.testing.assert_allclose(midrange[[0, 2, 3, 4]], real[[0, 2, 3, 4], 0])  # Table 7 real = Table 6 mid-range
+    assert midrange[1] == 4.25 and real[1, 0] == 6.5  # ... but not for approaching
+    assert table8[:, 0].mean() == pytest.approx(7.91, abs=0.005)  # the conclusion's "real ... 7.91 mm"
+    assert real[:, 0].mean() == pytest.approx(16.41, abs=1e-9)
+    # Table 7's CAE row: 8.5 / 8.53 ("with load") and 16.41 / 16.45 ("without load") are the column averages
+    assert sim.mean(axis=0) == pytest.approx([8.496, 8.5302], abs=1e-9)
+    assert real.mean(axis=0) == pytest.approx([16.41, 16.442], abs=1e-9)
+    # the manipulation "rank" x = y = 2.5, z = 1.5 m is a range: its corner is reachable; the target is Fig. 9's
+    from robotdyn.description.kinematics import position_ik
+
+    np.testing.assert_allclose(mm.MANIPULATION_TARGET, [2.0, 2.0, 1.5])
+    corner = position_ik(robot, "E", [2.5, 2.5, 1.5], mm.state(robot, psi=np.pi / 4),
+                         ["x", "y", "psi", "theta1", "lambda2", "theta3"], regularisation=1e-3)
+    assert corner.success and corner.error < 1e-9
+    robot.check_q(corner.q)  # within the joint ranges
 
 
 def test_manipulator_rows_follow_pauls_order_so_the_paper_mixes_conventions():

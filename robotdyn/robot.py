@@ -495,13 +495,14 @@ class Robot:
         nudot = None if tau is None else solve_mass(red.M, red.B @ np.asarray(tau, float) - red.h)
         return ill_conditioned(red, self.velocity_names, nudot)
 
-    def warn_conditioning(self, red, nudot=None, extra: list | None = None) -> list:
+    def warn_conditioning(self, red, nudot=None, extra: list | None = None, forward: bool = True) -> list:
         """Warn (one :class:`~robotdyn.errors.RobotDynWarning`) when the results of ``red`` (with the accelerations
         ``nudot`` computed from it) are beyond what the state can produce (:mod:`robotdyn.reduction.conditioning`),
-        with ``extra`` parts found by the caller (e.g. the force system); returns the parts found."""
+        with ``extra`` parts found by the caller (e.g. the force system); ``forward``: whether ``nudot`` was solved
+        from the mass matrix (else its conditioning is not a cause); returns the parts found."""
         from .reduction.conditioning import ill_conditioned, message
 
-        found = ill_conditioned(red, self.velocity_names, nudot)
+        found = ill_conditioned(red, self.velocity_names, nudot, forward)
         found += [e for e in (extra or []) if e.part not in {f.part for f in found}]
         if found:
             warnings.warn(message(found), RobotDynWarning, stacklevel=3)

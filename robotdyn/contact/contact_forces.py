@@ -285,6 +285,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
     q = robot.check_q(q)
     nu = robot.check_nu(nu, "v")
     red = robot.reduced(q, nu)
+    forward = nudot is None  # accelerations solved from the mass matrix (its conditioning then matters)
     friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
     if sliding_now(robot):
         if nudot is not None:
@@ -313,7 +314,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
     from ..reduction.conditioning import WARN_CONDITION, IllConditioned
 
     system = [IllConditioned("force system", out.condition)] if out.condition > WARN_CONDITION else []
-    out.ill_conditioned = robot.warn_conditioning(red, nudot, system)
+    out.ill_conditioned = robot.warn_conditioning(red, nudot, system, forward)
     return out
 
 

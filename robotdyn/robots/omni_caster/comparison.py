@@ -118,9 +118,9 @@ def terms_params(p: dict, wheel: float, steering: float) -> dict:
 
 
 def fit_steady_turn(p: dict, free_terms: bool = True, start=(-1.0, 0.0)) -> dict:
-    """The steady turn (trailing casters at zero steering rate, :func:`~robotdyn.robots.omni_caster.model.
-    steady_steering`) whose I_uu* (eq 48 transcription) best matches the printed with-wheel matrix (its entries'
-    rounding: :data:`PRINTED_ROUNDING`).
+    """The steady turn (trailing casters at zero steering rate,
+    :func:`~robotdyn.robots.omni_caster.model.steady_steering`) whose I_uu* (eq 48 transcription) best matches the
+    printed with-wheel matrix (its entries' rounding: :data:`PRINTED_ROUNDING`).
 
     Args:
         p: Parameters (Table 1-2).

@@ -19,7 +19,8 @@ import numpy as np
 from ..description.urdf import _ROOT_CHAINS
 
 TOL = 1e-9
-"""Largest |A v| (relative to |A|, with v_i = 1) accepted as a motion without slip."""
+"""Largest :math:`|A v|` (relative to the largest entry of A, with :math:`v_i = 1`) accepted as a motion without
+slip."""
 
 
 def free_coordinates(robot) -> np.ndarray:

@@ -132,7 +132,8 @@ def fit_steady_turn(p: dict, free_terms: bool = True, start=(-1.0, 0.0)) -> dict
 
     Returns:
         dict with ``wheel``, ``steering`` [kg], ``centre`` (X, Y) [m], ``radius`` [m], ``phi`` [rad], ``residual``
-        (fit - printed, 6 entries) and ``ratio`` (|residual| / rounding, 6 entries; all <= 1: reproduced).
+        (fit - printed, 6 entries) and ``ratio`` (the residuals' magnitudes over the rounding, 6 entries; all <= 1:
+        reproduced).
     """
     from scipy.optimize import least_squares, minimize
 

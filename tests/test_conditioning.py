@@ -111,10 +111,17 @@ def test_cli_dump_warns_once_on_stderr(robot, capsys):
     args = ["dump", "adaptable_wheel", "--q", *map(str, REPRODUCER), "--v", "0.1", "0.1", "0.1",
             "--tau", "1", "1", "1", "1", "1", "1"]
     assert main(args) == 0
-    err = capsys.readouterr().err
-    assert err.count("reduced mass matrix S^T M S has condition number 5.61e+15") == 1
-    assert main(args[:-7]) == 0  # no torques, no accelerations: nothing to warn about
+    captured = capsys.readouterr()
+    assert captured.err.count("reduced mass matrix S^T M S has condition number 5.61e+15") == 1
+    assert "constraint block condition 176, S^T M S condition 5.61e+15" in captured.out  # both shown
+    assert main(args[:-7]) == 0  # no torques, no accelerations: nothing to warn about ...
     assert "beyond what it can produce" not in capsys.readouterr().err
+    assert main([*args, "--json"]) == 0
+    import json
+
+    data = json.loads(capsys.readouterr().out)
+    assert data["mass_matrix_condition"] == pytest.approx(5.61e15, rel=1e-2)
+    assert [p["part"] for p in data["ill_conditioned"]] == ["mass matrix"]
 
 
 def test_built_in_robots_are_far_from_the_thresholds_at_neutral():

@@ -272,6 +272,8 @@ class Robot:
         params: Resolved parameter values.
         model, data: The Pinocchio model and data (natural coordinates, nq == nv).
         constraints, motors: The constraint and motor objects.
+        implausible_inertias: Links whose inertia is implausible for their mass and size, with their share of the
+            effective mass (:mod:`robotdyn.description.inertia_check`; a warning names them on load).
     """
 
     def __init__(self, spec: RobotSpec, params: dict | None = None, terrain: Terrain | None = None) -> None:
@@ -328,6 +330,11 @@ class Robot:
         self.operational = spec.operational.build(self.description) if spec.operational is not None else None
         if self.operational is not None:
             self.velocity_names = list(self.operational.names)
+        from .description.inertia_check import implausible_inertias, message
+
+        self.implausible_inertias = implausible_inertias(self)  # placeholder inertias (issue 24): data, and a warning
+        if self.implausible_inertias:
+            warnings.warn(message(self.implausible_inertias), RobotDynWarning, stacklevel=2)
 
     def __getstate__(self) -> dict:
         """Pickle without the per-thread caches (Pinocchio data and compiled models are rebuilt on use)."""
@@ -688,6 +695,7 @@ class Robot:
                                  "what double precision holds)")
         if check:
             self._warn_dropped(red, out)
+            self.warn_conditioning(red, out)
         return out
 
     def dynamics_derivatives(self, q, nu, tau):
@@ -703,6 +711,31 @@ class Robot:
         from .reduction.dynamics_derivatives import dynamics_derivatives
 
         return dynamics_derivatives(self, q, nu, tau)
+
+    def conditioning(self, q, nu, tau=None) -> list:
+        """The ill-conditioned parts of the reduced solve at (q, nu) (the projection's :math:`A_d`, the reduced
+        mass matrix :math:`S^TMS`) that make its results (with motor torques ``tau``: the accelerations they
+        give) beyond what the state can produce, as data: a list of
+        :class:`~robotdyn.reduction.conditioning.IllConditioned`, empty where they are within it
+        (:mod:`robotdyn.reduction.conditioning`)."""
+        from .reduction.conditioning import ill_conditioned
+
+        red = self.reduced(q, nu)
+        nudot = None if tau is None else solve_mass(red.M, red.B @ np.asarray(tau, float) - red.h)
+        return ill_conditioned(red, self.velocity_names, nudot)
+
+    def warn_conditioning(self, red, nudot=None, extra: list | None = None, forward: bool = True) -> list:
+        """Warn (one :class:`~robotdyn.errors.RobotDynWarning`) when the results of ``red`` (with the accelerations
+        ``nudot`` computed from it) are beyond what the state can produce (:mod:`robotdyn.reduction.conditioning`),
+        with ``extra`` parts found by the caller (e.g. the force system); ``forward``: whether ``nudot`` was solved
+        from the mass matrix (else its conditioning is not a cause); returns the parts found."""
+        from .reduction.conditioning import ill_conditioned, message
+
+        found = ill_conditioned(red, self.velocity_names, nudot, forward)
+        found += [e for e in (extra or []) if e.part not in {f.part for f in found}]
+        if found:
+            warnings.warn(message(found), RobotDynWarning, stacklevel=3)
+        return found
 
     def redundant_row_violations(self, q, nu, nudot=None) -> list:
         """The constraint rows dropped as redundant at q that the velocities ``nu`` (and the accelerations
@@ -811,8 +844,11 @@ class Robot:
 
     def mobility_check(self) -> tuple[int, list[str]]:
         """The mobility n - rank A at the neutral configuration, and plain-language notes where the wheels lock
-        the base (no admissible motion turns it, or moves it at all), e.g. a skid-steer base whose non-steering
-        wheels roll without slipping."""
+        the base (no admissible motion turns it, or moves it at all, at the neutral configuration and at the other
+        admissible ones :func:`~robotdyn.constraints.base_mobility.reachable_motion` finds), e.g. a skid-steer base
+        whose non-steering wheels roll without slipping, or where that holds only at the neutral configuration
+        (steerable wheels parallel there); and joint-origin angles that look like a rounded multiple of pi/2
+        (:mod:`robotdyn.description.rounded_angles`)."""
         A = self.rows_at(self.neutral()).A
         rank = int(np.linalg.matrix_rank(A)) if A.size else 0
         notes = []
@@ -822,12 +858,32 @@ class Robot:
             names = self.description.joint_names
             yaw = names.index("psi" if "psi" in names else "yaw")
             xy = [names.index("x"), names.index("y")]
+            from .constraints.base_mobility import reachable_motion
+
             if not np.any(np.abs(null[:, yaw]) > 1e-9):
-                notes.append("the base cannot turn: in every motion its wheels allow (rolling without slipping) the "
-                             "yaw rate is zero, so turning requires slip; give the wheels a friction law "
-                             "(friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and friction')")
+                elsewhere = reachable_motion(self, names[yaw])
+                if elsewhere is None:
+                    notes.append("the base cannot turn: in every motion its wheels allow (rolling without slipping) "
+                                 "the yaw rate is zero, at the neutral configuration and at the other admissible "
+                                 "ones searched (steering moved), so turning requires slip; give the wheels a "
+                                 "friction law (friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and "
+                                 "friction')")
+                else:
+                    moved = self._moved(elsewhere)
+                    notes.append("the base cannot turn at the neutral configuration (e.g. its steerable wheels are "
+                                 f"parallel there), but it can without slip at other admissible ones, e.g. {moved}: "
+                                 "steer the wheels first")
             if not np.any(np.abs(null[:, xy]) > 1e-9):
-                notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+                if all(reachable_motion(self, names[i]) is None for i in xy):
+                    notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+                else:
+                    notes.append("the base cannot translate at the neutral configuration, but it can at other "
+                                 "admissible ones (steer the wheels first)")
+        from .description.rounded_angles import hint, rounded_angles
+
+        rounded = rounded_angles(self.description.urdf)
+        if rounded:
+            notes.append(hint(rounded))
         nearby = self._nearby_rank(rank)
         if nearby > rank:
             notes.append(f"the mobility changes at the neutral configuration: {self.nq - rank} here, "
@@ -836,6 +892,11 @@ class Robot:
                          "and velocities or accelerations that leave this configuration violate them (robotdyn warns, "
                          "naming the row: Robot.redundant_row_violations)")
         return self.nq - rank, notes
+
+    def _moved(self, q) -> str:
+        """The coordinates of q that differ from the neutral configuration, as text (name = value rad/m)."""
+        q0 = self.neutral()
+        return ", ".join(f"{c} = {x:.3g}" for c, x, x0 in zip(self.coordinates, q, q0) if abs(x - x0) > 1e-3)
 
     def _nearby_rank(self, rank: int, samples: int = 3, step: float = 0.1) -> int:
         """The largest rank of the constraint rows at a few valid configurations near the neutral one, to tell a
@@ -878,6 +939,7 @@ class Robot:
             "root_height": self.description.root_height,
             "root_height_source": self.root_height_source,
             "visual_warnings": report.warnings if report is not None else [],
+            "implausible_inertias": [vars(f) for f in self.implausible_inertias],  # warned on load, not repeated
             "robot": self.spec.name,
             "title": self.spec.title,
             "paper": self.spec.paper,

@@ -703,7 +703,23 @@ class Robot:
         independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
         :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (Python path; see
         :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`, and with slipping wheels
-        :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`)."""
+        :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] in the order of :attr:`coordinates`, on the holonomic constraint
+                manifold for ``dq_manifold`` to be the derivative along it.
+            nu: Independent velocities (k,) [m/s, rad/s] in the order of :attr:`velocity_names`.
+            tau: Motor torques/forces (n_motors,) [N m or N] in the order of :attr:`motors`.
+
+        Returns:
+            A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`.
+
+        Raises:
+            InputError: Wrong sizes, or a constraint without derivatives (a stick-slip wheel, exact Coulomb
+                friction, a user's own constraint class).
+            SingularConstraintError: Slipping wheels whose coupled system is singular (Painlevé).
+            NonFiniteError: A non-finite result.
+        """
         if sliding_now(self):
             from .contact.sliding_derivatives import sliding_derivatives
 

@@ -733,7 +733,17 @@ class Robot:
         mass matrix :math:`S^TMS`) that make its results (with motor torques ``tau``: the accelerations they
         give) beyond what the state can produce, as data: a list of
         :class:`~robotdyn.reduction.conditioning.IllConditioned`, empty where they are within it
-        (:mod:`robotdyn.reduction.conditioning`)."""
+        (:mod:`robotdyn.reduction.conditioning`).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as :attr:`coordinates`.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as :attr:`velocity_names`.
+            tau: Motor torques/forces (motors,) [N m or N], ordered as the motors (default ``None``: the
+                accelerations are not judged, only the parts' conditioning).
+
+        Returns:
+            The ill-conditioned parts, a list of :class:`~robotdyn.reduction.conditioning.IllConditioned`.
+        """
         from .reduction.conditioning import ill_conditioned
 
         red = self.reduced(q, nu)
@@ -742,9 +752,18 @@ class Robot:
 
     def warn_conditioning(self, red, nudot=None, extra: list | None = None, forward: bool = True) -> list:
         """Warn (one :class:`~robotdyn.errors.RobotDynWarning`) when the results of ``red`` (with the accelerations
-        ``nudot`` computed from it) are beyond what the state can produce (:mod:`robotdyn.reduction.conditioning`),
-        with ``extra`` parts found by the caller (e.g. the force system); ``forward``: whether ``nudot`` was solved
-        from the mass matrix (else its conditioning is not a cause); returns the parts found."""
+        ``nudot`` computed from it) are beyond what the state can produce (:mod:`robotdyn.reduction.conditioning`).
+
+        Args:
+            red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` the results come from.
+            nudot: The independent accelerations (k,) [m/s^2, rad/s^2] computed from it (default ``None``: only
+                the parts' conditioning is judged).
+            extra: Ill-conditioned parts found by the caller (e.g. the force system), added where not already found.
+            forward: Whether ``nudot`` was solved from the mass matrix (else its conditioning is not a cause).
+
+        Returns:
+            The parts found (a list of :class:`~robotdyn.reduction.conditioning.IllConditioned`; empty: no warning).
+        """
         from .reduction.conditioning import ill_conditioned, message
 
         found = ill_conditioned(red, self.velocity_names, nudot, forward)

@@ -25,7 +25,15 @@ slip."""
 
 def free_coordinates(robot) -> np.ndarray:
     """Mask of the joint coordinates no holonomic row involves at the neutral configuration (the root's excluded):
-    moving them keeps a configuration admissible."""
+    moving them keeps a configuration admissible.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        Boolean mask (n,), ordered as the robot's coordinates: True for a joint coordinate (steering, wheel spin)
+        that no holonomic constraint row involves.
+    """
     rows = robot.rows_at(robot.neutral())
     root = {name for name, _, _ in _ROOT_CHAINS[robot.spec.root]}
     free = np.array([j not in root for j in robot.description.joint_names])

@@ -257,7 +257,14 @@ SMALL_SHARE = 0.01
 
 def message(found: list[ImplausibleInertia]) -> str:
     """One line naming every link of :func:`implausible_inertias`: those that matter (share of the effective mass
-    of at least :data:`SMALL_SHARE`, or unknown) with their numbers, the others by name."""
+    of at least :data:`SMALL_SHARE`, or unknown) with their numbers, the others by name.
+
+    Args:
+        found: The links :func:`implausible_inertias` found (an empty list gives an empty line).
+
+    Returns:
+        The warning's text, one line.
+    """
     big = [f for f in found if f.share is None or f.share >= SMALL_SHARE]
     small = [f.link for f in found if f not in big]
     text = "; ".join(f.text() for f in big)

@@ -50,7 +50,14 @@ def _words(k: int) -> str:
 
 
 def rounded_angles(urdf: str) -> list[RoundedAngle]:
-    """Joint-origin rpy angles of a URDF text within :data:`NEAR` of a nonzero multiple of pi/2, not exact."""
+    """Joint-origin rpy angles of a URDF text within :data:`NEAR` of a nonzero multiple of pi/2, not exact.
+
+    Args:
+        urdf: The URDF's XML text (Xacro already expanded).
+
+    Returns:
+        One :class:`RoundedAngle` per such angle, in the file's joint order (empty where there is none).
+    """
     out = []
     for joint in ET.fromstring(urdf).iter("joint"):
         origin = joint.find("origin")
@@ -69,7 +76,14 @@ def rounded_angles(urdf: str) -> list[RoundedAngle]:
 
 
 def hint(found: list[RoundedAngle]) -> str:
-    """One line naming each rounded angle and the exact value to write."""
+    """One line naming each rounded angle and the exact value to write.
+
+    Args:
+        found: The angles :func:`rounded_angles` found.
+
+    Returns:
+        The hint's text, one line.
+    """
     items = ", ".join(f"{f.joint} {f.axis} = {f.value:.10g} ({f.off:+.2g} rad from {f.text})" for f in found)
     return (f"joint origin angles that look like a rounded multiple of pi/2: {items}; a rounded angle tilts axles "
             "and axes by that much, which can make dependent constraint rows independent and change the mobility: "

@@ -63,7 +63,15 @@ class IllConditioned:
 
 def mass_condition(M: np.ndarray) -> tuple[float, np.ndarray]:
     """2-norm condition number of a symmetric positive (semi-)definite matrix and the eigenvector of its smallest
-    eigenvalue (``inf`` where that eigenvalue is not positive)."""
+    eigenvalue (``inf`` where that eigenvalue is not positive).
+
+    Args:
+        M: A symmetric positive (semi-)definite matrix (k, k), e.g. the reduced mass matrix :math:`S^TMS`.
+
+    Returns:
+        ``(condition, vector)``: the 2-norm condition number (1.0 for an empty matrix) and the unit eigenvector
+        (k,) of the smallest eigenvalue (its softest direction).
+    """
     if M.size == 0:
         return 1.0, np.zeros(0)
     w, V = np.linalg.eigh(M)
@@ -110,7 +118,15 @@ WHAT = "the accelerations, forces and loads"
 
 
 def message(found: list[IllConditioned], what: str = WHAT) -> str:
-    """One line for :func:`ill_conditioned`'s list: which part, its condition number, and what it means."""
+    """One line for :func:`ill_conditioned`'s list: which part, its condition number, and what it means.
+
+    Args:
+        found: The ill-conditioned parts (:class:`IllConditioned`), in the order to name them.
+        what: What is implausible, the sentence's subject (default :data:`WHAT`).
+
+    Returns:
+        The warning's text, one line.
+    """
     parts = []
     for f in found:
         if f.part == "projection":

@@ -126,7 +126,19 @@ def terms_params(p: dict, wheel: float, steering: float) -> dict:
     """Parameters with eq 43's wheel term ``wheel`` = I_theta / r^2 = I_axle / r^2 + m_wheel + m_link and steering
     term ``steering`` = I_eta / d^2 = (m_link p^2 + I_wheel_diam + I_link_z) / d^2 [kg], reached by changing only
     the offset link's mass and its mass-centre offset p (Table 2's wheel kept: a wheel heavier without more axle
-    inertia than 2 I_diam allows is not a rigid body)."""
+    inertia than 2 I_diam allows is not a rigid body).
+
+    Args:
+        p: The model's parameters by name (Table 2's values and units: kg, m, kg m^2).
+        wheel: Eq 43's wheel term I_theta / r^2 [kg].
+        steering: Eq 43's steering term I_eta / d^2 [kg].
+
+    Returns:
+        A copy of ``p`` with ``m_link`` [kg] and ``p`` [m] (the offset link's mass and mass-centre offset) set.
+
+    Raises:
+        ValueError: No positive link mass and real offset give these terms.
+    """
     m_link = wheel - p["I_wheel_axle"] / p["r"] ** 2 - p["m_wheel"]
     offset2 = (steering * p["d"] ** 2 - p["I_wheel_diam"] - p["I_link_z"]) / m_link
     if m_link <= 0 or offset2 < 0:

@@ -495,6 +495,22 @@ class Robot:
         """
         return as_vector(tau, len(self.motors), "tau", [m.name for m in self.motors], MAX_FORCE, "N m or N")
 
+    def _state(self, q, nu, tau=None, what: str = "nu") -> tuple:
+        """``q``, ``nu`` (and ``tau``) as float arrays, their lengths checked (a wrong length is a one-line
+        :class:`~robotdyn.errors.InputError` from :meth:`check_q`/:meth:`check_nu`/:meth:`check_tau`, never
+        numpy's shape error deep inside); values are not range-checked here (the API's hot path)."""
+        q_, nu_ = np.asarray(q, float), np.asarray(nu, float)
+        if q_.shape != (self.nq,):
+            self.check_q(q)
+        if nu_.shape != (self.mobility,):
+            self.check_nu(nu, what)
+        if tau is None:
+            return q_, nu_
+        tau_ = np.asarray(tau, float)
+        if tau_.shape != (len(self.motors),):
+            self.check_tau(tau)
+        return q_, nu_, tau_
+
     # ------------------------------------------------------------------------------------------ constraints
     def constraint_rows(self, kin: KinematicState) -> ConstraintRows:
         """All constraint rows at the state of ``kin``.
@@ -626,6 +642,7 @@ class Robot:
             The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` (``M``, ``h``, ``g``, ``B``, ``S``, ...).
 
         Raises:
+            InputError: ``q`` or ``nu`` of the wrong length (one line naming the entries expected).
             NonFiniteError: The state gives non-finite numbers.
 
         Example:
@@ -637,7 +654,7 @@ class Robot:
             >>> bool(abs(red.M - red.M.T).max() < 1e-12)  # symmetric
             True
         """
-        q, nu = np.asarray(q, float), np.asarray(nu, float)
+        q, nu = self._state(q, nu)
         return checked(reduce(self, q, nu, coriolis), q, nu)
 
     def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -675,6 +692,7 @@ class Robot:
             The independent accelerations (k,) [m/s^2, rad/s^2].
 
         Raises:
+            InputError: ``q``, ``nu`` or ``tau`` of the wrong length (one line naming the entries expected).
             NonFiniteError: The accelerations are not finite.
 
         Example:
@@ -686,10 +704,11 @@ class Robot:
             >>> bool(abs(nudot[0] - nudot[1]) < 1e-12)  # equal torques: the wheels accelerate alike
             True
         """
+        q, nu, tau = self._state(q, nu, tau)
         if sliding_now(self):
-            return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
+            return forward_sliding(self, q, nu, tau).nudot
         red = self.reduced(q, nu)
-        out = solve_mass(red.M, red.B @ np.asarray(tau, float) - red.h)
+        out = solve_mass(red.M, red.B @ tau - red.h)
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
                                  "what double precision holds)")
@@ -808,6 +827,9 @@ class Robot:
             :math:`B_r\\tau = Q` in least squares, and the norm of what the motors cannot produce (0 when the
             motion is feasible).
 
+        Raises:
+            InputError: ``q``, ``nu`` or ``nudot`` of the wrong length (one line naming the entries expected).
+
         Example:
             >>> import robotdyn
             >>> robot = robotdyn.load("quasimoro")
@@ -817,8 +839,11 @@ class Robot:
             [0.1, 0.1]
         """
         red = self.reduced(q, nu)
-        Q = red.M @ np.asarray(nudot, float) + red.h
-        self._warn_dropped(red, np.asarray(nudot, float))
+        nudot = np.asarray(nudot, float)
+        if nudot.shape != (self.mobility,):
+            self.check_nu(nudot, "nudot")
+        Q = red.M @ nudot + red.h
+        self._warn_dropped(red, nudot)
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)

@@ -96,4 +96,24 @@ def normal_compliance(robot) -> NormalCompliance:
     return NormalCompliance(tuple(names), np.array(k, float), np.array(c, float), np.array(given, bool), rule)
 
 
-__all__ = ["NormalCompliance", "normal_compliance", "weight", "STATIC_DEFLECTION", "DAMPING_RATIO"]
+def wheel_stiffness(robot, names: list[str]) -> np.ndarray:
+    """The normal stiffness [N/m] of the robot's wheels called ``names`` (:func:`normal_compliance`, kept on the
+    robot as ``_normal_compliance``; a wheel constraint that is not among the spec's wheels gets the default
+    rule's value).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        names: Wheel names, e.g. those of its wheel constraints in their order.
+
+    Returns:
+        (len(names),) stiffnesses [N/m].
+    """
+    comp = getattr(robot, "_normal_compliance", None)
+    if comp is None:
+        comp = robot._normal_compliance = normal_compliance(robot)
+    by_name = dict(zip(comp.names, comp.stiffness))
+    default = weight(robot) / (max(len(comp.names), 1) * STATIC_DEFLECTION)
+    return np.array([by_name.get(n, default) for n in names], float)
+
+
+__all__ = ["NormalCompliance", "normal_compliance", "wheel_stiffness", "weight", "STATIC_DEFLECTION", "DAMPING_RATIO"]

@@ -134,13 +134,18 @@ class SlidingState:
     slip: np.ndarray
     force: np.ndarray
     power: float
+    lam: np.ndarray | None = None  # (m,) every row's multiplier where the loads are split by the rigid limit
+    unloaded: tuple = ()  # wheels the rigid limit leaves unloaded (they would pull)
 
 
 def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingState:
     """Accelerations and normal loads with the slipping wheels' friction, solved together (see the module).
 
+    Where the rows are redundant so that rigid-body dynamics leave wheel loads open (a rigid chassis on four
+    wheels), the loads are those of the rigid limit of the wheels' normal compliance, solved together with the
+    accelerations and friction (:func:`robotdyn.contact.rigid_limit.coupled`).
+
     Raises:
-        ConstraintError: a slipping wheel's normal row is redundant (its load is not determined).
         SingularConstraintError: the coupled system is singular (Painlevé).
     """
     wheels = sliding_now(robot)
@@ -149,6 +154,12 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     kin = KinematicState(model, data, q, red.v)
     rows = red.jacobian_rows
     kept = np.asarray(red.projection.rows, int)
+    if len(kept) < rows.A.shape[0]:
+        from .rigid_limit import coupled
+
+        out = coupled(robot, q, red, kin, wheels, tau)
+        if out is not None:
+            return out
     G = rows.A[kept].T.copy()
     slip = np.zeros((len(wheels), 2))
     coef = np.zeros((len(wheels), 2))

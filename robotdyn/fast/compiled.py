@@ -216,7 +216,11 @@ class CompiledModel:
         sliding = [c for c in robot.constraints if getattr(c, "sliding", False)]  # contact.sliding.sliding_now
         if not sliding:
             return None
-        labels = robot.rows_at(robot.neutral()).labels
+        rows = robot.rows_at(robot.neutral())
+        labels = rows.labels
+        if _loads_open(rows.A, labels, self.wheels):
+            return ("the wheels' normal loads are statically indeterminate (split by the rigid limit of their normal "
+                    "compliance, robotdyn.contact.rigid_limit): simulated on the Python path")
         laws = []
         for c in sliding:
             friction = c.compiled_friction() if hasattr(c, "compiled_friction") else \
@@ -373,6 +377,25 @@ class CompiledModel:
         Q, NU = np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float)
         M, h, g, S, w, B, failed = self.ev.evaluate_many(Q, NU)
         return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
+
+
+def _loads_open(A: np.ndarray, labels: list[str], wheels: list) -> bool:
+    """Whether the rows A (m, n) leave some wheel's normal load open (a combination of redundant rows moves it):
+    the wheel constraints' normal components (their ``_labels()`` and ``_directions``) against the null space of
+    :math:`A^T`."""
+    if not len(A):
+        return False
+    _, s, Vt = np.linalg.svd(A.T, full_matrices=True)
+    rank = int(np.sum(s > s.max(initial=0.0) * max(A.shape) * np.finfo(float).eps))
+    if rank == A.shape[0]:
+        return False
+    N = Vt[rank:].T
+    index = {lab: i for i, lab in enumerate(labels)}
+    for c in wheels:
+        idx = [index[lab] for lab in c._labels()]
+        if np.linalg.norm(np.asarray(c._directions, float)[:, 2] @ N[idx]) > 1e-9:
+            return True
+    return False
 
 
 __all__ = ["Fallback", "CompiledModel", "LazyProjection", "why_not", "available"]

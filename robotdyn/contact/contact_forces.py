@@ -348,6 +348,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
     nu = robot.check_nu(nu, "v")
     red = robot.reduced(q, nu)
     friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
+    st = None
     if sliding_now(robot):
         if nudot is not None:
             raise InputError("with slipping wheels the forces follow from motor torques: give tau, not nudot")
@@ -372,18 +373,29 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
     out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
     if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
         out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
-    if compliance and not friction:
+    if st is not None and st.lam is not None:  # the loads of the coupled solve (rigid limit with friction)
+        apply_rigid_limit(robot, out, st.lam, st.unloaded)
+    elif compliance and not friction:
         apply_rigid_limit(robot, out)
     return out
 
 
-def apply_rigid_limit(robot, out: ConstraintForces) -> ConstraintForces:
+def apply_rigid_limit(robot, out: ConstraintForces, lam: np.ndarray | None = None, unloaded: tuple = ()
+                      ) -> ConstraintForces:
     """Fix the loads that rigid-body dynamics leave open in ``out`` by the rigid limit of the wheels' normal
     compliance (:func:`robotdyn.contact.rigid_limit.split`), in place: ``lam`` on the rows it fixes, each wheel's
     force and its ``compliance`` flags, ``compliance``, ``open_space`` and ``unloaded``. The rows rigid-body
     dynamics determine keep their values bit for bit. Nothing changes where no normal load is open, nor where
     rows act on no coordinate of the model (a planar root's normal rows: no equilibrium to split; its floating
-    twin's loads are split instead)."""
+    twin's loads are split instead).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (its wheels' normal stiffnesses).
+        out: The forces at a state (``lam`` the minimum-norm multipliers).
+        lam: (m,) multipliers already split (with slipping wheels: :func:`robotdyn.contact.rigid_limit.coupled`,
+            whose friction depends on them); ``None``: split here.
+        unloaded: With ``lam``, the wheels it leaves unloaded.
+    """
     if out.null_space.shape[1] == 0 or not out.wheels or all(w.determined[2] for w in out.wheels) or out._inert:
         return out
     rows = [np.asarray(idx, int) for idx, _, _ in out._tangential]
@@ -391,6 +403,13 @@ def apply_rigid_limit(robot, out: ConstraintForces) -> ConstraintForces:
     C = rigid_limit.normal_map(rows, dirs, len(out.lam))
     k = wheel_stiffness(robot, [w.name for w in out.wheels])
     res = rigid_limit.split(out.lam, out.null_space, C, k, out.determined)
+    if lam is not None:
+        given = np.array(lam, float)
+        if res.open.shape[1]:
+            given -= res.open @ (res.open.T @ given)
+        given[out.determined] = out.lam[out.determined]
+        res.lam, res.feasible = given, True
+        res.unloaded = [i for i, w in enumerate(out.wheels) if w.name in unloaded]
     out.lam, out.compliance, out.open_space = res.lam, res.fixed, res.open
     out.unloaded = [out.wheels[i].name for i in res.unloaded]
     for w, idx, D, (_, _, fr) in zip(out.wheels, rows, dirs, out._tangential):

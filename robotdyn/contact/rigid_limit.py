@@ -77,8 +77,8 @@ def normal_map(rows: list[np.ndarray], directions: list[np.ndarray], m: int) -> 
     return C
 
 
-def split(lam: np.ndarray, N: np.ndarray, C: np.ndarray, k: np.ndarray, determined: np.ndarray | None = None
-          ) -> RigidLimit:
+def split(lam: np.ndarray, N: np.ndarray, C: np.ndarray, k: np.ndarray, determined: np.ndarray | None = None,
+          offset: np.ndarray | None = None) -> RigidLimit:
     """The rigid limit of normal compliance on the family :math:`\\lambda + N z` (see the module).
 
     Args:
@@ -88,6 +88,10 @@ def split(lam: np.ndarray, N: np.ndarray, C: np.ndarray, k: np.ndarray, determin
         k: (W,) the wheels' normal stiffnesses [N/m] (> 0; only their ratios matter).
         determined: (m,) rows rigid-body dynamics determine (default: those with no weight in N); their values are
             kept bit for bit.
+        offset: (W,) how far each wheel is raised against the chassis' rigid fit [m] (a prestress: a wheel on a
+            block of height h_i is compressed by h_i more); the complementary energy is then
+            :math:`\\sum_i n_i^2 / (2k_i) - n_i h_i` (the loads of finite stiffnesses, no longer a rigid limit).
+            Default: none.
 
     Returns:
         The :class:`RigidLimit`.
@@ -105,7 +109,9 @@ def split(lam: np.ndarray, N: np.ndarray, C: np.ndarray, k: np.ndarray, determin
     opened = N @ Vo
     if p == 0:
         return RigidLimit(lam.copy(), np.zeros(m, bool), opened, [])
-    y, unloaded, feasible = _loads(C @ lam, P @ Vn, np.asarray(k, float))
+    k = np.asarray(k, float)
+    shift = np.zeros(len(k)) if offset is None else k * np.asarray(offset, float)
+    y, unloaded, feasible = _loads(C @ lam - shift, P @ Vn, k, -shift)
     out = lam + N @ (Vn @ y)
     if opened.shape[1]:
         out -= opened @ (opened.T @ out)  # minimum-norm along what stays open (moves no normal load)
@@ -114,10 +120,12 @@ def split(lam: np.ndarray, N: np.ndarray, C: np.ndarray, k: np.ndarray, determin
     return RigidLimit(out, fixed, opened, unloaded, feasible)
 
 
-def _loads(n0: np.ndarray, G: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, list[int], bool]:
+def _loads(n0: np.ndarray, G: np.ndarray, k: np.ndarray, low: np.ndarray | None = None
+           ) -> tuple[np.ndarray, list[int], bool]:
     """``(y, unloaded, feasible)``: y minimising :math:`\\sum_i (n_0 + G y)_i^2 / k_i` subject to
-    :math:`n_0 + G y \\ge 0` (G full column rank p): the equality solution where it pulls on no wheel, else
-    Lawson & Hanson's least-distance program by NNLS (see the module)."""
+    :math:`n_0 + G y \\ge l` (G full column rank p; l = ``low``, default 0): the equality solution where it
+    holds, else Lawson & Hanson's least-distance program by NNLS (see the module)."""
+    low = np.zeros(len(n0)) if low is None else low
     r = 1.0 / np.sqrt(k)
     Wm, w0 = G * r[:, None], n0 * r
     Q, R = np.linalg.qr(Wm)  # Wm = Q R, R (p, p) invertible
@@ -125,13 +133,13 @@ def _loads(n0: np.ndarray, G: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, li
     y = -np.linalg.solve(R, c)  # the compatible loads n = K J (J^T K J)^-1 W
     n = n0 + G @ y
     scale = max(float(np.max(np.abs(n0), initial=0.0)), float(np.max(np.abs(n), initial=0.0)), 1e-300)
-    if np.all(n >= -PULL_TOL * scale):
+    if np.all(n - low >= -PULL_TOL * scale):
         return y, [], True
     from scipy.optimize import nnls
 
     # x = R y + c (so that |Wm y + w0|^2 = |x|^2 + const); n >= 0  <=>  E x >= h
     E = np.linalg.solve(R.T, G.T).T  # G R^-1
-    h = E @ c - n0
+    h = E @ c - n0 + low
     p = G.shape[1]
     Ematrix = np.vstack([E.T, h[None, :]])  # (p + 1, W)
     target = np.zeros(p + 1)
@@ -139,11 +147,11 @@ def _loads(n0: np.ndarray, G: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, li
     u, _ = nnls(Ematrix, target, maxiter=50 * (len(n0) + p + 1))
     res = Ematrix @ u - target
     if abs(res[p]) <= 1e-12 or np.linalg.norm(res) <= 1e-12:  # no x with E x >= h: every split pulls somewhere
-        return y, [int(i) for i in np.flatnonzero(n < 0)], False
+        return y, [int(i) for i in np.flatnonzero(n < low)], False
     x = -res[:p] / res[p]
     y = np.linalg.solve(R, x - c)
     n = n0 + G @ y
-    return y, [int(i) for i in np.flatnonzero(n <= PULL_TOL * scale)], True
+    return y, [int(i) for i in np.flatnonzero(n - low <= PULL_TOL * scale)], True
 
 
 def split_many(lam: np.ndarray, N: np.ndarray, C: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray,

@@ -164,7 +164,7 @@ def test_compliant_loads_converge_to_the_rigid_limit():
     errors = [np.max(np.abs(_stiff_statics(robot, k) - rigid)) for k in (1e4, 1e5, 1e6)]
     assert errors[2] < 1e-3 * rigid.max()
     assert errors[0] > errors[1] > errors[2]
-    assert errors[0] / errors[2] > 20  # at least ~1/k (100 for a clean first-order rate)
+    assert 50 < errors[0] / errors[2] < 200  # first order: 100 (k times the error ~ 2030 N^2/m here)
 
 
 def test_rigid_determined_combinations_unchanged_to_1e9():

@@ -201,3 +201,71 @@ def test_pulling_wheel_carries_zero():
     statics = np.linalg.solve(np.vstack([np.ones(3), x[:3], y[:3]]), W * np.array([1.0, xc, yc]))
     np.testing.assert_allclose(got[:3], statics, rtol=1e-9)
     assert "unloaded (would pull): rear_right" in f.table()
+
+
+CAR = """name = "rigid_car"
+urdf = "{urdf}"
+root = "floating"
+neutral = {{ z = 0.165 }}
+{wheels}
+[[motors]]
+name = "tau_rl"
+joint = "rear_left_wheel"
+[[motors]]
+name = "tau_rr"
+joint = "rear_right_wheel"
+[[scenarios]]
+name = "drive"
+t_end = 0.05
+torque = [{tau}, {tau}]
+"""
+
+
+def _car_mu(robot: Robot, tau: float) -> float:
+    """The rear (driven) wheels' required mu of a rigid four-wheel car driven straight from rest by tau on each
+    rear wheel, in closed form (derived here). Whole robot: mass m, weight W, centre of mass x_c ahead of the
+    axles' middle at height z_c, wheelbase L = 2a, wheel radius r and spin inertia I_w. Rolling straight:
+    m acc = 2 F_r + 2 F_f with the wheels' spin balances F_r = tau / r - I_w acc / r^2, F_f = -I_w acc / r^2, so
+    acc = 2 tau / r / (m + 4 I_w / r^2). Moments about the rear contact line (the friction forces act on it): the
+    weight W (a + x_c) against the front loads 2 N_f L equals the rate of angular momentum m acc z_c + 4 I_w acc / r
+    (the chassis' and the wheels' spin), so N_f = (W (a + x_c) - m acc z_c - 4 I_w acc / r) / (2 L) and
+    N_r = W / 2 - N_f. The lateral forces are open but nothing asks for them (a straight run): the best split
+    needs none, so the smallest mu is F_r / N_r (the front wheels need far less)."""
+    model = robot.model
+    data = model.createData()
+    q = robot.neutral()
+    c = pin.centerOfMass(model, data, q)
+    m = float(data.mass[0])
+    W, xc, zc = m * G, float(c[0]), float(c[2])
+    _, _, _, a, _ = geometry(robot)
+    r = 0.165
+    Iw = float(model.inertias[model.getJointId("rear_left_wheel")].inertia[1, 1])
+    acc = 2 * tau / r / (m + 4 * Iw / r**2)
+    Nf = (W * (a + xc) - m * acc * zc - 4 * Iw * acc / r) / (4 * a)
+    return (tau / r - Iw * acc / r**2) / (W / 2 - Nf)
+
+
+def test_rigid_car_cannot_hold_below_the_smallest_mu(tmp_path, capsys):
+    """A rigid four-wheel car (the Husky-like chassis, rear-wheel drive, wheels rolling): the torque at which its
+    driven wheels need mu = 0.39 under every admissible split; the API's minimum mu equals the closed form, and
+    simulate --mu 0.3 says it cannot hold (0.45: it holds)."""
+    from scipy.optimize import brentq
+
+    from robotdyn.cli.commands import main
+
+    wheels = "".join(f'[[wheels]]\nname = "{n}"\njoint = "{n}_wheel"\nradius = 0.165\n' for n in NAMES)
+    urdf = EXAMPLES / "husky_like.urdf.xacro"
+    path = tmp_path / "car.toml"
+    path.write_text(CAR.format(urdf=urdf, wheels=wheels, tau=1.0))
+    robot = read(path).robot()
+    tau = brentq(lambda t: _car_mu(robot, t) - 0.39, 0.1, 50.0, xtol=1e-12)
+    f = robot.contact_forces(robot.neutral(), np.zeros(robot.mobility), tau=[tau, tau])
+    assert f.minimum_mu() == pytest.approx(0.39, rel=1e-6)
+    assert not f.wheel("rear_left").determined[1] and f.wheel("rear_left").source == MODEL
+    path.write_text(CAR.format(urdf=urdf, wheels=wheels, tau=tau))
+    assert main(["simulate", "--constraints", str(path), "--scenario", "drive", "--mu", "0.3", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "no admissible split of the open forces stays within mu" in out and "assumption holds" not in out
+    assert main(["simulate", "--constraints", str(path), "--scenario", "drive", "--mu", "0.45", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "no-slip assumption holds" in out and "rigid limit of compliance" in out

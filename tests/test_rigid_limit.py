@@ -269,3 +269,29 @@ def test_rigid_car_cannot_hold_below_the_smallest_mu(tmp_path, capsys):
     assert main(["simulate", "--constraints", str(path), "--scenario", "drive", "--mu", "0.45", "--quiet"]) == 0
     out = capsys.readouterr().out
     assert "no-slip assumption holds" in out and "rigid limit of compliance" in out
+
+
+def test_compiled_forces_give_the_rigid_limit():
+    """CompiledModel.forces (C++) splits the open loads as constraint_forces (Python) does, at a moving, driven
+    state with unequal stiffnesses; rigid_limit(False) returns the basic solution (another split, the same
+    determined rows)."""
+    from robotdyn.fast.dispatch import compiled_model
+
+    robot = rolling("husky_like", {"com_x": "0.04", "com_y": "-0.02"}, {"front_left": 4.0e5, "rear_left": 1.0e5})
+    fast = compiled_model(robot)
+    if fast is None or not hasattr(fast.ev, "set_rigid_limit"):
+        pytest.skip("no compiled model with the rigid limit")
+    q = robot.neutral()
+    nu = np.array([0.8, 0.9, 1.1, 0.7, 1.2])[: robot.mobility]
+    tau = np.array([3.0, -1.0, 2.0, 0.5])
+    ref = constraint_forces(robot, q, nu, tau=tau)
+    local = np.array(fast.forces(q, nu, tau)[3])
+    scale = max(1.0, float(np.max(np.abs(local))))
+    np.testing.assert_allclose(local[:, 2], [w.normal for w in ref.wheels], atol=1e-9 * scale)
+    fast.rigid_limit(False)
+    try:
+        basic = np.array(fast.forces(q, nu, tau)[3])
+    finally:
+        fast.rigid_limit(True)
+    assert np.max(np.abs(basic[:, 2] - local[:, 2])) > 1.0
+    assert np.sum(basic[:, 2]) == pytest.approx(np.sum(local[:, 2]), abs=1e-9 * scale)

@@ -295,3 +295,26 @@ def test_compiled_forces_give_the_rigid_limit():
         fast.rigid_limit(True)
     assert np.max(np.abs(basic[:, 2] - local[:, 2])) > 1.0
     assert np.sum(basic[:, 2]) == pytest.approx(np.sum(local[:, 2]), abs=1e-9 * scale)
+
+
+def test_traction_fast_pass_equals_the_reference_with_open_loads():
+    """The fast traction pass (robotdyn/contact/traction_fast.py) splits the open loads as constraint_forces does,
+    sample by sample: loads, required and minimum mu, and names the model."""
+    from robotdyn.contact.traction import traction
+
+    robot = rolling("jackal_like", COM, {"front_left": 2.0e5})
+    torque = lambda t, q, nu: np.array([0.4, 0.6, 0.4, 0.6])  # noqa: E731
+    traj = simulate_short(robot, torque)
+    fast = traction(robot, traj, torque, mu=0.8)
+    ref = traction(robot, traj, torque, mu=0.8, method="reference")
+    assert fast.method == "fast" and ref.method == "reference" and fast.wheels == list(NAMES)
+    np.testing.assert_allclose(fast.normal, ref.normal, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(fast.minimum_mu, ref.minimum_mu, rtol=1e-7, atol=1e-12)
+    assert fast.compliance == ref.compliance == list(NAMES)
+    assert "rigid limit of compliance" in fast.summary()
+
+
+def simulate_short(robot, torque):
+    from robotdyn.simulation.engine import simulate
+
+    return simulate(robot, 0.2, robot.neutral(), np.zeros(robot.mobility), torque, n_out=21, progress=False)

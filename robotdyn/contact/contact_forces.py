@@ -628,5 +628,6 @@ def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
     if others > 0:
         mixed = sorted({lab for col in N.T for lab, c in zip(labels, col) if abs(c) > DETERMINED_TOL} - set(zero))
         out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: the rows are "
-                   "redundant, e.g. more wheels than a rigid body needs; a compliance model would split them)")
+                   "redundant, e.g. more wheels than a rigid body needs; the normal loads among them are split by "
+                   "the rigid limit of the wheels' normal compliance)")
     return out

@@ -679,8 +679,8 @@ class Evaluator {
   }
 
   // The loads rigid-body dynamics leave open, by the rigid limit of the wheels' normal compliance
-  // (robotdyn/contact/rigid_limit.py, the same formulas): lambda + N z with N an orthonormal null space of A^T (a
-  // column-pivoting QR of A), z along the directions V_n that move normal loads (an SVD of C N) minimising
+  // (robotdyn/contact/rigid_limit.py, the same formulas): lambda + N z with N a basis of the null space of A^T (from
+  // the projection's LU of A_d; with operational velocities a column-pivoting QR of A), z along the directions V_n that move normal loads (an SVD of C N) minimising
   // sum n_i^2 / k_i: the compatible loads; minimum norm along those that move none; the rows rigid-body dynamics
   // determine keep their values. Where the compatible loads would pull on a wheel the no-pull split (a
   // least-distance program) is the Python path's: Fallback. Nothing happens without redundant rows, where a row acts
@@ -692,12 +692,33 @@ class Evaluator {
     const double scale = std::max(1.0, A_.cwiseAbs().maxCoeff());
     for (int r = 0; r < m; ++r)
       if (A_.row(r).cwiseAbs().maxCoeff() <= 1e-12 * scale) return;
-    rl_qr_.setThreshold(std::max(m, nv_) * std::numeric_limits<double>::epsilon());
-    rl_qr_.compute(A_);
-    const int d = m - static_cast<int>(rl_qr_.rank());
-    if (d <= 0) return;
-    rl_Q_ = rl_qr_.householderQ();
-    rl_N_ = rl_Q_.rightCols(d);
+    const int nr = static_cast<int>(rows_.size());
+    int d;
+    if (!operational_) {
+      // a basis of null(A^T) from the projection's own LU of A_d: each row j outside the projection's choice is
+      // A_j = c^T A_R with A_d^T c = (A_j on the dependent columns), so e_j - sum_r c_r e_{rows_r} is in null(A^T)
+      d = m - nr;
+      rl_N_.setZero(m, d);
+      rl_in_.assign(m, false);
+      for (int r = 0; r < nr; ++r) rl_in_[rows_[r]] = true;
+      int col = 0;
+      for (int j = 0; j < m; ++j) {
+        if (rl_in_[j]) continue;
+        rl_c_.resize(nr);
+        for (int r = 0; r < nr; ++r) rl_c_[r] = A_(j, dependent_[r]);
+        lu_solve_transposed(lu_, rl_c_);
+        rl_N_(j, col) = 1.0;
+        for (int r = 0; r < nr; ++r) rl_N_(rows_[r], col) = -rl_c_[r];
+        ++col;
+      }
+    } else {
+      rl_qr_.setThreshold(std::max(m, nv_) * std::numeric_limits<double>::epsilon());
+      rl_qr_.compute(A_);
+      d = m - static_cast<int>(rl_qr_.rank());
+      if (d <= 0) return;
+      rl_Q_ = rl_qr_.householderQ();
+      rl_N_ = rl_Q_.rightCols(d);
+    }
     rl_P_.setZero(nw, d);
     rl_n0_.setZero(nw);
     for (int i = 0; i < nw; ++i) {
@@ -727,11 +748,12 @@ class Evaluator {
     if (n.minCoeff() < -1e-9 * big) throw Fallback("a wheel would pull: the rigid limit's no-pull split is solved on the Python path");
     rl_saved_ = lambda_;
     lambda_.noalias() += rl_N_ * (V.leftCols(p) * y);
-    if (d > p) {
-      const MatrixXd O = rl_N_ * V.rightCols(d - p);  // orthonormal: N and V are
-      lambda_.noalias() -= O * (O.transpose() * lambda_);
+    if (d > p) {  // minimum norm along the open directions N V_o (orthonormalised: N need not be orthonormal)
+      rl_oqr_.compute(rl_N_ * V.rightCols(d - p));
+      rl_O_ = rl_oqr_.householderQ() * MatrixXd::Identity(m, d - p);
+      lambda_.noalias() -= rl_O_ * (rl_O_.transpose() * lambda_);
     }
-    for (int r = 0; r < m; ++r)
+    for (int r = 0; r < m; ++r)  // (a row's weight in null(A^T) is zero in every basis)
       if (rl_N_.row(r).norm() <= 1e-8) lambda_[r] = rl_saved_[r];
   }
   void set_normal_stiffness(const Eigen::Ref<const VectorXd>& k) {
@@ -1526,8 +1548,11 @@ class Evaluator {
   MatrixXd Ks_, Jt_;
   bool rigid_limit_ = true;
   VectorXd kstiff_, rl_n0_, rl_saved_;
-  MatrixXd rl_Q_, rl_N_, rl_P_, rl_G_;
+  MatrixXd rl_Q_, rl_N_, rl_P_, rl_G_, rl_O_;
+  VectorXd rl_c_;
+  std::vector<bool> rl_in_;
   Eigen::ColPivHouseholderQR<MatrixXd> rl_qr_;
+  Eigen::HouseholderQR<MatrixXd> rl_oqr_;
   Eigen::JacobiSVD<MatrixXd> rl_svd_;
   VectorXd bs_, xs_, slip_normal_;
   Eigen::Matrix<double, Eigen::Dynamic, 2> slip_s_, slip_c_;

@@ -737,29 +737,41 @@ class Evaluator {
     while (p < sv.size() && sv[p] > 1e-9) ++p;
     if (p == 0) return;
     const MatrixXd& V = rl_svd_.matrixV();
+    if (rl_rk_.size() != nw) rl_rk_.setOnes(nw);  // 1 / sqrt(k) (set_normal_stiffness; equal without it)
     rl_G_.noalias() = rl_P_ * V.leftCols(p);
-    VectorXd rk(nw);
-    for (int i = 0; i < nw; ++i) rk[i] = 1.0 / std::sqrt(i < kstiff_.size() ? kstiff_[i] : 1.0);
-    const MatrixXd Wm = rk.asDiagonal() * rl_G_;
-    const VectorXd y = -(Wm.transpose() * Wm).ldlt().solve(Wm.transpose() * rk.cwiseProduct(rl_n0_));
-    const VectorXd n = rl_n0_ + rl_G_ * y;
-    const double big = std::max(rl_n0_.cwiseAbs().maxCoeff(), n.cwiseAbs().maxCoeff());
-    if (!y.allFinite()) throw Fallback("the rigid limit's split is not finite here");
-    if (n.minCoeff() < -1e-9 * big) throw Fallback("a wheel would pull: the rigid limit's no-pull split is solved on the Python path");
+    rl_W_.noalias() = rl_rk_.asDiagonal() * rl_G_;
+    rl_H_.noalias() = rl_W_.transpose() * rl_W_;
+    rl_y_.noalias() = rl_W_.transpose() * rl_rk_.cwiseProduct(rl_n0_);
+    rl_llt_.compute(rl_H_);
+    rl_llt_.solveInPlace(rl_y_);
+    rl_y_ = -rl_y_;
+    rl_n_ = rl_n0_;
+    rl_n_.noalias() += rl_G_ * rl_y_;
+    const double big = std::max(rl_n0_.cwiseAbs().maxCoeff(), rl_n_.cwiseAbs().maxCoeff());
+    if (!rl_y_.allFinite()) throw Fallback("the rigid limit's split is not finite here");
+    if (rl_n_.minCoeff() < -1e-9 * big)
+      throw Fallback("a wheel would pull: the rigid limit's no-pull split is solved on the Python path");
     rl_saved_ = lambda_;
-    lambda_.noalias() += rl_N_ * (V.leftCols(p) * y);
-    if (d > p) {  // minimum norm along the open directions N V_o (orthonormalised: N need not be orthonormal)
-      rl_oqr_.compute(rl_N_ * V.rightCols(d - p));
-      rl_O_ = rl_oqr_.householderQ() * MatrixXd::Identity(m, d - p);
-      lambda_.noalias() -= rl_O_ * (rl_O_.transpose() * lambda_);
+    rl_z_.noalias() = V.leftCols(p) * rl_y_;
+    lambda_.noalias() += rl_N_ * rl_z_;
+    if (d > p) {  // minimum norm along the open directions N V_o (Gram-Schmidt: N need not be orthonormal)
+      rl_O_.noalias() = rl_N_ * V.rightCols(d - p);
+      for (int c = 0; c < d - p; ++c) {
+        for (int b = 0; b < c; ++b) rl_O_.col(c) -= rl_O_.col(b).dot(rl_O_.col(c)) * rl_O_.col(b);
+        rl_O_.col(c) /= rl_O_.col(c).norm();
+      }
+      rl_t_.noalias() = rl_O_.transpose() * lambda_;
+      lambda_.noalias() -= rl_O_ * rl_t_;
     }
-    for (int r = 0; r < m; ++r)  // (a row's weight in null(A^T) is zero in every basis)
-      if (rl_N_.row(r).norm() <= 1e-8) lambda_[r] = rl_saved_[r];
+    rl_w_ = rl_N_.rowwise().squaredNorm();  // (a row's weight in null(A^T) is zero in every basis)
+    for (int r = 0; r < m; ++r)
+      if (rl_w_[r] <= 1e-16) lambda_[r] = rl_saved_[r];
   }
   void set_normal_stiffness(const Eigen::Ref<const VectorXd>& k) {
     if (k.size() != static_cast<Eigen::Index>(wheels_.size())) throw std::invalid_argument("one stiffness per wheel");
     if (!(k.array() > 0.0).all() || !k.allFinite()) throw std::invalid_argument("stiffnesses must be finite and > 0");
     kstiff_ = k;
+    rl_rk_ = k.cwiseSqrt().cwiseInverse();
   }
   void set_rigid_limit(bool on) { rigid_limit_ = on; }
 
@@ -1548,11 +1560,11 @@ class Evaluator {
   MatrixXd Ks_, Jt_;
   bool rigid_limit_ = true;
   VectorXd kstiff_, rl_n0_, rl_saved_;
-  MatrixXd rl_Q_, rl_N_, rl_P_, rl_G_, rl_O_;
-  VectorXd rl_c_;
+  MatrixXd rl_Q_, rl_N_, rl_P_, rl_G_, rl_O_, rl_W_, rl_H_;
+  VectorXd rl_c_, rl_rk_, rl_y_, rl_n_, rl_z_, rl_t_, rl_w_;
+  Eigen::LLT<MatrixXd> rl_llt_;
   std::vector<bool> rl_in_;
   Eigen::ColPivHouseholderQR<MatrixXd> rl_qr_;
-  Eigen::HouseholderQR<MatrixXd> rl_oqr_;
   Eigen::JacobiSVD<MatrixXd> rl_svd_;
   VectorXd bs_, xs_, slip_normal_;
   Eigen::Matrix<double, Eigen::Dynamic, 2> slip_s_, slip_c_;

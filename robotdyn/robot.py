@@ -138,6 +138,8 @@ class Wheel:
     slip_velocity: float | None = None  # coulomb law's regularisation scale [m/s]
     stiffness: float | None = None  # linear law's slip stiffness [s/m]
     slip: str = "both"  # with a friction law: both tangential directions slip, or only the lateral one
+    normal_stiffness: float | None = None  # radial (normal) stiffness [N/m]; None: robotdyn.contact.compliance's rule
+    normal_damping: float | None = None  # radial (normal) damping [N s/m]; None: robotdyn.contact.compliance's rule
 
 
 @dataclass

@@ -58,6 +58,12 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
                                         # default 1e-3) | linear (stiffness [s/m], saturated at mu if given)
     slip = "both"                       # with a friction law: both | lateral (rolls along its rolling direction
                                         # and slides sideways: only the lateral force follows the law)
+    normal_stiffness = 2.0e5            # radial stiffness of tyre and wheel [N/m] (default: the robot's weight
+                                        # over the number of wheels per 1 mm of static deflection); only the
+                                        # ratios between wheels split the loads that rigid-body dynamics leave
+                                        # open (robotdyn.contact.compliance, robotdyn.contact.rigid_limit)
+    normal_damping = 600.0              # radial damping [N s/m] (default: damping ratio 0.3 of the wheel's share
+                                        # of the mass on its default stiffness)
     [[closures]]
     frame1 = "a"; frame2 = "b"; components = "x y z"   # subset of x y z rx ry rz in frame1's axes
 
@@ -110,7 +116,7 @@ TOP_KEYS = (
 TWIST_KEYS = ("frame", "components", "axes", "names")
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro", "minimum")
 WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
-              "slip_velocity", "stiffness", "slip")
+              "slip_velocity", "stiffness", "slip", "normal_stiffness", "normal_damping")
 MAX_RADIUS = 1e4
 """Largest wheel radius accepted [m] (larger values only overflow the dynamics)."""
 MAX_FILE_BYTES = 1_000_000
@@ -797,7 +803,8 @@ def _wheel(cx: _Context, where: str, w, pvalues: dict) -> tuple[Wheel, str | Non
     friction = w.get("friction", "rolling")
     if not isinstance(friction, str):
         r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
-    numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness") if key in w}
+    numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness", "normal_stiffness",
+                                                             "normal_damping") if key in w}
     slip = w.get("slip", "both")
     if slip not in SLIP_DIRECTIONS:
         r.fail(where, f"slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")

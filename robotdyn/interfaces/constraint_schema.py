@@ -144,6 +144,8 @@ SCHEMA: dict = _table({
         "slip_velocity": _number("a slip velocity in m/s, > 0", None, 1e6, 0.0),
         "stiffness": _number("a stiffness in s/m, > 0", None, 1e12, 0.0),
         "slip": {"enum": ["both", "lateral"], "expected": "both or lateral"},
+        "normal_stiffness": _number("a normal (radial) stiffness in N/m, > 0 and <= 1e12", None, 1e12, 0.0),
+        "normal_damping": _number("a normal (radial) damping in N s/m, >= 0 and <= 1e12", 0.0, 1e12),
     }, (), "a table: name, joint or frame, radius, ..."), "wheels"),
     "closures": _array_of(_table({
         "name": _string("a closure name"),

@@ -214,10 +214,11 @@ def plot_traction(tr, path=None, title: str = "", robot=None):
         ax_mu.plot(tr.t, mu, lw=1.2, color=line.get_color(), label=name)
         if np.isfinite(tr.mu[j]):
             ax_mu.axhline(tr.mu[j], color=line.get_color(), ls="--", lw=1.0)
-    if pending and tr.minimum_mu is not None:
+    if tr.minimum_mu is not None:  # every wheel's need, the open forces split at best
         minimum = np.where(np.isfinite(tr.minimum_mu), tr.minimum_mu, np.nan)
-        ax_mu.plot(tr.t, minimum, lw=1.6, color="k",
-                   label=f"{', '.join(pending)}: smallest mu of the best split (max {np.nanmax(minimum):.3g})")
+        peak = f"max {np.nanmax(minimum):.3g}" if np.isfinite(minimum).any() else "not determined"
+        who = f"{', '.join(pending)}: smallest mu of the best split" if pending else "all wheels, best split (minimum mu)"
+        ax_mu.plot(tr.t, minimum, lw=1.6, color="k", label=f"{who} ({peak})")
     elif pending:
         ax_mu.plot([], [], lw=0, label=f"{', '.join(pending)}: friction not determined")
     for ax in (ax_n, ax_mu):

@@ -87,6 +87,7 @@ import numpy as np
 
 from ..description.urdf import _ROOT_CHAINS, ROOT_KINDS, expand_xacro
 from ..errors import InputError, RobotDynError
+from ..input_files import resolved
 from ..contact.friction import LAWS, make_law
 from ..robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
 from ..description.ros_packages import HINT, PackageIndex
@@ -448,16 +449,24 @@ def _description(cx: _Context, urdf, xacro_args, package_dirs, packages) -> None
     """``package_dirs``, ``[packages]``, ``urdf``, ``root`` and ``[xacro_args]``: sets ``cx.pdirs``, ``cx.named``,
     ``cx.index``, ``cx.desc``, ``cx.root``, ``cx.xargs`` and ``cx.declared`` (the description's Xacro arguments)."""
     r, data, base = cx.r, cx.data, cx.base
-    pdirs = [str((base / d).resolve()) for d in r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")]
-    pdirs += [str(Path(d).resolve()) for d in package_dirs]
+    listed = r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")
+    try:  # a loop of symbolic links is one line naming the entry (never a RuntimeError)
+        pdirs = [str(resolved(base / d, "package_dirs")) for d in listed]
+        pdirs += [str(resolved(d, "--package")) for d in package_dirs]
+    except InputError as exc:
+        r.fail("package_dirs", str(exc))
     for d in pdirs:
         if not Path(d).is_dir():
             r.fail("package_dirs", f"{d}: no such directory; expected directories holding ROS packages (or --package "
                                    "DIR)")
     pkg_table = data.get("packages", {})
     r.keys("packages", pkg_table, list(pkg_table))
-    named = {k: str((base / r.string(f"packages.{k}", v, "directory")).resolve()) for k, v in pkg_table.items()}
-    named.update({k: str(Path(v).resolve()) for k, v in packages.items()})
+    dirs = {k: r.string(f"packages.{k}", v, "directory") for k, v in pkg_table.items()}
+    try:
+        named = {k: str(resolved(base / v, f"packages.{k} =")) for k, v in dirs.items()}
+        named.update({k: str(resolved(v, f"--package {k}=")) for k, v in packages.items()})
+    except InputError as exc:
+        r.fail("packages", str(exc))
     try:
         index = PackageIndex.create(named, pdirs)
     except RobotDynError as exc:

@@ -60,6 +60,10 @@ def _source(spec: SweepSpec) -> tuple[dict, dict]:
     if spec.robot is not None:
         if spec.urdf is not None:
             raise SweepSpecError("urdf = ... goes with constraints = FILE, not with a registered robot")
+        if spec.xacro_args:
+            raise SweepSpecError(f"xacro argument {next(iter(spec.xacro_args))!r} (--xacro-arg, xacro_args) is for your "
+                                 "own robot's description (constraints = FILE); a built-in robot's numbers are its "
+                                 "parameters: --param NAME=VALUE or --vary NAME=...")
         return {"robot": spec.robot}, {"robot": spec.robot}
     path = Path(spec.constraints).resolve()
     if not path.is_file():
@@ -97,6 +101,11 @@ def _terrain(mod, item, scenarios) -> tuple[str, tuple]:
         values = {k: float(v) for k, v in args.items()}
     except (TypeError, ValueError):
         raise SweepSpecError(f"terrain {item!r}: arguments must be numbers") from None
+    from ..interfaces.constraint_schema import terrain_problem
+
+    problem = terrain_problem({"kind": kind, **values})  # the constraint file's ranges: finite, widths > 0, ...
+    if problem is not None:
+        raise SweepSpecError(f"terrain {item!r}: {problem}")
     label = kind + ("(" + ", ".join(f"{k}={v!r}" for k, v in values.items()) + ")" if values else "")
     definition = ("kind", kind, values)
     try:
@@ -156,6 +165,8 @@ def plan(spec: SweepSpec) -> Plan:
     names = robot.coordinates + robot.velocity_names
     columns = spec.columns or names
     for c in columns:
+        if columns.count(c) > 1:  # (two columns of one name would make every results file of the sweep unreadable)
+            raise SweepSpecError(f"column {c!r} listed {columns.count(c)} times; expected distinct columns")
         if c not in names:
             raise SweepSpecError(f"unknown column {c!r}; expected one of {', '.join(names)}")
     tolerances = {}

@@ -46,6 +46,11 @@ DEFAULT_TIME_LIMIT = 600.0
 """Wall-clock limit [s] of one run by default (0 or ``None``: none): a crawling run becomes an error row."""
 MAX_RUNS = 1_000_000
 """Largest number of runs of one sweep (a larger one is refused before anything runs)."""
+MAX_SPEC_BYTES = 1_000_000
+"""Largest sweep file read [bytes] (a sweep file is a few lines; a larger file is refused before it is read)."""
+MAX_TORQUE_SCALE = 1e6
+"""Largest magnitude of the torque scale (beyond it the scaled torques leave every motor's range)."""
+MAX_SEED = 2**63 - 1
 RESERVED = ("run_id", "run_index", "robot", "scenario", "terrain", "status", "error", "t_end", "t_reached", "drift",
             "nfev", "wall", "run_wall")
 """Column names of the results that no varied parameter may take."""
@@ -202,12 +207,16 @@ def _count(x, where: str) -> int:
 def from_toml(path) -> SweepSpec:
     """Read and check the structure of a sweep file (names and values are checked against the robot by
     :func:`expand`). Relative ``constraints``/``urdf`` paths are taken from the file's directory."""
+    from ..input_files import read_text
+
     path = Path(path)
+    try:  # a regular file of bounded size: a FIFO would block, /dev/zero would never end
+        text = read_text(path, "sweep file", MAX_SPEC_BYTES)
+    except InputError as exc:
+        raise SweepSpecError(str(exc)) from None
     try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise SweepSpecError(f"cannot read sweep file {str(path)!r}: {exc.strerror or exc}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        data = tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError) as exc:
         raise SweepSpecError(f"{path}: not valid TOML ({exc})") from None
     for key in data:
         if key not in TOP_KEYS:
@@ -281,6 +290,8 @@ def resolve_axis(axis: Axis, parameter) -> Axis:
         if parameter is not None and parameter.choices is not None:
             return parameter.convert(x)
         value = parse_value(x, unit if unit != "-" else "", where)
+        if parameter is None and abs(value) > MAX_TORQUE_SCALE:
+            raise SweepSpecError(f"{where} = {x!r}; expected a torque scale of magnitude <= {MAX_TORQUE_SCALE:g}")
         return value if parameter is None else parameter.convert(value)
 
     if parameter is not None and parameter.choices is not None and axis.ranged:
@@ -301,6 +312,8 @@ def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
     axes (seeded) crossed with the grid of the axes given as values."""
     if spec.sample not in SAMPLERS:
         raise SweepSpecError(f"sample = {spec.sample!r}; expected one of {', '.join(SAMPLERS)}")
+    if isinstance(spec.seed, bool) or not isinstance(spec.seed, int) or not 0 <= spec.seed <= MAX_SEED:
+        raise SweepSpecError(f"seed = {spec.seed!r}; expected a whole number from 0 to {MAX_SEED}")
     if spec.sample == "grid":
         if spec.n is not None:
             raise SweepSpecError(f"n = {spec.n} samples with sample = 'grid'; expected sample = 'lhs' or 'random' "

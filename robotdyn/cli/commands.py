@@ -87,6 +87,8 @@ def _jsonable(x):
 
 
 def _matrix_text(name: str, rows: list[str], cols: list[str], A: np.ndarray) -> str:
+    if not rows or not cols:  # e.g. B of a robot without motors: said, not an empty grid
+        return f"{name}: (none: {len(rows)} x {len(cols)})"
     w = max(14, *(len(c) + 2 for c in cols))  # a '-1.23457e-05' (12 characters) keeps a space on its left
     left = max(14, *(len(r) for r in rows)) if rows else 14  # long row names keep the columns aligned
     lines = [f"{name}:", " " * left + "".join(f"{c:>{w}}" for c in cols)]
@@ -141,6 +143,12 @@ def cmd_info(args) -> int:
 
 
 def cmd_dump(args) -> int:
+    from ..inputs import refuse_together
+
+    refuse_together(args, "a", "tau_set")  # (--a and --tau: argparse's own group)
+    if args.full and args.forces:
+        raise RobotDynError("--forces and --full exclude each other: the contact forces are those of the constrained "
+                            "robot; expected --forces without --full")
     _, robot = _load(args)
     q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates, MAX_POSITION)
     for name, x in _numbers(args.set, "--set", "a value in m or rad").items():
@@ -172,13 +180,14 @@ def cmd_dump(args) -> int:
            "B": red.B, "motors": motors, "S": red.S, "condition": red.projection.condition}
     text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g})",
             _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
-            _vector_text("g", names, red.g), _matrix_text("B", names, motors, red.B)]
+            _vector_text("g", names, red.g), _matrix_text("B", names, motors, red.B) if motors else "B: none (the robot has no motors)"]
     if args.a is not None:
         nudot = robot.check_nu(args.a, "a")
         Q, tau, resid = robot.inverse_dynamics(q, nu, nudot)
         out.update(tau=Q, motor_torques=dict(zip(motors, tau)), motor_residual=resid)
         text += [_vector_text("tau (generalised forces M a + C v + g)", names, Q),
-                 _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
+                 _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau) if motors else
+                 f"motor torques: none (the robot has no motors; residual {resid:.3g})"]
     elif args.tau is not None or args.tau_set:
         tau = _torques(robot, args.tau, args.tau_set)
         nudot = solve_mass(red.M, red.B @ tau - red.h)

@@ -96,13 +96,20 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
     from . import cache as description_cache
     from .ros_packages import PackageIndex
 
+    from ..input_files import regular_file
+
     path = Path(path)
     if not path.is_file():
         raise DescriptionError(f"description file not found: {path}")
+    try:  # a regular file of bounded size (60 MB ran past a minute)
+        regular_file(path, "description", MAX_DESCRIPTION_BYTES)
+    except InputError as exc:
+        raise DescriptionError(str(exc)) from None
     mappings = {str(k): xacro_value(str(k), v) for k, v in (args or {}).items()}
     index = packages if packages is not None else PackageIndex.create()
     cached = description_cache.lookup(path, mappings, index)
     if cached is not None:
+        check_size(cached, path.name)
         return cached
     import xacro
 
@@ -122,11 +129,35 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
                 raise MissingPackagesError(needed, f"cannot expand xacro {path.name}: ") from None
             raise DescriptionError(f"cannot expand xacro {path.name}: {msg}") from None
     urdf = doc.toxml()
+    check_size(urdf, path.name)
     description_cache.store(path, mappings, index, read, urdf)
     return urdf
 
 
-_CHECKS = 2
+MAX_DESCRIPTION_BYTES = 10_000_000
+"""Largest description accepted [bytes], as a file and expanded (real robots' URDFs are well under 1 MB; meshes are
+separate files): a larger one is refused before it is parsed."""
+MAX_LINKS = 300
+"""Most links of a description (humanoids and mobile manipulators have 50 to 150; a chain of 300 takes 15 s to load): a larger tree is
+refused in one line before the model is built (3000 links ended in a MemoryError after 54 s)."""
+_LINK = re.compile(r"<link[\s/>]")
+
+
+def check_size(urdf: str, name: str) -> None:
+    """Refuse an expanded description beyond :data:`MAX_DESCRIPTION_BYTES` or :data:`MAX_LINKS` links.
+
+    Raises:
+        DescriptionError: Naming the description, its size or link count, and the limit.
+    """
+    if len(urdf) > MAX_DESCRIPTION_BYTES:
+        raise DescriptionError(f"description {name}: {len(urdf):,} characters expanded; expected at most "
+                               f"{MAX_DESCRIPTION_BYTES:,}")
+    links = len(_LINK.findall(urdf))
+    if links > MAX_LINKS:
+        raise DescriptionError(f"description {name}: {links:,} links; expected at most {MAX_LINKS:,} (a robot's tree)")
+
+
+_CHECKS = 3
 """Revision of robotdyn's own checks in :func:`_validate_with_yourdfpy` (raise it when they change, so that the
 cache of validated texts does not skip a new check)."""
 
@@ -175,6 +206,9 @@ def validate_urdf(urdf: str) -> None:
         pass
 
 
+MIN_MASS = 1e-9
+"""Smallest non-zero link mass accepted [kg] (a microgram: dummy links of real descriptions weigh 1e-9 kg and more);
+below it a mass is 0 in effect but its inertia's inverse overflows the dynamics."""
 MAX_DESCRIPTION_LENGTH = 1e6
 """Largest offset or size in a description [m] (beyond it the kinematics lose every digit)."""
 
@@ -227,6 +261,9 @@ def _check_numbers(urdf: str) -> None:
                     m = _numbers(mass, "value", 1, f"{name} mass")
                     if m and m[0] < 0:
                         raise DescriptionError(f"{name} mass: value={m[0]:g} kg; expected a mass >= 0")
+                    if m and 0 < m[0] < MIN_MASS:  # (a wheel of 1e-300 kg gave accelerations of 1e302)
+                        raise DescriptionError(f"{name} mass: value={m[0]:g} kg; expected 0 (a massless link) or at "
+                                               f"least {MIN_MASS:g} kg")
                     total += m[0] if m else 0.0
                 inertia = el.find("inertial/inertia")
                 if inertia is not None:

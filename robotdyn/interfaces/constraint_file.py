@@ -87,6 +87,7 @@ import numpy as np
 
 from ..description.urdf import _ROOT_CHAINS, ROOT_KINDS, expand_xacro
 from ..errors import InputError, RobotDynError
+from ..inputs import MAX_ANGLE
 from ..input_files import resolved
 from ..contact.friction import LAWS, make_law
 from ..robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
@@ -232,7 +233,10 @@ class _Reader:
             if not match:
                 self.fail(where, f"{what} = {x!r}; expected a number in rad or a string like '45 deg' or '0.79 rad'")
             value = self.number(where, float(match.group(1)), what)
-            return float(np.radians(value)) if match.group(2) == "deg" else value
+            value = float(np.radians(value)) if match.group(2) == "deg" else value
+            if abs(value) > MAX_ANGLE:  # (1e300 rad was accepted)
+                self.fail(where, f"{what} = {x!r}; expected an angle within one turn (|angle| <= 360 deg)")
+            return value
         value = self.number(where, x, what)
         if abs(value) > np.pi:
             self.fail(where, f"{what} = {value:g}; a bare number is in rad and expected in [-pi, pi]: write "
@@ -798,6 +802,9 @@ def _root_height(cx: _Context) -> float | None:
     root_height = r.number("root_height", root_height, "root_height")
     if cx.root == "fixed":
         r.fail("root_height", "a fixed root has no height; expected root = 'planar' or 'floating'")
+    if cx.root == "floating":  # (it was ignored): a floating root's height is a coordinate
+        r.fail("root_height", f"{root_height:g} m: a floating root's height is its coordinate z; expected neutral = "
+                              f"{{ z = {root_height:g} }} (and q0 of the scenarios), or root = 'planar'")
     if abs(root_height) > MAX_RADIUS:
         r.fail("root_height", f"{root_height:g} m; expected the root link's height above the ground in m")
     return root_height

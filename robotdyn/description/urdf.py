@@ -46,16 +46,30 @@ _ROOT_CHAINS = {
 
 
 _PLAIN_WORD = re.compile(r"[A-Za-z0-9_./:+-]*")
+XACRO_NAMES = frozenset(
+    ["list", "dict", "map", "len", "str", "float", "int", "bool", "True", "False", "min", "max", "round", "sorted",
+     "range", "python", "math", "xacro", "load_yaml", "abs_filename", "dotify"]
+    + [k for k in math.__dict__ if not k.startswith("_")])
+"""The names xacro 2 binds inside ``${...}`` (``xacro.create_global_symbols``: Python builtins, everything of
+:mod:`math` such as ``pi`` and ``e``, xacro's own): a word among them is a value there, not a word."""
 
 
-def xacro_value(name: str, value) -> str:
+def xacro_value(name: str, value, properties=()) -> str:
     """A value for a ``xacro:arg`` as data, never as code.
 
     xacro substitutes ``$(arg name)`` textually, also inside ``${...}`` expressions, which it evaluates: a value is
-    therefore handed over only as a number (finite, in Python's canonical form) or a plain word (letters, digits
-    and ``_ . / : + -``, no ``__``: a choice, a frame name, a ``package://`` path). Anything else raises
-    :class:`~robotdyn.errors.InputError` before xacro sees it. (A Xacro *file* is code by design: only expand
-    descriptions you trust.)
+    therefore handed over only as a number (finite, in Python's canonical form) or a plain word that no
+    expression can read as anything but a name: letters, digits and ``_ . / : + -``, no ``__``; not starting with
+    a digit or a point (``1e5j``, ``.5.5``); no ``+`` or ``-`` unless it is a path (holding ``/``: ``1-1``,
+    ``r+r`` would be sums); not a name that xacro binds (:data:`XACRO_NAMES`: ``pi``, ``e``, ``max``, ``math.pi``)
+    nor one of the description's ``properties``. A choice, a frame name and a ``package://`` path pass.
+    Anything else raises :class:`~robotdyn.errors.InputError` before xacro sees it. (A Xacro *file* is code by
+    design: only expand descriptions you trust.)
+
+    Args:
+        name: The argument's name (for the message).
+        value: A number, bool or string.
+        properties: Names of the ``xacro:property`` s of the description (a word naming one would be its value).
     """
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -68,13 +82,22 @@ def xacro_value(name: str, value) -> str:
     try:
         x = float(text)
     except ValueError:
-        if _PLAIN_WORD.fullmatch(text) and "__" not in text:
-            return text
-        raise InputError(f"xacro argument {name} = {text!r}; expected a number or a plain word (letters, digits and "
-                         "_ . / : + -): robotdyn hands xacro data, never expressions") from None
+        if not _PLAIN_WORD.fullmatch(text) or "__" in text:
+            raise InputError(f"xacro argument {name} = {text!r}; expected a number or a plain word (letters, digits "
+                             "and _ . / : + -): robotdyn hands xacro data, never expressions") from None
+        head = text.split(".")[0].split("/")[0]
+        if (text[:1].isdigit() or text[:1] == "." or ("/" not in text and ("+" in text or "-" in text))
+                or head in XACRO_NAMES or head in set(properties)):
+            raise InputError(f"xacro argument {name} = {text!r}: xacro would evaluate it inside ${{...}} (an "
+                             "expression, or a name it binds); expected a number, or a word that is only a name "
+                             "(a choice, a frame, a package:// path)") from None
+        return text
     if not np.isfinite(x):
         raise InputError(f"xacro argument {name} = {text!r}; expected a finite number")
     return text if _PLAIN_WORD.fullmatch(text) else repr(x)
+
+
+_PROPERTY = re.compile(r"<xacro:property\s+name=[\"']([^\"']+)[\"']")
 
 
 def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packages=None) -> str:
@@ -105,7 +128,8 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
         regular_file(path, "description", MAX_DESCRIPTION_BYTES)
     except InputError as exc:
         raise DescriptionError(str(exc)) from None
-    mappings = {str(k): xacro_value(str(k), v) for k, v in (args or {}).items()}
+    properties = _PROPERTY.findall(path.read_text(errors="replace")) if args else ()
+    mappings = {str(k): xacro_value(str(k), v, properties) for k, v in (args or {}).items()}
     index = packages if packages is not None else PackageIndex.create()
     cached = description_cache.lookup(path, mappings, index)
     if cached is not None:
@@ -138,8 +162,9 @@ MAX_DESCRIPTION_BYTES = 10_000_000
 """Largest description accepted [bytes], as a file and expanded (real robots' URDFs are well under 1 MB; meshes are
 separate files): a larger one is refused before it is parsed."""
 MAX_LINKS = 300
-"""Most links of a description (humanoids and mobile manipulators have 50 to 150; a chain of 300 takes 15 s to load): a larger tree is
-refused in one line before the model is built (3000 links ended in a MemoryError after 54 s)."""
+"""Most links of a description (humanoids and mobile manipulators have 50 to 150; a chain of 300 takes 15 s to
+load): a larger tree is refused in one line before the model is built (3000 links ended in a MemoryError after
+54 s)."""
 _LINK = re.compile(r"<link[\s/>]")
 
 

@@ -54,6 +54,9 @@ def _digest(path) -> str:
 
 def _source(spec: SweepSpec) -> tuple[dict, dict]:
     """The robot's source (what workers load) and its identity (what run ids hash)."""
+    if spec.urdf is not None and spec.constraints is None and spec.robot is None:
+        raise SweepSpecError(f"urdf = {spec.urdf!r} (--urdf) needs constraints = FILE (--constraints): the wheels, "
+                             "closures and motors of the robot")
     if (spec.robot is None) == (spec.constraints is None):
         raise SweepSpecError("give either a robot name (robot = ...) or a constraint file (constraints = ...), "
                              "exactly one")

@@ -304,6 +304,8 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     start = time.perf_counter()
     p = plan(spec)
     phases = {"plan": time.perf_counter() - start}
+    if scheduler is not None and client is None:
+        _probe(scheduler)  # a wrong address is one line before anything is written or shown
     out = sweep_store.prepare(out)
     done = sweep_store.finished(out)
     todo = [r for r in p.runs if r.run_id not in done or (retry_errors and done[r.run_id] == "error")]

@@ -56,6 +56,8 @@ RESERVED = ("run_id", "run_index", "robot", "scenario", "terrain", "status", "er
 """Column names of the results that no varied parameter may take."""
 TOP_KEYS = ("robot", "constraints", "urdf", "xacro_args", "fixed", "parameters", "scenarios", "terrains", "sample",
             "n", "seed", "t_end", "n_out", "rtol", "atol", "columns", "trajectories", "plot_column", "time_limit")
+RANGE_KEYS = ("min", "max", "n", "scale")
+"""The keys of a range of the ``[parameters]`` table."""
 _VALUE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*")
 
 
@@ -269,7 +271,7 @@ def _toml_axis(path: Path, name: str, v) -> Axis:
         return Axis(name, tuple(v))
     if not isinstance(v, dict):
         return Axis(name, (v,))
-    allowed = ("min", "max", "n", "scale")
+    allowed = RANGE_KEYS
     for k in v:
         if k not in allowed:
             raise SweepSpecError(f"{where}: unknown key {k!r}; expected {', '.join(allowed)}")

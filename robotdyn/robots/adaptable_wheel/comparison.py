@@ -174,13 +174,13 @@ def cmd_ik(args) -> int:
 
     from ...inputs import MAX_ANGLE, MAX_POSITION, refuse_together
 
-    if args.robot != SPEC.name:
-        raise InputError(f"ik is implemented for {SPEC.name} only, not {args.robot!r}")
-    refuse_together(args, "mission", "commands")
     for flag in ("urdf", "constraints", "xacro_arg", "package", "twist"):  # ik solves the built-in robot's eqs 4-24
         if getattr(args, flag, None):
             raise InputError(f"--{flag.replace('_', '-')}: ik solves {SPEC.name}'s own equations (eqs 4-24); "
                              "expected --param NAME=VALUE for its numbers")
+    if args.robot != SPEC.name:
+        raise InputError(f"ik is implemented for {SPEC.name} only, not {args.robot!r}")
+    refuse_together(args, "mission", "commands")
     if args.csv and not args.mission:
         raise InputError("--csv writes a mission's steps; expected it with --mission")
     robot = Robot(SPEC, parse_assignments(args.param))

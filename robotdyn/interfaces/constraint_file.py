@@ -324,13 +324,16 @@ def read(
     """
     path = Path(path)
     r = _Reader(path)
-    if not path.is_file():
+    from ..input_files import read_text
+
+    if not path.exists() and not path.is_symlink():
         raise ConstraintFileError(f"constraint file not found: {path}")
-    if path.stat().st_size > MAX_FILE_BYTES:
-        raise ConstraintFileError(f"{path}: {path.stat().st_size:,} bytes; expected a constraint file of at most "
-                                  f"{MAX_FILE_BYTES:,} bytes")
+    try:  # a regular file of bounded size, read at most that far (a FIFO would block, a device never end)
+        text = read_text(path, "constraint file", MAX_FILE_BYTES)
+    except InputError as exc:
+        raise ConstraintFileError(str(exc)) from None
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConstraintFileError(f"{path}: not valid TOML: {exc}") from None
     except UnicodeDecodeError:

@@ -48,8 +48,9 @@ MAX_RUNS = 1_000_000
 """Largest number of runs of one sweep (a larger one is refused before anything runs)."""
 MAX_SPEC_BYTES = 1_000_000
 """Largest sweep file read [bytes] (a sweep file is a few lines; a larger file is refused before it is read)."""
-MAX_TORQUE_SCALE = 1e6
-"""Largest magnitude of the torque scale (beyond it the scaled torques leave every motor's range)."""
+MAX_TORQUE_SCALE = 1e9
+"""Largest magnitude of the torque scale: :data:`robotdyn.inputs.MAX_FORCE` per N m of the scenario's torques
+(beyond it a torque of 1 N m leaves the range any motor torque is accepted in)."""
 MAX_SEED = 2**63 - 1
 RESERVED = ("run_id", "run_index", "robot", "scenario", "terrain", "status", "error", "t_end", "t_reached", "drift",
             "nfev", "wall", "run_wall")

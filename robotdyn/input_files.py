@@ -33,7 +33,7 @@ def resolved(path, what: str) -> Path:
         return Path(os.path.expanduser(str(path))).resolve()
     except (RuntimeError, OSError) as exc:  # Python 3.11: RuntimeError("Symlink loop from ..."); 3.13: OSError
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "a loop of symbolic links"
-        raise InputError(f"{what} {str(path)!r}: {reason}; expected a file or directory that exists") from None
+        raise InputError(f"{what} = {str(path)!r}: {reason}; expected a file or directory that exists") from None
 
 
 def regular_file(path, what: str, max_bytes: int) -> os.stat_result:

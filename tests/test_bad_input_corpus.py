@@ -604,6 +604,14 @@ case("i24-sweep-spec-height-nan", ["sweep", "--spec", "{d}/nan.toml", "--workers
      {"nan.toml": 'robot = "quasimoro"\nterrains = [{kind = "flat", height = nan}]\n[parameters]\nM = [4.0, 5.0]\n'})
 case("i24-constraints-package-loop", ["info", *SKID_ARGS, "--package", "{d}/loop"], "loop", {"loop": LOOP})
 case("i24-constraints-fifo", ["info", "--constraints", "{d}/fifo.toml"], "fifo.toml", {"fifo.toml": FIFO})
+case("i24-constraints-loop", ["info", "--constraints", "{d}/loop"], "loop", {"loop": LOOP})
+case("i24-package-dirs-loop", ["info", "--constraints", "{d}/robot.toml"], "loop", {
+    "loop": LOOP, "robot.toml": SKID.read_text().replace('urdf = "skid_steer.urdf.xacro"',
+                                                        f'urdf = "{SKID_XACRO}"\npackage_dirs = ["loop"]')})
+case("i24-sweep-constraints-loop", ["sweep", "--constraints", "{d}/loop", "--workers", "0", "--out", "{d}/s"], "loop",
+     {"loop": LOOP})
+case("i24-sweep-spec-constraints-loop", ["sweep", "--spec", "{d}/spec.toml", "--workers", "0", "--out", "{d}/s"],
+     "loop", {"loop": LOOP, "spec.toml": 'constraints = "loop"\n'})
 dd_case("i24-wheel-mass-1e-300", "mass", urdf_text(wheel_mass="1e-300"))
 dd_case("i24-wheel-zero-mass-with-inertia", "left", urdf_text(wheel_mass="0"))
 dd_case("i24-links-3000", "links", urdf_text(extra="".join(

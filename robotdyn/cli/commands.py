@@ -643,6 +643,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("robotdyn: interrupted", file=sys.stderr)
         return 130
+    except RuntimeError as exc:  # Path.resolve() of a loop of symbolic links (Python < 3.13) where no check caught it
+        if "Symlink loop" not in str(exc):
+            raise
+        print(f"robotdyn: error: {exc}: a loop of symbolic links; expected a file or directory that exists",
+              file=sys.stderr)
+        return 2
     except RecursionError:  # a nesting deeper than any valid input (e.g. a hostile TOML or XML file)
         print("robotdyn: error: input nested too deeply; expected a robot description or constraint file of "
               "ordinary depth", file=sys.stderr)

@@ -170,7 +170,7 @@ class PackageIndex:
         """
         explicit = {}
         for name, d in (packages or {}).items():
-            path = resolved(d, f"package {name} =")
+            path = resolved(d, f"package {name}")
             if not path.is_dir():
                 raise DescriptionError(f"package {name} = {d}: no such directory; expected the package's directory "
                                        "(the one holding its package.xml)")

@@ -470,8 +470,8 @@ def _description(cx: _Context, urdf, xacro_args, package_dirs, packages) -> None
     r.keys("packages", pkg_table, list(pkg_table))
     dirs = {k: r.string(f"packages.{k}", v, "directory") for k, v in pkg_table.items()}
     try:
-        named = {k: str(resolved(base / v, f"packages.{k} =")) for k, v in dirs.items()}
-        named.update({k: str(resolved(v, f"--package {k}=")) for k, v in packages.items()})
+        named = {k: str(resolved(base / v, f"packages.{k}")) for k, v in dirs.items()}
+        named.update({k: str(resolved(v, f"--package {k}")) for k, v in packages.items()})
     except InputError as exc:
         r.fail("packages", str(exc))
     try:

@@ -68,7 +68,12 @@ def _source(spec: SweepSpec) -> tuple[dict, dict]:
                                  "own robot's description (constraints = FILE); a built-in robot's numbers are its "
                                  "parameters: --param NAME=VALUE or --vary NAME=...")
         return {"robot": spec.robot}, {"robot": spec.robot}
-    path = Path(spec.constraints).resolve()
+    from ..input_files import resolved
+
+    try:
+        path = resolved(spec.constraints, "constraints")
+    except InputError as exc:
+        raise SweepSpecError(str(exc)) from None
     if not path.is_file():
         raise SweepSpecError(f"constraint file {spec.constraints!r} not found")
     source = {"constraints": str(path), "urdf": spec.urdf, "xacro_args": dict(spec.xacro_args),

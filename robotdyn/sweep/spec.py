@@ -210,7 +210,7 @@ def _count(x, where: str) -> int:
 def from_toml(path) -> SweepSpec:
     """Read and check the structure of a sweep file (names and values are checked against the robot by
     :func:`expand`). Relative ``constraints``/``urdf`` paths are taken from the file's directory."""
-    from ..input_files import read_text
+    from ..input_files import read_text, resolved
 
     path = Path(path)
     try:  # a regular file of bounded size: a FIFO would block, /dev/zero would never end
@@ -231,7 +231,7 @@ def from_toml(path) -> SweepSpec:
                 raise SweepSpecError(f"{path}: {key} = {data[key]!r}; expected a non-empty string")
             value = data[key]
             if key in ("constraints", "urdf") and not value.startswith("package://"):
-                value = str((path.parent / value).resolve())
+                value = str(resolved(path.parent / value, key))
             setattr(spec, key, value)
     for key in ("xacro_args", "fixed"):
         table = data.get(key, {})

@@ -183,3 +183,14 @@ def test_directory_with_a_results_file_of_repeated_columns_still_works(tmp_path,
     err = capsys.readouterr().err
     assert str(bad) in err and "repeated columns" in err
     assert pq.read_table(out / "results.parquet").num_rows == 2
+
+
+def test_api_refuses_too_many_local_workers(tmp_path):
+    """sweep.run(..., workers=100000) hung starting the processes; refused before anything is written."""
+    from robotdyn.errors import RobotDynError
+    from robotdyn.sweep.spec import SweepSpec, parse_axis
+
+    spec = SweepSpec(robot="quasimoro", axes=[parse_axis("M=4,5")], t_end=0.2)
+    with pytest.raises(RobotDynError, match="workers = 100000"):
+        runner.run(spec, tmp_path / "s", workers=100_000, progress=False, plot=False)
+    assert not (tmp_path / "s").exists()

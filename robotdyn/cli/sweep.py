@@ -60,15 +60,6 @@ def register(sub, parents) -> None:
     p.set_defaults(func=cmd_sweep)
 
 
-WORKERS_PER_CPU = 4
-"""Most local Dask worker processes per CPU (beyond it they only wait for each other; 100,000 hung the start)."""
-
-
-def max_local_workers() -> int:
-    """The largest ``--workers`` of a local cluster: :data:`WORKERS_PER_CPU` per CPU of this machine."""
-    return WORKERS_PER_CPU * (os.cpu_count() or 1)
-
-
 def spec_from_args(args):
     """The sweep spec of the command line: the ``--spec`` file, then the flags on top."""
     from ..inputs import parse_assignments
@@ -101,6 +92,8 @@ def cmd_sweep(args) -> int:
         if value is not None and value < (0 if flag == "workers" else 1):
             raise InputError(f"--{flag.replace('_', '-')} {value}; expected a whole number >= "
                              f"{0 if flag == 'workers' else 1}")
+    from ..sweep.runner import WORKERS_PER_CPU, max_local_workers
+
     if args.workers is not None and args.workers > max_local_workers() and args.scheduler is None:
         raise InputError(f"--workers {args.workers}: more worker processes than this machine runs usefully; expected "
                          f"at most {max_local_workers()} ({WORKERS_PER_CPU} per CPU), or a cluster: --scheduler ADDRESS")

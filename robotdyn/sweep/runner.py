@@ -123,6 +123,17 @@ def _worker_info() -> str:
     return robotdyn.__version__
 
 
+WORKERS_PER_CPU = 4
+"""Most local Dask worker processes per CPU (beyond it they only wait for each other; 100,000 hung the start)."""
+
+
+def max_local_workers() -> int:
+    """The largest number of worker processes of a local cluster: :data:`WORKERS_PER_CPU` per CPU here."""
+    import os
+
+    return WORKERS_PER_CPU * (os.cpu_count() or 1)
+
+
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
 """Address schemes of a Dask scheduler (``inproc``: a cluster of threads in this process, from the API)."""
 
@@ -306,6 +317,9 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     phases = {"plan": time.perf_counter() - start}
     if scheduler is not None and client is None:
         _probe(scheduler)  # a wrong address is one line before anything is written or shown
+    elif client is None and workers > max_local_workers():
+        raise RobotDynError(f"workers = {workers}: more local worker processes than this machine runs usefully; "
+                            f"expected at most {max_local_workers()} ({WORKERS_PER_CPU} per CPU), or a scheduler")
     out = sweep_store.prepare(out)
     done = sweep_store.finished(out)
     todo = [r for r in p.runs if r.run_id not in done or (retry_errors and done[r.run_id] == "error")]

@@ -180,7 +180,8 @@ def cmd_dump(args) -> int:
            "B": red.B, "motors": motors, "S": red.S, "condition": red.projection.condition}
     text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g})",
             _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
-            _vector_text("g", names, red.g), _matrix_text("B", names, motors, red.B) if motors else "B: none (the robot has no motors)"]
+            _vector_text("g", names, red.g),
+            _matrix_text("B", names, motors, red.B) if motors else "B: none (the robot has no motors)"]
     if args.a is not None:
         nudot = robot.check_nu(args.a, "a")
         Q, tau, resid = robot.inverse_dynamics(q, nu, nudot)

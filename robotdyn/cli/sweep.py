@@ -96,7 +96,8 @@ def cmd_sweep(args) -> int:
 
     if args.workers is not None and args.workers > max_local_workers() and args.scheduler is None:
         raise InputError(f"--workers {args.workers}: more worker processes than this machine runs usefully; expected "
-                         f"at most {max_local_workers()} ({WORKERS_PER_CPU} per CPU), or a cluster: --scheduler ADDRESS")
+                         f"at most {max_local_workers()} ({WORKERS_PER_CPU} per CPU), or a cluster: --scheduler "
+                         "ADDRESS")
     for flag, value, where in (("--twist", args.twist, "[twist] frame = ..."),
                                ("--package", args.package, "[packages] NAME = DIR or package_dirs = [DIR]")):
         if value:  # not carried to the runs: refused rather than silently ignored

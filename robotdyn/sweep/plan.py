@@ -64,9 +64,9 @@ def _source(spec: SweepSpec) -> tuple[dict, dict]:
         if spec.urdf is not None:
             raise SweepSpecError("urdf = ... goes with constraints = FILE, not with a registered robot")
         if spec.xacro_args:
-            raise SweepSpecError(f"xacro argument {next(iter(spec.xacro_args))!r} (--xacro-arg, xacro_args) is for your "
-                                 "own robot's description (constraints = FILE); a built-in robot's numbers are its "
-                                 "parameters: --param NAME=VALUE or --vary NAME=...")
+            raise SweepSpecError(f"xacro argument {next(iter(spec.xacro_args))!r} (--xacro-arg, xacro_args) is for "
+                                 "your own robot's description (constraints = FILE); a built-in robot's numbers are "
+                                 "its parameters: --param NAME=VALUE or --vary NAME=...")
         return {"robot": spec.robot}, {"robot": spec.robot}
     from ..input_files import resolved
 

@@ -23,6 +23,10 @@ demo: $(STAMP)
 	$(PY) -m robotdyn compare quasimoro
 	mkdir -p out
 	$(PY) -m robotdyn simulate quasimoro --scenario rectilinear --t-end 10 --csv out/quasimoro_rectilinear.csv --plot out/quasimoro_rectilinear.png
+	@echo ""
+	@echo "robotdyn is installed in .venv/, not on your PATH: run it as .venv/bin/robotdyn (e.g. .venv/bin/robotdyn list),"
+	@echo "or run 'source .venv/bin/activate' once per shell, then robotdyn ... and python -c 'import robotdyn' work."
+	@echo "Next: docs/getting-started.md (or make docs, then open docs/_build/html/index.html)."
 
 ## make chromium: Debian's chromium for the browser tests (tests/test_browser.py), installed if missing
 ## (ROBOTDYN_SKIP_BROWSER=1 skips both the install and those tests)
@@ -33,10 +37,11 @@ chromium:
 ## make test: install, then run the whole test suite, notebooks included
 test: $(STAMP) chromium
 	$(PY) -m pytest -q tests
-	$(PY) -m pytest -q --nbmake notebooks
+	NB=$$(mktemp -d) && cp notebooks/*.ipynb $$NB/ && cd $$NB && $(CURDIR)/$(PY) -m pytest -q --nbmake -p no:cacheprovider --rootdir=. *.ipynb; status=$$?; rm -rf $$NB; exit $$status  # from a copy outside the repository
 
 ## make docs: the documentation site into docs/_build/html (Sphinx + MyST-NB: the notebooks executed, the API
-## reference from the docstrings, the errata, the viewer pages), warnings as errors. Installs the `docs` group of
+## reference from the docstrings, the errata, the viewer pages), warnings as errors, then checked by
+## tools/check_site.py (screenshots of four pages in docs/_build/screenshots/). Installs the `docs` group of
 ## pyproject.toml without reinstalling robotdyn (no recompilation). SPHINXOPTS="-D nb_execution_mode=cache" reuses
 ## notebook outputs whose source did not change.
 DOCS_STAMP := $(VENV)/.docs-installed
@@ -46,9 +51,10 @@ $(DOCS_STAMP): $(STAMP) pyproject.toml
 	$(PY) -m pip install --quiet -r $(VENV)/docs-requirements.txt
 	touch $(DOCS_STAMP)
 
-docs: $(DOCS_STAMP)
+docs: $(DOCS_STAMP) chromium
 	rm -rf docs/api
 	$(PY) -m sphinx -b html -W --keep-going -c docs $(SPHINXOPTS) . docs/_build/html
+	$(PY) tools/check_site.py docs/_build/html  # local links and anchors, machine paths, alt text; math and figures in Chromium
 	@echo "docs: open docs/_build/html/index.html"
 
 ## make bench: speed of the reduced model against raw Pinocchio, side by side in one run; MuJoCo on the same

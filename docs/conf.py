@@ -38,8 +38,10 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",  # Google-style docstrings
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax 3 shipped in the package and copied into _static: math renders offline
     "sphinx.ext.viewcode",
     "robotdyn_docs",  # viewer pages from `robotdyn view --html`, embedded in the gallery
+    "robotdyn_site",  # alt text for every figure, no lock objects in the API reference
 ]
 
 # ----------------------------------------------------------------------------------------------- notebooks
@@ -50,6 +52,7 @@ nb_execution_show_tb = True
 nb_merge_streams = True
 myst_enable_extensions = ["dollarmath", "amsmath"]
 myst_heading_anchors = 3
+nb_render_markdown_format = "myst"  # Markdown printed by a cell (the generated reference tables) parsed as MyST
 
 # ------------------------------------------------------------------------------------------- API reference
 autosummary_generate = True
@@ -64,7 +67,7 @@ napoleon_use_rtype = False
 
 # ---------------------------------------------------------------------------------------------------- HTML
 html_theme = "pydata_sphinx_theme"
-html_title = "robotdyn"
+html_title = f"robotdyn {release}"  # the version in every page's header (pyproject.toml, via the metadata)
 html_theme_options = {"show_toc_level": 2, "navigation_depth": 3, "secondary_sidebar_items": ["page-toc"]}
 html_show_sourcelink = False
 html_static_path = ["_static"]

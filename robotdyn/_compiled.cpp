@@ -559,6 +559,7 @@ class Evaluator {
   void deriv(double t, const std::vector<double>& y, std::vector<double>& dy, double alpha,
              const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
     const int k = mobility();
+    last_t_ = t;  // where an escaping Fallback happened (the Python side names the time)
     tau_.resize(profile.motors());
     profile.eval(t, tau_);
     dy.resize(y.size());
@@ -1467,6 +1468,11 @@ class Evaluator {
   Eigen::JacobiSVD<MatrixXd> slip_svd_;
   double slip_kappa1_ = 0.0, slip_kappa2_ = 0.0;  // the last Painleve test (slip_condition)
   double slip_min_ = HUGE_VAL, event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
+
+ public:
+  double last_t_ = std::numeric_limits<double>::quiet_NaN();  // time of the last right-hand side evaluated
+
+ private:
   double slip_error_t_ = 0.0;
   std::vector<double> event_y_, event_dy_, slip_error_y_;
   std::vector<Geometry> geo_;
@@ -1503,6 +1509,7 @@ PYBIND11_MODULE(_compiled, m) {
       .def("add_motor", &Evaluator::add_motor)
       .def("add_slipping", &Evaluator::add_slipping)
       .def_property_readonly("slipping", &Evaluator::slipping)
+      .def_readonly("last_t", &Evaluator::last_t_, "Time [s] of the last right-hand side a simulation evaluated")
       .def_property_readonly("slip_condition", &Evaluator::slip_condition,
                              "The last slipping evaluation's Painleve test: (||K||_1 times LAPACK's estimate of "
                              "||K^-1||_1, the 2-norm condition number from the singular values or NaN where the "

@@ -76,7 +76,15 @@ def as_vector(values, n: int, what: str, names: Sequence[str] | None = None,
 
 
 def parse_assignments(items: Iterable[str], what: str = "--param") -> dict[str, str]:
-    """Parse ``NAME=VALUE`` strings into a dict (values kept as strings)."""
+    """Parse ``NAME=VALUE`` strings into a dict (values kept as strings).
+
+    Args:
+        items: ``NAME=VALUE`` strings (``None``: none).
+        what: The option's name, for messages.
+
+    Raises:
+        InputError: An item without ``=``.
+    """
     out: dict[str, str] = {}
     for item in items or []:
         if "=" not in item:

@@ -4,14 +4,18 @@ Every file robotdyn writes (CSV, images, HTML pages) goes through :func:`atomic_
 a temporary file in the target's directory and renamed over the target only once it is complete (``os.replace``,
 atomic on POSIX), so a failing or interrupted run never truncates or half-writes an existing file. A target that
 cannot be written (missing directory, a directory, no permission, a full disk) is a
-:class:`~robotdyn.errors.OutputError` naming the file and what was expected.
+:class:`~robotdyn.errors.OutputError` naming the file and what was expected. Files are created with the user's umask
+(mode 0666 less the umask), as any program's ``open()`` creates them. A streamed simulation writes its rows, as they
+are computed, to the visible ``<target>.partial`` instead (:func:`visible_output`), renamed over the target at the
+end.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
-import tempfile
+import secrets
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -23,7 +27,17 @@ IMAGE_FORMATS = ("png", "pdf", "svg", "jpg", "jpeg", "eps", "ps", "tif", "tiff",
 
 def check_target(path, what: str = "output file", suffixes: tuple[str, ...] | None = None) -> Path:
     """Validate an output path before any work is done: its directory exists and is writable, it is not a
-    directory, and (with ``suffixes``) its extension is one of them."""
+    directory, and (with ``suffixes``) its extension is one of them.
+
+    Args:
+        path: The output file.
+        what: What it is, for messages.
+        suffixes: Allowed extensions (e.g. ``(".png", ".pdf")``; default ``None``: any).
+
+    Raises:
+        OutputError: The path is a directory, its directory is missing or not writable, or its extension is not
+            allowed.
+    """
     p = Path(path)
     if p.is_dir():
         raise OutputError(f"{what} {str(path)!r} is a directory; expected a file name")
@@ -41,15 +55,42 @@ def check_target(path, what: str = "output file", suffixes: tuple[str, ...] | No
     return p
 
 
+def _create(path: Path, exclusive: bool) -> int:
+    """Open ``path`` for writing, created with mode 0666 less the user's umask (as ``open()`` creates files; not
+    tempfile's 0600): a file robotdyn writes gets the permissions any other program of the user's would give it."""
+    flags = os.O_WRONLY | os.O_CREAT | (os.O_EXCL if exclusive else os.O_TRUNC) | getattr(os, "O_CLOEXEC", 0)
+    return os.open(path, flags, 0o666)
+
+
+def _temporary(target: Path) -> Path:
+    """A new empty hidden file next to ``target`` (``.<name>.<random>.tmp<suffix>``), mode 0666 less the umask."""
+    for _ in range(100):
+        tmp = target.parent / f".{target.name}.{secrets.token_hex(4)}.tmp{target.suffix}"
+        try:
+            os.close(_create(tmp, exclusive=True))
+            return tmp
+        except FileExistsError:
+            continue
+    raise FileExistsError(errno.EEXIST, f"no free temporary name next to {target}")
+
+
 @contextlib.contextmanager
 def atomic_output(path, what: str = "output file") -> Iterator[Path]:
     """Yield a temporary path next to ``path``; on success it replaces ``path`` atomically, on any error it is
-    removed and ``path`` is left as it was. OS errors become one-line :class:`OutputError`."""
+    removed and ``path`` is left as it was. OS errors become one-line :class:`OutputError`. The file is created
+    with the user's umask (mode 0666 less the umask), whatever the mode of a file it replaces.
+
+    Args:
+        path: The output file.
+        what: What it is, for messages.
+    """
     target = check_target(path, what)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".tmp{target.suffix}", dir=target.parent or ".")
-    os.close(fd)
     try:
-        yield Path(tmp)
+        tmp = _temporary(target)
+    except OSError as exc:
+        raise OutputError(f"cannot write {what} {str(path)!r}: {exc.strerror or exc}") from None
+    try:
+        yield tmp
         os.replace(tmp, target)
     except OSError as exc:
         raise OutputError(f"cannot write {what} {str(path)!r}: {exc.strerror or exc}") from None
@@ -58,8 +99,65 @@ def atomic_output(path, what: str = "output file") -> Iterator[Path]:
             os.unlink(tmp)
 
 
+PARTIAL_SUFFIX = ".partial"
+"""What :func:`visible_output` appends to the target's name for the file being written."""
+
+
+@contextlib.contextmanager
+def visible_output(path, what: str = "output file") -> Iterator[tuple[Path, object]]:
+    """Yield ``(partial path, binary file open for writing and reading)`` for an output written while it is computed
+    (a streamed simulation): the rows go to ``<path>.partial``, visible next to the target from the first row on, and
+    replace ``path`` atomically when the block ends normally (a finished file, or one the writer marked as
+    partial); on an error the ``.partial`` file is removed and ``path`` is left as it was. A process killed hard
+    (SIGKILL, power loss) leaves the ``.partial`` file with the rows written so far, and ``path`` untouched.
+
+    The ``.partial`` file is locked (``flock``) while written: a second run writing the same target is refused in
+    one line; a ``.partial`` left by a killed run is not locked and is overwritten.
+
+    Raises:
+        OutputError: The target or its ``.partial`` file cannot be written, or another process is writing them.
+    """
+    target = check_target(path, what)
+    partial = check_target(target.with_name(target.name + PARTIAL_SUFFIX), what)
+    try:  # not truncated before it is locked: another run may be writing it
+        fd = os.open(partial, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666)
+    except OSError as exc:
+        raise OutputError(f"cannot write {what} {str(partial)!r}: {exc.strerror or exc}") from None
+    try:
+        import fcntl
+
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise OutputError(f"{what} {str(path)!r}: another process is writing it ({str(partial)!r} is locked); expected "
+                          "one run per output file") from None
+    except ImportError:  # no flock (Windows): no lock
+        pass
+    ok = False
+    try:
+        os.ftruncate(fd, 0)  # a leftover of a killed run
+        with open(os.dup(fd), "r+b") as f:  # the lock belongs to fd, closed after the rename
+            yield partial, f
+            f.flush()
+        os.replace(partial, target)
+        ok = True
+    except OSError as exc:
+        raise OutputError(f"cannot write {what} {str(path)!r}: {exc.strerror or exc}") from None
+    finally:
+        if not ok:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(partial)
+        os.close(fd)  # releases the lock, after the rename
+
+
 def save_figure(fig, path, dpi: int = 110) -> None:
-    """Save a matplotlib figure atomically, in the format its extension names."""
+    """Save a matplotlib figure atomically, in the format its extension names.
+
+    Args:
+        fig: The matplotlib figure.
+        path: The image file (PNG, PDF, SVG, ... by its extension).
+        dpi: Resolution of raster formats [dots per inch].
+    """
     target = check_target(path, "plot", IMAGE_FORMATS)
     with atomic_output(target, "plot") as tmp:
         fig.savefig(tmp, dpi=dpi, format=target.suffix.lower().lstrip("."))

@@ -43,7 +43,20 @@ angle beyond one turn is a unit mistake)."""
 
 @dataclass
 class Parameter:
-    """A physical parameter: name, default, unit, meaning; ``xacro=False`` if it is not a xacro argument."""
+    """A physical parameter of a robot: name, default, unit, meaning.
+
+    Attributes:
+        name: The name used by ``--param NAME=VALUE``, ``sweep --vary`` and ``Robot(spec, params)``.
+        default: The default value (a number in ``unit``, or one of ``choices``).
+        unit: The unit as text (``m``, ``kg``, ``kg m^2``, ``rad``, ``m/s^2``, ``-``; empty for a choice); masses
+            and inertias (``kg``, ``kg m^2``) are >= 0 unless ``minimum`` says otherwise.
+        description: One line shown by ``robotdyn info``.
+        choices: The allowed strings of a categorical parameter (``None``: a number).
+        xacro: Whether the value is passed to the Xacro description as an argument of the same name (``False``: it
+            is used only by the robot's Python or constraint file, e.g. g).
+        minimum: The smallest physical value in ``unit`` (default ``None``: 0 for masses and inertias, else none).
+        positive: Whether the value must be > 0 (a length such as a radius, a link length or a track).
+    """
 
     name: str
     default: float | str
@@ -56,7 +69,18 @@ class Parameter:
     maximum: float | None = None  # largest physical value (e.g. a friction coefficient: MAX_FRICTION)
 
     def convert(self, value) -> float | str:
-        """Validate and convert a user value."""
+        """Validate and convert a user value.
+
+        Args:
+            value: A number (or a string that parses as one) in the parameter's unit, or one of ``choices``.
+
+        Returns:
+            The value as a float (or the choice as a string).
+
+        Raises:
+            InputError: Not a number, not finite, not one of the choices, <= 0 where ``positive``, below ``minimum``,
+                or beyond :data:`PARAMETER_LIMITS` for its unit.
+        """
         if self.choices is not None:
             if str(value) not in self.choices:
                 raise InputError(f"parameter {self.name} = {value!r}; expected one of {', '.join(self.choices)}")
@@ -86,7 +110,26 @@ class Parameter:
 
 @dataclass
 class Wheel:
-    """A wheel: its frame (centre), radius (number or parameter name), axle axis in the frame, kind."""
+    """A wheel: its frame (centre), radius (number or parameter name), axle axis in the frame, kind.
+
+    Attributes:
+        frame: The frame (link) whose origin is the wheel centre.
+        radius: Radius [m] (> 0), or the name of a :class:`Parameter` giving it.
+        axis: Axle direction in the wheel frame's axes (3 numbers, normalised when built; default y).
+        kind: ``standard`` (rolls without slipping: longitudinal, lateral and normal rows), ``omni`` (rolls along
+            its rollers only: driving and normal rows) or ``support`` (touches the ground only: the normal row).
+        roller_angle: Omni wheels: angle [rad] of the rollers' constrained direction from the rolling direction
+            (0: a 90-degree omni wheel; pi/4: a mecanum wheel), or a parameter name.
+        radius_joint: A prismatic joint whose coordinate [m] adds to the radius (adaptable wheels), or ``None``.
+        name: Name in row labels, loads and messages (default ``None``: the frame name).
+        mu: Friction coefficient (>= 0) for traction checks and the coulomb law; ``None``: not given.
+        friction: ``rolling`` (no slip, default), ``coulomb``, ``linear`` or ``stick_slip``
+            (:mod:`robotdyn.contact.friction`).
+        slip_velocity: Coulomb law's regularisation velocity [m/s] (``None``: the law's default).
+        stiffness: Linear law's slip stiffness [s/m] (``None``: the law's default).
+        slip: With a friction law: ``both`` tangential directions follow it, or ``lateral`` (rolls along its
+            rolling direction, only the lateral force follows the law).
+    """
 
     frame: str
     radius: float | str
@@ -104,7 +147,15 @@ class Wheel:
 
 @dataclass
 class Closure:
-    """A loop closure between two frames, closing the given components (in frame1's axes)."""
+    """A loop closure between two frames, closing the given components (in frame1's axes).
+
+    Attributes:
+        frame1: The first frame; its axes express the closed components.
+        frame2: The second frame, on another body, coinciding with ``frame1`` in the closed components.
+        components: Which of ``x y z`` (translations) and ``rx ry rz`` (rotations) are closed (default: the three
+            translations: a spherical joint).
+        name: Name in row labels and messages (default ``None``: from the frames).
+    """
 
     frame1: str
     frame2: str
@@ -114,7 +165,13 @@ class Closure:
 
 @dataclass
 class MotorSpec:
-    """A motor on a joint, reacting on ``reaction`` (a link) or on the joint's parent."""
+    """A motor on a joint, reacting on ``reaction`` (a link) or on the joint's parent.
+
+    Attributes:
+        name: The motor's name (torque vectors are ordered as the spec's motors).
+        joint: The driven joint (its torque [N m] or force [N] acts along the joint axis).
+        reaction: The link on which the reaction torque acts (default ``None``: the joint's parent link).
+    """
 
     name: str
     joint: str
@@ -135,7 +192,7 @@ class RobotSpec:
         labels: Display name of a coordinate for a joint name (e.g. ``wheel_left_joint -> theta_L``).
         independent: Coordinate labels whose velocities are the independent ones (``None``: automatic).
         terrain: A terrain, or a function of the parameter values returning one (default: flat z = 0).
-        paper: The paper's file name in ``shared/papers``.
+        paper: A short reference of the robot's paper (authors, title; full references: ``docs/bibliography.md``).
         neutral: Coordinate values of a valid configuration (default all zero), used e.g. by ``info``.
         xacro_args: Fixed xacro arguments (name -> string) that are not parameters (e.g. from ``--xacro-arg``).
         package_dirs: Directories where ``package://`` URIs (meshes) are resolved.
@@ -178,11 +235,31 @@ class RobotSpec:
     root_height: float | None = 0.0
 
     def parameter(self, name: str) -> Parameter:
+        """The declared parameter called ``name``.
+
+        Args:
+            name: A parameter name (``robotdyn info ROBOT`` lists them).
+
+        Returns:
+            The :class:`Parameter`.
+
+        Raises:
+            InputError: No parameter has that name; the message names the declared ones or, where there are none,
+                how to declare them.
+        """
         for p in self.parameters:
             if p.name == name:
                 return p
+        if not self.parameters:
+            raise InputError(
+                f"unknown parameter {name!r}: {self.name} has no parameters to set or sweep; declare them in its "
+                "constraint file as [[parameters]] (name, default, unit) and use them by name (e.g. a wheel's "
+                "radius = \"r\"); a number of the URDF itself (a link mass, a length) must be a <xacro:arg> of a "
+                ".urdf.xacro description, declared with xacro = true")
         raise InputError(
             f"unknown parameter {name!r} for {self.name}; expected one of {', '.join(p.name for p in self.parameters)}"
+            " (to vary another number of the description, make it a <xacro:arg> and declare it under [[parameters]] "
+            "with xacro = true)"
         )
 
 
@@ -344,7 +421,17 @@ class Robot:
         return out
 
     def coordinate_index(self, label: str) -> int:
-        """Index of a coordinate by its display name or joint name."""
+        """Index of a coordinate in q.
+
+        Args:
+            label: The coordinate's display name (:attr:`coordinates`) or its URDF joint name.
+
+        Returns:
+            Its index in q (and in the full velocity v).
+
+        Raises:
+            InputError: No coordinate has that name.
+        """
         if label in self.coordinates:
             return self.coordinates.index(label)
         if label in self.description.joint_names:
@@ -359,7 +446,17 @@ class Robot:
         return q
 
     def check_q(self, q) -> np.ndarray:
-        """Validate a configuration (length, finiteness, joint limits)."""
+        """Validate a configuration (length, finiteness, joint limits).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as :attr:`coordinates`.
+
+        Returns:
+            q as a float array.
+
+        Raises:
+            InputError: Wrong length, a non-finite or huge value, or a coordinate outside its joint range.
+        """
         q = as_vector(q, self.nq, "q", self.coordinates, MAX_POSITION, "m or rad")
         lo, hi = self.description.lower, self.description.upper
         bad = np.flatnonzero((q < lo - 1e-12) | (q > hi + 1e-12))
@@ -371,32 +468,86 @@ class Robot:
         return q
 
     def check_nu(self, nu, what: str = "v") -> np.ndarray:
-        """Validate a vector of independent velocities (or accelerations)."""
+        """Validate a vector of independent velocities (or accelerations).
+
+        Args:
+            nu: Independent velocities (k,) [m/s, rad/s] (or accelerations [m/s^2, rad/s^2]), ordered as
+                :attr:`velocity_names`.
+            what: Its name in messages; ``"a"`` or ``"nudot"`` checks against the acceleration limit instead of the
+                velocity limit.
+
+        Returns:
+            nu as a float array.
+
+        Raises:
+            InputError: Wrong length, or a non-finite or huge value.
+        """
         limit = MAX_ACCELERATION if what in ("a", "nudot") else MAX_VELOCITY
         return as_vector(nu, self.mobility, what, self.velocity_names, limit)
 
     def check_tau(self, tau) -> np.ndarray:
-        """Validate motor torques."""
+        """Validate motor torques.
+
+        Args:
+            tau: One torque [N m] (or force [N] for a prismatic joint) per motor, ordered as :attr:`motors`.
+
+        Returns:
+            tau as a float array.
+
+        Raises:
+            InputError: Wrong length, or a non-finite or huge value.
+        """
         return as_vector(tau, len(self.motors), "tau", [m.name for m in self.motors], MAX_FORCE, "N m or N")
 
     # ------------------------------------------------------------------------------------------ constraints
     def constraint_rows(self, kin: KinematicState) -> ConstraintRows:
-        """All constraint rows at the state of ``kin``."""
+        """All constraint rows at the state of ``kin``.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            The stacked :class:`~robotdyn.constraints.constraint.ConstraintRows` (A, Adot, residual, labels), in the
+            order of :attr:`constraints`.
+        """
         return ConstraintRows.stack([c.rows(kin) for c in self.constraints], self.model.nv)
 
     def rows_at(self, q) -> ConstraintRows:
-        """All constraint rows at configuration q (at rest, so ``Adot`` is zero)."""
+        """All constraint rows at configuration q (at rest, so ``Adot`` is zero).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+
+        Returns:
+            The stacked :class:`~robotdyn.constraints.constraint.ConstraintRows`.
+        """
         return self.constraint_rows(KinematicState(self.model, self.data, q, np.zeros(self.model.nv)))
 
     def constraint_residual(self, q) -> np.ndarray:
-        """Position residuals of the holonomic constraint rows at q (m, rad)."""
+        """Position residuals of the holonomic constraint rows at q.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+
+        Returns:
+            One residual per holonomic row [m or rad] (0 where the constraint holds).
+        """
         rows = self.rows_at(q)
         return rows.residual[rows.holonomic]
 
     def check_constraints(self, q, tol: float = 1e-6, rows: ConstraintRows | None = None) -> None:
         """Raise :class:`ConstraintError` if q violates a holonomic constraint by more than ``tol``, with the advice
         that fits: a root at the wrong height when every wheel misses the ground by the same amount, else the
-        wheels or closures that do not close (``rows``: :meth:`rows_at` of q, when the caller has them)."""
+        wheels or closures that do not close.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            tol: Largest accepted residual [m or rad].
+            rows: :meth:`rows_at` of q, when the caller has them (default ``None``: computed here).
+
+        Raises:
+            ConstraintError: A holonomic row's residual exceeds ``tol`` (one line naming the row and the fix).
+        """
         rows = self.rows_at(q) if rows is None else rows
         if not (rows.residual.size and np.max(np.abs(rows.residual)) > tol):
             return
@@ -421,8 +572,15 @@ class Robot:
         )
 
     def wheel_heights(self, q=None) -> dict[str, float]:
-        """Each wheel's contact-point height above the terrain [m] (its holonomic residual) at q (default: the
-        neutral configuration); 0 when it touches, positive when it floats above."""
+        """Each wheel's contact-point height above the terrain [m] (its holonomic residual); 0 when it touches,
+        positive when it floats above.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] (default ``None``: the neutral configuration).
+
+        Returns:
+            Height [m] by wheel name.
+        """
         kin = KinematicState(self.model, self.data, self.neutral() if q is None else np.asarray(q, float),
                              np.zeros(self.model.nv))
         out = {}
@@ -440,6 +598,9 @@ class Robot:
         plate), while a planar root moves the root link in the plane z = 0. When every wheel's contact point is the
         same height d below (or above) the terrain at the neutral configuration, the root belongs at -d [m].
 
+        Args:
+            tol: Agreement [m] within which the wheels' heights count as one height (and below which a height is 0).
+
         Returns:
             ``(height, wheel heights)``: the height (0 when the wheels already touch, or when they disagree by
             more than ``tol``: then no single height makes them all touch) and :meth:`wheel_heights`.
@@ -454,13 +615,45 @@ class Robot:
 
     # ------------------------------------------------------------------------------------------- dynamics
     def reduced(self, q, nu, coriolis: bool = False) -> ReducedDynamics:
-        """The minimal-coordinate model at (q, nu); see :mod:`robotdyn.reduction.reduced_dynamics` (compiled where
-        the robot allows it: :func:`robotdyn.fast.dispatch.reduce`)."""
+        """The minimal-coordinate model at (q, nu): :math:`M_r\\dot\\nu + C_r\\nu + g_r = B_r\\tau` with
+        :math:`v = S(q)\\nu`; see :mod:`robotdyn.reduction.reduced_dynamics` (compiled where the robot allows it:
+        :func:`robotdyn.fast.dispatch.reduce`).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as :attr:`coordinates`; should satisfy the holonomic
+                constraints (:meth:`check_constraints`).
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as :attr:`velocity_names`.
+            coriolis: Also compute the matrix :math:`C_r` (k, k) and :math:`\\dot S` (default: only the bias
+                :math:`h = C_r\\nu + g_r`, which is cheaper).
+
+        Returns:
+            The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` (``M``, ``h``, ``g``, ``B``, ``S``, ...).
+
+        Raises:
+            NonFiniteError: The state gives non-finite numbers.
+
+        Example:
+            >>> import robotdyn
+            >>> robot = robotdyn.load("quasimoro")
+            >>> red = robot.reduced([0, 0, 0, 0, 0, 0.1], [1.0, 1.0, 0.0])
+            >>> red.M.shape, red.h.shape, red.B.shape
+            ((3, 3), (3,), (3, 2))
+            >>> bool(abs(red.M - red.M.T).max() < 1e-12)  # symmetric
+            True
+        """
         q, nu = np.asarray(q, float), np.asarray(nu, float)
         return checked(reduce(self, q, nu, coriolis), q, nu)
 
     def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Full-coordinate M(q), C(q, v), g(q) of the unconstrained tree (Pinocchio)."""
+        """Full-coordinate M(q), C(q, v), g(q) of the unconstrained tree (Pinocchio), without the constraints.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            v: Full velocities (n,) [m/s, rad/s].
+
+        Returns:
+            ``(M, C, g)``: the mass matrix (n, n), the Coriolis matrix (n, n) and the gravity vector (n,).
+        """
         q, v = np.asarray(q, float), np.asarray(v, float)
         M = pin.crba(self.model, self.data, q).copy()
         C = pin.computeCoriolisMatrix(self.model, self.data, q, v).copy()
@@ -474,7 +667,29 @@ class Robot:
         With ``check``, rows the projection dropped as redundant are checked at the velocity and acceleration
         level (:mod:`robotdyn.constraints.redundancy`): where the mobility changes (e.g. steerable wheels all parallel) these
         accelerations can violate them, and a :class:`~robotdyn.errors.RobotDynWarning` names each row and by
-        how much."""
+        how much.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            nu: Independent velocities (k,) [m/s, rad/s].
+            tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the order of :attr:`motors`.
+            check: Check the dropped redundant rows (default True).
+
+        Returns:
+            The independent accelerations (k,) [m/s^2, rad/s^2].
+
+        Raises:
+            NonFiniteError: The accelerations are not finite.
+
+        Example:
+            >>> import robotdyn
+            >>> robot = robotdyn.load("quasimoro")
+            >>> nudot = robot.forward_dynamics([0, 0, 0, 0, 0, 0], [0.0, 0.0, 0.0], [0.1, 0.1])
+            >>> nudot.shape
+            (3,)
+            >>> bool(abs(nudot[0] - nudot[1]) < 1e-12)  # equal torques: the wheels accelerate alike
+            True
+        """
         if sliding_now(self):
             return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
         red = self.reduced(q, nu)
@@ -486,10 +701,32 @@ class Robot:
             self._warn_dropped(red, out)
         return out
 
+    def dynamics_derivatives(self, q, nu, tau):
+        """:math:`\\dot\\nu` and its derivatives in q (natural coordinates, and along the holonomic manifold in
+        independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
+        :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (Python path; see
+        :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`, and with slipping wheels
+        :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`)."""
+        if sliding_now(self):
+            from .contact.sliding_derivatives import sliding_derivatives
+
+            return sliding_derivatives(self, q, nu, tau)
+        from .reduction.dynamics_derivatives import dynamics_derivatives
+
+        return dynamics_derivatives(self, q, nu, tau)
+
     def redundant_row_violations(self, q, nu, nudot=None) -> list:
         """The constraint rows dropped as redundant at q that the velocities ``nu`` (and the accelerations
-        ``nudot``, if given) violate: a list of :class:`~robotdyn.constraints.redundancy.RowViolation` (empty where the state is
-        consistent). See :mod:`robotdyn.constraints.redundancy`."""
+        ``nudot``, if given) violate. See :mod:`robotdyn.constraints.redundancy`.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            nu: Independent velocities (k,) [m/s, rad/s].
+            nudot: Independent accelerations (k,) [m/s^2, rad/s^2] (default ``None``: velocities only).
+
+        Returns:
+            A list of :class:`~robotdyn.constraints.redundancy.RowViolation` (empty where the state is consistent).
+        """
         from .constraints.redundancy import violations
 
         return violations(self.reduced(q, nu), nudot)
@@ -504,10 +741,23 @@ class Robot:
     def inverse_dynamics(self, q, nu, nudot) -> tuple[np.ndarray, np.ndarray, float]:
         """Generalised forces and motor torques for given independent accelerations.
 
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            nu: Independent velocities (k,) [m/s, rad/s].
+            nudot: Independent accelerations (k,) [m/s^2, rad/s^2].
+
         Returns:
             ``(Q, tau, residual)``: :math:`Q = M_r\\dot\\nu + C_r\\nu + g_r` (k,), the motor torques tau solving
             :math:`B_r\\tau = Q` in least squares, and the norm of what the motors cannot produce (0 when the
             motion is feasible).
+
+        Example:
+            >>> import robotdyn
+            >>> robot = robotdyn.load("quasimoro")
+            >>> q, nu = [0, 0, 0, 0, 0, 0], [0.0, 0.0, 0.0]
+            >>> Q, tau, residual = robot.inverse_dynamics(q, nu, robot.forward_dynamics(q, nu, [0.1, 0.1]))
+            >>> [round(float(t), 9) for t in tau]  # the torques that produced the motion
+            [0.1, 0.1]
         """
         red = self.reduced(q, nu)
         Q = red.M @ np.asarray(nudot, float) + red.h
@@ -520,17 +770,53 @@ class Robot:
     def contact_forces(self, q, nu, tau=None, nudot=None, twin: bool = True):
         """Wheel-ground contact forces and loop-closure forces at (q, nu) for motor torques ``tau`` (forward
         dynamics) or independent accelerations ``nudot`` (inverse dynamics); see
-        :func:`robotdyn.contact.contact_forces.constraint_forces`."""
+        :func:`robotdyn.contact.contact_forces.constraint_forces`.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            nu: Independent velocities (k,) [m/s, rad/s].
+            tau: Motor torques [N m or N], one per motor (default ``None``: zero, or from ``nudot``).
+            nudot: Independent accelerations (k,) [m/s^2, rad/s^2] (default ``None``: from ``tau``).
+            twin: For a planar root, take the normal loads the planar model leaves undetermined from its floating
+                twin (default True).
+
+        Returns:
+            The :class:`~robotdyn.contact.contact_forces.ConstraintForces` (per wheel: normal load [N] and friction
+            force [N] in its contact frame).
+
+        Example:
+            >>> import robotdyn
+            >>> robot = robotdyn.load("quasimoro")
+            >>> forces = robot.contact_forces([0, 0, 0, 0, 0, 0], [0.0, 0.0, 0.0], tau=[0.0, 0.0])
+            >>> [round(w.normal, 2) for w in forces.wheels]  # (2 m + M) g / 2 on each wheel at rest [N]
+            [29.43, 29.43]
+        """
         from .contact.contact_forces import constraint_forces
 
         return constraint_forces(self, q, nu, tau=tau, nudot=nudot, twin=twin)
 
     def velocity(self, q, nu) -> np.ndarray:
-        """Full velocity v = S(q) nu."""
+        """Full velocity v = S(q) nu.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            nu: Independent velocities (k,) [m/s, rad/s].
+
+        Returns:
+            The full velocity (n,) [m/s, rad/s], admissible (A(q) v = 0).
+        """
         return self.reduced(q, nu).v
 
     def energy(self, q, v) -> float:
-        """Total mechanical energy (kinetic + potential) [J]."""
+        """Total mechanical energy (kinetic + potential) [J].
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+            v: Full velocities (n,) [m/s, rad/s] (e.g. :meth:`velocity`).
+
+        Returns:
+            Kinetic plus gravitational potential energy [J] (potential zero at z = 0).
+        """
         kinetic, potential = energy(self.model, self.data, np.asarray(q, float), np.asarray(v, float))
         return kinetic + potential
 

@@ -529,6 +529,26 @@ case("toml-urdf-cli-binary", ["info", "--constraints", str(SKID), "--urdf", "{d}
      {"bin.urdf": b"\xff\xfe\x00\x81\x90 garbage"})
 case("toml-urdf-cli-directory", ["info", "--constraints", str(SKID), "--urdf", "{d}"], "description")
 
+# ------------------------------------------------------------------------------------------------ linearize
+LIN = ["linearize", "quasimoro"]
+UPRIGHT = ["--set", "theta3=3.14159", "--states", "theta3", "theta1_dot", "theta2_dot", "theta3_dot"]
+case("linearize-unknown-option", [*LIN, "--bogus-flag"], "--bogus-flag")
+case("linearize-states-unknown", [*LIN, "--states", "nosuchstate"], "nosuchstate")
+case("linearize-v-short", [*LIN, "--v", "0", "0"], "v")
+case("linearize-v-nan", [*LIN, "--v", "nan", "0", "0"], "v")
+case("linearize-v-word", [*LIN, "--v", "fast", "0", "0"], "v")
+case("linearize-tau-short", [*LIN, "--tau", "1"], "tau")
+case("linearize-tau-inf", [*LIN, "--tau", "inf", "0"], "tau")
+case("linearize-tau-set-unknown", [*LIN, "--tau-set", "nosuchmotor=1"], "nosuchmotor")
+case("linearize-q-short", [*LIN, "--q", "0", "0", "0"], "q")
+case("linearize-set-unknown", [*LIN, "--set", "nosuchcoord=1"], "nosuchcoord")
+case("linearize-off-ground", ["linearize", "adaptable_wheel"], "normal")
+case("linearize-lqr-q-alone", [*LIN, *UPRIGHT, "--lqr-q", "1", "1", "1", "1"], "--lqr-r")
+case("linearize-lqr-q-short", [*LIN, *UPRIGHT, "--lqr-q", "1", "1", "--lqr-r", "1", "1"], "--lqr-q")
+case("linearize-lqr-q-nan", [*LIN, *UPRIGHT, "--lqr-q", "nan", "1", "1", "1", "--lqr-r", "1", "1"], "--lqr-q")
+case("linearize-lqr-r-zero", [*LIN, *UPRIGHT, "--lqr-q", "1", "1", "1", "1", "--lqr-r", "0", "1"], "--lqr-r")
+case("linearize-lqr-unstabilisable", [*LIN, "--lqr-q", *["1"] * 9, "--lqr-r", "1", "1"], "stabilisable")
+
 # --------------------------------------------------------------------------------------------- descriptions
 dd_case("valid-control", "", urdf_text())  # (replaced below: the control must pass; see test_control_is_valid)
 CASES.pop()
@@ -674,6 +694,9 @@ FLAG_CASES: dict = {
     "--direction": (["--direction", "abc"], ("direction",)),
     "--e": (["--e", "-0.5"], ("--e",)),
     "--speed": (["--speed", "-1"], ("--speed",)),
+    "--states": (["--states", "nosuchstate"], ("nosuchstate",)),
+    "--lqr-q": (["--lqr-q", "abc"], ("lqr",)),
+    "--lqr-r": (["--lqr-r", "abc"], ("lqr",)),
 }
 FLAG_CASE_OVERRIDES: dict = {  # (command, flag): a different bad use where the generic one does not fit
     ("sweep", "--t-end"): (["--t-end", "nan"], ("t_end",)),
@@ -682,7 +705,7 @@ FLAG_CASE_OVERRIDES: dict = {  # (command, flag): a different bad use where the 
     ("linkage-posture", "--terrain"): (["--terrain", "lunar"], ("lunar",)),
 }
 SWITCHES = ("--json", "--full", "--forces", "--quiet", "--frames", "--open", "--trajectories", "--no-plot",
-            "--retry-errors")
+            "--retry-errors", "--replace")
 """Flags without a value: their bad use is a value (``--json=1``, refused by argparse)."""
 
 

@@ -127,6 +127,7 @@ SAMPLES = {
     "compare": ["compare", "quasimoro"],
     "view": ["view", "quasimoro", "--html", "x.html"],
     "sweep": ["sweep", "quasimoro", "--vary", "M=4,6", "--out", "d"],
+    "linearize": ["linearize", "quasimoro", "--set", "theta3=3.14", "--states", "theta3", "theta3_dot"],
 }
 
 

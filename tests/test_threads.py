@@ -62,3 +62,125 @@ def test_robot_pickles_without_its_thread_caches():
     compiled_model(robot)
     copy = pickle.loads(pickle.dumps(robot))
     np.testing.assert_array_equal(copy.reduced(q, nu).h, h)
+
+
+def test_use_compiled_is_local_to_its_thread():
+    """Issue 24: use_compiled(False) was a process-wide global that each block saved and restored. Two threads whose
+    blocks interleave (A enters, B enters, A leaves, B leaves) left it off for the whole process: B restored the
+    False it had saved while A was inside. Now the switch is a ContextVar: inside a block only the calling thread
+    sees the fast path off, the main thread meanwhile does not, and afterwards every thread has it on again."""
+    from robotdyn.fast.dispatch import enabled, use_compiled
+
+    if not enabled():
+        pytest.skip("the compiled fast path is off here")
+    steps = [threading.Event() for _ in range(4)]  # A in, B in, A out, B out (each waits for the one before)
+    seen = {}
+
+    def a():
+        with use_compiled(False):
+            seen["A inside"] = enabled()
+            steps[0].set()
+            steps[1].wait(5)
+        steps[2].set()
+
+    def b():
+        steps[0].wait(5)
+        with use_compiled(False):
+            seen["B inside"] = enabled()
+            steps[1].set()
+            seen["main while both inside"] = None
+            steps[2].wait(5)
+        steps[3].set()
+
+    threads = [threading.Thread(target=a), threading.Thread(target=b)]
+    for t in threads:
+        t.start()
+    steps[1].wait(5)
+    main_inside = enabled()  # both threads are inside their blocks now
+    for t in threads:
+        t.join()
+    assert steps[3].is_set()
+    assert seen["A inside"] is False and seen["B inside"] is False
+    assert main_inside is True
+    assert enabled() is True
+    after = {}
+    t = threading.Thread(target=lambda: after.setdefault("enabled", enabled()))
+    t.start()
+    t.join()
+    assert after["enabled"] is True
+
+
+def test_many_threads_switching_leave_the_fast_path_on():
+    """The issue's report: four threads running with use_compiled(False) while others use the fast path. Afterwards
+    simulate_many (which needs the compiled model) still runs, and no thread ever saw another's switch."""
+    from robotdyn.fast.dispatch import enabled, use_compiled
+    from robotdyn.simulation.many_runs import simulate_many
+
+    if not enabled():
+        pytest.skip("the compiled fast path is off here")
+    robot = robotdyn.load("quasimoro")
+    q = robot.neutral()
+    wrong = []
+
+    def off():
+        for _ in range(200):
+            with use_compiled(False):
+                if compiled_model(robot) is not None:
+                    wrong.append("off block saw a compiled model")
+
+    def on():
+        for _ in range(200):
+            if compiled_model(robot) is None:
+                wrong.append("the fast path was off outside any block")
+
+    threads = [threading.Thread(target=off) for _ in range(4)] + [threading.Thread(target=on) for _ in range(2)]
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert wrong == []
+    assert enabled()
+    runs = simulate_many(robot, 0.2, q0=np.tile(q, (2, 1)), nu0=[[0.1, 0.0, 0.0], [0.0, 0.1, 0.0]], n_out=3,
+                         threads=1, progress=False)
+    assert runs.ok.all()
+
+
+def test_compiled_model_refuses_a_thread_that_does_not_own_it():
+    """Issue 24: a CompiledModel handed to other threads gave wrong numbers in about one call in ten (its buffers
+    are overwritten by the other threads' calls). Now every evaluation from a thread that did not build it raises
+    a one-line ThreadError; the owning thread and compiled_model(robot) in the other thread still work, and the
+    other thread's own model gives the owner's numbers to round-off."""
+    from robotdyn.fast.compiled import ThreadError
+
+    robot = robotdyn.load("quasimoro")
+    fast = compiled_model(robot)
+    if fast is None:
+        pytest.skip("quasimoro is not compiled here")
+    q, nu = robot.neutral(), np.array([0.3, -0.2, 0.1])
+    h = np.array(fast.compute(q, nu)[1])
+    caught, own = [], {}
+
+    def other():
+        for call in (lambda: fast.compute(q, nu), lambda: fast.reduced(q, nu), lambda: fast.evaluate(q, nu),
+                     lambda: fast.rhs(q, nu, np.zeros(len(robot.motors)), 10.0),
+                     lambda: fast.forces(q, nu, np.zeros(len(robot.motors)))):
+            try:
+                call()
+            except ThreadError as exc:
+                caught.append(str(exc))
+        mine = compiled_model(robot)
+        own["same object"] = mine is fast
+        own["h"] = np.array(mine.compute(q, nu)[1])
+
+    t = threading.Thread(target=other)
+    t.start()
+    t.join()
+    assert len(caught) == 5 and all("\n" not in m and "thread" in m for m in caught)
+    assert own["same object"] is False
+    np.testing.assert_allclose(own["h"], h, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(np.array(fast.compute(q, nu)[1]), h)  # the owner is unaffected

@@ -85,7 +85,7 @@ def gallery() -> str:
         spec = mod.SPEC
         lines = [f"### {name}", "", f"{spec.title}", ""]
         if spec.paper:
-            lines += [f"Paper: `shared/papers/{spec.paper}`", ""]
+            lines += [f"Paper: {spec.paper} ([bibliography](bibliography.md))", ""]
         if (IMG / f"{name}.png").is_file():
             lines += [f"![{name} in the meshcat viewer](img/{name}.png)", ""]
         scenarios = getattr(mod, "SCENARIOS", {})

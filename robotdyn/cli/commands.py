@@ -1,4 +1,4 @@
-"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep`` plus robot-specific commands
+"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep | linearize`` plus robot-specific commands
 (every command has ``--json``).
 
 Robot modules may add their own subcommands by defining ``register_cli(subparsers, parents)``; each such
@@ -16,6 +16,7 @@ import sys
 
 import numpy as np
 
+from .. import __version__
 from ..errors import RobotDynError
 from ..inputs import MAX_ACCELERATION, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector, parse_assignments
 from ..reduction.reduced_dynamics import solve_mass
@@ -104,6 +105,15 @@ def _vector_text(name: str, rows: list[str], x: np.ndarray) -> str:
 
 # --------------------------------------------------------------------------------------------- commands
 def cmd_list(args) -> int:
+    """``robotdyn list``: the registered robots and their titles.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     from ..robots import module, names
 
     data = {n: module(n).SPEC.title for n in names()}
@@ -112,12 +122,21 @@ def cmd_list(args) -> int:
 
 
 def cmd_info(args) -> int:
+    """``robotdyn info ROBOT``: coordinates, independent velocities, mobility, parameters, actuators, constraints and scenarios.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     mod, robot = _load(args)
     info = robot.info()
     info["scenarios"] = {k: s.description for k, s in getattr(mod, "SCENARIOS", {}).items()}
     lines = [
         f"{info['robot']}: {info['title']}",
-        *([f"paper: shared/papers/{info['paper']}"] if info["paper"] else []),
+        *([f"paper: {info['paper']} (full reference: docs/bibliography.md)"] if info["paper"] else []),
         f"coordinates q ({len(info['coordinates'])}): {', '.join(info['coordinates'])}   [m, rad]",
         f"independent velocities ({info['mobility']}): {', '.join(info['independent_velocities'])}",
         f"mobility at the neutral configuration: {info['mobility_at_neutral']} (n - rank A)"
@@ -143,6 +162,15 @@ def cmd_info(args) -> int:
 
 
 def cmd_dump(args) -> int:
+    """``robotdyn dump ROBOT``: the reduced model (M_r, h, g_r, B_r, S) at a state, and with ``--a``/``--tau`` the inverse or forward dynamics and the constraint forces.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     from ..inputs import refuse_together
 
     refuse_together(args, "a", "tau_set")  # (--a and --tau: argparse's own group)
@@ -240,6 +268,24 @@ def _numbers(items, option: str, expected: str) -> dict[str, float]:
 
 
 def cmd_simulate(args) -> int:
+    """``robotdyn simulate ROBOT --scenario NAME``: run a scenario; summary, CSV, plots and the traction check.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status (0 on success; 130 after an interruption, 124 past ``--time-limit``, whose partial results were kept). Errors raise
+        :class:`~robotdyn.errors.RobotDynError`, which :func:`~robotdyn.cli.commands.main` prints in one line with
+        status 2.
+    """
+    from .time_limit import wall_clock_limit
+
+    with wall_clock_limit(getattr(args, "time_limit", None)) as limit:  # robotdyn.cli.time_limit: a partial run past it
+        return _simulate(args, limit)
+
+
+def _simulate(args, limit) -> int:
+    """:func:`cmd_simulate` inside its wall-clock ``limit`` (:mod:`robotdyn.cli.time_limit`)."""
     from ..output import IMAGE_FORMATS, check_target
 
     # output paths checked before the run, so that a typo does not cost a simulation
@@ -266,7 +312,8 @@ def cmd_simulate(args) -> int:
 
     if args.csv and not (args.plot or args.traction_plot) and sc.span(args.t_end, None, streamed=True)[1] > SEGMENT \
             and not stick_slip_wheels(robot):
-        return _simulate_streamed(args, robot, sc, extra)  # more samples than a segment: to disk as they come
+        return _simulate_streamed(args, robot, sc, extra, limit)  # more samples than a segment: to disk as they come
+    limit.start()
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")
     tr = None
@@ -285,16 +332,21 @@ def cmd_simulate(args) -> int:
             partial = traj.stats["partial"] = (partial + "; " if partial else "") + "traction not computed (interrupted)"
             tr = None
         if tr is not None and args.traction_plot:
-            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction")
+            plot_traction(tr, args.traction_plot, f"{args.robot}: {sc.name}, wheel loads and required friction",
+                          traj.robot or robot)
     elif args.mu is not None or args.traction_plot:
         raise RobotDynError(f"--mu/--traction-plot: robot {args.robot!r} has no wheels")
+    limit.stop()
+    partial = limit.reason(partial)
+    if partial:  # the CSV file's marker says why the run stopped
+        traj.stats["partial"] = partial
     if args.csv:
         traj.to_csv(args.csv, tr.columns() if tr is not None else None)
     if args.plot:
-        from ..interfaces.plotting import plot_trajectory
+        from ..interfaces.plotting import plot_trajectory, pose_columns
 
         plot_trajectory(traj, sc.plot or traj.velocity_names, args.plot, f"{args.robot}: {sc.name}", sc.zoom,
-                        sc.references)
+                        sc.references, pose_columns(traj.robot or robot, traj))
     drift = float(np.max(traj.residual)) if traj.residual.size else 0.0
     final = dict(zip(traj.coordinates + traj.velocity_names, np.concatenate([traj.q[-1], traj.nu[-1]])))
     out = {"scenario": sc.name, "t_end": float(traj.t[-1]), "samples": len(traj.t), "final": final,
@@ -318,12 +370,12 @@ def cmd_simulate(args) -> int:
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(
             f"; t = {s['t']:.6g} s {s['wheel']} -> {s['phase']}" for s in switches[:10])
             + ("; ..." if len(switches) > 10 else ""))
-    return _finish_run(args, out, text, traj.stats, partial, [args.csv, args.plot, args.traction_plot])
+    return _finish_run(args, out, text, traj.stats, partial, [args.csv, args.plot, args.traction_plot], limit)
 
 
-def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | None, written: list) -> int:
+def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | None, written: list, limit) -> int:
     """The end of ``simulate``'s report, in memory or streamed: constant offsets, an event that stopped the run, the
-    files written and a partial run's note (stderr, exit status 130)."""
+    files written and a partial run's note (stderr, exit status 130; 124 past ``--time-limit``)."""
     if "offsets" in stats:  # holonomic residuals no coordinate can change (robotdyn.reduction.pull_back)
         out["constant_offsets"] = stats["offsets"]
     if "event" in stats:
@@ -337,11 +389,11 @@ def _finish_run(args, out: dict, text: list[str], stats: dict, partial: str | No
     _emit(args, out, "\n".join(text))
     if partial:
         print(f"robotdyn: {partial}; wrote the partial results: {', '.join(written) or 'nothing'}", file=sys.stderr)
-        return 130
+        return limit.status
     return 0
 
 
-def _simulate_streamed(args, robot, sc, extra: dict) -> int:
+def _simulate_streamed(args, robot, sc, extra: dict, limit) -> int:
     """``simulate --csv`` of a run longer than one segment (robotdyn.simulation.streaming): the samples go to the
     CSV file segment by segment, with the wheel-load columns; only the ends and extremes stay in memory."""
     from ..simulation.streaming import SEGMENT, CsvSink
@@ -364,9 +416,11 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
             events.setdefault((e.kind, e.wheel), e)
         return tr.columns()
 
+    limit.start()
     res = sc.run(robot, t_end=args.t_end, progress=not args.quiet,
                  sink=CsvSink(args.csv, columns if has_wheels else None, SEGMENT), **extra)
-    partial = res.stats.get("partial")
+    limit.stop()
+    partial = limit.reason(res.stats.get("partial"))
     final = dict(zip(res.coordinates + res.velocity_names, np.concatenate([res.q, res.nu])))
     out = {"scenario": sc.name, "t_end": res.t, "samples": res.samples, "final": final, "streamed": True,
            "segments": res.stats["segments"], "energy_start": res.energy_start, "energy_end": res.energy_end,
@@ -385,7 +439,7 @@ def _simulate_streamed(args, robot, sc, extra: dict) -> int:
                            "events": [vars(e) for e in first]}
         text.append(f"loads {min(p[0] for p in peaks.values()):.4g} N minimum"
                     + (f"; first: {first[0]}" if first else "; no lift-off or slip"))
-    return _finish_run(args, out, text, res.stats, partial, [args.csv])
+    return _finish_run(args, out, text, res.stats, partial, [args.csv], limit)
 
 
 def _nonnegative(text: str) -> float:
@@ -415,6 +469,15 @@ def _interrupt(signum, frame):
 
 
 def cmd_compare(args) -> int:
+    """``robotdyn compare ROBOT``: the paper comparison table of a built-in robot.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     mod, robot = _load(args)
     if not hasattr(mod, "compare"):
         raise RobotDynError(f"robot {args.robot!r} has no paper comparison")
@@ -424,7 +487,16 @@ def cmd_compare(args) -> int:
 
 
 def cmd_view(args) -> int:
-    """The meshcat viewer: the robot (and a scenario's animation); a standalone HTML file or a live server."""
+    """The meshcat viewer: the robot (and a scenario's animation); a standalone HTML file or a live server.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0 (also when Ctrl-C stops the live server). Errors raise
+        :class:`~robotdyn.errors.RobotDynError`, which :func:`~robotdyn.cli.commands.main` prints in one line with
+        status 2.
+    """
     from ..interfaces.viewer import Viewer
 
     mod, robot = _load(args)
@@ -479,21 +551,30 @@ class _Parser(argparse.ArgumentParser):
                             "--help)")
 
 
-BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep")
+HELP_EPILOG = ("file formats (constraint TOML, sweep spec, simulate CSV, sweep Parquet): docs/reference/file-formats.md "
+               "(the documentation site: make docs)")
+"""The last line of ``robotdyn --help``: where the file formats are documented."""
+
+BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep", "linearize")
 """The built-in commands (robot modules add theirs, see :func:`_add_robot_commands`)."""
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The ``robotdyn`` parser; with ``only`` (one of :data:`BUILT_IN`), a parser holding that command alone (what
     :func:`main` needs to parse it: the others' parsers cost start-up time and change nothing of its parsing, help
-    or errors)."""
+    or errors).
+
+    Args:
+        only: One of :data:`BUILT_IN` (default ``None``: every command).
+    """
     if only is not None and only not in BUILT_IN:
         raise ValueError(f"only = {only!r}; expected one of {', '.join(BUILT_IN)}")
 
     def wanted(name: str) -> bool:
         return only is None or only == name
 
-    parser = _Parser(prog="robotdyn", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="robotdyn", description=__doc__.splitlines()[0], epilog=HELP_EPILOG)
+    parser.add_argument("--version", action="version", version=f"robotdyn {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     common = _Parser(add_help=False)
     common.add_argument("--json", action="store_true", help="machine-readable output")
@@ -505,7 +586,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     robot_args.add_argument("--xacro-arg", action="append", default=[], metavar="NAME=VALUE",
                             help="a xacro argument of --urdf (repeatable)")
     robot_args.add_argument("--constraints", metavar="FILE",
-                            help="TOML constraint file: root, wheels, closures, motors (see examples/*.toml)")
+                            help="TOML constraint file: root, wheels, closures, motors (format: docs/reference/file-formats.md; "
+                                 "examples/*.toml)")
     robot_args.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                             help="override a parameter (repeatable; robotdyn info ROBOT lists them)")
     robot_args.add_argument("--package", action="append", default=[], metavar="NAME=DIR|DIR",
@@ -524,8 +606,14 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
         register(sub, parents)
 
-    added = {"dump": _add_dump, "simulate": _add_simulate, "view": _add_view, "sweep": _add_sweep}
-    for name in ("list", "info", "dump", "simulate", "compare", "view", "sweep"):  # the order of --help
+    def _add_linearize(sub, parents) -> None:
+        from .linearize import register
+
+        register(sub, parents)
+
+    added = {"dump": _add_dump, "simulate": _add_simulate, "view": _add_view, "sweep": _add_sweep,
+             "linearize": _add_linearize}
+    for name in BUILT_IN:  # the order of --help
         if not wanted(name):
             continue
         if name in plain:
@@ -571,6 +659,9 @@ def _add_simulate(sub, parents) -> None:
                    help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
     p.add_argument("--traction-plot", metavar="FILE",
                    help="save the wheel loads and required friction against time to this image file")
+    p.add_argument("--time-limit", type=_duration, default=None, metavar="SECONDS",
+                   help="wall-clock limit of the run: past it the run stops, the samples so far are written as a "
+                        "marked partial file, and the exit status is 124 (Ctrl-C/SIGTERM: 130)")
     p.set_defaults(func=cmd_simulate)
 
 
@@ -623,7 +714,14 @@ def _one_line_warnings() -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``robotdyn`` console script."""
+    """Entry point of the ``robotdyn`` console script.
+
+    Args:
+        argv: The arguments after the program name (default ``None``: ``sys.argv[1:]``).
+
+    Returns:
+        The exit status: 0 on success, 2 on a one-line error, 130 after Ctrl-C.
+    """
     _one_line_warnings()
     try:
         argv = sys.argv[1:] if argv is None else list(argv)

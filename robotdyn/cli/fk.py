@@ -7,7 +7,15 @@ from ..description.kinematics import frame_pose, pose_text, relative_pose, rotat
 
 
 def cmd_fk(args) -> int:
-    """``robotdyn fk ROBOT --q ... --frame NAME [--base NAME]``: print the 4x4 pose of a frame."""
+    """``robotdyn fk ROBOT --q ... --frame NAME [--base NAME]``: print the 4x4 pose of a frame.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
+        :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     from .commands import _emit, _load
 
     _, robot = _load(args)
@@ -27,7 +35,12 @@ def cmd_fk(args) -> int:
 
 
 def register_fk_cli(subparsers, parents) -> None:
-    """Add the generic ``fk`` subcommand (once, whichever robot module registers it first)."""
+    """Add the generic ``fk`` subcommand (once, whichever robot module registers it first).
+
+    Args:
+        subparsers: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     if "fk" in subparsers.choices:
         return
     p = subparsers.add_parser("fk", parents=parents, help="4x4 pose of a frame (forward kinematics)")

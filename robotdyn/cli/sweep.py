@@ -16,7 +16,12 @@ EXAMPLES = """examples:
 
 
 def register(sub, parents) -> None:
-    """Add ``sweep`` to the CLI's subparsers (``parents``: the common and robot arguments)."""
+    """Add ``sweep`` to the CLI's subparsers (``parents``: the common and robot arguments).
+
+    Args:
+        sub: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     import argparse
 
     p = sub.add_parser("sweep", parents=parents, help="parameter sweep on Dask, results in Parquet",
@@ -53,6 +58,9 @@ def register(sub, parents) -> None:
     p.add_argument("--time-limit", type=float, metavar="SECONDS",
                    help="wall-clock limit of one run (default 600; 0: none): beyond it the run is an error row")
     p.add_argument("--retry-errors", action="store_true", help="compute again the runs that ended in an error")
+    p.add_argument("--replace", action="store_true",
+                   help="delete the results of another sweep found in --out (else refused: its runs are not this "
+                        "sweep's, e.g. another specification or an input changed since)")
     p.add_argument("--batch", choices=("auto", "always", "never"), default="auto",
                    help="simulate runs that vary only masses, inertias, lengths as variants of one compiled model "
                         "(auto: where the sweep is large enough to pay for the fit; never: build every run)")
@@ -61,7 +69,11 @@ def register(sub, parents) -> None:
 
 
 def spec_from_args(args):
-    """The sweep spec of the command line: the ``--spec`` file, then the flags on top."""
+    """The sweep spec of the command line: the ``--spec`` file, then the flags on top.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+    """
     from ..inputs import parse_assignments
     from ..sweep.spec import SweepSpec, from_toml, parse_axis
 
@@ -80,6 +92,16 @@ def spec_from_args(args):
 
 
 def cmd_sweep(args) -> int:
+    """``robotdyn sweep``: run a parameter sweep and print its summary.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status (0 on success; 130 after an interruption whose partial results were kept). Errors raise
+        :class:`~robotdyn.errors.RobotDynError`, which :func:`~robotdyn.cli.commands.main` prints in one line with
+        status 2.
+    """
     import signal
     import threading
 
@@ -108,7 +130,8 @@ def cmd_sweep(args) -> int:
         signal.signal(signal.SIGTERM, _interrupt)
     workers = args.workers if args.workers is not None else (os.cpu_count() or 1)
     res = run(spec, args.out, workers=workers, scheduler=args.scheduler, chunk_size=args.chunk_size,
-              progress=not args.quiet, retry_errors=args.retry_errors, plot=not args.no_plot, batch=args.batch)
+              progress=not args.quiet, retry_errors=args.retry_errors, plot=not args.no_plot, batch=args.batch,
+              replace=args.replace)
     rows = res.table.to_pydict() if res.table.num_rows else {"run_id": [], "status": [], "error": []}
     varied = [a.name for a in spec.axes] + ["scenario"] + (["terrain"] if spec.terrains else [])
     errors = [{"run_id": rows["run_id"][i], "inputs": {k: rows[k][i] for k in varied if k in rows},

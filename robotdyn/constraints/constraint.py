@@ -21,12 +21,27 @@ LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 def skew(x: np.ndarray) -> np.ndarray:
-    """The cross-product matrix :math:`[x]_\\times` with :math:`[x]_\\times y = x \\times y`."""
+    """:math:`[x]_\\times`, the 3x3 matrix with :math:`[x]_\\times y = x \\times y`.
+
+    Args:
+        x: A 3-vector.
+
+    Returns:
+        The skew-symmetric 3x3 matrix.
+    """
     return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """:math:`a \\times b` for 3-vectors (several times faster than ``np.cross`` on single vectors)."""
+    """The cross product of two 3-vectors (cheaper than ``np.cross`` on 3-vectors).
+
+    Args:
+        a: A 3-vector.
+        b: A 3-vector.
+
+    Returns:
+        a x b (3,).
+    """
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
@@ -37,6 +52,12 @@ class KinematicState:
     ``updateFramePlacements``. Frame quantities are cached per frame; ``geometry`` is a cache for
     configuration-only quantities of constraints (e.g. a wheel's contact point), which
     :meth:`with_velocity` carries over to the same configuration at another velocity.
+
+    Args:
+        model: The Pinocchio model (natural coordinates: nq == nv).
+        data: Its data, overwritten (one per thread).
+        q: Natural coordinates (nq,) [m, rad].
+        v: Velocities (nv,) [m/s, rad/s].
 
     Attributes:
         q, v: The state (natural coordinates, velocities), copied.
@@ -59,14 +80,29 @@ class KinematicState:
 
     def with_velocity(self, v: np.ndarray) -> KinematicState:
         """The same configuration at velocity ``v`` (recomputes the Jacobians' time variation, keeps the
-        configuration-level caches: frame placements, Jacobians and :attr:`geometry`)."""
+        configuration-level caches: frame placements, Jacobians and :attr:`geometry`).
+
+        Args:
+            v: Velocities (nv,) [m/s, rad/s].
+
+        Returns:
+            A new :class:`KinematicState`.
+        """
         out = KinematicState(self.model, self.data, self.q, v)
         out._poses = self._poses
         out.geometry = self.geometry
         return out
 
     def pose(self, fid: int) -> tuple[pin.SE3, np.ndarray]:
-        """Placement and LOCAL_WORLD_ALIGNED Jacobian (6 x nv) of a frame (configuration-level, cached)."""
+        """Placement and LOCAL_WORLD_ALIGNED Jacobian (6 x nv) of a frame (configuration-level, cached).
+
+        Args:
+            fid: The Pinocchio frame id.
+
+        Returns:
+            ``(placement, J)``: the frame's ``pin.SE3`` in the world and its Jacobian (6 x nv; rows: linear velocity
+            of the frame origin [m/s], then angular velocity [rad/s], world axes).
+        """
         if fid not in self._poses:
             self._poses[fid] = (
                 self.data.oMf[fid].copy(),
@@ -80,6 +116,12 @@ class KinematicState:
         The Jacobian's first three rows give the classical velocity of the frame origin in world axes [m/s],
         the last three the angular velocity [rad/s]; :math:`\\dot J v` is the classical acceleration at
         :math:`\\dot v = 0`.
+
+        Args:
+            fid: The Pinocchio frame id.
+
+        Returns:
+            ``(placement, J, Jdot)``.
         """
         if fid not in self._frames:
             placement, jac = self.pose(fid)
@@ -91,7 +133,14 @@ class KinematicState:
         return self._frames[fid]
 
     def joint_axis(self, jid: int) -> np.ndarray:
-        """World direction of a one-degree-of-freedom joint's axis (its own Jacobian column)."""
+        """World direction of a one-degree-of-freedom joint's axis (its own Jacobian column).
+
+        Args:
+            jid: The Pinocchio joint id (a revolute or prismatic joint).
+
+        Returns:
+            The axis (3,) in world axes (the angular column for a revolute joint, the linear one for a prismatic).
+        """
         jac = pin.getJointJacobian(self.model, self.data, jid, LWA)
         col = self.model.joints[jid].idx_v
         ang = jac[3:, col]
@@ -119,7 +168,15 @@ class ConstraintRows:
 
     @staticmethod
     def stack(parts: list[ConstraintRows], nv: int) -> ConstraintRows:
-        """Stack the rows of several constraints (an empty list gives zero rows)."""
+        """Stack the rows of several constraints (an empty list gives zero rows).
+
+        Args:
+            parts: The constraints' rows, in order.
+            nv: Number of velocities (columns), for the empty case.
+
+        Returns:
+            One :class:`ConstraintRows` (``Adot`` is ``None`` if any part's is).
+        """
         if not parts:
             return ConstraintRows(np.zeros((0, nv)), np.zeros((0, nv)), np.zeros(0), np.zeros(0, bool), [])
         return ConstraintRows(
@@ -140,17 +197,41 @@ class Constraint:
     name: str = "constraint"
 
     def rows(self, kin: KinematicState) -> ConstraintRows:
-        """The constraint's rows at the state held by ``kin`` (A, Adot, residual, ...)."""
+        """The constraint's rows at the state held by ``kin`` (A, Adot, residual, ...).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`ConstraintRows` (A and Adot: rows x nv; residual [m or rad] of the holonomic rows).
+        """
         raise NotImplementedError
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
         """The rows without their time derivative (``Adot`` may be ``None``); only the configuration matters.
-        Subclasses override it when that is cheaper than :meth:`rows`."""
+        Subclasses override it when that is cheaper than :meth:`rows`.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`ConstraintRows`.
+        """
         return self.rows(kin)
 
     def drift(self, kin: KinematicState) -> np.ndarray:
         """The drift term :math:`\\dot A v` at the state of ``kin``. Subclasses override it when a vector
-        formula is cheaper than the matrix :math:`\\dot A`."""
+        formula is cheaper than the matrix :math:`\\dot A`.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            One value per row [m/s^2 or rad/s^2].
+        """
         return self.rows(kin).Adot @ kin.v
 
     def __repr__(self) -> str:

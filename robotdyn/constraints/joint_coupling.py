@@ -32,7 +32,9 @@ class CosineLaw:
     path of :mod:`robotdyn.fast.compiled` evaluates too; any other callable keeps a robot on the Python path).
 
     Attributes:
-        amplitude: a [unit of the driven joint]; rate: b [1/unit of the driver]; phase: c [rad];
+        amplitude: a [unit of the driven joint: m or rad].
+        rate: b [1/unit of the driver].
+        phase: c [rad].
         offset: d [unit of the driven joint].
     """
 
@@ -45,11 +47,25 @@ class CosineLaw:
         return self.amplitude * math.cos(self.rate * q + self.phase) + self.offset
 
     def d(self, q: float) -> float:
-        """:math:`f'(q) = -ab\\sin(bq + c)`."""
+        """:math:`f'(q) = -ab\\sin(bq + c)`.
+
+        Args:
+            q: The driver's coordinate [m or rad].
+
+        Returns:
+            The derivative [unit of the driven joint per unit of the driver].
+        """
         return -self.amplitude * self.rate * math.sin(self.rate * q + self.phase)
 
     def dd(self, q: float) -> float:
-        """:math:`f''(q) = -ab^2\\cos(bq + c)`."""
+        """:math:`f''(q) = -ab^2\\cos(bq + c)`.
+
+        Args:
+            q: The driver's coordinate [m or rad].
+
+        Returns:
+            The second derivative.
+        """
         return -self.amplitude * self.rate * self.rate * math.cos(self.rate * q + self.phase)
 
 
@@ -60,9 +76,13 @@ class JointCoupling(Constraint):
         description: The robot's :class:`~robotdyn.description.urdf.Description`.
         driven: Joint whose coordinate is set by the law (:math:`q_d`).
         driver: Joint whose coordinate is the law's argument (:math:`q_r`).
-        law: :math:`f`; ``dlaw``: :math:`f'`; ``ddlaw``: :math:`f''` (callables of a float; for a
-            :class:`CosineLaw` the derivatives default to its own).
+        law: :math:`f`, a callable of a float (the driver's coordinate) returning the driven one.
+        dlaw: :math:`f'` (default ``None``: a :class:`CosineLaw`'s own; required for other laws).
+        ddlaw: :math:`f''` (default ``None``: a :class:`CosineLaw`'s own; required for other laws).
         name: Name used in the row label (default ``"driven=f(driver)"``).
+
+    Raises:
+        DescriptionError: The same joint twice, or a law that is not callable.
     """
 
     def __init__(
@@ -88,10 +108,26 @@ class JointCoupling(Constraint):
         return f"JointCoupling(driven={self.driven!r}, driver={self.driver!r})"
 
     def residual(self, q: np.ndarray) -> float:
-        """:math:`\\phi = q_d - f(q_r)` at configuration q."""
+        """:math:`\\phi = q_d - f(q_r)` at configuration q.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+
+        Returns:
+            The residual [unit of the driven joint].
+        """
         return float(q[self.i] - self.law(float(q[self.j])))
 
     def rows(self, kin: KinematicState) -> ConstraintRows:
+        """The row :math:`\\dot q_d - f'(q_r)\\dot q_r = 0` with its time derivative and residual.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`~robotdyn.constraints.constraint.ConstraintRows` (one holonomic row).
+        """
         qr, vr = float(kin.q[self.j]), float(kin.v[self.j])
         A = np.zeros((1, self.nv))
         A[0, self.i] = 1.0
@@ -102,19 +138,42 @@ class JointCoupling(Constraint):
         return ConstraintRows(A, Adot, residual, np.ones(1, bool), [f"{self.name}.coupling"])
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
-        """The row and residual without :math:`\\dot A` (the law's second derivative is not evaluated)."""
+        """The row and residual without :math:`\\dot A` (the law's second derivative is not evaluated).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`~robotdyn.constraints.constraint.ConstraintRows`.
+        """
         A = np.zeros((1, self.nv))
         A[0, self.i] = 1.0
         A[0, self.j] -= float(self.dlaw(float(kin.q[self.j])))
         return ConstraintRows(A, None, np.array([self.residual(kin.q)]), np.ones(1, bool), [f"{self.name}.coupling"])
 
     def drift(self, kin: KinematicState) -> np.ndarray:
-        """:math:`\\dot A v = -f''(q_r)\\dot q_r^2`."""
+        """:math:`\\dot A v = -f''(q_r)\\dot q_r^2`.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The drift (1,).
+        """
         vr = float(kin.v[self.j])
         return np.array([-float(self.ddlaw(float(kin.q[self.j]))) * vr * vr])
 
     def solve_driven(self, q: np.ndarray) -> np.ndarray:
-        """A copy of q with the driven coordinate set so that the residual vanishes (exact: the law is explicit)."""
+        """A copy of q with the driven coordinate set so that the residual vanishes (exact: the law is explicit).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
+
+        Returns:
+            The corrected copy (n,).
+        """
         out = np.array(q, dtype=float)
         out[self.i] = self.law(float(out[self.j]))
         return out

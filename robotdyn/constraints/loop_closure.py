@@ -59,6 +59,16 @@ class LoopClosure(Constraint):
         return f"LoopClosure({self.frame1!r}, {self.frame2!r}, components={' '.join(self.components)!r})"
 
     def rows(self, kin: KinematicState) -> ConstraintRows:
+        """The closure rows (relative velocity of the two frames in the closed components, in frame1's axes) with
+        their time derivative and position residuals.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`~robotdyn.constraints.constraint.ConstraintRows` (one holonomic row per closed component).
+        """
         M1, J1, dJ1 = kin.frame(self.f1)
         M2, J2, dJ2 = kin.frame(self.f2)
         v = kin.v
@@ -79,7 +89,15 @@ class LoopClosure(Constraint):
         return ConstraintRows(A[sel], Adot[sel], residual[sel], np.ones(len(sel), bool), labels)
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
-        """The rows and residuals without :math:`\\dot A` (configuration only)."""
+        """The rows and residuals without :math:`\\dot A` (configuration only).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`~robotdyn.constraints.constraint.ConstraintRows`.
+        """
         M1, J1 = kin.pose(self.f1)
         M2, J2 = kin.pose(self.f2)
         R1T = M1.rotation.T
@@ -93,7 +111,15 @@ class LoopClosure(Constraint):
         return ConstraintRows(A[sel], None, residual[sel], np.ones(len(sel), bool), labels)
 
     def drift(self, kin: KinematicState) -> np.ndarray:
-        """:math:`\\dot A v` from the frames' velocities and :math:`\\dot J v` (3-vectors, no matrix :math:`\\dot A`)."""
+        """:math:`\\dot A v` from the frames' velocities and :math:`\\dot J v` (3-vectors, no matrix :math:`\\dot A`).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            One value per closed component [m/s^2 or rad/s^2].
+        """
         M1, J1, dJ1 = kin.frame(self.f1)
         M2, J2, dJ2 = kin.frame(self.f2)
         v = kin.v

@@ -48,6 +48,13 @@ def set_terrain(robot, terrain: Terrain) -> None:
     """Put every terrain-dependent constraint of ``robot`` (and ``robot.terrain``) on ``terrain``, in place.
 
     Cheaper than rebuilding the robot (no Xacro expansion) when many terrains are tried.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`, changed in place.
+        terrain: The new :class:`~robotdyn.constraints.terrain.Terrain`.
+
+    Raises:
+        InputError: ``terrain`` is not a Terrain.
     """
     if not isinstance(terrain, Terrain):
         raise InputError(f"terrain {terrain!r} is not a robotdyn Terrain")

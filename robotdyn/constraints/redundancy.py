@@ -54,11 +54,18 @@ class RowViolation:
 
 
 def violations(red, nudot=None, tol: float = TOL) -> list[RowViolation]:
-    """The rows that the reduced model ``red`` (:class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu))
-    dropped as redundant and that its velocity :math:`v = S\\nu`, or its accelerations :math:`a = S\\dot\\nu + w`
-    for ``nudot`` (independent accelerations), violate by more than ``tol`` (relative).
+    """The rows that the reduced model ``red`` dropped as redundant and that its velocity :math:`v = S\\nu`, or its
+    accelerations :math:`a = S\\dot\\nu + w` for ``nudot``, violate by more than ``tol`` (relative).
 
     Rows kept by the projection hold by construction and are not checked.
+
+    Args:
+        red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu).
+        nudot: Independent accelerations (k,) [m/s^2, rad/s^2] (default ``None``: the velocity level only).
+        tol: Relative tolerance (of the row's scale times the velocity or acceleration).
+
+    Returns:
+        The :class:`RowViolation` of each violated row (empty: consistent).
     """
     rows = red.jacobian_rows
     m = rows.A.shape[0]
@@ -93,7 +100,14 @@ def violations(red, nudot=None, tol: float = TOL) -> list[RowViolation]:
 
 
 def message(found: list[RowViolation]) -> str:
-    """One line naming every violated row and by how much."""
+    """One line naming every violated row and by how much.
+
+    Args:
+        found: The violations (:func:`violations`), not empty.
+
+    Returns:
+        The warning's text.
+    """
     return (f"{len(found)} constraint row(s) dropped as redundant at this configuration are violated: "
             f"{'; '.join(map(str, found))}. The mobility changes here (rows dependent only at this configuration, "
             "e.g. steerable wheels all parallel or with axles through one point) and this motion leaves it, which "

@@ -13,7 +13,7 @@ vector ``axis`` in that frame. With terrain normal n at the contact point p and 
 - the time derivative follows the contact point as it moves around the rim (not a body-fixed point):
   :math:`\\dot A_w v = a_c^0 + \\dot\\omega^0 \\times r + \\omega \\times \\dot r - \\dot u \\dot R`,
   :math:`r = p - c`, :math:`\\dot r = -(R\\dot u + \\dot R u)`, with :math:`\\dot u` from a 3x3 implicit solve on
-  curved terrain (see ``shared/notes/rolling-contact-and-projection.md``).
+  curved terrain (see the concepts page, ``docs/concepts.md``).
 
 An omni (Swedish) wheel keeps the normal row and one tangential row along its rollers' axis, at ``roller_angle``
 from t1 towards t2 (0 for a 90-degree omni wheel whose rollers leave the lateral motion free).
@@ -137,10 +137,18 @@ class RollingWheel(Constraint):
     def contact(self, kin: KinematicState) -> dict:
         """Contact geometry and its rates at the state of ``kin`` (world frame).
 
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
         Returns:
             dict with ``p`` (contact point), ``n`` (normal), ``u`` (unit vector contact -> centre), ``R``,
             ``E`` (3x3, columns t1, t2, n), ``Edot``, ``r`` (p - c), ``rdot``, ``udot``, ``a`` (axle),
             ``phi`` (holonomic residual [m]), and the frame Jacobian ``J`` and ``dJ``.
+
+        Raises:
+            ConstraintError: The axle is parallel to the ground normal, the contact point does not converge on a
+                curved terrain, or an adaptable radius is not positive.
         """
         c, a, R, n, u, p, nw, phi, N, E, nc1 = self._geometry(kin)
         _, jac, djac = kin.frame(self.fid)
@@ -185,6 +193,16 @@ class RollingWheel(Constraint):
         return [f"{self.name}.{s}" for s in self._row_names]
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        """The wheel's rows :math:`D E^T A_w` (in its contact frame t1, t2, n) and the normal row's residual,
+        without :math:`\\dot A`.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`~robotdyn.constraints.constraint.ConstraintRows`.
+        """
         Aw, geo = self._world_jacobian(kin)
         D = self._directions
         holonomic = D[:, 2] != 0
@@ -192,7 +210,15 @@ class RollingWheel(Constraint):
 
     def drift(self, kin: KinematicState) -> np.ndarray:
         """:math:`\\dot A v = D(\\dot E^T s + E^T(a_c^0 + \\dot\\omega^0 \\times r + \\omega \\times \\dot r
-        - \\dot u \\dot R))` with :math:`s = A_w v` the velocity of the wheel's material point at the contact."""
+        - \\dot u \\dot R))` with :math:`s = A_w v` the velocity of the wheel's material point at the contact.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            One value per row [m/s^2].
+        """
         g = self.contact(kin)
         Aw, _ = self._world_jacobian(kin)
         jac, djac, v = g["J"], g["dJ"], kin.v
@@ -203,6 +229,16 @@ class RollingWheel(Constraint):
         return self._directions @ (g["Edot"].T @ s + g["E"].T @ acc)
 
     def rows(self, kin: KinematicState) -> ConstraintRows:
+        """The wheel's rows with their time derivative: longitudinal, lateral and normal for a standard wheel
+        (fewer for the subclasses), labelled ``<name>.<row>``.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (placements, Jacobians and
+                their time variation of the robot's model).
+
+        Returns:
+            The :class:`~robotdyn.constraints.constraint.ConstraintRows`.
+        """
         g = self.contact(kin)
         jac, djac = g["J"], g["dJ"]
         Aw, _ = self._world_jacobian(kin)
@@ -222,11 +258,13 @@ class RollingWheel(Constraint):
 class OmniWheel(RollingWheel):
     """An omni/Swedish wheel: rolls without slipping along its rollers' axis only, and touches the ground.
 
-    Takes the arguments of :class:`RollingWheel` and:
-
     Args:
+        description: The robot's :class:`~robotdyn.description.urdf.Description`.
+        frame: Frame (link) whose origin is the wheel centre.
+        radius: Wheel radius R [m] (> 0).
         roller_angle: Angle [rad] of the constrained direction from the rolling direction t1 towards t2
             (0: a 90-degree omni wheel, lateral motion free; pi/4: a 45-degree mecanum wheel).
+        **kwargs: ``axis``, ``terrain``, ``radius_joint``, ``name`` as for :class:`RollingWheel`.
     """
 
     _row_names = ("driving", "normal")

@@ -6,7 +6,7 @@ With the constraint rows :math:`A(q)v = 0` (m rows, rank r) the full equations o
 
 so once :math:`\\dot\\nu` is known (forward dynamics from motor torques) or given (inverse dynamics), the residual
 :math:`e = M a + h - B\\tau = \\mathrm{RNEA}(q, v, a) - B\\tau` lies in the range of :math:`A^T` and
-:math:`A^T\\lambda = e` gives the constraint forces (``shared/notes/contact-forces-and-friction.md``).
+:math:`A^T\\lambda = e` gives the constraint forces (the concepts page ``docs/concepts.md``).
 
 Units and frames. Each row's multiplier is the force along that row:
 
@@ -161,7 +161,14 @@ class ConstraintForces:
         return cone_minimum(maps, fn, self.null_space.shape[1])
 
     def wheel(self, name: str) -> WheelForce:
-        """The force on the wheel called ``name``."""
+        """The force on the wheel called ``name``.
+
+        Args:
+            name: The wheel's name (its ``name``, else its frame).
+
+        Returns:
+            Its :class:`WheelForce`.
+        """
         for w in self.wheels:
             if w.name == name:
                 return w
@@ -276,6 +283,14 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
 
     Returns:
         The :class:`ConstraintForces`.
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.contact.contact_forces import constraint_forces
+        >>> robot = robotdyn.load("quasimoro")
+        >>> forces = constraint_forces(robot, robot.neutral(), [0.0, 0.0, 0.0], tau=[0.0, 0.0])
+        >>> round(sum(w.normal for w in forces.wheels), 2)  # the weight (2 m + M) g [N]
+        58.86
     """
     q = robot.check_q(q)
     nu = robot.check_nu(nu, "v")
@@ -370,6 +385,9 @@ TWIN_RESIDUAL = 1e-8
 
 def floating_twin(robot) -> tuple:
     """A planar-root robot's floating twin and where its coordinates go in the twin's.
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` with a planar root.
 
     Returns:
         ``(twin, index)``: the same description on a floating root (x, y, z, yaw, pitch, roll), built once per

@@ -27,11 +27,28 @@ class FrictionLaw:
     name = "law"
 
     def coefficient(self, s: np.ndarray) -> np.ndarray:
-        """:math:`c(s)` (2,) for the slip velocity s (2,) [m/s]."""
+        """:math:`c(s)` (2,) for the slip velocity s (2,) [m/s].
+
+        Args:
+            s: The slip velocity (2,) [m/s] of the wheel's material point at the contact, in (t1, t2) of its contact
+                frame.
+
+        Returns:
+            c(s) (2,) [-]: the friction force is -f_n c(s).
+        """
         raise NotImplementedError
 
     def force(self, s: np.ndarray, normal: float) -> np.ndarray:
-        """Tangential force on the wheel :math:`F_t = -f_n c(s)` (2,) [N]."""
+        """Tangential force on the wheel :math:`F_t = -f_n c(s)` (2,) [N].
+
+        Args:
+            s: The slip velocity (2,) [m/s] of the wheel's material point at the contact, in (t1, t2) of its contact
+                frame.
+            normal: The normal load f_n [N] (>= 0).
+
+        Returns:
+            The tangential force (2,) [N] in (t1, t2).
+        """
         return -float(normal) * self.coefficient(np.asarray(s, float))
 
     def encode(self) -> tuple[int, float, float] | None:
@@ -141,6 +158,9 @@ def make_law(name: str, mu: float | None = None, slip_velocity: float | None = N
             ``mu`` saturates it, default none) or ``stick_slip`` (needs ``mu``: exact switching,
             :mod:`robotdyn.simulation.stick_slip`).
         wheel: The wheel's name, for messages.
+        mu: Friction coefficient (>= 0; default ``None``: not given).
+        slip_velocity: The coulomb law's regularisation velocity [m/s] (> 0; default ``None``: 1e-3).
+        stiffness: The linear law's slip stiffness [s/m] (> 0; default ``None``).
     """
     try:
         if name == "stick_slip":

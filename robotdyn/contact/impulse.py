@@ -65,7 +65,15 @@ def _check(M, n, e: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def effective_mass(M, n) -> float:
-    """:math:`1/(n^T M^{-1} n)` for the unit direction :math:`n/\\|n\\|` [kg for a force direction]."""
+    """:math:`1/(n^T M^{-1} n)` for the unit direction :math:`n/\\|n\\|` [kg for a force direction].
+
+    Args:
+        M: Reduced inertia (k, k), symmetric positive definite.
+        n: A direction of generalised force (k,) (normalised here).
+
+    Returns:
+        The effective mass [kg for a force direction in m/s velocities].
+    """
     M, n = _check(M, n, 0.0)
     return float(1.0 / (n @ np.linalg.solve(M, n)))
 
@@ -103,6 +111,13 @@ def impulse_curve(M, e: float, speed: float = 1.0, plane: tuple[int, int] = (0, 
     For each angle a, the motion is ``speed * d`` with d = cos(a) e_i + sin(a) e_j (i, j = ``plane``) and the
     wall normal is n = -d. The curve :math:`a \\mapsto |F(a)|\\,d` is what Chung, Yi, Kim, Han call the impulse ellipse
     (Figs. 16-19); it is a circle when the plane block of M^{-1} is isotropic.
+
+    Args:
+        M: Reduced inertia (k, k), symmetric positive definite.
+        e: Coefficient of restitution, 0 (plastic) to 1 (elastic).
+        speed: Approach speed [m/s] (> 0) in every direction.
+        plane: The two velocity components (indices into nu) spanning the plane of directions.
+        samples: Number of angles over [0, 2 pi].
 
     Returns:
         (angles [rad] (samples,), magnitudes [N s] (samples,)).

@@ -6,7 +6,7 @@ are replaced by the force of its :class:`~robotdyn.contact.friction.FrictionLaw`
 :math:`s = J_t v`) and :math:`F_t = -f_n c(s)`. The normal load :math:`f_n` is a constraint force, so it depends on
 the accelerations; with the friction direction fixed by the current slip, the system in
 :math:`(\\dot\\nu, \\lambda)` stays linear and is solved exactly at each evaluation (no lagged load,
-``shared/notes/contact-forces-and-friction.md``):
+the concepts page ``docs/concepts.md``):
 
 .. math:: M S\\dot\\nu - \\Big(A_R^T - \\sum_i J_{t,i}^T c_i e_{n_i}^T\\Big)\\lambda = B\\tau - \\mathrm{RNEA}(q, v, w),
 
@@ -51,6 +51,9 @@ class SlippingWheel(SupportWheel):
         law: The :class:`~robotdyn.contact.friction.FrictionLaw` of its tangential force.
         slip: ``both`` (default) or ``lateral`` (:data:`SLIP_DIRECTIONS`).
         **kwargs: The other arguments of :class:`~robotdyn.constraints.rolling_contact.RollingWheel`.
+        description: The robot's :class:`~robotdyn.description.urdf.Description`.
+        frame: Frame (link) whose origin is the wheel centre.
+        radius: Wheel radius R [m] (> 0).
     """
 
     sliding = True  # its friction force comes from a law (robotdyn.contact.sliding.forward)
@@ -69,7 +72,15 @@ class SlippingWheel(SupportWheel):
 
     def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
         """:math:`c(s)` of its law on the free directions: the friction force is :math:`-f_n c(s)` (t1, t2), zero
-        along a direction that rolls without slipping."""
+        along a direction that rolls without slipping.
+
+        Args:
+            s: The slip velocity (2,) [m/s] of the wheel's material point at the contact, in (t1, t2) of its contact
+                frame.
+
+        Returns:
+            c(s) (2,) [-].
+        """
         return self.law.coefficient(s * self._free) * self._free
 
     def __repr__(self) -> str:
@@ -78,7 +89,11 @@ class SlippingWheel(SupportWheel):
                 f"terrain={self.terrain!r})")
 
     def slip(self, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
-        """The tangential rows :math:`J_t` (2, nv) and the slip velocity (2,) [m/s]: :func:`tangential`."""
+        """The tangential rows :math:`J_t` (2, nv) and the slip velocity (2,) [m/s]: :func:`tangential`.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+        """
         return tangential(self, kin)
 
     def compiled_friction(self) -> tuple[tuple, np.ndarray] | str:
@@ -98,7 +113,12 @@ class SlippingWheel(SupportWheel):
 def tangential(wheel, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
     """A wheel's tangential rows :math:`J_t` (2, nv) (t1 longitudinal, t2 lateral of the contact frame) and its slip
     velocity :math:`s = J_t v` (2,) [m/s] at the state of ``kin`` (the velocity of its material point at the
-    contact, in the tangent plane)."""
+    contact, in the tangent plane).
+
+    Args:
+        wheel: A rolling-contact wheel (:class:`~robotdyn.constraints.rolling_contact.RollingWheel` or a subclass).
+        kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+    """
     Aw, geo = wheel._world_jacobian(kin)
     Jt = geo[9][:, :2].T @ Aw
     return Jt, Jt @ kin.v
@@ -106,12 +126,26 @@ def tangential(wheel, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
 
 def sliding_now(robot) -> list:
     """The robot's wheels whose tangential force currently comes from friction (slipping wheels, and stick-slip
-    wheels in their sliding phase)."""
+    wheels in their sliding phase).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The wheels (constraint objects) whose tangential force is friction now.
+    """
     return [c for c in robot.constraints if getattr(c, "sliding", False)]
 
 
 def slipping_wheels(robot) -> list[SlippingWheel]:
-    """The robot's slipping wheels (empty: every wheel rolls without slipping)."""
+    """The robot's slipping wheels (empty: every wheel rolls without slipping).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The :class:`SlippingWheel` constraints of the robot.
+    """
     return [c for c in robot.constraints if isinstance(c, SlippingWheel)]
 
 
@@ -138,6 +172,15 @@ class SlidingState:
 
 def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingState:
     """Accelerations and normal loads with the slipping wheels' friction, solved together (see the module).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+        tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+
+    Returns:
+        The :class:`SlidingState` (``nudot`` (k,), the slipping wheels' normal loads [N] and friction forces [N]).
 
     Raises:
         ConstraintError: a slipping wheel's normal row is redundant (its load is not determined).
@@ -177,7 +220,12 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
 
 def painleve_error(wheels, cond: float) -> SingularConstraintError:
     """The error of a singular contact problem of slipping ``wheels`` (condition number ``cond`` of the coupled
-    system), the same on every engine."""
+    system), the same on every engine.
+
+    Args:
+        wheels: The slipping wheels.
+        cond: Condition number of the coupled system.
+    """
     return SingularConstraintError(
         f"the friction of slipping wheels {', '.join(w.name for w in wheels)} makes the contact problem "
         f"singular (condition {cond:.3g}; Painleve paradox: the accelerations and loads have no or many "
@@ -185,14 +233,26 @@ def painleve_error(wheels, cond: float) -> SingularConstraintError:
 
 
 def redundant_load_error(wheel) -> ConstraintError:
-    """The error of a slipping wheel whose normal row is redundant (its load is not determined)."""
+    """The error of a slipping wheel whose normal row is redundant (its load is not determined).
+
+    Args:
+        wheel: The slipping wheel.
+    """
     return ConstraintError(f"slipping wheel {wheel.name!r}: its normal row is redundant here, so its load "
                            "(and its friction) is not determined by rigid-body dynamics")
 
 
 def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> str:
     """``stats["event"]`` of a run stopped where a slipping wheel's normal load reached zero at time t [s] and
-    state (q, nu), with torques tau there (the same on every engine)."""
+    state (q, nu), with torques tau there (the same on every engine).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        t: Time of the lift-off [s].
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+        tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+    """
     wheels = sliding_now(robot)
     st = forward(robot, q, nu, tau)
     wheel = wheels[int(np.argmin(st.normal))].name

@@ -45,7 +45,15 @@ class ContactForces:
 
 
 def equilibrium_matrix(points: np.ndarray, origin: np.ndarray) -> np.ndarray:
-    """G (6, 3k) with :math:`G\\,[F_1; ...; F_k] = [\\sum F_i; \\sum (p_i - o)\\times F_i]`."""
+    """G (6, 3k) with :math:`G\\,[F_1; ...; F_k] = [\\sum F_i; \\sum (p_i - o)\\times F_i]`.
+
+    Args:
+        points: Contact points p_i (k, 3) [m], world frame.
+        origin: The point o (3,) [m] about which moments are taken.
+
+    Returns:
+        G (6, 3k).
+    """
     k = len(points)
     G = np.zeros((6, 3 * k))
     for i, p in enumerate(points):

@@ -30,6 +30,11 @@ class StickSlipWheel(RollingWheel):
 
     Args:
         mu: Friction coefficient (>= 0), the same for sticking and sliding.
+        description: The robot's :class:`~robotdyn.description.urdf.Description`.
+        frame: Frame (link) whose origin is the wheel centre.
+        radius: Wheel radius R [m] (> 0).
+        **kwargs: ``axis``, ``terrain``, ``radius_joint``, ``name`` as for
+            :class:`~robotdyn.constraints.rolling_contact.RollingWheel`.
     """
 
     def __init__(self, description, frame: str, radius: float, mu: float, **kwargs) -> None:
@@ -41,7 +46,12 @@ class StickSlipWheel(RollingWheel):
         return f"StickSlipWheel(frame={self.frame!r}, radius={self.radius}, mu={self.mu}, phase={self.phase!r})"
 
     def set_phase(self, phase: str, direction: np.ndarray | None = None) -> None:
-        """Switch to ``stick`` or to ``slide`` (with the initial slip direction (2,) in (t1, t2))."""
+        """Switch to ``stick`` or to ``slide`` (with the initial slip direction (2,) in (t1, t2)).
+
+        Args:
+            phase: ``stick`` (rolls: three rows) or ``slide`` (normal row; Coulomb friction opposes the slip).
+            direction: Sliding: the initial slip direction (2,) in (t1, t2), normalised here (default ``None``).
+        """
         self.phase = phase
         self._directions, self._row_names = _STICK if phase == "stick" else _SLIDE
         self.direction = None if direction is None else np.asarray(direction, float) / np.linalg.norm(direction)
@@ -52,7 +62,15 @@ class StickSlipWheel(RollingWheel):
         return self.phase == "slide"
 
     def friction_coefficient(self, s: np.ndarray) -> np.ndarray:
-        """Coulomb's :math:`\\mu\\hat s` (the friction force is :math:`-f_n\\mu\\hat s`)."""
+        """Coulomb's :math:`\\mu\\hat s` (the friction force is :math:`-f_n\\mu\\hat s`).
+
+        Args:
+            s: The slip velocity (2,) [m/s] of the wheel's material point at the contact, in (t1, t2) of its contact
+                frame.
+
+        Returns:
+            mu times the unit slip direction (2,) (the initial direction below the zero-slip threshold).
+        """
         speed = float(np.hypot(s[0], s[1]))
         return self.mu * (s / speed if speed > SLIP_ZERO else self.direction)
 
@@ -61,5 +79,12 @@ class StickSlipWheel(RollingWheel):
 
 
 def stick_slip_wheels(robot) -> list[StickSlipWheel]:
-    """The robot's stick-slip wheels (a robot with any is simulated by the exact switching engine only)."""
+    """The robot's stick-slip wheels (a robot with any is simulated by the exact switching engine only).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The :class:`StickSlipWheel` constraints of the robot.
+    """
     return [c for c in robot.constraints if isinstance(c, StickSlipWheel)]

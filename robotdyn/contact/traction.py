@@ -156,6 +156,19 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
 
     Returns:
         The :class:`Traction` (``method`` says which pass computed it: ``fast`` or ``reference``).
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.contact.traction import traction
+        >>> from robotdyn.robots.quasimoro import model
+        >>> robot = robotdyn.load("quasimoro")
+        >>> scenario = model.SCENARIOS["rectilinear"]
+        >>> traj = scenario.run(robot, t_end=1.0, progress=False)
+        >>> tr = traction(robot, traj, scenario.torque)
+        >>> tr.wheels, round(float(tr.normal.min()), 2)  # (2 m + M) g / 2 on each wheel [N]
+        (['wheel_A', 'wheel_B'], 29.43)
+        >>> round(float(tr.minimum_mu.max()), 4)  # the friction the manoeuvre needs
+        0.0103
     """
     if method not in METHODS:
         raise InputError(f"method = {method!r}; expected one of {', '.join(METHODS)}")

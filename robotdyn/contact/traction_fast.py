@@ -80,7 +80,11 @@ class WheelLoads:
 def sample_loads(forces) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]:
     """One sample's ``(names, normal [N], tangential [N], determined (W, 3))`` from a
     :class:`~robotdyn.contact.contact_forces.ConstraintForces` (the reference's values, as
-    :attr:`~robotdyn.contact.contact_forces.WheelForce.normal` and ``.tangential``)."""
+    :attr:`~robotdyn.contact.contact_forces.WheelForce.normal` and ``.tangential``).
+
+    Args:
+        forces: One sample's :class:`~robotdyn.contact.contact_forces.ConstraintForces`.
+    """
     wheels = forces.wheels
     return ([w.name for w in wheels], np.array([w.normal for w in wheels], float),
             np.array([w.tangential for w in wheels], float),
@@ -91,7 +95,15 @@ def torques(torque, t: np.ndarray, Q: np.ndarray, NU: np.ndarray, motors: int) -
     """The motor torques of every sample [N m or N]: zeros without ``torque``, a torque profile's vectorised
     ``at(times)`` (:class:`robotdyn.simulation.torque_profile.TorqueProfile`: the same formulas, q and nu
     ignored), else ``torque(t, q, nu)`` sample by sample (a list of what it returned: checked by
-    :func:`_checked_torques`)."""
+    :func:`_checked_torques`).
+
+    Args:
+        torque: ``None``, a torque profile, or a callable ``tau(t, q, nu)``.
+        t: Sample times (N,) [s].
+        Q: Coordinates (N, n) [m, rad].
+        NU: Independent velocities (N, k).
+        motors: The robot's number of motors.
+    """
     if torque is None:
         return np.zeros((len(t), motors))
     kind = type(torque)

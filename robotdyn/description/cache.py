@@ -41,7 +41,11 @@ def cache_dir() -> Path | None:
 
 def package_stamp(name: str) -> str:
     """A cheap stamp of an installed Python package (path, size and mtime of its ``__init__``), without importing
-    it or ``importlib.metadata`` (which alone costs ~50 ms)."""
+    it or ``importlib.metadata`` (which alone costs ~50 ms).
+
+    Args:
+        name: The package's import name.
+    """
     from importlib.util import find_spec
 
     spec = find_spec(name)
@@ -68,7 +72,13 @@ def _entry(path: Path, mappings: dict[str, str], index) -> Path | None:
 
 def lookup(path: Path, mappings: dict[str, str], index) -> str | None:
     """The cached URDF text of an expansion, or None (no entry, or a file it read has changed). Restores the
-    packages the expansion used into ``index.used``."""
+    packages the expansion used into ``index.used``.
+
+    Args:
+        path: The description file expanded.
+        mappings: The xacro arguments (name -> value text) of the expansion.
+        index: The :class:`~robotdyn.description.ros_packages.PackageIndex` that answered ``$(find)``.
+    """
     entry = _entry(path, mappings, index)
     if entry is None:
         return None
@@ -84,7 +94,15 @@ def lookup(path: Path, mappings: dict[str, str], index) -> str | None:
 
 
 def store(path: Path, mappings: dict[str, str], index, files: list[str], urdf: str) -> None:
-    """Remember an expansion (``files``: every file xacro read, the description first)."""
+    """Remember an expansion (``files``: every file xacro read, the description first).
+
+    Args:
+        path: The description file expanded.
+        mappings: The xacro arguments (name -> value text) of the expansion.
+        index: The :class:`~robotdyn.description.ros_packages.PackageIndex` that answered ``$(find)``.
+        files: Every file xacro read, the description first.
+        urdf: The expanded URDF text.
+    """
     entry = _entry(path, mappings, index)
     if entry is None:
         return

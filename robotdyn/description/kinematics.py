@@ -22,6 +22,9 @@ ROTATION_TOL = 1e-9
 def rotation_defects(R) -> tuple[float, float]:
     """How far a 3x3 matrix is from a rotation.
 
+    Args:
+        R: A 3x3 matrix.
+
     Returns:
         ``(orthonormality, determinant)``: ``max|R^T R - I|`` and ``det R - 1``.
     """
@@ -32,13 +35,29 @@ def rotation_defects(R) -> tuple[float, float]:
 
 
 def is_rotation(R, tol: float = ROTATION_TOL) -> bool:
-    """True if R is orthonormal with determinant +1 within ``tol``."""
+    """True if R is orthonormal with determinant +1 within ``tol``.
+
+    Args:
+        R: A 3x3 matrix.
+        tol: Tolerance on both defects (:func:`rotation_defects`).
+
+    Returns:
+        Whether R is a proper rotation within ``tol``.
+    """
     ortho, det = rotation_defects(R)
     return ortho <= tol and abs(det) <= tol
 
 
 def check_pose(T, tol: float = ROTATION_TOL, what: str = "pose") -> np.ndarray:
     """Validate a 4x4 homogeneous transform (finite, last row 0 0 0 1, proper rotation); return it as an array.
+
+    Args:
+        T: A 4x4 homogeneous transform (rotation, translation [m]).
+        tol: Tolerance on the rotation's defects.
+        what: What the pose is, for messages.
+
+    Returns:
+        T as a float array (4, 4).
 
     Raises:
         RobotDynError: naming the defect.
@@ -56,7 +75,11 @@ def check_pose(T, tol: float = ROTATION_TOL, what: str = "pose") -> np.ndarray:
 
 
 def frame_names(robot) -> list[str]:
-    """Names of the robot's link frames (the frames ``frame_pose`` accepts), in model order."""
+    """Names of the robot's link frames (the frames ``frame_pose`` accepts), in model order.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+    """
     return [f.name for f in robot.model.frames if f.type == pin.FrameType.BODY]
 
 
@@ -81,7 +104,17 @@ def frame_pose(robot, q, frame: str) -> np.ndarray:
 
 
 def relative_pose(robot, q, frame: str, base: str) -> np.ndarray:
-    """Pose of ``frame`` in the axes and origin of ``base`` (4x4): ``T_base^-1 T_frame``."""
+    """Pose of ``frame`` in the axes and origin of ``base`` (4x4): ``T_base^-1 T_frame``.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        frame: The frame (link) whose pose is wanted.
+        base: The frame (link) it is expressed in.
+
+    Returns:
+        The 4x4 pose T_base^-1 T_frame.
+    """
     Tb = frame_pose(robot, q, base)
     Tf = frame_pose(robot, q, frame)
     out = np.linalg.solve(Tb, Tf)
@@ -173,7 +206,12 @@ def position_ik(
 
 
 def pose_text(T: np.ndarray, title: str) -> str:
-    """A 4x4 pose as text (10 significant digits)."""
+    """A 4x4 pose as text (10 significant digits).
+
+    Args:
+        T: A 4x4 pose.
+        title: The first line.
+    """
     return title + "\n" + "\n".join("  " + " ".join(f"{x: .10g}".rjust(18) for x in row) for row in T)
 
 

@@ -70,7 +70,11 @@ directory is refused in one line rather than crawled for minutes."""
 def package_name(directory: Path) -> str | None:
     """The ``<name>`` in ``directory/package.xml``, or None (no file, not a regular file of at most
     :data:`MAX_MANIFEST_BYTES`, or not a package manifest). A FIFO or a device named ``package.xml`` is never
-    opened (reading it would block or never end)."""
+    opened (reading it would block or never end).
+
+    Args:
+        directory: A directory that may hold a ``package.xml``.
+    """
     manifest = directory / "package.xml"
     try:
         st = os.stat(manifest)
@@ -92,6 +96,13 @@ def crawl(root: Path, depth: int = MAX_DEPTH) -> dict[str, Path]:
     The walk is bounded and loop-safe: each directory is visited once (by device and inode, so symbolic links
     back up the tree or to itself are not followed again), at most ``depth`` levels down and at most
     :data:`MAX_CRAWL_DIRECTORIES` directories in all.
+
+    Args:
+        root: The directory crawled.
+        depth: Largest depth of subdirectories searched.
+
+    Returns:
+        Package directory by name.
 
     Raises:
         DescriptionError: More than :data:`MAX_CRAWL_DIRECTORIES` directories below ``root``.
@@ -165,6 +176,11 @@ class PackageIndex:
         """An index of explicit ``packages`` (name -> directory), search directories ``dirs``, and (with
         ``environment``) ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH`` and pip-installed robot data.
 
+        Args:
+            packages: Explicit packages, name -> directory (default ``None``: none).
+            dirs: Directories searched for packages (crawled for ``package.xml``).
+            environment: Also search ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH`` and pip-installed robot data.
+
         Raises:
             DescriptionError: An explicit package directory that does not exist.
         """
@@ -190,7 +206,11 @@ class PackageIndex:
                 f"prefixes={[str(d) for d in self.prefixes]})")
 
     def find(self, name: str) -> Path | None:
-        """The directory of package ``name`` (resolved), or None."""
+        """The directory of package ``name`` (resolved), or None.
+
+        Args:
+            name: The package's name.
+        """
         path = self._lookup(name)
         if path is not None:
             self.used[name] = path
@@ -216,7 +236,11 @@ class PackageIndex:
         return None
 
     def resolve_uri(self, uri: str) -> tuple[Path | None, str | None]:
-        """The file a ``package://NAME/rest`` URI names, and the missing package's name if NAME was not found."""
+        """The file a ``package://NAME/rest`` URI names, and the missing package's name if NAME was not found.
+
+        Args:
+            uri: A ``package://NAME/rest`` URI.
+        """
         rest = uri[len("package://"):]
         name, _, tail = rest.partition("/")
         root = self.find(name)
@@ -230,7 +254,11 @@ class PackageIndex:
 
 
 def missing_name(path: str) -> str | None:
-    """The package name if ``path`` came from ``$(find NAME)`` of a package that was not found."""
+    """The package name if ``path`` came from ``$(find NAME)`` of a package that was not found.
+
+    Args:
+        path: A path produced by ``$(find NAME)``.
+    """
     match = re.match(re.escape(MISSING_ROOT) + r"/([^/]+)", str(path))
     return match.group(1) if match else None
 
@@ -243,6 +271,9 @@ def xacro_find(index: PackageIndex):
     attributes and text, and bound as ``find`` for ``$(eval ...)``). Both are replaced for the duration (under
     :data:`XACRO_LOCK`) by the index's lookup; a package not found expands to ``MISSING_ROOT/NAME`` and its name is
     appended to the yielded list.
+
+    Args:
+        index: The :class:`PackageIndex` that answers ``$(find NAME)``.
     """
     import xacro.substitution_args as sa
 
@@ -279,6 +310,11 @@ def required_packages(path: Path, index: PackageIndex, limit: int = 200) -> set[
 
     A static scan: expansion stops at the first include it cannot read, and this finds the packages that later
     includes would need, so that all of them can be named at once.
+
+    Args:
+        path: The Xacro file scanned.
+        index: The :class:`PackageIndex` resolving the includes that can be followed.
+        limit: Largest number of files scanned.
     """
     seen: set[Path] = set()
     names: set[str] = set()

@@ -27,7 +27,10 @@ import pinocchio as pin
 from ..errors import DescriptionError, InputError, RobotDynError
 
 URDF_DIR = Path(__file__).resolve().parents[2] / "urdf"
-"""Directory of the Xacro descriptions shipped with robotdyn."""
+"""Directory of the Xacro descriptions shipped with robotdyn (``urdf/`` of the repository).
+
+:meta hide-value:
+"""
 
 ROOT_KINDS = ("fixed", "planar", "floating")
 _UNBOUNDED = 1.0e9
@@ -201,6 +204,9 @@ def validate_urdf(urdf: str) -> None:
 
     A text that passed once (same SHA-256, same yourdfpy version) is not checked again: the cache file of
     :func:`_validated_cache` remembers it (importing yourdfpy alone costs about 0.15 s of every command).
+
+    Args:
+        urdf: The URDF XML text.
 
     Raises:
         DescriptionError: naming the first problem found.
@@ -428,6 +434,9 @@ class Description:
         root: ``"fixed"``, ``"planar"`` or ``"floating"``.
         joint_names: Joint name of each coordinate, in ``q`` order.
         lower, upper: Joint limits of each coordinate (``±inf`` when unbounded).
+        visual_report: The :class:`~robotdyn.description.visual_geometry.VisualReport` of its meshes (``None``: not
+            built).
+        root_height: Height [m] of the root chain above the world origin (:meth:`set_root_height`).
     """
 
     model: pin.Model
@@ -447,7 +456,11 @@ class Description:
         """Raise the root chain by ``height`` [m]: the first root joint's placement gets the translation
         (0, 0, height), so that a planar root moves its link in the plane z = height (a base whose link sits above
         the ground, as most ROS descriptions' ``base_link`` does) and a floating root's z is measured from there.
-        The stored URDF text says the same (an ``<origin>`` on that joint)."""
+        The stored URDF text says the same (an ``<origin>`` on that joint).
+
+        Args:
+            height: Height [m] of the root chain above the world origin.
+        """
         height = float(height)
         if not np.isfinite(height):
             raise DescriptionError(f"root height {height}; expected a finite height in m")
@@ -470,13 +483,33 @@ class Description:
         self.root_height = height
 
     def q_index(self, joint: str) -> int:
-        """Index in ``q`` (and ``v``) of a one-degree-of-freedom joint."""
+        """Index in ``q`` (and ``v``) of a one-degree-of-freedom joint.
+
+        Args:
+            joint: The joint's name.
+
+        Returns:
+            The index.
+
+        Raises:
+            DescriptionError: No such joint.
+        """
         if not self.model.existJointName(joint):
             raise DescriptionError(f"no joint named {joint!r}; joints are {', '.join(self.joint_names)}")
         return int(self.model.joints[self.model.getJointId(joint)].idx_q)
 
     def frame_id(self, frame: str) -> int:
-        """Pinocchio frame index of a link or joint frame, with a clear error for a typo."""
+        """Pinocchio frame index of a link or joint frame, with a clear error for a typo.
+
+        Args:
+            frame: A link or joint name.
+
+        Returns:
+            The frame id.
+
+        Raises:
+            DescriptionError: No such frame (the message lists the links).
+        """
         if not self.model.existFrame(frame):
             links = sorted({f.name for f in self.model.frames if f.type == pin.FrameType.BODY})
             raise DescriptionError(f"no frame named {frame!r}; links are {', '.join(links)}")
@@ -484,7 +517,12 @@ class Description:
 
 
 def drop_inertials(urdf: str, links) -> str:
-    """Remove the ``<inertial>`` of the named links (they become massless); unknown link names are an error."""
+    """Remove the ``<inertial>`` of the named links (they become massless); unknown link names are an error.
+
+    Args:
+        urdf: The URDF XML text.
+        links: Names of the links made massless.
+    """
     links = list(links or [])
     if not links:
         return urdf
@@ -505,6 +543,11 @@ def lock_joints(model: pin.Model, visual: pin.GeometryModel, locked: dict[str, f
     """Replace the named one-DOF joints by fixed ones at the given values (m or rad), merging the inertias.
 
     Uses ``pin.buildReducedModel``; the remaining joints keep their natural coordinates.
+
+    Args:
+        model: The Pinocchio model.
+        visual: Its visual geometry model.
+        locked: Joint name -> value [m or rad] at which it is held.
     """
     ids, q_ref = [], np.zeros(model.nq)
     for name, value in locked.items():

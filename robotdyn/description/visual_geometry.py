@@ -48,6 +48,7 @@ class VisualReport:
         standins: Link -> what stands in for its visual (``"collision"``, ``"inertia box"``, ``"marker"``).
         missing_packages: Packages named by meshes that were not found.
         roots: The trees meshes may be read from.
+        no_visuals: The description has no visual at all (each link is drawn as its inertia box).
     """
 
     missing: list[tuple[str, str, str]] = field(default_factory=list)
@@ -94,7 +95,11 @@ def _short(ref: str) -> str:
 
 def description_tree(source: Path | None) -> Path | None:
     """The tree a description file belongs to: the nearest directory above it holding a ``package.xml``, else its
-    own directory (None without a file)."""
+    own directory (None without a file).
+
+    Args:
+        source: The description file (``None``: none).
+    """
     if source is None:
         return None
     source = Path(source).resolve()
@@ -241,7 +246,12 @@ def _floats(text: str | None, n: int) -> np.ndarray:
 def inertia_box(mass: float, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """Sides [m] and principal axes (columns, a rotation) of the uniform box with ``mass`` [kg] and central
     ``inertia`` [kg m^2] (3x3): :math:`I_i = m(a_j^2 + a_k^2)/12`, so :math:`a_i^2 = 6(\\operatorname{tr}I - 2I_i)/m`;
-    None for a massless or non-physical inertia."""
+    None for a massless or non-physical inertia.
+
+    Args:
+        mass: Mass [kg].
+        inertia: Central inertia tensor (3, 3) [kg m^2].
+    """
     if not (np.isfinite(mass) and mass > 0) or not np.all(np.isfinite(inertia)):
         return None
     eig, axes = np.linalg.eigh(0.5 * (inertia + inertia.T))
@@ -282,7 +292,15 @@ def _inertia_box(link: ET.Element) -> ET.Element | None:
 def build_visual(model: pin.Model, urdf: str, index: PackageIndex, source: Path | None = None,
                  allowed=()) -> tuple[pin.GeometryModel, VisualReport]:
     """Pinocchio's visual geometry of ``urdf`` (already naturalised, for ``model``), never empty of the robot:
-    missing, unloadable and refused meshes are replaced (see the module docstring) and reported."""
+    missing, unloadable and refused meshes are replaced (see the module docstring) and reported.
+
+    Args:
+        model: The Pinocchio model built from ``urdf``.
+        urdf: The (naturalised) URDF XML text.
+        index: The :class:`~robotdyn.description.ros_packages.PackageIndex` resolving ``package://`` meshes.
+        source: The description file, whose tree meshes may be read from (default ``None``).
+        allowed: More directories meshes may be read from.
+    """
     text, report = prepare_visuals(urdf, index, source, allowed)
     loader = _mesh_loader()
     try:

@@ -27,9 +27,12 @@ the Python path on every robot.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from ..constraints.constraint import ConstraintRows, KinematicState
+from ..errors import RobotDynError
 from ..constraints.joint_coupling import CosineLaw, JointCoupling
 from ..constraints.loop_closure import LoopClosure
 from ..reduction.operational_space import OperationalProjection
@@ -85,7 +88,11 @@ def _compiled_formulas(constraint, base: type) -> bool:
 
 
 def why_not(robot) -> str | None:
-    """Why ``robot`` cannot use the compiled path (``None``: it can)."""
+    """Why ``robot`` cannot use the compiled path (``None``: it can).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+    """
     if _compiled is None:
         return "the compiled extension robotdyn._compiled was not built"
     for i in range(1, robot.model.njoints):
@@ -148,8 +155,18 @@ def _placement(M) -> np.ndarray:
     return np.hstack([M.rotation, M.translation[:, None]])
 
 
+class ThreadError(RobotDynError):
+    """A :class:`CompiledModel` used from a thread other than the one that built it."""
+
+
 class CompiledModel:
     """A robot's reduced model as one C++ object (build with :func:`compiled_model`).
+
+    A compiled model belongs to the thread that built it: its evaluations write into the evaluator's own buffers and
+    :meth:`compute` and :meth:`forces` return views of them, which a call from another thread would overwrite while
+    the first still reads them (a lock could not protect views that outlive the call). Every evaluation from
+    another thread therefore raises :class:`ThreadError` in one line; each thread gets its own model from
+    :func:`robotdyn.fast.dispatch.compiled_model`.
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` for which :func:`why_not` is ``None``.
@@ -161,6 +178,7 @@ class CompiledModel:
     def __init__(self, robot) -> None:
         model = robot.model
         self.robot = robot
+        self.owner = threading.get_ident()  # the thread that may evaluate it (see the class docstring)
         self.constraints = list(robot.constraints)
         kinds, parents, placements, axes, inertias = [], [], [], [], []
         for i in range(1, model.njoints):
@@ -232,6 +250,13 @@ class CompiledModel:
     def __repr__(self) -> str:
         return f"CompiledModel({self.robot.spec.name!r}, nv={self.ev.nv}, rows={self.ev.nrows})"
 
+    def _mine(self) -> None:
+        """Refuse a call from a thread that does not own the model (:class:`ThreadError`)."""
+        if threading.get_ident() != self.owner:
+            raise ThreadError(f"compiled model of {self.robot.spec.name} used from a thread that did not build it "
+                              "(its buffers are the building thread's); expected one model per thread: call "
+                              "robotdyn.fast.dispatch.compiled_model(robot) in each thread")
+
     def _check_model(self) -> None:
         """The rebuilt model must give Pinocchio's M, g and RNEA of the robot's model at a random state."""
         import pinocchio as pin
@@ -261,7 +286,13 @@ class CompiledModel:
         self.select(checked(reference(self.robot, q, nu), q, nu).projection)
 
     def select(self, proj) -> None:
-        """Use the row choice (and independent velocities) of a Python projection from now on."""
+        """Use the row choice (and independent velocities) of a Python projection from now on.
+
+        Args:
+            proj: A projection of the Python path (:class:`~robotdyn.reduction.projection.Projection` or the
+                operational one).
+        """
+        self._mine()
         if proj is self._hint:
             return
         if self.operational is not None:
@@ -277,9 +308,14 @@ class CompiledModel:
         ``condition`` and ``inverse`` :math:`K^{-1}` for operational velocities, ``None`` otherwise (the exact
         condition number and :math:`A_d^{-1}` then come from :class:`LazyProjection`, on request).
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         return self.ev.evaluate(q, nu)
@@ -288,9 +324,14 @@ class CompiledModel:
         """``(M_r, h, g_r, B_r, S, w, v)`` at (q, nu) without copies: read-only views of the evaluator's buffers,
         overwritten by the next call (copy what must be kept). The cheapest evaluation, e.g. inside an integrator.
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         generation = self._compute(q, nu)
@@ -303,7 +344,14 @@ class CompiledModel:
     def reduced(self, q: np.ndarray, nu: np.ndarray, independent: np.ndarray | None = None):
         """The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu), or ``None`` where the Python path
         must decide (then call :meth:`select` with its projection): no projection chosen yet, other
-        ``independent`` velocity indices than the chosen ones, or a :meth:`evaluate` fallback."""
+        ``independent`` velocity indices than the chosen ones, or a :meth:`evaluate` fallback.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+            independent: Indices of the independent velocities in v (default ``None``: the chosen ones).
+        """
+        self._mine()
         hint = self._hint
         if hint is None or (independent is not None and independent is not getattr(hint, "independent", None)
                             and not np.array_equal(independent, hint.independent)):
@@ -324,9 +372,16 @@ class CompiledModel:
     def rhs(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray, stabilisation: float) -> np.ndarray:
         """:math:`(\\dot q, \\dot\\nu)` of :func:`robotdyn.simulation.engine.simulate`'s ODE in one call.
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+            tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+            stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         return self.ev.rhs(q, nu, tau, stabilisation)
@@ -340,9 +395,15 @@ class CompiledModel:
         redundant rows (the basic solution: equal to any other on the rows rigid-body dynamics determine;
         :mod:`robotdyn.contact.contact_forces` reports the others).
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+            tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, nu)
         generation = self.ev.forces(q, nu, tau)
@@ -358,16 +419,29 @@ class CompiledModel:
         ``(lambda, e, (wheel forces, world forces, frames, points), A)`` as :meth:`forces` (copies), with the
         constraint rows A (rows in :attr:`labels`' order).
 
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            v: Full velocities (n,) [m/s, rad/s].
+            a: Full accelerations (n,) [m/s^2, rad/s^2].
+            tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
+        self._mine()
         if self._hint is None:
             self._choose(q, np.zeros(self.robot.mobility))
         return self.ev.forces_at(q, v, a, tau)
 
     def evaluate_many(self, Q: np.ndarray, NU: np.ndarray) -> tuple:
         """Many states in one call: ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n),
-        B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path."""
+        B_r (N, k, motors), failed)`` with ``failed`` the indices left for the Python path.
+
+        Args:
+            Q: Coordinates (N, n) [m, rad].
+            NU: Independent velocities (N, k).
+        """
+        self._mine()
         N, n = Q.shape
         k = NU.shape[1]
         Q, NU = np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float)
@@ -375,4 +449,4 @@ class CompiledModel:
         return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
 
 
-__all__ = ["Fallback", "CompiledModel", "LazyProjection", "why_not", "available"]
+__all__ = ["Fallback", "CompiledModel", "ThreadError", "LazyProjection", "why_not", "available"]

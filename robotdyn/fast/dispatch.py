@@ -5,43 +5,58 @@ Every evaluation that has a compiled form asks this module: :func:`reduce` (the 
 back to the Python reference of :mod:`robotdyn.reduction` (which also chooses the projection's rows the compiled
 model then uses); the simulation engines, the constraint forces and the many-run/batch evaluators ask
 :func:`compiled_model` for the robot's compiled model (``None``: take the Python path). ``ROBOTDYN_COMPILED=0`` in
-the environment, or :func:`use_compiled` ``(False)`` in a ``with`` block, turns the fast path off everywhere.
+the environment turns the fast path off everywhere; :func:`use_compiled` ``(False)`` in a ``with`` block turns it off
+for the calls made inside that block only: the switch is a :class:`contextvars.ContextVar`, so it belongs to the
+calling thread (or asyncio task), and a block in one thread never changes what another thread evaluates.
 """
 
 from __future__ import annotations
 
 import os
+import threading
 from contextlib import contextmanager
+from contextvars import ContextVar
 
 import numpy as np
 
 from ..reduction.reduced_dynamics import ReducedDynamics, reference
 from .compiled import CompiledModel, available, why_not
 
-_ENABLED = os.environ.get("ROBOTDYN_COMPILED", "1") != "0"
+_DEFAULT = os.environ.get("ROBOTDYN_COMPILED", "1") != "0"
+"""Whether the fast path is on where no :func:`use_compiled` block says otherwise (``ROBOTDYN_COMPILED``)."""
+_ENABLED: ContextVar[bool] = ContextVar("robotdyn_compiled", default=_DEFAULT)
+"""The switch of :func:`use_compiled`: context-local (a new thread starts from :data:`_DEFAULT`)."""
 
 
 def enabled() -> bool:
-    """Whether the fast path is used where a robot allows it (built, and not turned off)."""
-    return _ENABLED and available()
+    """Whether the fast path is used where a robot allows it (built, and not turned off in this thread's context)."""
+    return _ENABLED.get() and available()
 
 
 @contextmanager
 def use_compiled(flag: bool):
-    """Turn the fast path on or off inside a ``with`` block (e.g. to compare it with the Python path)."""
-    global _ENABLED
-    old, _ENABLED = _ENABLED, bool(flag)
+    """Turn the fast path on or off for the calls made inside a ``with`` block (e.g. to compare it with the Python
+    path). Context-local: other threads, and code after the block, are unaffected.
+
+    Args:
+        flag: True: the compiled path where it serves; False: always the Python path.
+    """
+    token = _ENABLED.set(bool(flag))
     try:
         yield
     finally:
-        _ENABLED = old
+        _ENABLED.reset(token)
 
 
 def compiled_model(robot) -> CompiledModel | None:
     """The robot's :class:`CompiledModel` for the calling thread (built once per thread; rebuilt when its
     constraints, their terrain, radius or friction law, or the model's gravity change), or ``None`` when the fast
     path is off or :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated
-    from several threads at once."""
+    from several threads at once.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+    """
     if not enabled():
         return None
     # one compiled model per thread: compute() returns views of its buffers, which another thread's call would
@@ -49,7 +64,8 @@ def compiled_model(robot) -> CompiledModel | None:
     local = getattr(robot, "_local", None)
     cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
     gravity = robot.model.gravity.linear
-    if cached is not None and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
+    if cached is not None and (cached[3] is None or cached[3].owner == threading.get_ident()) \
+            and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
         getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r and getattr(c, "law", None) is law
         for c, (t, r, law) in zip(robot.constraints, cached[2])
     ):
@@ -69,7 +85,15 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     """The reduced model of ``robot`` at (q, nu) (in its operational velocities if it has them): by the robot's
     compiled model where it serves, else (and to choose the projection's rows) by the Python reference
     (:func:`robotdyn.reduction.reduced_dynamics.reference`). ``coriolis`` (the matrix :math:`C_r`) is the Python
-    path's; ``independent`` overrides the independent velocity indices (not with operational velocities)."""
+    path's; ``independent`` overrides the independent velocity indices (not with operational velocities).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+        coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
+        independent: Indices of the independent velocities in v (default ``None``: the robot's).
+    """
     op = getattr(robot, "operational", None)
     fast = None if coriolis else compiled_model(robot)
     if fast is not None:

@@ -41,12 +41,29 @@ class Row:
 
 @dataclass
 class Comparison:
-    """A titled list of :class:`Row` s with text and JSON renderings."""
+    """A titled list of :class:`Row` s with text and JSON renderings.
+
+    Attributes:
+        title: The table's title.
+        rows: The compared quantities (:class:`Row`).
+    """
 
     title: str
     rows: list[Row] = field(default_factory=list)
 
     def add(self, quantity: str, paper: float, model: float, tol: float, note: str = "") -> Row:
+        """Append a row comparing the paper's value with the model's.
+
+        Args:
+            quantity: What is compared (with the paper's equation number).
+            paper: The paper's value (or its closed form evaluated).
+            model: The model's value.
+            tol: Tolerance on ``|paper - model|`` for ``reproduced``.
+            note: How the tolerance was chosen or what a difference means.
+
+        Returns:
+            The new :class:`Row`.
+        """
         row = Row(quantity, float(paper), float(model), float(tol), note)
         self.rows.append(row)
         return row
@@ -69,6 +86,10 @@ class Comparison:
 
 def quadratic_coefficients(bias: Callable[[np.ndarray], np.ndarray], k: int) -> dict[tuple[int, int], np.ndarray]:
     """Coefficients of a vector function quadratic in nu (e.g. :math:`C_r(q,\\nu)\\nu`) by polarisation.
+
+    Args:
+        bias: A function of nu (k,) returning a vector, quadratic in nu.
+        k: The length of nu.
 
     Returns:
         ``{(i, j): c}`` with i <= j such that ``bias(nu) = sum c_ij nu_i nu_j`` (c_ij a vector).

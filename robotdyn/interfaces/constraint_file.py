@@ -48,7 +48,8 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     joint = "wheel_right_joint"         # the wheel's spin joint (its child link's origin is the wheel centre)
     # frame = "wheel_right_link"        # ... or the wheel centre frame directly
     radius = 0.0985                     # a number > 0 or a parameter name
-    axis = [0, 0, 1]                    # axle in the wheel frame (default: the spin joint's axis)
+    axis = [0, 0, 1]                    # axle in the wheel frame (default: the spin joint's axis; a support
+                                        # without one, e.g. a ball: the world y axis at the zero configuration)
     kind = "standard"                   # standard | omni (with roller_angle: rad, or "45 deg") | caster (a wheel on a
                                         # steering joint of the URDF: nothing special) | support (touches the
                                         # ground only: normal row, frictionless, e.g. a free castor or a skid)
@@ -79,6 +80,7 @@ import os
 import re
 import sysconfig
 import tomllib
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -86,7 +88,7 @@ from pathlib import Path
 import numpy as np
 
 from ..description.urdf import _ROOT_CHAINS, ROOT_KINDS, expand_xacro
-from ..errors import InputError, RobotDynError
+from ..errors import InputError, RobotDynError, RobotDynWarning
 from ..inputs import MAX_ANGLE
 from ..input_files import resolved
 from ..contact.friction import LAWS, make_law
@@ -133,7 +135,14 @@ def _suggest(name: str, candidates) -> str:
 def package_search_dirs(extra=()) -> list[Path]:
     """Directories where ``package://NAME/...`` is looked up: ``extra``, ``ROS_PACKAGE_PATH``, and the
     ``cmeel.prefix/share`` directory of pip-installed robot data (e.g. example-robot-data), if present.
-    (:class:`robotdyn.description.ros_packages.PackageIndex` is the lookup itself.)"""
+    (:class:`robotdyn.description.ros_packages.PackageIndex` is the lookup itself.)
+
+    Args:
+        extra: Directories searched first (paths or strings).
+
+    Returns:
+        The directories, in search order.
+    """
     dirs = [Path(d) for d in extra]
     dirs += [Path(d) for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
     share = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
@@ -144,8 +153,21 @@ def package_search_dirs(extra=()) -> list[Path]:
 
 def resolve_path(text: str, base: Path, package_dirs=(), packages: PackageIndex | None = None) -> Path:
     """Resolve a description path: ``package://PKG/rest`` with a :class:`~robotdyn.description.ros_packages.PackageIndex`
-    (default: one of ``package_dirs`` and the environment), a relative path against ``base``. Raises
-    :class:`ConstraintFileError` if the file does not exist."""
+    (default: one of ``package_dirs`` and the environment), a relative path against ``base``.
+
+    Args:
+        text: The path as written: ``package://PKG/rest``, absolute, relative, or starting with ``~``.
+        base: The directory a relative path is relative to (the constraint file's).
+        package_dirs: Directories searched for packages when ``packages`` is not given.
+        packages: The package index to resolve ``package://`` with (default ``None``: one built from
+            ``package_dirs`` and the environment).
+
+    Returns:
+        The absolute path of an existing file.
+
+    Raises:
+        ConstraintFileError: The package or the file is not found.
+    """
     if text.startswith("package://"):
         index = packages if packages is not None else PackageIndex.create(dirs=package_dirs)
         path, missing = index.resolve_uri(text)
@@ -182,8 +204,29 @@ class _Tree:
                 "parent": j.find("parent").get("link"),
                 "child": j.find("child").get("link"),
                 "axis": [float(x) for x in axis.get("xyz").split()] if axis is not None else [1.0, 0.0, 0.0],
+                "rpy": [float(x) for x in (origin.get("rpy") or "0 0 0").split()]
+                if (origin := j.find("origin")) is not None else [0.0, 0.0, 0.0],
             }
         return cls(links, joints, declared)
+
+    def rotation(self, frame: str) -> np.ndarray:
+        """The rotation of a link (or a joint's frame) relative to the root link at the zero configuration (every
+        joint at 0: only the joints' origin rpy), from the URDF alone."""
+        R = np.eye(3)
+        joint = frame if frame in self.joints else next(
+            (n for n, j in self.joints.items() if j["child"] == frame), None)
+        seen = set()
+        while joint is not None and joint not in seen:
+            seen.add(joint)
+            roll, pitch, yaw = self.joints[joint]["rpy"]
+            cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
+                                      math.cos(yaw), math.sin(yaw))
+            R = np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                          [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                          [-sp, cp * sr, cp * cr]]) @ R
+            parent = self.joints[joint]["parent"]
+            joint = next((n for n, j in self.joints.items() if j["child"] == parent), None)
+        return R
 
     def movable(self, locked=()) -> list[str]:
         return [n for n, j in self.joints.items() if j["type"] != "fixed" and n not in locked]
@@ -265,14 +308,36 @@ class _Reader:
 @dataclass
 class ConstraintFile:
     """A validated constraint file: the robot's :class:`RobotSpec` and scenarios (module-like: ``SPEC``,
-    ``SCENARIOS``), plus where they came from."""
+    ``SCENARIOS``), plus where they came from.
+
+    Attributes:
+        path: The constraint file.
+        SPEC: The robot's :class:`~robotdyn.robot.RobotSpec` (what ``Robot(spec)`` builds).
+        SCENARIOS: The file's ``[[scenarios]]`` by name (:class:`~robotdyn.simulation.scenario.Scenario`).
+    """
 
     path: Path
     SPEC: RobotSpec
     SCENARIOS: dict[str, Scenario] = field(default_factory=dict)
 
     def robot(self, params: dict | None = None, terrain: Terrain | None = None) -> Robot:
-        """Build the robot; core errors are prefixed with the file name."""
+        """Build the robot; core errors are prefixed with the file name.
+
+        Without ``independent`` in the file (and no ``[twist]``) the independent velocities are chosen
+        automatically; a :class:`~robotdyn.errors.RobotDynWarning` names them and the line that chooses them, unless
+        they are the motor joints.
+
+        Args:
+            params: Parameter values by name (default ``None``: the file's defaults).
+            terrain: A terrain replacing the file's ``[terrain]`` (default ``None``).
+
+        Returns:
+            The :class:`~robotdyn.robot.Robot`.
+
+        Raises:
+            ConstraintFileError: The robot cannot be built, or ``independent`` or a scenario's ``nu0`` does not fit it
+                (one line naming the file).
+        """
         try:
             robot = Robot(self.SPEC, params, terrain)
         except ConstraintFileError:
@@ -280,6 +345,11 @@ class ConstraintFile:
         except RobotDynError as exc:
             raise ConstraintFileError(f"{self.path}: {exc}") from None
         independent = self.SPEC.independent
+        if independent is None and self.SPEC.operational is None:  # silent only where it picked the motor joints
+            message = automatic_independent_message(robot, self.path)
+            if message:
+                warnings.warn(message, RobotDynWarning, stacklevel=2)
+        held = _sliding_rows(robot)  # stick-slip wheels: counted sliding, their freest phase
         if independent:  # more independent velocities than the constraints leave free cannot be independent
             A = robot.rows_at(robot.neutral()).A
             free = robot.nq - (int(np.linalg.matrix_rank(A)) if A.size else 0)
@@ -288,15 +358,66 @@ class ConstraintFile:
                     f"{self.path}: independent: {len(independent)} coordinates ({', '.join(independent)}) but the "
                     f"constraints leave {free} velocities free at the neutral configuration (n = {robot.nq}, rank A = "
                     f"{robot.nq - free}); expected at most {free}")
+        held.restore()
         for i, sc in enumerate(self.SCENARIOS.values()):
             for name in sc.nu0:
-                if name not in robot.velocity_names:
+                if name not in robot.velocity_names and not (held.wheels and name in robot.velocity_labels):
                     raise ConstraintFileError(
                         f"{self.path}: scenarios[{i}] ({sc.name}): nu0 {name.removesuffix('_dot')!r} is not an "
                         "independent velocity; expected one of "
                         f"{', '.join(v.removesuffix('_dot') for v in robot.velocity_names)}"
                     )
         return robot
+
+
+def automatic_independent_message(robot: Robot, path: str | Path) -> str:
+    """The warning for a constraint file without ``independent``: which velocities were chosen automatically
+    (the best-conditioned set at the neutral configuration, which may be a caster's swivel and spin rather than
+    the drive wheels) and the line that chooses them, suggesting the motor joints where they form a valid set.
+
+    Args:
+        robot: The robot built from the file (its automatic choice made).
+        path: The constraint file (named in the message).
+
+    Returns:
+        One line; empty where the automatic choice is the motor joints (nothing to warn about).
+    """
+    chosen = [robot.coordinates[i] for i in robot.independent_indices]
+    A = robot.rows_at(robot.neutral()).A
+    rank = int(np.linalg.matrix_rank(A)) if A.size else 0
+    motors = []
+    for m in robot.motors:
+        label = robot.spec.labels.get(m.joint, m.joint)
+        if label in robot.coordinates and label not in motors:
+            motors.append(label)
+    idx = [robot.coordinates.index(c) for c in motors]
+    rest = [i for i in range(robot.nq) if i not in idx]
+    valid = len(idx) == robot.nq - rank and (not A.size or int(np.linalg.matrix_rank(A[:, rest])) == rank)
+    if valid and set(motors) == set(chosen):
+        return ""
+    suggestion = motors if valid else None
+    text = (f"{path}: no 'independent' given: the independent velocities are those of {', '.join(chosen)} (chosen "
+            "automatically: best conditioned at the neutral configuration); to choose them, add independent = "
+            f"[{', '.join(repr(c) for c in (suggestion or chosen))}]")
+    return text + (" (the motor joints)" if suggestion else "") + " to the file"
+
+
+class _sliding_rows:  # noqa: N801 (used as a statement: held = _sliding_rows(robot) ... held.restore())
+    """Put a robot's stick-slip wheels in their sliding phase (only the normal row constrains) until
+    :meth:`restore`: the freest phase, which bounds the independent velocities a stick-slip vehicle may be given
+    (all sticking it may be held, with none free)."""
+
+    def __init__(self, robot) -> None:
+        from ..contact.stick_slip_wheel import stick_slip_wheels
+
+        self.wheels = stick_slip_wheels(robot)
+        self.phases = [(w.phase, getattr(w, "direction", None)) for w in self.wheels]
+        for w in self.wheels:
+            w.set_phase("slide", np.array([1.0, 0.0]))
+
+    def restore(self) -> None:
+        for w, (phase, direction) in zip(self.wheels, self.phases):
+            w.set_phase(phase, direction)
 
 
 def read(
@@ -319,8 +440,19 @@ def read(
         twist: Independent velocities that are a body twist instead (overrides the file's ``independent`` and
             ``twist``): ``FRAME`` (components vx vy wz) or ``FRAME:vx,vy,wz``.
 
+    Returns:
+        The :class:`ConstraintFile` (its ``SPEC`` and ``SCENARIOS``; :meth:`ConstraintFile.robot` builds it).
+
     Raises:
         ConstraintFileError: one line naming the file, the entry and what was expected.
+
+    Example:
+        >>> from pathlib import Path
+        >>> import robotdyn
+        >>> from robotdyn.interfaces.constraint_file import read
+        >>> cf = read(Path(robotdyn.__file__).parents[1] / "examples" / "quasimoro.toml")
+        >>> [w.name for w in cf.SPEC.wheels], [m.name for m in cf.SPEC.motors]
+        (['wheel_A', 'wheel_B'], ['m1', 'm2'])
     """
     path = Path(path)
     r = _Reader(path)
@@ -628,8 +760,10 @@ def _wheel(cx: _Context, where: str, w, pvalues: dict) -> tuple[Wheel, str | Non
     if "joint" in w:
         spin = cx.joint(where, w["joint"], "joint", movable=False)
         if tree.joints[spin]["type"] not in ROTATING:
+            child = tree.joints[spin]["child"]
             r.fail(where, f"joint {spin!r} is {tree.joints[spin]['type']}; a wheel spins about a revolute or "
-                          "continuous joint (a fixed caster is a support, not a rolling wheel)")
+                          "continuous joint. For a ball caster, skid or other support without a spin joint, name its "
+                          f"centre frame instead: frame = {child!r} (with kind = 'support'; no axis needed)")
         if spin in cx.locked:
             r.fail(where, f"joint {spin!r} is locked; a wheel must spin")
         fname = tree.joints[spin]["child"]
@@ -644,8 +778,11 @@ def _wheel(cx: _Context, where: str, w, pvalues: dict) -> tuple[Wheel, str | Non
         axis = [r.number(where, a, "axis component") for a in axis]
     elif spin is not None:
         axis = tree.joints[spin]["axis"]
+    elif w.get("kind") == "support":  # a ball or skid: any axle horizontal at rest puts the contact straight below
+        axis = (tree.rotation(fname).T @ np.array([0.0, 1.0, 0.0])).tolist()  # the world y axis, in the frame
     else:
-        r.fail(where, f"frame {fname!r} has no spin joint: give 'axis' (the axle in the wheel frame)")
+        r.fail(where, f"frame {fname!r} has no spin joint: give 'axis' (the axle in the wheel frame), or "
+                      "kind = 'support' for a ball caster or skid (then no axis is needed)")
     if np.linalg.norm(axis) < 1e-12:
         r.fail(where, f"axis {axis} has zero length; expected the axle direction in the wheel frame")
     if "radius" not in w:
@@ -892,7 +1029,31 @@ def load_robot(
     terrain: Terrain | None = None,
     package_dirs=(),
 ) -> Robot:
-    """Read a constraint file (see :func:`read`) and build its :class:`~robotdyn.robot.Robot`."""
+    """Read a constraint file (see :func:`read`) and build its :class:`~robotdyn.robot.Robot`.
+
+    Args:
+        path: The TOML constraint file.
+        urdf: The URDF/Xacro description, overriding the file's ``urdf`` (default ``None``).
+        xacro_args: Xacro arguments by name (strings), overriding the file's ``xacro_args``.
+        params: Parameter values by name (the file's ``[[parameters]]``; default ``None``: their defaults).
+        terrain: A :class:`~robotdyn.constraints.terrain.Terrain` replacing the file's (default ``None``).
+        package_dirs: Extra directories searched for ROS packages.
+
+    Returns:
+        The :class:`~robotdyn.robot.Robot`, the same object :func:`robotdyn.load` returns for a built-in robot.
+
+    Raises:
+        ConstraintFileError: One line naming the file, the entry and what was expected.
+
+    Example:
+        >>> from pathlib import Path
+        >>> import robotdyn
+        >>> from robotdyn.interfaces.constraint_file import load_robot
+        >>> examples = Path(robotdyn.__file__).parents[1] / "examples"
+        >>> robot = load_robot(examples / "quasimoro.toml")
+        >>> robot.velocity_names
+        ['theta1_dot', 'theta2_dot', 'theta3_dot']
+    """
     return read(path, urdf, xacro_args, package_dirs).robot(params, terrain)
 
 

@@ -93,7 +93,7 @@ _TERRAIN_NUMBERS = {
 SCHEMA: dict = _table({
     "name": _string("a non-empty name"),
     "title": {"type": "string", "expected": "a string"},
-    "paper": {"type": "string", "expected": "a string (a file name under shared/papers)"},
+    "paper": {"type": "string", "expected": "a string (a short reference of the robot's paper: authors, title)"},
     "urdf": _string("a path or package://PKG/... to the URDF/Xacro description"),
     "root": {"enum": list(ROOT_KINDS), "expected": f"one of {', '.join(ROOT_KINDS)}"},
     "package_dirs": _strings("a list of directories"),

@@ -29,6 +29,7 @@ def plot_trajectory(
     title: str = "",
     zoom: float | None = None,
     references: dict[str, list[tuple[float, str]]] | None = None,
+    pose: tuple[str, str, str] | None = None,
 ):
     """Plot columns of a :class:`~robotdyn.simulation.trajectory.Trajectory` against time.
 
@@ -39,12 +40,23 @@ def plot_trajectory(
         title: Figure title.
         zoom: If given, a second column of axes shows only ``0 <= t <= zoom`` (the paper's transient windows).
         references: Horizontal reference lines per column, e.g. a paper's printed amplitude.
+        pose: Names of the root's x [m], y [m] and heading [rad] coordinates (:func:`pose_columns`); if given, a
+            first column of axes draws the root's path in the world x-y plane with its heading (:func:`plot_path`).
 
     Returns:
         The matplotlib figure.
     """
     ncol = 2 if zoom else 1
-    fig, axes = plt.subplots(len(columns), ncol, figsize=(5.5 * ncol, 2.3 * len(columns)), squeeze=False)
+    extra = 1 if pose else 0
+    rows = max(len(columns), 2 if pose else 1)
+    fig, grid = plt.subplots(rows, ncol + extra, figsize=(5.5 * (ncol + extra), 2.3 * rows), squeeze=False)
+    axes = grid[:, extra:]
+    if pose:
+        for ax in grid[:, 0]:
+            ax.remove()
+        plot_path(traj, *pose, fig.add_subplot(1, ncol + extra, 1))
+    for ax in axes[len(columns):].ravel():
+        ax.remove()
     for i, name in enumerate(columns):
         y = traj.column(name)
         for j in range(ncol):
@@ -64,9 +76,64 @@ def plot_trajectory(
     return finish(fig, path, title)
 
 
+def pose_columns(robot, traj) -> tuple[str, str, str] | None:
+    """The names of a planar or floating root's x, y and heading (psi, or yaw) coordinates in ``traj`` (the
+    robot's labels of the root joints); ``None`` for a fixed root or a trajectory without them.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` simulated.
+        traj: Its :class:`~robotdyn.simulation.trajectory.Trajectory`.
+    """
+    joints = robot.description.joint_names
+    heading = "psi" if robot.spec.root == "planar" else "yaw" if robot.spec.root == "floating" else None
+    if heading is None or not all(j in joints for j in ("x", "y", heading)):
+        return None
+    names = tuple(robot.coordinates[joints.index(j)] for j in ("x", "y", heading))
+    return names if all(n in traj.coordinates for n in names) else None
+
+
+def plot_path(traj, x: str, y: str, heading: str, ax=None):
+    """Draw the root's path in the world x-y plane [m], equal axes, with its heading as arrows at about ten
+    evenly spaced times, the start (circle) and the end (square).
+
+    Args:
+        traj: The :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        x, y: Names of the root's world x and y coordinates [m].
+        heading: Name of its heading (yaw about the world z axis) [rad].
+        ax: Axes to draw in (default: a new figure's).
+
+    Returns:
+        The axes.
+    """
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5.0, 5.0))
+    px, py, psi = traj.column(x), traj.column(y), traj.column(heading)
+    ax.plot(px, py, lw=1.4, color="C0", label="path")
+    span = max(float(np.ptp(px)), float(np.ptp(py)), 1e-3)
+    idx = np.unique(np.linspace(0, len(px) - 1, min(len(px), 11)).astype(int))
+    ax.quiver(px[idx], py[idx], np.cos(psi[idx]), np.sin(psi[idx]), angles="xy", scale_units="xy",
+              scale=1.0 / (0.08 * span), width=0.006, color="C1", label=f"heading ({heading})")
+    ax.plot(px[0], py[0], "o", color="k", ms=5, label=f"start (t = {traj.t[0]:g} s)")
+    ax.plot(px[-1], py[-1], "s", color="k", ms=5, label=f"end (t = {traj.t[-1]:g} s)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.margins(0.15)
+    ax.set_xlabel(f"{x} [m]")
+    ax.set_ylabel(f"{y} [m]")
+    ax.set_title("path in the world x-y plane")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    return ax
+
+
 def finish(fig, path=None, title: str = ""):
     """Title and lay out a figure, then save it atomically (:func:`robotdyn.output.save_figure`) and close it when
-    ``path`` is given; returns the figure."""
+    ``path`` is given; returns the figure.
+
+    Args:
+        fig: The matplotlib figure.
+        path: The image file (default ``None``: not saved, the figure stays open).
+        title: The figure's title (default: none).
+    """
     if title:
         fig.suptitle(title)
     fig.tight_layout()
@@ -80,32 +147,92 @@ def finish(fig, path=None, title: str = ""):
     return fig
 
 
-def plot_traction(tr, path=None, title: str = ""):
-    """A :class:`~robotdyn.contact.traction.Traction`: normal loads and required friction per wheel against time, shaded where the no-slip assumption is broken
-    (load <= 0, or required friction above the wheel's mu, drawn dashed)."""
+def wheel_order(robot, wheels: Sequence[str]) -> tuple[list[str], set[str]]:
+    """Wheels in the order a traction plot lists them, drive wheels first (a wheel whose spin joint a motor
+    drives), then the others in the robot's order; and the support wheels among them (frictionless: they carry a
+    load but cannot slip).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (``None``: the given order, no support wheels known).
+        wheels: Wheel names (:attr:`robotdyn.contact.traction.Traction.wheels`).
+
+    Returns:
+        ``(ordered names, names of the support wheels)``.
+    """
+    if robot is None:
+        return list(wheels), set()
+    driven_links = set()
+    joints = robot.description.joint_names
+    for m in robot.spec.motors:
+        joint = m.joint if m.joint in joints else next((j for j, label in robot.spec.labels.items()
+                                                        if label == m.joint), m.joint)
+        jid = robot.model.getJointId(joint) if robot.model.existJointName(joint) else None
+        if jid is not None:
+            driven_links.update(f.name for f in robot.model.frames if f.parentJoint == jid)
+    spec = {(w.name or w.frame): w for w in robot.spec.wheels}
+    drive = [w for w in wheels if w in spec and spec[w].frame in driven_links]
+    rest = [w for w in wheels if w not in drive]
+    supports = {w for w in wheels if w in spec and spec[w].kind == "support"}
+    return drive + rest, supports
+
+
+def plot_traction(tr, path=None, title: str = "", robot=None):
+    """Plot a :class:`~robotdyn.contact.traction.Traction`: normal loads (top) and required friction (bottom)
+    per wheel against time, shaded where the no-slip assumption is broken (load <= 0, or required friction above
+    the wheel's mu, drawn dashed).
+
+    Drive wheels come first. Every wheel that can slip has its required friction ``|f_t|/f_n`` drawn where it is
+    determined; where rigid-body dynamics split a force between wheels only as a sum (e.g. two wheels on one
+    axle share a lateral force), the smallest mu with which some split lies inside every friction cone
+    (:attr:`~robotdyn.contact.traction.Traction.minimum_mu`) is drawn for them instead. Support wheels
+    (frictionless) appear only in the load panel.
+
+    Args:
+        tr: The traction (:func:`robotdyn.contact.traction.traction`).
+        path: Where to save the figure (PNG/PDF/SVG by extension); ``None`` to only return it.
+        title: Figure title.
+        robot: The :class:`~robotdyn.robot.Robot` simulated, to order the wheels (drive wheels first) and tell
+            the support wheels (default ``None``: the traction's order, every wheel treated alike).
+
+    Returns:
+        The matplotlib figure.
+    """
     fig, (ax_n, ax_mu) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
     broken = tr.broken().any(axis=1) if tr.wheels else np.zeros(len(tr.t), bool)
-    for j, name in enumerate(tr.wheels):
-        ax_n.plot(tr.t, tr.normal[:, j], lw=1.2, label=name)
+    order, supports = wheel_order(robot, tr.wheels)
+    pending = []  # wheels that can slip but whose own friction force is not determined
+    for name in order:
+        j = tr.wheels.index(name)
+        (line,) = ax_n.plot(tr.t, tr.normal[:, j], lw=1.2,
+                            label=f"{name} (support, frictionless)" if name in supports else name)
+        if name in supports:
+            continue
         if not tr.friction_determined[j]:
-            ax_mu.plot([], [], lw=1.2, label=f"{name}: friction not determined")
+            pending.append(name)
             continue
         mu = np.where(np.isfinite(tr.required_mu[:, j]), tr.required_mu[:, j], np.nan)
-        (line,) = ax_mu.plot(tr.t, mu, lw=1.2, label=name)
+        ax_mu.plot(tr.t, mu, lw=1.2, color=line.get_color(), label=name)
         if np.isfinite(tr.mu[j]):
             ax_mu.axhline(tr.mu[j], color=line.get_color(), ls="--", lw=1.0)
+    if pending and tr.minimum_mu is not None:
+        minimum = np.where(np.isfinite(tr.minimum_mu), tr.minimum_mu, np.nan)
+        ax_mu.plot(tr.t, minimum, lw=1.6, color="k",
+                   label=f"{', '.join(pending)}: smallest mu of the best split (max {np.nanmax(minimum):.3g})")
+    elif pending:
+        ax_mu.plot([], [], lw=0, label=f"{', '.join(pending)}: friction not determined")
     for ax in (ax_n, ax_mu):
         if broken.any():
             ax.fill_between(tr.t, 0, 1, where=broken, transform=ax.get_xaxis_transform(), color="C3", alpha=0.15,
                             label="no-slip broken" if ax is ax_n else None)
         ax.grid(alpha=0.3)
     ax_n.axhline(0.0, color="k", lw=0.8)
+    ax_mu.set_ylim(bottom=0.0)
     ax_n.set_ylabel("normal load [N]")
     ax_mu.set_ylabel("required friction |f_t|/f_n")
     ax_mu.set_xlabel("t [s]")
     if tr.wheels:
-        ax_n.legend(fontsize=7, loc="upper right")
-        ax_mu.legend(fontsize=7, loc="upper right")
+        ax_n.legend(fontsize=7, loc="best")
+        ax_mu.legend(fontsize=7, loc="best")
     if tr.undetermined:
         ax_n.set_title(f"loads of {', '.join(tr.undetermined)} not determined", fontsize=8)
     return finish(fig, path, title)

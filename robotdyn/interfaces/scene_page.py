@@ -61,6 +61,9 @@ def pack_scene(commands: list[bytes]) -> bytes:
     (four identical wheels) is stored once; concatenating a command's segments gives back its bytes exactly.
     Layout before compression (little-endian uint32): number of segments, their lengths, their bytes; number of
     commands, then for each its number of segments and their indices.
+
+    Args:
+        commands: The scene's msgpack commands, in order.
     """
     import umsgpack
 
@@ -100,7 +103,11 @@ def pack_scene(commands: list[bytes]) -> bytes:
 
 
 def unpack_scene(packed: bytes) -> list[bytes]:
-    """The commands of :func:`pack_scene`'s output, in order (what the page's script does in the browser)."""
+    """The commands of :func:`pack_scene`'s output, in order (what the page's script does in the browser).
+
+    Args:
+        packed: The output of :func:`pack_scene`.
+    """
     buf = zlib.decompress(packed)
     (n,), o = struct.unpack_from("<I", buf, 0), 4
     lens = struct.unpack_from(f"<{n}I", buf, o)
@@ -121,7 +128,11 @@ def unpack_scene(packed: bytes) -> list[bytes]:
 
 
 def page_commands(page: str) -> list[bytes]:
-    """The scene commands a standalone page (:meth:`Viewer.static_html`) applies, in order."""
+    """The scene commands a standalone page (:meth:`Viewer.static_html`) applies, in order.
+
+    Args:
+        page: A page's HTML text (:meth:`~robotdyn.interfaces.viewer.Viewer.static_html`).
+    """
     start = page.index('var robotdyn_scene = "') + len('var robotdyn_scene = "')
     return unpack_scene(base64.b64decode(page[start:page.index('"', start)]))
 
@@ -133,7 +144,15 @@ def static_page(commands: list[bytes], title: str = "robotdyn") -> str:
     synchronously by the page's own inflate (:data:`_UNPACK_JS`, after Mark Adler's ``puff.c``) before the first
     frame is drawn, so a headless browser's screenshot sees the complete scene. (The browser's asynchronous
     ``DecompressionStream`` was tried first: headless Chromium's virtual time then stalled, now and then, on pages
-    holding several such frames.) ``page.html#t=SECONDS`` opens an animation paused at that time."""
+    holding several such frames.) ``page.html#t=SECONDS`` opens an animation paused at that time.
+
+    Args:
+        commands: The scene's msgpack commands, in order.
+        title: The page's title.
+
+    Returns:
+        The HTML text.
+    """
     mc = _meshcat()
     js = (Path(mc.__file__).parent / "viewer" / "dist" / "main.min.js").read_text(encoding="utf-8")
     js = js.replace("</script", "<\\/script")

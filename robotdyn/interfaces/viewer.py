@@ -151,6 +151,16 @@ class Viewer:
         tile: Edge [m] of the ground's checker tiles (about 0.4 times the robot's size, rounded to 1, 2 or 5).
         camera_position: Where :meth:`set_camera` put the camera (world frame, m); it looks at the origin with
             meshcat's default perspective (75 degrees vertical field of view, z up on screen).
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.interfaces.viewer import Viewer
+        >>> robot = robotdyn.load("quasimoro")
+        >>> viewer = Viewer(robot)             # live=True also serves it at viewer.url
+        >>> viewer.display(robot.neutral())
+        >>> viewer.save("quasimoro.html").name  # a page that works offline
+        'quasimoro.html'
+        >>> viewer.close()
     """
 
     def __init__(self, robot, live: bool = False, contacts: bool = True, frames: bool = False,
@@ -343,7 +353,12 @@ class Viewer:
 
     # -------------------------------------------------------------------------------------------- public
     def show(self, layer: str, visible: bool = True) -> None:
-        """Show or hide a layer: ``robot``, ``terrain``, ``contacts`` or ``frames``."""
+        """Show or hide a layer: ``robot``, ``terrain``, ``contacts`` or ``frames``.
+
+        Args:
+            layer: ``robot``, ``terrain``, ``contacts`` or ``frames``.
+            visible: Show (True) or hide (False).
+        """
         if layer not in LAYERS:
             raise InputError(f"unknown layer {layer!r}; expected one of {', '.join(LAYERS)}")
         self.vis[f"{_ROOT}/{layer}"].set_property("visible", bool(visible))
@@ -352,6 +367,9 @@ class Viewer:
         """Draw the robot at configuration q (natural coordinates in robot.coordinates order; m, rad).
 
         The contact markers sit at each wheel's contact point with the terrain, oriented along its contact frame.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad].
         """
         q = self._check_q(q)
         self.q = q.copy()
@@ -366,7 +384,12 @@ class Viewer:
         (default: 2.6 times the robot's size plus the largest distance of the robot's centre from the origin in
         the configuration displayed or the animation, so the robot stays in view). It looks at the origin.
         :meth:`display` does not move the camera (call this again after it); :meth:`animate` re-frames it unless
-        told not to."""
+        told not to.
+
+        Args:
+            direction: Direction (3,) from the origin to the camera, world frame (normalised here).
+            distance: Distance [m] from the origin (default ``None``: from the robot's size).
+        """
         d = np.asarray(direction, dtype=float)
         if d.shape != (3,) or not np.all(np.isfinite(d)) or np.linalg.norm(d) == 0:
             raise InputError(f"camera direction {np.asarray(direction).tolist()}; expected a non-zero 3-vector")
@@ -428,7 +451,12 @@ class Viewer:
 
     @staticmethod
     def key_times(t: np.ndarray, fps: float) -> np.ndarray:
-        """Key times [s]: t0 + k / fps up to the last sample time, which is always included."""
+        """Key times [s]: t0 + k / fps up to the last sample time, which is always included.
+
+        Args:
+            t: Sample times (N,) [s], increasing.
+            fps: Keyframe rate [1/s].
+        """
         n = int(np.floor((t[-1] - t[0]) * fps + 1e-9))
         times = t[0] + np.arange(n + 1) / fps
         if t[-1] - times[-1] > 1e-9:
@@ -440,7 +468,11 @@ class Viewer:
         return static_page(self._window.commands(), f"robotdyn: {self.robot.spec.name}")
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`static_html` to ``path`` and return the path."""
+        """Write :meth:`static_html` to ``path`` and return the path.
+
+        Args:
+            path: The HTML file (written atomically).
+        """
         path = Path(path)
         try:
             with atomic_output(path, "HTML page") as tmp:
@@ -450,7 +482,14 @@ class Viewer:
         return path
 
     def iframe(self, height: int = 420) -> str:
-        """HTML of an iframe holding the static export (for notebooks)."""
+        """HTML of an iframe holding the static export (for notebooks).
+
+        Args:
+            height: Height of the iframe [px].
+
+        Returns:
+            The HTML text.
+        """
         doc = html.escape(self.static_html(), quote=True)
         return (f'<iframe srcdoc="{doc}" style="width: 100%; height: {int(height)}px; border: none" '
                 'loading="lazy"></iframe>')

@@ -45,7 +45,11 @@ class Motor:
         return f"Motor(name={self.name!r}, joint={self.joint!r}, reaction={self.reaction!r})"
 
     def column(self, kin: KinematicState) -> np.ndarray:
-        """The motor's column of the input matrix B (nv,) at the state of ``kin``."""
+        """The motor's column of the input matrix B (nv,) at the state of ``kin``.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+        """
         col = np.zeros(kin.model.nv)
         if self.rid is None:
             col[self.index] = 1.0
@@ -59,7 +63,12 @@ class Motor:
 
 
 def input_matrix(motors: list[Motor], kin: KinematicState) -> np.ndarray:
-    """Stack the motors' columns into B (nv, n_motors)."""
+    """Stack the motors' columns into B (nv, n_motors).
+
+    Args:
+        motors: The :class:`Motor` objects, in the robot's motor order.
+        kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+    """
     B = np.zeros((kin.model.nv, len(motors)))
     for j, m in enumerate(motors):
         if m.rid is None:  # the usual joint motor: a unit column, no kinematics needed

@@ -12,27 +12,61 @@ import pinocchio as pin
 
 
 def mass_matrix(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
-    """:math:`M(q)` (nv x nv, symmetric) by CRBA."""
+    """:math:`M(q)` (nv x nv, symmetric) by CRBA.
+
+    Args:
+        model: The Pinocchio model (natural coordinates: nq == nv).
+        data: Its Pinocchio data (overwritten).
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+    """
     return pin.crba(model, data, q).copy()
 
 
 def coriolis_matrix(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """:math:`C(q, v)` with :math:`C v` the Coriolis and centrifugal forces."""
+    """:math:`C(q, v)` with :math:`C v` the Coriolis and centrifugal forces.
+
+    Args:
+        model: The Pinocchio model (natural coordinates: nq == nv).
+        data: Its Pinocchio data (overwritten).
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        v: Full velocities (n,) [m/s, rad/s].
+    """
     return pin.computeCoriolisMatrix(model, data, q, v).copy()
 
 
 def gravity(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
-    """:math:`g(q)`, the generalised gravity forces (positive opposes lifting)."""
+    """:math:`g(q)`, the generalised gravity forces (positive opposes lifting).
+
+    Args:
+        model: The Pinocchio model (natural coordinates: nq == nv).
+        data: Its Pinocchio data (overwritten).
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+    """
     return pin.computeGeneralizedGravity(model, data, q).copy()
 
 
 def inverse_dynamics(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """:math:`\\tau = M a + C v + g` by RNEA."""
+    """:math:`\\tau = M a + C v + g` by RNEA.
+
+    Args:
+        model: The Pinocchio model (natural coordinates: nq == nv).
+        data: Its Pinocchio data (overwritten).
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        v: Full velocities (n,) [m/s, rad/s].
+        a: Full accelerations (n,) [m/s^2, rad/s^2].
+    """
     return pin.rnea(model, data, q, v, a).copy()
 
 
 def energy(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> tuple[float, float]:
-    """Kinetic and potential energy [J] (potential relative to z = 0, gravity of the model)."""
+    """Kinetic and potential energy [J] (potential relative to z = 0, gravity of the model).
+
+    Args:
+        model: The Pinocchio model (natural coordinates: nq == nv).
+        data: Its Pinocchio data (overwritten).
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        v: Full velocities (n,) [m/s, rad/s].
+    """
     kinetic = pin.computeKineticEnergy(model, data, q, v)
     potential = pin.computePotentialEnergy(model, data, q)
     return float(kinetic), float(potential)

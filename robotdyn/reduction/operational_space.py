@@ -75,6 +75,9 @@ class FrameTwist:
         ``computeJointJacobiansTimeVariation``), so that Pinocchio's frame Jacobian and its time variation refer to
         (kin.q, kin.v). In LOCAL axes :math:`\\dot J v` is the spatial acceleration's linear part, which is the time
         derivative of the body-axes velocity components (not the body components of the classical acceleration).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
         """
         J = self.jacobian(kin)
         if not np.any(kin.v):  # at rest the time variation is zero (and kin may not have computed it)
@@ -83,7 +86,11 @@ class FrameTwist:
         return J, dJ[self.select].copy()
 
     def jacobian(self, kin: KinematicState) -> np.ndarray:
-        """:math:`J_o` (k, n) at the configuration of ``kin`` (the most recent kinematics pass on its data)."""
+        """:math:`J_o` (k, n) at the configuration of ``kin`` (the most recent kinematics pass on its data).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+        """
         return pin.getFrameJacobian(kin.model, kin.data, self.fid, self.reference)[self.select].copy()
 
 
@@ -107,16 +114,31 @@ class OperationalProjection:
         return int(self.S.shape[1])
 
     def offset(self, drift: np.ndarray, Jdot_v: np.ndarray) -> np.ndarray:
-        """:math:`w` with :math:`A w = -\\text{drift}` (drift = :math:`\\dot A v`) and :math:`J_o w = -\\dot J_o v`."""
+        """:math:`w` with :math:`A w = -\\text{drift}` (drift = :math:`\\dot A v`) and :math:`J_o w = -\\dot J_o v`.
+
+        Args:
+            drift: The constraints' drift terms dA/dt v (all rows).
+            Jdot_v: dJ_o/dt v (k,), the outputs' drift.
+        """
         return -self._inv @ np.concatenate([drift[self.rows], Jdot_v])
 
     def Sdot(self, Adot: np.ndarray, Jdot: np.ndarray) -> np.ndarray:
-        """:math:`\\dot S = -K^{-1}\\dot K S` (n, k)."""
+        """:math:`\\dot S = -K^{-1}\\dot K S` (n, k).
+
+        Args:
+            Adot: dA/dt (all rows x n) along the motion.
+            Jdot: dJ_o/dt (k, n) along the motion.
+        """
         return -self._inv @ np.vstack([Adot[self.rows] @ self.S, Jdot @ self.S])
 
 
 def project_operational(A: np.ndarray, J: np.ndarray, names: list[str] | None = None) -> OperationalProjection:
     """Build :math:`S` for constraint rows ``A`` (m, n) and output rows ``J`` (k, n).
+
+    Args:
+        A: Constraint Jacobian (m, n) (all rows; the independent ones are chosen here).
+        J: Output Jacobian J_o (k, n): nu = J_o v.
+        names: Names of the k outputs, for messages (default ``None``: nu0, nu1, ...).
 
     Raises:
         SingularConstraintError: k differs from the mobility n - rank(A), or K is singular / ill-conditioned
@@ -142,7 +164,13 @@ def project_operational(A: np.ndarray, J: np.ndarray, names: list[str] | None = 
 
 
 def operational_projection(robot, twist: FrameTwist, q: np.ndarray) -> OperationalProjection:
-    """Only the projection (S, condition) at configuration q: one kinematics pass, no dynamics."""
+    """Only the projection (S, condition) at configuration q: one kinematics pass, no dynamics.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        twist: The :class:`FrameTwist` whose components are the independent velocities.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+    """
     kin = KinematicState(robot.model, robot.data, np.asarray(q, float), np.zeros(robot.model.nv))
     J = twist.jacobian(kin)
     A = constraint_set(robot).jacobian(kin).A
@@ -157,6 +185,13 @@ def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
     :func:`robotdyn.reduction.reduced_dynamics.reduce` (``M`` = operational-space inertia,
     ``h`` = :math:`C_r\\nu + g_r`, ``B`` = :math:`S^T B`, ...), with ``projection`` an
     :class:`OperationalProjection`.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        twist: The :class:`FrameTwist` whose components are the independent velocities.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        nu: The twist components (k,) [m/s, rad/s], in the twist's axes and order.
+        coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
     """
     model, data = robot.model, robot.data
     q = np.asarray(q, float)
@@ -192,11 +227,20 @@ class OperationalVelocities:
     names: list[str] | None = None
 
     def build(self, description) -> OperationalModel:
+        """The built :class:`OperationalModel` (the twist of ``frame`` in the robot's model).
+
+        Args:
+            description: The robot's :class:`~robotdyn.description.urdf.Description`.
+        """
         return OperationalModel(FrameTwist(description, self.frame, self.components, self.axes, self.names))
 
 
 class OperationalModel:
-    """A built :class:`OperationalVelocities`: names and ``reduce(robot, q, nu, coriolis)``."""
+    """A built :class:`OperationalVelocities`: names and ``reduce(robot, q, nu, coriolis)``.
+
+    Args:
+        twist: The built :class:`FrameTwist`.
+    """
 
     def __init__(self, twist: FrameTwist) -> None:
         self.twist = twist
@@ -206,17 +250,33 @@ class OperationalModel:
         return f"OperationalModel({self.twist!r})"
 
     def projection(self, robot, q) -> OperationalProjection:
-        """S(q) only (cheaper than :meth:`reduce` when no dynamics is needed, e.g. kinematic integration)."""
+        """S(q) only (cheaper than :meth:`reduce` when no dynamics is needed, e.g. kinematic integration).
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot`.
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        """
         return operational_projection(robot, self.twist, q)
 
     def check(self, nu) -> None:
-        """Raises InputError unless ``nu`` has one value per operational velocity."""
+        """Raises InputError unless ``nu`` has one value per operational velocity.
+
+        Args:
+            nu: The twist components (k,).
+        """
         nu = np.asarray(nu, float)
         if nu.shape != (len(self.names),):
             raise InputError(f"nu has shape {nu.shape}; expected {len(self.names)} values ({', '.join(self.names)})")
 
     def reduce(self, robot, q, nu, coriolis: bool = False) -> ReducedDynamics:
-        """The Python reference (:func:`reduce_operational`); the compiled path: :func:`robotdyn.fast.dispatch.reduce`."""
+        """The Python reference (:func:`reduce_operational`); the compiled path: :func:`robotdyn.fast.dispatch.reduce`.
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot`.
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: The twist components (k,) [m/s, rad/s].
+            coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
+        """
         self.check(nu)
         return reduce_operational(robot, self.twist, q, np.asarray(nu, float), coriolis)
 

@@ -101,6 +101,10 @@ def solve(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """:math:`A^{-1}B` for a small square A by LAPACK ``dgesv``: the routine ``numpy.linalg.solve`` and
     ``numpy.linalg.inv`` (B = I) call, with the same numbers, without their wrapper's overhead.
 
+    Args:
+        A: A small square matrix (m, m).
+        B: The right-hand side (m,) or (m, p).
+
     Raises:
         numpy.linalg.LinAlgError: A is exactly singular.
     """
@@ -112,7 +116,11 @@ def solve(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 def inverse_and_condition(A: np.ndarray) -> tuple[np.ndarray | None, float]:
     """:math:`A^{-1}` (``None`` if A is exactly singular) and the 1-norm condition number
-    :math:`\\|A\\|_1 \\|A^{-1}\\|_1` (``inf`` if singular) of a small square matrix."""
+    :math:`\\|A\\|_1 \\|A^{-1}\\|_1` (``inf`` if singular) of a small square matrix.
+
+    Args:
+        A: A small square matrix.
+    """
     try:
         inv = solve(A, np.eye(len(A)))
     except np.linalg.LinAlgError:
@@ -121,7 +129,12 @@ def inverse_and_condition(A: np.ndarray) -> tuple[np.ndarray | None, float]:
 
 
 def independent_rows(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
-    """Indices of a maximal set of linearly independent rows of ``A`` (rank-revealing QR with pivoting)."""
+    """Indices of a maximal set of linearly independent rows of ``A`` (rank-revealing QR with pivoting).
+
+    Args:
+        A: The constraint Jacobian (m, n).
+        tol: Relative rank tolerance: a pivot counts when above ``tol`` times the largest (at least 1).
+    """
     if A.shape[0] == 0:
         return np.zeros(0, dtype=int)
     R_diag, piv = _pivoted_qr(A.T)
@@ -133,7 +146,12 @@ def independent_rows(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
 
 
 def auto_independent(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
-    """A well-conditioned choice of independent velocity indices (the columns QR pivoting chooses last)."""
+    """A well-conditioned choice of independent velocity indices (the columns QR pivoting chooses last).
+
+    Args:
+        A: The constraint Jacobian (m, n).
+        tol: Relative rank tolerance (:func:`independent_rows`).
+    """
     n = A.shape[1]
     rows = independent_rows(A, tol)
     if rows.size == 0:
@@ -169,14 +187,22 @@ class Projection:
         return int(self.S.shape[1])
 
     def Sdot(self, Adot: np.ndarray) -> np.ndarray:
-        """:math:`\\dot S` (n, k) given :math:`\\dot A` (all rows) along the motion."""
+        """:math:`\\dot S` (n, k) given :math:`\\dot A` (all rows) along the motion.
+
+        Args:
+            Adot: dA/dt of all rows (m, n) along the motion.
+        """
         out = np.zeros_like(self.S)
         if self.rows.size:
             out[self.dependent] = -self.Ad_inv @ (Adot[self.rows] @ self.S)
         return out
 
     def offset(self, drift: np.ndarray) -> np.ndarray:
-        """:math:`w` with :math:`A w = -\\text{drift}` and zero independent part (drift = :math:`\\dot A v`)."""
+        """:math:`w` with :math:`A w = -\\text{drift}` and zero independent part (drift = :math:`\\dot A v`).
+
+        Args:
+            drift: dA/dt v of all rows (m,) [m/s^2 or rad/s^2].
+        """
         w = np.zeros(self.S.shape[0])
         if self.rows.size:
             w[self.dependent] = -self.Ad_inv @ drift[self.rows]
@@ -248,7 +274,9 @@ def project(
         except SingularConstraintError:
             proj = None
         scale = max(1.0, float(abs(A).max())) if A.size else 1.0
-        if proj is not None and (A.size == 0 or abs(A @ proj.S).max() <= 1e-10 * scale):
+        # no independent velocity (S has no columns, e.g. every wheel of a vehicle at rest sticking): A S is empty,
+        # and the hint's rows, n of them with a regular block, span every row
+        if proj is not None and (A.size == 0 or proj.S.shape[1] == 0 or abs(A @ proj.S).max() <= 1e-10 * scale):
             return proj
     rows = independent_rows(A)
     if independent is None:

@@ -4,7 +4,7 @@ The velocity constraints hold exactly along a simulation (v = S nu), but the pos
 :math:`\\phi(q)` of holonomic rows (a wheel's normal row, loop closures, joint couplings) drift by the integrator's
 error. :func:`robotdyn.simulation.engine.simulate` adds :math:`-\\alpha\\,\\delta q` to :math:`\\dot q`, with
 :math:`\\delta q` the minimum-norm solution of :math:`A_h\\,\\delta q = \\phi`
-(``shared/notes/rolling-contact-and-projection.md``, "Loop closures"), so that :math:`\\dot\\phi = -\\alpha\\phi`
+(the concepts page ``docs/concepts.md``, "The projection"), so that :math:`\\dot\\phi = -\\alpha\\phi`
 on every residual the model's coordinates can change.
 
 Rows whose Jacobian has no rank relative to its scale cannot be corrected by any coordinate. The textbook case is
@@ -58,7 +58,12 @@ def correction(A_h: np.ndarray, phi: np.ndarray) -> np.ndarray:
 def position_rate(red, stabilisation: float) -> np.ndarray:
     """:math:`\\dot q = v - \\alpha A_h^+\\phi` (n,) [m/s or rad/s]: the velocity of a
     :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` ``red`` with its holonomic residuals pulled back
-    at the gain ``stabilisation`` [1/s] (0: none)."""
+    at the gain ``stabilisation`` [1/s] (0: none).
+
+    Args:
+        red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu).
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+    """
     qdot = red.v
     rows = red.jacobian_rows
     hol = rows.holonomic
@@ -85,7 +90,11 @@ def offsets(A_h: np.ndarray, phi: np.ndarray, labels) -> dict[str, float]:
 
 
 def describe_offsets(found: dict[str, float]) -> str:
-    """One line naming the offsets of :func:`offsets`."""
+    """One line naming the offsets of :func:`offsets`.
+
+    Args:
+        found: Residual [m or rad] by row label (:func:`offsets`).
+    """
     parts = ", ".join(f"{lab} {x:.3g}" for lab, x in found.items())
     return (f"holonomic residuals that no coordinate of this model can change, kept as constant offsets (not "
             f"pulled back): {parts} (m or rad; e.g. a wheel's height or axle tilt under a planar root)")
@@ -99,6 +108,12 @@ model (see :func:`check_start`)."""
 
 def check_start(A_h: np.ndarray, phi: np.ndarray, labels, stabilisation: float) -> dict[str, float]:
     """The offsets (:func:`offsets`) at the start of a simulation, after checking that the pull-back can work.
+
+    Args:
+        A_h: The holonomic rows of A (h, n).
+        phi: Their residuals (h,) [m or rad].
+        labels: Their labels.
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
 
     Raises:
         ConstraintError: With ``stabilisation`` on, removing the correctable residual would move a coordinate by
@@ -120,7 +135,12 @@ def check_start(A_h: np.ndarray, phi: np.ndarray, labels, stabilisation: float) 
 
 def weakest(A_h: np.ndarray, labels) -> tuple[float, str]:
     """The smallest nonzero-rank singular value of :math:`A_h` relative to its scale, and the rows that weigh
-    most in its direction (for the error where the pull-back cannot work: nearly rank-deficient rows)."""
+    most in its direction (for the error where the pull-back cannot work: nearly rank-deficient rows).
+
+    Args:
+        A_h: The holonomic rows of A (h, n).
+        labels: Their labels.
+    """
     if A_h.size == 0:
         return float("inf"), ""
     U, s, _, rank = _svd(A_h)
@@ -134,7 +154,14 @@ def weakest(A_h: np.ndarray, labels) -> tuple[float, str]:
 def start_offsets(robot, q0: np.ndarray, stabilisation: float, rows=None) -> dict[str, float]:
     """The holonomic residuals at q0 that no coordinate can change (reported once on stderr, kept as constant
     offsets); raises where the pull-back cannot work (:func:`robotdyn.reduction.pull_back.check_start`).
-    ``rows``: ``robot.rows_at(q0)``, when the caller has them."""
+    ``rows``: ``robot.rows_at(q0)``, when the caller has them.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q0: The initial configuration (n,) [m, rad].
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+        rows: ``robot.rows_at(q0)``, when the caller has them (default ``None``: computed).
+    """
     rows = robot.rows_at(q0) if rows is None else rows
     hol = rows.holonomic
     found = check_start(rows.A[hol], rows.residual[hol], [lab for lab, h in zip(rows.labels, hol) if h],
@@ -146,7 +173,13 @@ def start_offsets(robot, q0: np.ndarray, stabilisation: float, rows=None) -> dic
 
 def failure_note(robot, q: np.ndarray, stabilisation: float) -> str:
     """Where an integration failed with the pull-back on and nearly rank-deficient holonomic rows: the rows and
-    their relative singular value (else empty)."""
+    their relative singular value (else empty).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: The configuration where the integration failed (n,) [m, rad].
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+    """
     if not stabilisation or not np.all(np.isfinite(q)):
         return ""
     try:

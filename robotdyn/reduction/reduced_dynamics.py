@@ -86,17 +86,29 @@ class ConstraintSet:
     def current(self, constraints) -> bool:
         """Whether this set still describes ``constraints`` (the same objects in the same order; a constraint
         changed in place, e.g. by :func:`robotdyn.constraints.posture.set_terrain`, evaluates with its new
-        attributes)."""
+        attributes).
+
+        Args:
+            constraints: The robot's current constraint objects.
+        """
         return len(constraints) == len(self.constraints) and all(
             a is b for a, b in zip(constraints, self.constraints))
 
     def jacobian(self, kin: KinematicState) -> ConstraintRows:
-        """All rows without their time derivative, stacked in constraint order."""
+        """All rows without their time derivative, stacked in constraint order.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+        """
         parts = [c.jacobian(kin) for c in self.constraints]
         return ConstraintRows.stack(parts, self.nv) if len(parts) != 1 else parts[0]
 
     def drift(self, kin: KinematicState) -> np.ndarray:
-        """All drift terms :math:`\\dot A v`, stacked in constraint order."""
+        """All drift terms :math:`\\dot A v`, stacked in constraint order.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+        """
         with np.errstate(over="ignore", invalid="ignore"):  # beyond double precision: refused by checked, in one line
             parts = [c.drift(kin) for c in self.constraints]
         if not parts:
@@ -105,7 +117,11 @@ class ConstraintSet:
 
 
 def constraint_set(robot) -> ConstraintSet:
-    """The robot's :class:`ConstraintSet` (built once, rebuilt if ``robot.constraints`` was changed)."""
+    """The robot's :class:`ConstraintSet` (built once, rebuilt if ``robot.constraints`` was changed).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+    """
     cset = getattr(robot, "_constraint_set", None)
     if cset is None or not cset.current(robot.constraints):
         cset = ConstraintSet(robot.constraints, robot.model.nv)
@@ -126,7 +142,13 @@ def _project_at(robot, q: np.ndarray, independent) -> tuple[KinematicState, Cons
 
 def velocity(robot, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, ConstraintRows]:
     """Only :math:`v = S(q)\\nu` and the constraint rows at q (one kinematics pass, no dynamics): the same ``v`` and
-    ``jacobian_rows`` as :func:`reduce` (or the robot's operational reduction) at a fraction of the cost."""
+    ``jacobian_rows`` as :func:`reduce` (or the robot's operational reduction) at a fraction of the cost.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+    """
     if getattr(robot, "operational", None) is not None:
         red = robot.reduced(q, nu)
         return red.v, red.jacobian_rows
@@ -139,6 +161,17 @@ def assemble(robot, q: np.ndarray, proj, rows0: ConstraintRows, v: np.ndarray, w
     """The dynamics shared by every reduction, once S, v = S nu, w and B are known:
     :math:`M_r = S^TMS`, :math:`C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, v, w)`, :math:`g_r`, :math:`B_r`, and with
     ``coriolis`` :math:`C_r = S^T(M\\dot S + CS)`, :math:`\\dot S` = ``sdot(Adot)``.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        proj: The projection (S and what differentiates it).
+        rows0: The constraint rows at q (without dA/dt).
+        v: Full velocity S nu (n,).
+        w: The acceleration offset dS/dt nu (n,).
+        B: The full input matrix (n, motors).
+        coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
+        sdot: ``sdot(Adot)`` -> dS/dt (n, k), called only with ``coriolis``.
     """
     model, data = robot.model, robot.data
     S = proj.S
@@ -180,7 +213,12 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
 
 def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
     """:math:`M^{-1} b` for a reduced mass matrix, which must be positive definite (Cholesky); else a one-line
-    :class:`~robotdyn.errors.InputError` naming the likely cause."""
+    :class:`~robotdyn.errors.InputError` naming the likely cause.
+
+    Args:
+        M: A reduced mass matrix (k, k), symmetric positive definite.
+        b: The right-hand side (k,) or (k, p).
+    """
     try:
         L = np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
@@ -193,7 +231,15 @@ def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def reference(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
     """The Python reference of the robot's reduced model: :func:`reduce`, or the robot's operational reduction
-    (``robot.operational.reduce``) where its independent velocities are a frame twist."""
+    (``robot.operational.reduce``) where its independent velocities are a frame twist.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+        nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+        coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
+        independent: Indices of the independent velocities in v (default ``None``: the robot's).
+    """
     op = getattr(robot, "operational", None)
     if op is not None:
         return op.reduce(robot, q, nu, coriolis)
@@ -202,6 +248,11 @@ def reference(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, inde
 
 def checked(out: ReducedDynamics, q, nu) -> ReducedDynamics:
     """``out``, after checking that its M, h and w are finite.
+
+    Args:
+        out: The reduced model to check.
+        q: Its configuration (for the message).
+        nu: Its independent velocities (for the message).
 
     Raises:
         NonFiniteError: They are not (a state beyond what double precision holds).

@@ -24,6 +24,9 @@ def names() -> list[str]:
 def module(name: str) -> ModuleType:
     """The module of a registered robot.
 
+    Args:
+        name: The robot's registry name (:func:`names`).
+
     Raises:
         UnknownRobotError: naming the known robots.
     """

@@ -28,7 +28,15 @@ _WORKER_ROBOT = None
 
 @dataclass
 class Batch:
-    """Reduced models at N states (arrays stacked along the first axis)."""
+    """Reduced models at N states (arrays stacked along the first axis).
+
+    Attributes:
+        M: Reduced mass matrices (N, k, k) [kg, kg m^2].
+        h: Biases C_r nu + g_r (N, k) [N, N m].
+        g: Gravity terms g_r (N, k) [N, N m].
+        B: Reduced input matrices (N, k, motors).
+        S: Velocity maps (N, n, k) with v = S nu.
+    """
 
     M: np.ndarray
     h: np.ndarray

@@ -37,6 +37,7 @@ import time
 
 import numpy as np
 
+from ..fast.compiled import Fallback
 from ..fast.dispatch import compiled_model
 from ..errors import NonFiniteError, RobotDynError
 from ..reduction.pull_back import failure_note
@@ -54,7 +55,11 @@ DONE, INTERRUPTED, FAILED = 0, 1, 3
 
 
 def native_profile(profile: TorqueProfile):
-    """The C++ object of a :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (``robotdyn._compiled.TorqueProfile``)."""
+    """The C++ object of a :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (``robotdyn._compiled.TorqueProfile``).
+
+    Args:
+        profile: The :class:`~robotdyn.simulation.torque_profile.TorqueProfile`.
+    """
     from .._compiled import TorqueProfile as Native
 
     kinds, coefs, pars = profile.encode()
@@ -92,8 +97,12 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     native = native_profile(profile)
     breaks = [float(b) for b in profile.breakpoints() if t0 < b < t_end]
     n = robot.nq
-    out = fast.ev.simulate(q0, nu0, float(t0), float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
-                           native, breaks, method, progress, rechooser(robot, fast))
+    rechoose = rechooser(robot, fast)
+    try:
+        out = fast.ev.simulate(q0, nu0, float(t0), float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
+                               native, breaks, method, progress, rechoose)
+    except Fallback as exc:  # the Python path's row choice did not serve the compiled model either
+        raise stuck(robot, rechoose.last, float(fast.ev.last_t), str(exc)) from None
     status, t_stop = out["status"], float(out["t_stop"])
     if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's errors
         from ..contact.sliding import painleve_error, redundant_load_error
@@ -121,6 +130,15 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
 def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     """Whether :func:`robotdyn.simulation.engine.simulate` runs on the compiled engine (see its docstring).
 
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        torque: The torque law (``None``, a profile, or a Python callable).
+        method: The integrator method asked for (``None``: the engine's default).
+        engine: ``auto``, ``compiled`` or ``scipy``.
+
+    Returns:
+        True for the compiled engine, False for scipy's.
+
     Raises:
         RobotDynError: An unknown engine or method, or ``engine="compiled"`` where it cannot run (naming why).
     """
@@ -134,15 +152,17 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     if engine == "scipy" or (method is not None and engine == "auto"):
         return False
     reason = None
+    fast = None if stick_slip_wheels(robot) else compiled_model(robot)
     if stick_slip_wheels(robot):
         reason = "stick-slip wheels (exact switching) are simulated on the Python path"
-    elif compiled_model(robot) is None:
+    elif fast is None:
         from ..fast.dispatch import enabled
         from ..fast.compiled import why_not
 
-        reason = why_not(robot) if enabled() else "the compiled fast path is turned off (ROBOTDYN_COMPILED=0)"
-    elif compiled_model(robot).slip_refusal is not None:
-        reason = compiled_model(robot).slip_refusal
+        reason = why_not(robot) if enabled() else ("the compiled fast path is turned off (ROBOTDYN_COMPILED=0 or "
+                                                   "use_compiled(False))")
+    elif fast.slip_refusal is not None:
+        reason = fast.slip_refusal
     elif torque is not None and not isinstance(torque, TorqueProfile):
         reason = ("the torques are a Python function; give a robotdyn.simulation.torque_profile.TorqueProfile (constant, sine, "
                   "table) to run them compiled")
@@ -156,7 +176,25 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
     """:func:`robotdyn.simulation.engine.simulate` on the compiled engine (:func:`run`), after its checks: a
     :class:`~robotdyn.simulation.trajectory.Trajectory` with ``stats["engine"]``. ``progress`` is the run's reporter
     (:class:`robotdyn.simulation.progress.Progress`: prints, and raises past the run's time limit). The run
-    starts at ``t0`` [s] and samples ``times`` (default ``n_out`` evenly spaced from t0 to t_end)."""
+    starts at ``t0`` [s] and samples ``times`` (default ``n_out`` evenly spaced from t0 to t_end).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        t_end: Final time [s].
+        q0: Initial coordinates (n,) [m, rad].
+        nu0: Initial independent velocities (k,).
+        torque: ``None`` or a :class:`~robotdyn.simulation.torque_profile.TorqueProfile`.
+        n_out: Number of evenly spaced output samples (unless ``times``).
+        rtol: Relative error tolerance.
+        atol: Absolute error tolerance per component.
+        method: One of :data:`METHODS` (``None``: adams).
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+        progress: The run's :class:`~robotdyn.simulation.progress.Progress` reporter.
+        offsets: Holonomic residuals kept as constant offsets, by row label [m or rad]
+            (:func:`robotdyn.reduction.pull_back.start_offsets`).
+        t0: Start time [s].
+        times: Output times [s] (increasing, t0 to t_end; default ``None``: ``n_out`` evenly spaced).
+    """
 
     profile = as_profile(torque, len(robot.motors))
     robot.forward_dynamics(q0, nu0, profile(t0))  # regular where the run starts (raises the Python path's error)
@@ -187,13 +225,60 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
                       list(robot.velocity_names), stats, robot.units, work)
 
 
+def at_time(exc: RobotDynError, t: float) -> RobotDynError:
+    """The same error (class and attributes) with the simulated time where it happened in front of its message."""
+    import copy
+
+    out = copy.copy(exc)
+    out.args = (f"at t = {t:.6g} s: {exc}",)
+    return out
+
+
+def stuck(robot, state, t: float, reason: str) -> RobotDynError:
+    """The one-line error where the compiled engine's projection stops working at time t even after the Python
+    path re-chose its rows at ``state`` = (q, nu) (e.g. a steerable base leaving its parallel-wheel configuration,
+    where the mobility changes): the Python path's own error there without its cached row choice (the scipy
+    engine's error at that state), with the time; else a message naming the reason."""
+    from ..fast.dispatch import use_compiled
+
+    if state is not None:
+        robot._projection_hint = None  # decide afresh, as a first evaluation would
+        try:
+            with use_compiled(False):
+                robot.reduced(*state)
+        except RobotDynError as exc:
+            return at_time(exc, t)
+        # the Python path's rank decision still passes here; the rows' exact rank says what the compiled check saw
+        from ..errors import SingularConstraintError
+
+        A = robot.rows_at(state[0]).A
+        rank = int(np.linalg.matrix_rank(A)) if A.size else 0
+        independent = getattr(robot, "independent_indices", None)
+        if independent is not None and getattr(robot, "operational", None) is None \
+                and robot.nq - rank != len(independent):
+            names = robot.velocity_labels  # the message of robotdyn.reduction.projection.project
+            return SingularConstraintError(
+                f"at t = {t:.6g} s: {len(independent)} independent velocities chosen "
+                f"({', '.join(names[i] for i in independent)}) but the constraints leave {robot.nq - rank} "
+                f"(n = {robot.nq}, rank A = {rank}); expected exactly the mobility")
+    return RobotDynError(f"at t = {t:.6g} s: the projection cannot be continued ({reason}): the constraints changed "
+                         "rank here (e.g. steerable wheels leaving a parallel configuration); expected a motion that "
+                         "keeps the mobility, or start away from this configuration")
+
+
 def rechooser(robot, fast=None):
     """The callback with which the C++ integrator asks the Python path for a new row choice at (q, nu), where the
     compiled one stops working: returns ``(rows, independent, dependent)`` of the Python projection there (and
-    makes ``fast``, if given, use it), or raises the Python path's error (e.g. a singular configuration)."""
+    makes ``fast``, if given, use it), or raises the Python path's error (e.g. a singular configuration).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        fast: The robot's compiled model, told to use the new choice (default ``None``).
+    """
     from ..fast.dispatch import use_compiled
 
     def rechoose(q: np.ndarray, nu: np.ndarray) -> tuple[list[int], list[int], list[int]]:
+        rechoose.last = (np.array(q), np.array(nu))  # where the compiled model last needed the Python path
         with use_compiled(False):
             proj = robot.reduced(q, nu).projection
         if fast is not None:
@@ -203,7 +288,8 @@ def rechooser(robot, fast=None):
         return ([int(r) for r in proj.rows], [] if independent is None else [int(i) for i in independent],
                 [] if dependent is None else [int(i) for i in dependent])
 
+    rechoose.last = None
     return rechoose
 
 
-__all__ = ["run", "simulate_compiled", "choose_engine", "native_profile", "rechooser", "METHODS"]
+__all__ = ["run", "simulate_compiled", "choose_engine", "native_profile", "rechooser", "at_time", "METHODS"]

@@ -33,7 +33,14 @@ Reference = Callable[[float], tuple[np.ndarray, np.ndarray, np.ndarray]]
 
 
 def hold(values) -> Reference:
-    """A constant reference."""
+    """A constant reference.
+
+    Args:
+        values: The constant value(s) y_d.
+
+    Returns:
+        A :data:`Reference` returning (y_d, 0, 0) at every time.
+    """
     y = np.atleast_1d(np.asarray(values, dtype=float))
     z = np.zeros_like(y)
     return lambda t: (y, z, z)
@@ -45,7 +52,12 @@ class Task:
     reference: Reference
 
     def evaluate(self, robot, kin: KinematicState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Return (y, J, Jdot_v) at the state of ``kin``."""
+        """Return (y, J, Jdot_v) at the state of ``kin``.
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot`.
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+        """
         raise NotImplementedError
 
 
@@ -54,8 +66,10 @@ class PointTask(Task):
     """The world position of a point fixed in a frame (selected world axes 0=x, 1=y, 2=z).
 
     Attributes:
-        frame: Frame name. offset: The point in the frame's axes [m]. axes: Controlled world components.
-        reference: t -> (p_d, p_d', p_d'') of the controlled components.
+        frame: Frame name.
+        reference: t -> (p_d, p_d', p_d'') of the controlled components [m, m/s, m/s^2].
+        offset: The point in the frame's axes [m] (default: the frame origin).
+        axes: Controlled world components (0 = x, 1 = y, 2 = z; default all three).
     """
 
     frame: str
@@ -76,7 +90,12 @@ class PointTask(Task):
 
 @dataclass
 class CoordinateTask(Task):
-    """Natural coordinates by label (a joint-space task)."""
+    """Natural coordinates by label (a joint-space task).
+
+    Attributes:
+        labels: The controlled coordinates (display or joint names).
+        reference: t -> (y_d, y_d', y_d'') of those coordinates [m or rad, per s, per s^2].
+    """
 
     labels: Sequence[str]
     reference: Reference
@@ -93,6 +112,11 @@ def computed_torque(red, nudot: np.ndarray, controlled: np.ndarray | None = None
 
     Solves :math:`M_r\\dot\\nu + h = B_r\\tau` for (tau, the uncontrolled accelerations) in least squares
     (minimum norm when the motors are redundant).
+
+    Args:
+        red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu).
+        nudot: The wanted accelerations of the controlled independent velocities [m/s^2, rad/s^2].
+        controlled: Indices of the controlled independent velocities (default ``None``: all).
 
     Returns:
         ``(tau, nudot_all)``: the torques and the full vector of independent accelerations they produce.
@@ -143,7 +167,13 @@ class LinearisingController:
             self._ctrl = np.array([names.index(c if c in names else f"{c}_dot") for c in self.controlled])
 
     def outputs(self, q, nu, t: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(y, y', y_d, y_d') of the stacked tasks at (q, nu)."""
+        """(y, y', y_d, y_d') of the stacked tasks at (q, nu).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+            t: Time [s] at which the references are evaluated.
+        """
         red = self.robot.reduced(q, nu)
         kin = KinematicState(self.robot.model, self.robot.data, q, red.v)
         ys, yds, ydots, yddots = [], [], [], []
@@ -154,7 +184,13 @@ class LinearisingController:
         return np.concatenate(ys), np.concatenate(ydots), np.concatenate(yds), np.concatenate(yddots)
 
     def command(self, t: float, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The new input u (eq: nu' = u) and the motor torques at (t, q, nu)."""
+        """The new input u (eq: nu' = u) and the motor torques at (t, q, nu).
+
+        Args:
+            t: Time [s].
+            q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+        """
         red = self.robot.reduced(q, nu)
         kin = KinematicState(self.robot.model, self.robot.data, q, red.v)
         A, b = self._rows(self.tasks, t, kin, red)
@@ -189,7 +225,14 @@ class LinearisingController:
 
 def tracking_errors(controller: LinearisingController, traj: Trajectory, task: int = 0,
                     after: float = 0.0) -> dict[str, float]:
-    """Position error norms :math:`\\|y_d - y\\|` of one task along a trajectory: mean, RMS and max [same unit as y]."""
+    """Position error norms :math:`\\|y_d - y\\|` of one task along a trajectory: mean, RMS and max [same unit as y].
+
+    Args:
+        controller: The :class:`LinearisingController` run.
+        traj: The :class:`~robotdyn.simulation.trajectory.Trajectory` it produced.
+        task: Index of the task in the controller's tasks.
+        after: Ignore samples before this time [s] (the transient).
+    """
     errs = []
     for t, q, nu in zip(traj.t, traj.q, traj.nu):
         if t < after:
@@ -209,6 +252,16 @@ class ControlledScenario(Scenario):
     """A scenario whose torque law is built for the robot it runs on (e.g. a model-based controller).
 
     Attributes:
+        name: Identifier (``robotdyn simulate ROBOT --scenario NAME``).
+        description: One line, citing the paper's section.
+        t_end: Default duration [s].
+        torque: Motor torques used when ``make_controller`` is ``None`` (as :class:`Scenario`).
+        q0: Initial coordinates by name [m, rad] (missing entries: the neutral configuration).
+        nu0: Initial independent velocities by name (missing entries are zero).
+        n_out: Default number of output samples.
+        plot: Columns to plot (default all independent velocities).
+        zoom: Length [s] of the zoomed transient window in plots (``None``: no zoom column).
+        references: Horizontal reference lines per plotted column.
         make_controller: robot -> controller (a callable tau(t, q, nu)).
         adapt_robot: Optional robot -> robot (e.g. the same robot with other contacts) used for the run.
         initial: Optional robot -> (q0, nu0) overriding ``q0``/``nu0``.
@@ -219,7 +272,11 @@ class ControlledScenario(Scenario):
     initial: Callable | None = None
 
     def prepare(self, robot):
-        """(robot used, controller) for a run on ``robot``."""
+        """(robot used, controller) for a run on ``robot``.
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot`.
+        """
         if self.adapt_robot is not None:
             robot = self.adapt_robot(robot)
         controller = self.make_controller(robot) if self.make_controller is not None else self.torque

@@ -22,8 +22,8 @@ import numpy as np
 
 from ..fast.compiled import Fallback
 from ..fast.dispatch import compiled_model
-from .compiled_engine import METHODS, choose_engine, simulate_compiled
-from ..errors import NonFiniteError, RobotDynError
+from .compiled_engine import METHODS, at_time, choose_engine, simulate_compiled
+from ..errors import ConstraintError, NonFiniteError, RobotDynError
 from ..reduction.projection import solve
 from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
 from ..reduction.reduced_dynamics import velocity
@@ -75,7 +75,9 @@ def simulate(
         robot: A :class:`~robotdyn.robot.Robot`.
         t_end: Final time [s] (> 0).
         q0: Initial natural coordinates (must satisfy the holonomic constraints).
-        nu0: Initial independent velocities.
+        nu0: Initial independent velocities; with stick-slip wheels also the full velocities v (n,), where the
+            independent ones cannot give them (e.g. a vehicle launched sliding whose wheels all stick at rest:
+            no independent velocity); each wheel then starts sliding where its slip speed exceeds 1e-9 m/s.
         torque: Motor torques: a :class:`~robotdyn.simulation.torque_profile.TorqueProfile`, any callable ``tau(t, q, nu)``
             (scipy engine), or ``None`` for no actuation.
         n_out: Number of output samples.
@@ -96,6 +98,18 @@ def simulate(
             ``sink.segment`` samples (memory bounded whatever the duration; any ``n_out`` >= 2) and returns a
             :class:`robotdyn.simulation.streaming.StreamResult` instead of a Trajectory (see
             :func:`robotdyn.simulation.streaming.stream`: the integrator restarts at each segment boundary).
+
+    Example:
+        >>> import robotdyn
+        >>> from robotdyn.simulation.engine import simulate
+        >>> from robotdyn.simulation.torque_profile import Constant
+        >>> robot = robotdyn.load("quasimoro")
+        >>> traj = simulate(robot, 1.0, robot.neutral(), [0.0, 0.0, 0.0], Constant([0.1, 0.1]), n_out=11,
+        ...                 progress=False)
+        >>> traj.q.shape, traj.nu.shape
+        ((11, 6), (11, 3))
+        >>> bool(abs(traj.energy[-1] - traj.energy[0]) > 0)  # the motors did work
+        True
     """
     if sink is not None:
         from .streaming import stream
@@ -123,19 +137,27 @@ def simulate(
         raise RobotDynError(f"{n_out:.3g} output samples for t_end = {t_end:g} s ({8 * width * n_out / 1e9:.3g} GB); "
                             f"expected 2 to {MAX_SAMPLES:,} samples: give a shorter duration or fewer samples")
     q0 = robot.check_q(q0)
+    v0 = None  # stick-slip wheels: the full velocities v may be given instead (a vehicle held when every wheel sticks)
+    if stick_slip_wheels(robot) and np.ndim(nu0) == 1 and len(nu0) == robot.nq != robot.mobility:
+        from ..inputs import MAX_VELOCITY, as_vector
+
+        v0 = as_vector(nu0, robot.nq, "v", robot.velocity_labels, MAX_VELOCITY)
+        nu0 = np.zeros(robot.mobility)
     nu0 = robot.check_nu(nu0)
     if isinstance(torque, TorqueProfile):
         as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
     if not t0:  # a continuation starts where the earlier run ended (its drift is reported, not refused)
         robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
+    stiff_slip_warning(robot, t_end - t0)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
     if stick_slip_wheels(robot):  # exact switching: segment by segment
         if t0 or times is not None:
             raise RobotDynError("t0/times: stick-slip wheels are simulated from t = 0 on n_out samples only")
         from .stick_slip import simulate as simulate_stick_slip
 
-        return _applied(simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0), torque, n_out, rtol, atol,
+        return _applied(simulate_stick_slip(robot, t_end, q0, robot.velocity(q0, nu0) if v0 is None else v0, torque,
+                                            n_out, rtol, atol,
                                             method or "DOP853", stabilisation, progress, time_limit=time_limit),
                         robot, torque)
     if compiled_engine:
@@ -195,6 +217,7 @@ def simulate(
     start = time.perf_counter()
     y0 = np.concatenate([q0, nu0, [0.0] if slipping else []])
     interrupted = None
+    rhs = _timed(rhs)
     if events is None:
         breaks = torque.breakpoints() if isinstance(torque, TorqueProfile) else ()
         sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks, t0)
@@ -234,6 +257,53 @@ def simulate(
         stats["offsets"] = offsets
     return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
                       robot.units, sol.y[n + k][: len(times)] if slipping else None, robot, torque)
+
+
+MAX_STEPS = 1e8
+"""Integration steps beyond which :func:`stiff_slip_warning` warns (hours of wall time on either engine)."""
+
+
+def stiff_slip_warning(robot, duration: float) -> None:
+    """Warn (:class:`~robotdyn.errors.RobotDynWarning`) where a slipping wheel's friction law is so stiff that the
+    run needs more than :data:`MAX_STEPS` steps. Near zero slip a law's force per unit load grows as :math:`k s`
+    (:class:`~robotdyn.contact.friction.LinearTyre`: k its stiffness [s/m];
+    :class:`~robotdyn.contact.friction.RegularisedCoulomb`: :math:`k = \\mu / v_s`), so a wheel carrying its share
+    m of the weight (load m g) relaxes its slip at the rate :math:`k g` [1/s] at least (its own spin inertia only
+    makes the mode faster). An explicit (or Adams) stepper needs steps of about :math:`1/(k g)`: a run of T seconds
+    at least :math:`k g T` of them (e.g. k = 1e12 s/m: 1e13 steps a second, a run that never ends)."""
+    import warnings
+
+    from ..errors import RobotDynWarning
+
+    g = float(np.linalg.norm(robot.model.gravity.linear))
+    stiff = {}
+    for wheel in slipping_wheels(robot):
+        law = getattr(wheel, "law", None)
+        k = getattr(law, "stiffness", None)
+        if k is None and getattr(law, "slip_velocity", None):
+            k = law.mu / law.slip_velocity
+        if k and k * g * duration > MAX_STEPS:
+            stiff[wheel.name] = k
+    if stiff:
+        k = max(stiff.values())
+        warnings.warn(RobotDynWarning(
+            f"wheel(s) {', '.join(stiff)}: a friction law's slope up to k = {k:.3g} s/m relaxes slip at k g = "
+            f"{k * g:.3g} 1/s, so a run of {duration:g} s needs at least {k * g * duration:.2g} integration steps "
+            f"and will not end in a useful time (simulate --time-limit bounds it); expected k <= "
+            f"{MAX_STEPS / (g * duration):.3g} s/m for this duration (a lower stiffness, a larger slip_velocity) or "
+            "friction = 'rolling'"), stacklevel=3)
+
+
+def _timed(rhs):
+    """``rhs`` whose constraint errors (e.g. a singular configuration reached) name the simulated time, as the
+    compiled engine's do (:func:`robotdyn.simulation.compiled_engine.at_time`)."""
+    def timed(t: float, y: np.ndarray) -> np.ndarray:
+        try:
+            return rhs(t, y)
+        except ConstraintError as exc:
+            raise at_time(exc, t) from None
+
+    return timed
 
 
 def _applied(traj: Trajectory, robot, torque) -> Trajectory:
@@ -306,7 +376,16 @@ def _velocity(robot, fast, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, n
 
 
 def power(robot, traj: Trajectory, torque: TorqueFunction | None) -> np.ndarray:
-    """Motor power :math:`\\tau^T B_r^T \\nu` [W] along a trajectory (dE/dt must equal it without friction)."""
+    """Motor power :math:`\\tau^T B_r^T \\nu` [W] along a trajectory (dE/dt must equal it without friction).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` simulated.
+        traj: Its :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        torque: The torque law ``tau(t, q, nu)`` it was simulated with (``None``: unactuated, zero power).
+
+    Returns:
+        The power at each sample (N,) [W].
+    """
     out = np.zeros(len(traj.t))
     if torque is None:
         return out

@@ -40,6 +40,8 @@ class ManyRuns:
             the robot's): ``simulate(variant(robot, models[i]), ...)`` repeats run i alone, bit for bit.
         walls: (N,) wall-clock time of each run's integration [s] (0 for runs not started).
         stats: Wall time [s], threads, integrator, runs per second, ``partial`` after an interruption.
+        coordinates: Names of the n coordinates.
+        velocity_names: Names of the k independent velocities.
     """
 
     t: np.ndarray

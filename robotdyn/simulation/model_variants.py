@@ -48,14 +48,25 @@ def _fast(robot):
 
 
 def model_vector(robot) -> np.ndarray:
-    """The robot's model vector (as its compiled model reads it)."""
+    """The robot's model vector (as its compiled model reads it).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` with a compiled model.
+
+    Returns:
+        The model vector (L,).
+    """
     return np.array(_fast(robot).ev.model_vector())
 
 
 def structure(robot) -> tuple:
     """Everything of the compiled model that a model vector does not hold: joint kinds and parents, the frames'
     joints, the constraints' kinds, rows and joints, the motors, the terrain. Robots with equal structures can share
-    one compiled model."""
+    one compiled model.
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` with a compiled model.
+    """
     fast = _fast(robot)
     model = robot.model
     joints = tuple((model.joints[i].shortname(), int(model.parents[i])) for i in range(1, model.njoints))
@@ -125,7 +136,12 @@ def _inertia_slots(njoints: int) -> np.ndarray:
 
 def to_dynamic(V: np.ndarray, slots: np.ndarray) -> np.ndarray:
     """Model vectors (N, L) with each inertia block as :math:`\\pi = (m, mc, I_O)` (inertia about the joint frame's
-    origin: :math:`I_O = I_C + m(|c|^2 1 - cc^T)`, entries xx xy xz yy yz zz)."""
+    origin: :math:`I_O = I_C + m(|c|^2 1 - cc^T)`, entries xx xy xz yy yz zz).
+
+    Args:
+        V: Model vectors (N, L), inertia blocks as (m, c, I_C).
+        slots: Start index of each inertia block in a model vector.
+    """
     V = np.array(V, float)
     for s in slots:
         m, c, I = V[:, s], V[:, s + 1:s + 4], V[:, s + 4:s + 10]
@@ -137,7 +153,12 @@ def to_dynamic(V: np.ndarray, slots: np.ndarray) -> np.ndarray:
 
 
 def from_dynamic(V: np.ndarray, slots: np.ndarray) -> np.ndarray:
-    """The inverse of :func:`to_dynamic` (a massless body keeps a zero centre of mass)."""
+    """The inverse of :func:`to_dynamic` (a massless body keeps a zero centre of mass).
+
+    Args:
+        V: Model vectors (N, L), inertia blocks as (m, mc, I_O).
+        slots: Start index of each inertia block in a model vector.
+    """
     V = np.array(V, float)
     for s in slots:
         m = V[:, s]
@@ -152,7 +173,12 @@ def from_dynamic(V: np.ndarray, slots: np.ndarray) -> np.ndarray:
 def physical(V: np.ndarray, robot) -> list[str]:
     """Per model vector (N, L): '' where every body is physical, else why not (a negative mass, an inertia that is
     not positive semi-definite or breaks the triangle inequality of principal moments, as
-    :func:`robotdyn.description.urdf.validate_urdf` refuses in a description)."""
+    :func:`robotdyn.description.urdf.validate_urdf` refuses in a description).
+
+    Args:
+        V: Model vectors (N, L) (or one (L,)).
+        robot: The :class:`~robotdyn.robot.Robot` they are variants of (its joint names for the messages).
+    """
     V = np.atleast_2d(V)
     out = [""] * len(V)
     names = robot.model.names
@@ -298,6 +324,9 @@ class ParameterModel:
 
     def vectors(self, values: np.ndarray) -> np.ndarray:
         """Model vectors (N, L) at parameter values (N, len(names)) inside the box.
+
+        Args:
+            values: Parameter values (N, len(names)) in the parameters' units (or one row).
 
         Raises:
             InputError: A value outside the box (the fit is verified only inside it).

@@ -12,7 +12,7 @@ A :class:`~robotdyn.contact.stick_slip_wheel.StickSlipWheel` is in one of two ph
   :math:`\\hat s = s/\\|s\\|` (:math:`\\hat s_0` while :math:`\\|s\\|` is below 1e-12 m/s), the normal load solved
   together with the accelerations (:func:`robotdyn.contact.sliding.forward`). Event: :math:`s\\cdot\\hat s_0 = 0`
   (decreasing) tries sticking: the wheel sticks if the sticking solution's force lies inside the cone, else it
-  keeps sliding in the direction of that force (``shared/notes/contact-forces-and-friction.md``).
+  keeps sliding in the direction of that force (the concepts page ``docs/concepts.md``).
 
 Lift-off (a normal load reaching zero, decreasing) stops the run with a message naming the wheel, time and load.
 The independent velocities change with the phases, so :func:`simulate` integrates segment by segment and reports
@@ -67,12 +67,19 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` with :class:`StickSlipWheel` constraints.
         t_end: Duration [s] (> 0).
-        q0: Initial natural coordinates; v0: initial full velocities (n,) (each wheel starts sliding where its
-            slip speed exceeds 1e-9 m/s, else sticking; a sticking wheel outside its cone starts sliding).
+        q0: Initial natural coordinates (n,) [m, rad].
+        v0: Initial full velocities (n,) [m/s, rad/s] (each wheel starts sliding where its slip speed exceeds
+            1e-9 m/s, else sticking; a sticking wheel outside its cone starts sliding).
         torque: Motor torques ``tau(t, q, nu)`` (None: unactuated); nu are the current phase's independent
             velocities, so torque laws should use q (or the returned full velocities) only.
         max_switches: Bound on the number of phase switches (Zeno behaviour stops the run with a message).
         time_limit: Wall-clock limit [s] (None: none), as in :func:`robotdyn.simulation.engine.simulate`.
+        n_out: Number of output samples.
+        rtol: Relative error tolerance of the integrator.
+        atol: Absolute error tolerance per component.
+        method: The ``scipy.integrate.solve_ivp`` method.
+        stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+        progress: Print progress to stderr on long runs.
 
     Returns:
         A :class:`~robotdyn.simulation.trajectory.Trajectory` whose velocity columns are the full velocities v (named
@@ -111,12 +118,25 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
             (lambda tt, qq, nn: np.asarray(torque(tt, qq, nn), float))
         # a sticking wheel whose force is outside the cone starts sliding at once (opposite to that force)
         forces = _forces(robot, q, nu, tau_at(t, q, nu))
+        if len(nu) == 0:  # no velocity left (every wheel sticks, the vehicle is held): at rest while the cones hold
+            grid_rest = grid[(grid > t) | ((grid == 0.0) & (t == 0.0))]
+            constant = torque is None or type(torque).__name__ == "Constant"  # a TorqueProfile without time
+            moved_at = _at_rest(robot, wheels, q, t, grid_rest, tau_at, constant)
+            for tt in grid_rest[grid_rest < moved_at] if moved_at is not None else grid_rest:
+                out_t.append(tt)
+                out_q.append(q.copy())
+                out_v.append(np.zeros(n))
+                out_w.append(work)
+            if moved_at is None:
+                break
+            t, (wheel, direction) = moved_at, _breaking(robot, wheels, q, moved_at, tau_at)
+            wheel.set_phase("slide", direction)
+            switches.append({"t": t, "wheel": wheel.name, "phase": "slide"})
+            v = np.zeros(n)
+            continue
         unknown = [w.name for w in wheels if w.phase == "stick" and not forces.wheel(w.name).load_determined]
         if unknown:
-            raise RobotDynError(
-                f"the sticking forces of wheels {', '.join(unknown)} are not determined by rigid-body dynamics at "
-                f"t = {t:.6g} s (statically indeterminate contacts), so the friction cone cannot decide sticking; "
-                "expected determinate contacts, or a compliant friction law (friction = 'linear' or 'coulomb')")
+            raise _indeterminate(unknown, t)
         moved = False
         for w in wheels:
             if w.phase == "stick":
@@ -177,6 +197,11 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
             wheel.set_phase("slide", -f.force[:2])
         else:  # the slip along its initial direction reached zero: stick, if the sticking force is in the cone
             wheel.set_phase("stick")
+            kin = _kin(robot, q, v)
+            for w in wheels:  # wheels stopping together (a vehicle coming to rest) stick together
+                if w.phase == "slide" and np.linalg.norm(slip(w, kin)[1]) <= 1e-9:
+                    w.set_phase("stick")
+                    switches.append({"t": t, "wheel": w.name, "phase": "stick"})
             robot._stick_slip_q = q
             _configure(robot)
             v = robot.velocity(q, v[robot.independent_indices])  # the rolling rows hold from here on
@@ -196,6 +221,70 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         stats["event"] = stop
     return Trajectory(T, Q, V, energy, residual, list(robot.coordinates), list(robot.velocity_labels), stats,
                       robot.units, np.array(out_w))
+
+
+def _indeterminate(names: list[str], t: float) -> RobotDynError:
+    return RobotDynError(
+        f"the sticking forces of wheels {', '.join(names)} are not determined by rigid-body dynamics at t = {t:.6g} s "
+        "(statically indeterminate contacts), so the friction cone cannot decide sticking; expected determinate "
+        "contacts, or a compliant friction law (friction = 'linear' or 'coulomb')")
+
+
+def _rest_margin(robot, wheels, q, t, tau_at) -> tuple[float, list]:
+    """At rest at q (no velocity left) at time t: the smallest cone margin :math:`\\mu f_n - \\|f_t\\|` [N] of the
+    sticking wheels and those wheels' forces. With statically indeterminate contacts the margin is that of the
+    best admissible split (:meth:`~robotdyn.contact.contact_forces.ConstraintForces.minimum_mu`: some split lies in
+    every cone iff it is at most the smallest mu), scaled by the smallest normal load; ``-inf`` where no normal
+    load is determined (nothing can decide)."""
+    tau = tau_at(t, q, np.zeros(0))
+    forces = _forces(robot, q, np.zeros(0), tau)
+    sticking = [w for w in wheels if w.phase == "stick"]
+    if all(forces.wheel(w.name).load_determined for w in sticking):
+        margins = [w.mu * forces.wheel(w.name).normal - np.hypot(*forces.wheel(w.name).force[:2]) for w in sticking]
+        return (min(margins) if margins else np.inf), [forces.wheel(w.name) for w in sticking]
+    need = forces.minimum_mu()
+    if need is None or not np.isfinite(need):
+        return -np.inf, []
+    load = min(w.normal for w in forces.wheels)
+    return (min(w.mu for w in sticking) - need) * load, []
+
+
+def _at_rest(robot, wheels, q, t: float, grid: np.ndarray, tau_at, constant: bool) -> float | None:
+    """A vehicle held at rest by its sticking wheels (no independent velocity) from time t: the time at which a
+    wheel's force leaves its cone (located by bisection between the output samples, on the torques' time
+    dependence), or ``None`` if the cones hold at every sample to the end. Gravity and the torques are the only
+    forces at rest, so with torques constant in time (``constant``) the check at t decides the whole run.
+
+    Raises:
+        RobotDynError: Statically indeterminate sticking forces that no admissible split keeps in the cones (the
+            one-line error of indeterminate contacts, at the time it happens)."""
+    from scipy.optimize import brentq
+
+    def margin(tt: float) -> float:
+        return _rest_margin(robot, wheels, q, tt, tau_at)[0]
+
+    tol = 1e-12
+    times = [t] + [float(x) for x in grid if x > t]
+    last = times[0]
+    for i, tt in enumerate(times):
+        m = margin(tt)
+        if m < -tol:
+            if m == -np.inf or not _rest_margin(robot, wheels, q, tt, tau_at)[1]:
+                raise _indeterminate([w.name for w in wheels if w.phase == "stick"], tt)
+            return tt if i == 0 else float(brentq(lambda x: margin(x) + tol, last, tt, xtol=1e-12))
+        last = tt
+        if constant:
+            return None
+    return None
+
+
+def _breaking(robot, wheels, q, t: float, tau_at):
+    """The sticking wheel whose force leaves its cone at time t (determinate forces), and its slip direction
+    (opposite to that force)."""
+    sticking = [w for w in wheels if w.phase == "stick"]
+    forces = _rest_margin(robot, wheels, q, t, tau_at)[1]
+    j = int(np.argmin([w.mu * f.normal - np.hypot(*f.force[:2]) for w, f in zip(sticking, forces)]))
+    return sticking[j], -forces[j].force[:2]
 
 
 def _kin(robot, q, v):

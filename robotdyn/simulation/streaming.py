@@ -4,8 +4,9 @@
 [0, t_end] in segments of at most ``CsvSink.segment`` output samples (default :data:`SEGMENT`). Each segment is one
 :func:`~robotdyn.simulation.engine.simulate` call from the previous segment's last sample (q, nu and the absolute
 time, so torque profiles continue unchanged); its rows, and the extra columns ``CsvSink.columns`` computes from
-it (e.g. the wheel loads of :func:`robotdyn.contact.traction.traction`), are appended to the temporary file that
-:func:`robotdyn.output.atomic_output` renames over the target at the end, and then dropped. The output grid is the
+it (e.g. the wheel loads of :func:`robotdyn.contact.traction.traction`), are appended to ``<target>.partial``
+(:func:`robotdyn.output.visible_output`: visible, on disk as computed, left with its rows by a run killed hard) that
+replaces the target at the end, and then dropped. The output grid is the
 in-memory run's (``np.linspace(0, t_end, n_out)``), each time written once.
 
 **The integrator restarts at every segment boundary**, as both engines do at a torque profile's breakpoints: the
@@ -14,7 +15,9 @@ to the integration tolerance (``tests/test_streaming.py``: 1e-9 on Quasimoro), n
 
 A Ctrl-C or SIGTERM (the CLI turns it into ``KeyboardInterrupt``) keeps every row already written plus the
 interrupted segment's rows up to the interruption, followed by the ``# partial: ...`` line of
-:meth:`~robotdyn.simulation.engine.Trajectory.to_csv`: the rows are always a prefix of the full run's.
+:meth:`~robotdyn.simulation.engine.Trajectory.to_csv`: the rows are always a prefix of the full run's, and the
+times the line states are read back from the last row on disk (whatever the interruption hit: the integration, the
+extra columns or the formatting of a chunk), so the marker is true by construction.
 """
 
 from __future__ import annotations
@@ -112,7 +115,7 @@ def stream(robot, t_end: float, q0, nu0, torque, n_out: int, sink: CsvSink, prog
         RobotDynError: Bad arguments, or a segment's integration failed (the file is then not written).
     """
     from ..contact.stick_slip_wheel import stick_slip_wheels
-    from ..output import atomic_output, check_target
+    from ..output import check_target, visible_output
     from .engine import simulate
 
     segment = int(sink.segment)
@@ -136,7 +139,7 @@ def stream(robot, t_end: float, q0, nu0, torque, n_out: int, sink: CsvSink, prog
     energy_start = energy_end = float("nan")
     max_residual = 0.0
     start = last_print = time.perf_counter()
-    with atomic_output(sink.path, "CSV file") as tmp, open(tmp, "wb") as f:
+    with visible_output(sink.path, "CSV file") as (_, f):
         try:
             while a < n_out - 1:
                 b = min(a + segment - 1, n_out - 1)
@@ -194,9 +197,22 @@ def stream(robot, t_end: float, q0, nu0, torque, n_out: int, sink: CsvSink, prog
                     last_print = now
                     print(f"simulate: t = {t_last:.2f} / {t_end:g} s ({100 * t_last / t_end:.0f}%), {written:,} samples "
                           f"written to {sink.path}", file=sys.stderr, flush=True)
-        except KeyboardInterrupt:  # between two segments' calls, or in a segment's set-up
-            stats["partial"] = f"interrupted at t = {t_last:.6g} s: samples up to t = {t_last:.6g} s of {t_end:g} s"
-        if "partial" in stats:
+        except KeyboardInterrupt:  # anywhere else: between segments, in a set-up, in formatting a chunk
+            stats["partial"] = "interrupted"
+        if "partial" in stats:  # the rows on disk say where the run stopped (the marker must be true)
+            row = _last_row(f, 1 + len(robot.coordinates) + len(robot.velocity_names))
+            if row is not None and row[0] != t_last:
+                t_last = float(row[0])
+                q = row[1:1 + robot.nq]
+                nu = row[1 + robot.nq:1 + robot.nq + robot.mobility]
+                written = int(round(t_last / (t_end / (n_out - 1)))) + 1  # the rows are samples 0.. of the grid
+                energy_end = float(robot.energy(q, robot.velocity(q, nu)))
+                if written == 1:
+                    energy_start = energy_end
+            if row is None:
+                written = 0
+            reached = f"samples up to t = {t_last:.6g} s" if written else "no samples"
+            stats["partial"] = f"{stats['partial'].split(':')[0]}: {reached} of {t_end:g} s"
             f.write(f"# partial: {stats['partial']}\n".encode())
     return StreamResult(Path(sink.path), written, t_last, list(robot.coordinates), list(robot.velocity_names),
                         np.asarray(q, float), np.asarray(nu, float), energy_start, energy_end, max_residual, stats)
@@ -204,26 +220,51 @@ def stream(robot, t_end: float, q0, nu0, torque, n_out: int, sink: CsvSink, prog
 
 def _write(f, data: np.ndarray) -> int:
     """Append ``data``'s rows to the binary file ``f`` (numpy.savetxt's format), :data:`CHUNK` rows at a time.
-    Returns how many rows were written completely: an interruption (KeyboardInterrupt) cuts the file back to the
-    last whole chunk, so that no half line is left."""
+    Returns how many rows were written completely: an interruption (KeyboardInterrupt) anywhere in a chunk, its
+    formatting included, cuts the file back to the last whole chunk, so that no half line is left."""
     done = 0
     while done < len(data):
-        chunk = data[done:done + CHUNK]
+        pos, end = f.tell(), min(done + CHUNK, len(data))
         buf = io.BytesIO()
-        np.savetxt(buf, chunk, delimiter=",")
-        f.flush()
-        pos = f.tell()
         try:
+            np.savetxt(buf, data[done:end], delimiter=",")
             f.write(buf.getvalue())
             f.flush()
+            done = end
         except KeyboardInterrupt:
-            f.seek(pos)
-            f.truncate()
+            if done != end:  # the chunk is not counted: not on disk either
+                f.seek(pos)
+                f.truncate()
             return done
         finally:  # savetxt leaves buf in a reference cycle: free its text now, not at the next garbage collection
             buf.close()
-        done += len(chunk)
     return done
+
+
+def _last_row(f, width: int) -> np.ndarray | None:
+    """The last complete data row of the CSV file ``f`` (open for reading and writing), its first ``width`` numbers,
+    after cutting off an incomplete last line (``None``: no data row, only the header or nothing)."""
+    f.flush()
+    end = f.seek(0, io.SEEK_END)
+    start = max(0, end - (1 << 20))
+    f.seek(start)
+    tail = f.read(end - start)
+    cut = tail.rfind(b"\n") + 1
+    if start + cut != end:  # a half-written line (e.g. a write cut short): not a row
+        f.seek(start + cut)
+        f.truncate()
+        tail = tail[:cut]
+    f.seek(0, io.SEEK_END)
+    lines = tail[:-1].rsplit(b"\n", 1) if tail else []
+    if not lines:
+        return None
+    last = lines[-1]
+    if last.startswith(b"t,") or last.startswith(b"#"):  # the header (names start with "t"), or a comment
+        return None
+    try:
+        return np.array([float(x) for x in last.split(b",")[:width]])
+    except ValueError:
+        return None
 
 
 __all__ = ["stream", "CsvSink", "StreamResult", "SEGMENT"]

@@ -73,8 +73,14 @@ class TorqueProfile:
         return out
 
     def at(self, times) -> np.ndarray:
-        """The motor torques at many times (T,) [s] at once: (T, motors), row i the value of ``self(times[i])``
-        (the same formulas, vectorised)."""
+        """The motor torques at many times at once (the same formulas as calling the profile, vectorised).
+
+        Args:
+            times: Times (T,) [s].
+
+        Returns:
+            (T, motors) [N m or N]: row i the value of ``self(times[i])``.
+        """
         t = np.asarray(times, float).reshape(-1)
         terms = self._all()
         out = np.zeros((t.size, terms[0][1].shape[-1]))
@@ -115,7 +121,14 @@ class TorqueProfile:
         return Sum(self, other)
 
     def scaled(self, factor: float) -> TorqueProfile:
-        """The profile times a finite scalar ``factor`` (every term's coefficients scaled)."""
+        """The profile times a finite scalar ``factor`` (every term's coefficients scaled).
+
+        Args:
+            factor: The scale (dimensionless, finite).
+
+        Returns:
+            A :class:`Scaled` profile.
+        """
         return Scaled(self, factor)
 
     def __eq__(self, other) -> bool:
@@ -140,7 +153,20 @@ def _interpolate(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
 
 
 class Constant(TorqueProfile):
-    """Constant torques ``values`` (one per motor) [N m or N]."""
+    """Constant torques ``values`` (one per motor) [N m or N].
+
+    Args:
+        values: One torque [N m] (force [N] on a prismatic joint) per motor, in the robot's motor order.
+
+    Raises:
+        InputError: Not a finite vector.
+
+    Example:
+        >>> from robotdyn.simulation.torque_profile import Constant
+        >>> tau = Constant([0.5, -0.5])
+        >>> tau.at([0.0, 1.0]).tolist()
+        [[0.5, -0.5], [0.5, -0.5]]
+    """
 
     def __init__(self, values) -> None:
         self.values = _values(values, "torques")
@@ -210,7 +236,14 @@ class Table(TorqueProfile):
 
 
 class Sum(TorqueProfile):
-    """The sum of profiles (all with the same number of motors)."""
+    """The sum of profiles (all with the same number of motors).
+
+    Args:
+        *parts: The :class:`TorqueProfile` terms (at least one).
+
+    Raises:
+        InputError: No part, a part that is not a profile, or different numbers of motors.
+    """
 
     def __init__(self, *parts: TorqueProfile) -> None:
         if not parts or not all(isinstance(p, TorqueProfile) for p in parts):
@@ -227,7 +260,15 @@ class Sum(TorqueProfile):
 
 
 class Scaled(TorqueProfile):
-    """A profile times a scalar (:meth:`TorqueProfile.scaled`)."""
+    """A profile times a scalar (:meth:`TorqueProfile.scaled`).
+
+    Args:
+        part: The :class:`TorqueProfile` scaled.
+        factor: The scale (dimensionless, finite).
+
+    Raises:
+        InputError: ``part`` is not a profile or ``factor`` is not finite.
+    """
 
     def __init__(self, part: TorqueProfile, factor: float) -> None:
         if not isinstance(part, TorqueProfile):
@@ -244,8 +285,19 @@ class Scaled(TorqueProfile):
 
 
 def as_profile(torque, motors: int) -> TorqueProfile | None:
-    """``torque`` as a profile for a robot with ``motors`` motors: ``None`` (no torque) as zero constants, a
-    profile as itself (checked), anything else (a Python callable) as ``None``, meaning "Python only"."""
+    """``torque`` as a profile for a robot with ``motors`` motors.
+
+    Args:
+        torque: ``None`` (no torque), a :class:`TorqueProfile`, or a Python callable ``tau(t, q, nu)``.
+        motors: The robot's number of motors.
+
+    Returns:
+        Zero constants for ``None``, the profile itself (checked), ``None`` for a Python callable (meaning
+        "Python engine only").
+
+    Raises:
+        InputError: A profile for another number of motors.
+    """
     if torque is None:
         return Constant(np.zeros(motors))
     if isinstance(torque, TorqueProfile):

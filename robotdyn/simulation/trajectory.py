@@ -49,7 +49,17 @@ class Trajectory:
         return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"
 
     def column(self, name: str) -> np.ndarray:
-        """A coordinate or independent velocity by name."""
+        """A coordinate or independent velocity by name.
+
+        Args:
+            name: One of :attr:`coordinates` or :attr:`velocity_names`.
+
+        Returns:
+            Its values at the samples (N,) [m, rad, m/s or rad/s].
+
+        Raises:
+            RobotDynError: No column has that name.
+        """
         if name in self.coordinates:
             return self.q[:, self.coordinates.index(name)]
         if name in self.velocity_names:
@@ -58,7 +68,25 @@ class Trajectory:
 
     def to_csv(self, path, extra: dict[str, np.ndarray] | None = None) -> None:
         """Write ``t``, the q columns, the nu columns, then any ``extra`` columns by name (e.g. the wheel loads of
-        :meth:`robotdyn.contact.traction.Traction.columns`)."""
+        :meth:`robotdyn.contact.traction.Traction.columns`), atomically.
+
+        Args:
+            path: The CSV file (one header line of column names; a partial run ends with a ``# partial:`` line).
+            extra: More columns by name, each (N,) (default ``None``: none).
+
+        Raises:
+            OutputError: The file cannot be written.
+
+        Example:
+            >>> import numpy as np, robotdyn
+            >>> from robotdyn.robots.quasimoro import model
+            >>> traj = model.SCENARIOS["rectilinear"].run(robotdyn.load("quasimoro"), t_end=0.2, n_out=5, progress=False)
+            >>> traj.to_csv("run.csv")
+            >>> open("run.csv").readline().strip()
+            't,x,y,psi,theta1,theta2,theta3,theta1_dot,theta2_dot,theta3_dot'
+            >>> np.loadtxt("run.csv", delimiter=",", skiprows=1).shape
+            (5, 10)
+        """
         from ..output import atomic_output
 
         extra = extra or {}

@@ -61,7 +61,12 @@ _BASES: dict[tuple, object] = {}
 
 def base_robot(ctx: RunContext, terrain: str | None):
     """The robot every batched run of ``terrain`` varies (the sweep's fixed parameters, that terrain); kept per
-    process, so that the chunks a worker computes share it."""
+    process, so that the chunks a worker computes share it.
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        terrain: The terrain label of the runs (``None``: the robot's own terrain).
+    """
     key = (repr(sorted(ctx.source.items())), repr(sorted(ctx.fixed.items())), terrain,
            repr(ctx.terrains.get(terrain)))
     robot = _BASES.get(key)
@@ -83,13 +88,24 @@ can, ``never`` (every run built from its parameters)."""
 
 def fit_builds(m: int, degree: int = 3) -> int:
     """At most how many robots a :class:`~robotdyn.simulation.model_variants.ParameterModel` of ``m`` parameters
-    builds: an anchor, one step per parameter, and six more probes than the monomials of total degree <= 3."""
+    builds: an anchor, one step per parameter, and six more probes than the monomials of total degree <= 3.
+
+    Args:
+        m: Number of varied parameters.
+        degree: Total degree of the fitted polynomial.
+    """
     return 1 + m + math.comb(m + degree, degree) + 6
 
 
 def model_vectors(ctx: RunContext, runs: list[RunInput], mode: str = "auto") -> Batching:
     """The model vector of every run that can be simulated as a variant of the sweep's base robot (see the module
-    docstring and :data:`MODES`); the others are listed by cause in ``reasons``."""
+    docstring and :data:`MODES`); the others are listed by cause in ``reasons``.
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
+        mode: ``auto``, ``always`` or ``never`` (:data:`MODES`).
+    """
     if mode not in MODES:
         raise RobotDynError(f"batch = {mode!r}; expected one of {', '.join(MODES)}")
     if mode == "never":
@@ -182,6 +198,11 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
     Each run's start is checked as :func:`~robotdyn.simulation.engine.simulate` checks it (the same error rows); a
     run whose start holds residuals that no coordinate can change (constant offsets,
     :func:`robotdyn.reduction.pull_back.start_offsets`) is simulated alone by ``simulate`` on its variant.
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
+        vectors: The model vector (L,) of each run, in the same order.
     """
     mod = load_source(ctx.source)
     out: list = [None] * len(runs)

@@ -72,13 +72,23 @@ def _load(source_key: tuple):
 
 
 def load_source(source: dict):
-    """The module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``) of a sweep's robot."""
+    """The module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``) of a sweep's robot.
+
+    Args:
+        source: The :attr:`RunContext.source`.
+    """
     key = tuple(sorted((k, tuple(sorted(v.items())) if isinstance(v, dict) else v) for k, v in source.items()))
     return _load(key)
 
 
 def build_terrain(mod, definition: tuple):
-    """A terrain from its definition (see :class:`RunContext`)."""
+    """A terrain from its definition (see :class:`RunContext`).
+
+    Args:
+        mod: The robot's module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``; a robot module or a
+            :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`).
+        definition: ``("named", name)`` or ``("kind", kind, {arg: value})``.
+    """
     if definition[0] == "named":
         return mod.TERRAINS[definition[1]]()
     from ..interfaces.constraint_file import TERRAINS
@@ -88,12 +98,21 @@ def build_terrain(mod, definition: tuple):
 
 def overrides_run(scenario) -> bool:
     """Whether a scenario builds its own torque law in its ``run`` (a controller, feed-forward torques): then
-    its torques cannot be scaled from outside."""
+    its torques cannot be scaled from outside.
+
+    Args:
+        scenario: The :class:`~robotdyn.simulation.scenario.Scenario`.
+    """
     return type(scenario).run is not Scenario.run
 
 
 def prepare(ctx: RunContext, run: RunInput):
-    """The robot, scenario (a copy, on the run's terrain), duration and sample count of one run."""
+    """The robot, scenario (a copy, on the run's terrain), duration and sample count of one run.
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        run: The :class:`~robotdyn.sweep.spec.RunInput`.
+    """
     mod = load_source(ctx.source)
     params = {**ctx.fixed, **{k: v for k, v in run.params if k != "torque_scale"}}
     terrain = build_terrain(mod, ctx.terrains[run.terrain]) if run.terrain is not None else None
@@ -104,7 +123,14 @@ def prepare(ctx: RunContext, run: RunInput):
 
 
 def scenario_of(ctx: RunContext, mod, run: RunInput):
-    """A copy of the run's scenario, on the run's terrain (a scenario that picks its terrain by name gets it)."""
+    """A copy of the run's scenario, on the run's terrain (a scenario that picks its terrain by name gets it).
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        mod: The robot's module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``; a robot module or a
+            :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`).
+        run: The :class:`~robotdyn.sweep.spec.RunInput`.
+    """
     scenario = copy.copy(mod.SCENARIOS[run.scenario])
     if run.terrain is not None and dataclasses.is_dataclass(scenario) and hasattr(scenario, "terrain"):
         scenario = dataclasses.replace(scenario, terrain=ctx.terrains[run.terrain][1])
@@ -112,7 +138,14 @@ def scenario_of(ctx: RunContext, mod, run: RunInput):
 
 
 def build_robot(mod, params: dict, terrain):
-    """A robot module's robot, or a constraint file's (which also checks its scenarios against the robot)."""
+    """A robot module's robot, or a constraint file's (which also checks its scenarios against the robot).
+
+    Args:
+        mod: The robot's module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``; a robot module or a
+            :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`).
+        params: Parameter values by name.
+        terrain: A :class:`~robotdyn.constraints.terrain.Terrain` (``None``: the robot's own).
+    """
     from ..interfaces.constraint_file import ConstraintFile
     from ..robot import Robot
 
@@ -120,7 +153,12 @@ def build_robot(mod, params: dict, terrain):
 
 
 def scaled_torque(torque, scale: float):
-    """The torques times the run's scale: a profile stays a profile (the compiled engine runs it)."""
+    """The torques times the run's scale: a profile stays a profile (the compiled engine runs it).
+
+    Args:
+        torque: The scenario's torques (``None``, a profile, or a callable ``tau(t, q, nu)``).
+        scale: The run's torque scale (dimensionless).
+    """
     if torque is None or scale == 1.0:
         return torque
     if isinstance(torque, TorqueProfile):
@@ -134,7 +172,12 @@ SCENARIO_LAW = "the scenario's own torque law"
 
 def simulate_run(ctx: RunContext, run: RunInput):
     """Simulate one run: (robot, trajectory, torque law: a function, ``None`` without torques, or
-    :data:`SCENARIO_LAW` when the scenario builds its own)."""
+    :data:`SCENARIO_LAW` when the scenario builds its own).
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        run: The :class:`~robotdyn.sweep.spec.RunInput`.
+    """
     from ..simulation.engine import simulate
 
     robot, scenario, t_end, n_out = prepare(ctx, run)
@@ -151,7 +194,12 @@ def simulate_run(ctx: RunContext, run: RunInput):
 def energy_drift(traj, torque) -> float | None:
     """Largest :math:`|E(t) - E(t_0)|` [J] over the output samples from the first one after which the motor
     torques are zero at every sample (the whole run without torques), with the friction work of slipping wheels
-    added back; ``None`` when the torques never stop or are built by the scenario itself."""
+    added back; ``None`` when the torques never stop or are built by the scenario itself.
+
+    Args:
+        traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        torque: Its torque law (``None``: none; :data:`SCENARIO_LAW`: built by the scenario).
+    """
     if torque is SCENARIO_LAW:
         return None
     if torque is None:
@@ -172,7 +220,16 @@ def energy_drift(traj, torque) -> float | None:
 
 
 def summary(mod, robot, traj, torque, columns) -> dict:
-    """The summary outputs of one run (see :mod:`robotdyn.sweep.runner`)."""
+    """The summary outputs of one run (see :mod:`robotdyn.sweep.runner`).
+
+    Args:
+        mod: The robot's module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``; a robot module or a
+            :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`).
+        robot: The :class:`~robotdyn.robot.Robot`.
+        traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        torque: Its torque law (as :func:`energy_drift`).
+        columns: Columns whose maximum and minimum are kept.
+    """
     names = traj.coordinates + traj.velocity_names
     data = np.column_stack([traj.q, traj.nu])
     row = {f"final.{c}": float(x) for c, x in zip(names, data[-1])}
@@ -192,7 +249,11 @@ def summary(mod, robot, traj, torque, columns) -> dict:
 
 
 def trajectory_columns(traj) -> dict:
-    """A run's trajectory as the columns a sweep stores (t, q, nu, energy, residual)."""
+    """A run's trajectory as the columns a sweep stores (t, q, nu, energy, residual).
+
+    Args:
+        traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
+    """
     return {"t": traj.t, **{c: traj.q[:, i] for i, c in enumerate(traj.coordinates)},
             **{c: traj.nu[:, i] for i, c in enumerate(traj.velocity_names)},
             "energy": traj.energy, "residual": traj.residual}
@@ -200,7 +261,11 @@ def trajectory_columns(traj) -> dict:
 
 def error_message(exc: Exception) -> str:
     """The error row's message of a failed run: the first line (with the exception's type unless it is one of
-    robotdyn's), at most 1000 characters."""
+    robotdyn's), at most 1000 characters.
+
+    Args:
+        exc: The exception that ended the run.
+    """
     message = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
     if not isinstance(exc, RobotDynError):
         message = f"{type(exc).__name__}: {message}"
@@ -210,7 +275,15 @@ def error_message(exc: Exception) -> str:
 def finished_row(ctx: RunContext, run: RunInput, robot, traj, torque) -> tuple[dict, dict | None]:
     """The row (``ok``, or ``stopped`` where an event ended the run) and trajectory columns (``None`` unless
     ``ctx.trajectories``) of a simulated run, whichever engine ran it; an error row where a summarised number is
-    not finite or the summary fails. ``run_wall`` is the caller's to add."""
+    not finite or the summary fails. ``run_wall`` is the caller's to add.
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        run: The :class:`~robotdyn.sweep.spec.RunInput`.
+        robot: The :class:`~robotdyn.robot.Robot`.
+        traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        torque: Its torque law (as :func:`energy_drift`).
+    """
     try:
         row = {"run_id": run.run_id, "status": "ok", "error": None,
                **summary(load_source(ctx.source), robot, traj, torque, ctx.columns)}
@@ -241,7 +314,13 @@ def run_chunk(ctx: RunContext, runs: list[RunInput], vectors: dict | None = None
     """Compute a chunk of runs: for each, its summary row (``status`` ok, stopped or error, with the message) and
     its trajectory columns (``None`` unless ``ctx.trajectories``). Runs with a model vector in ``vectors`` (run id
     -> vector, :func:`robotdyn.sweep.batched.model_vectors`) are simulated together as variants of one compiled
-    model (:func:`robotdyn.sweep.batched.run_batched`), the others one after the other, each built afresh."""
+    model (:func:`robotdyn.sweep.batched.run_batched`), the others one after the other, each built afresh.
+
+    Args:
+        ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
+        runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
+        vectors: Model vectors by run id (default ``None``: every run built afresh).
+    """
     from ..fast.dispatch import use_compiled
 
     vectors = vectors or {}

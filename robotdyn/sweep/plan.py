@@ -4,9 +4,10 @@
 :class:`~robotdyn.sweep.spec.SweepSpec` against it (parameters and their units, scenarios, terrains, columns,
 durations, tolerances) and lists the runs in order: every parameter point (grid or sample), then every scenario,
 then every terrain. Each run's id hashes everything its result depends on: the robot (its name, or the bytes of
-its constraint file and description), robotdyn's version, the fixed and varied parameters, scenario, terrain,
-torque scale, duration, samples, tolerances, summarised columns, whether trajectories are kept and whether the
-compiled fast path is on.
+its constraint file and description), the expanded description at the fixed parameters (the URDF text: the
+content of every file the description includes, so a changed Xacro include is a new run), robotdyn's version, the
+fixed and varied parameters, scenario, terrain, torque scale, duration, samples, tolerances, summarised columns,
+whether trajectories are kept and whether the compiled fast path is on.
 """
 
 from __future__ import annotations
@@ -27,7 +28,18 @@ OUTPUT_UNITS = {"t_reached": "s", "energy.start": "J", "energy.end": "J", "energ
 @dataclass
 class Plan:
     """A checked sweep: the runs, their shared :class:`~robotdyn.sweep.chunk.RunContext`, the resolved axes,
-    the results' pyarrow schema, units by column and each scenario's (duration, samples)."""
+    the results' pyarrow schema, units by column and each scenario's (duration, samples).
+
+    Attributes:
+        spec: The :class:`~robotdyn.sweep.spec.SweepSpec`.
+        robot: The robot's name.
+        context: The :class:`~robotdyn.sweep.chunk.RunContext` every run shares.
+        axes: The resolved axes (plain values in the parameters' units).
+        runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
+        schema: The results' pyarrow schema.
+        units: Unit of each result column by name.
+        spans: (duration [s], samples) of each scenario by name.
+    """
 
     spec: SweepSpec
     robot: str
@@ -42,7 +54,11 @@ class Plan:
         return f"Plan({self.robot!r}, runs={len(self.runs)}, axes={[a.name for a in self.axes]})"
 
     def inputs(self, run: RunInput) -> dict:
-        """The input columns of a run's row."""
+        """The input columns of a run's row.
+
+        Args:
+            run: The :class:`~robotdyn.sweep.spec.RunInput`.
+        """
         return {"run_id": run.run_id, "run_index": run.index, "robot": self.robot, "scenario": run.scenario,
                 "terrain": run.terrain, "torque_scale": run.torque_scale, "t_end": self.spans[run.scenario][0],
                 **{k: v for k, v in run.params if k != TORQUE_SCALE}}
@@ -128,7 +144,14 @@ def _terrain(mod, item, scenarios) -> tuple[str, tuple]:
 
 
 def plan(spec: SweepSpec) -> Plan:
-    """Check ``spec`` against its robot and list its runs (see the module docstring)."""
+    """Check ``spec`` against its robot and list its runs (see the module docstring).
+
+    Args:
+        spec: The :class:`~robotdyn.sweep.spec.SweepSpec`.
+
+    Returns:
+        The :class:`Plan`.
+    """
     from ..fast.dispatch import enabled
 
     import robotdyn
@@ -201,7 +224,9 @@ def plan(spec: SweepSpec) -> Plan:
         raise SweepSpecError(f"{total:,} runs; expected at most {MAX_RUNS:,}: fewer points or samples")
     ctx = RunContext(source, dict(spec.fixed), terrains, spec.t_end, spec.n_out, tolerances, tuple(columns),
                      bool(spec.trajectories), enabled(), limit)
-    base = {"robot": identity, "version": robotdyn.__version__, "fixed": dict(spec.fixed), "tolerances": tolerances,
+    expanded = hashlib.sha256(robot.description.urdf.encode()).hexdigest()  # every included file's content
+    base = {"robot": {**identity, "expanded": expanded}, "version": robotdyn.__version__, "fixed": dict(spec.fixed),
+            "tolerances": tolerances,
             "columns": list(columns), "trajectories": bool(spec.trajectories), "compiled": ctx.compiled}
     runs = []
     for point in pts:

@@ -7,7 +7,11 @@ from pathlib import Path
 
 def default_column(plan) -> str:
     """The column plotted when the spec names none: the maximum of the first chosen column, else the final
-    value of the first coordinate."""
+    value of the first coordinate.
+
+    Args:
+        plan: The sweep's :class:`~robotdyn.sweep.plan.Plan`.
+    """
     if plan.spec.plot_column:
         return plan.spec.plot_column
     if plan.spec.columns:
@@ -17,7 +21,14 @@ def default_column(plan) -> str:
 
 def plot_summary(table, plan, path, column: str | None = None) -> Path:
     """Scatter ``column`` of the finished runs against each varied numeric parameter (the run index when none
-    varies), one colour per scenario and terrain; error runs are counted in the title. Returns the path."""
+    varies), one colour per scenario and terrain; error runs are counted in the title. Returns the path.
+
+    Args:
+        table: The results (pyarrow table).
+        plan: The sweep's :class:`~robotdyn.sweep.plan.Plan`.
+        path: The image file written (atomically).
+        column: The plotted column (default ``None``: :func:`default_column`).
+    """
     import matplotlib
 
     matplotlib.use("Agg")

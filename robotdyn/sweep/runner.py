@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import store as sweep_store
-from ..errors import RobotDynError
+from ..errors import OutputError, RobotDynError
 from .batched import MODES, Batching, model_vectors
 from .chunk import RunContext, load_source, run_chunk
 from .plan import Plan, plan
@@ -48,7 +48,22 @@ load_trajectory = sweep_store.load_trajectory
 
 @dataclass
 class SweepResult:
-    """What a sweep did: its directory, the results table (pyarrow; :meth:`frame` for pandas), counts."""
+    """What a sweep did: its directory, the results table (pyarrow; :meth:`frame` for pandas), counts.
+
+    Attributes:
+        out: The sweep directory.
+        table: The results (pyarrow table, one row per run in run order).
+        total: Number of runs of the sweep.
+        computed: Runs computed by this call.
+        resumed: Runs found finished on disk.
+        wall: Wall time [s].
+        plot: The summary plot's path (``None``: not written).
+        interrupted: Why the sweep stopped early (``None``: it finished).
+        statuses: Number of runs by status (ok, stopped, error).
+        batched: Runs simulated as variants of one compiled model.
+        notes: Lines on which runs were built one at a time and why.
+        phases: Wall time [s] of each phase (plan, compute, ...).
+    """
 
     out: Path
     table: object
@@ -286,7 +301,7 @@ def _execute(chunks, ctx: RunContext, vectors: dict, workers: int, scheduler: st
 
 def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: str | None = None,
         chunk_size: int | None = None, progress: bool = True, retry_errors: bool = False, plot: bool = True,
-        client=None, batch: str = "auto") -> SweepResult:
+        client=None, batch: str = "auto", replace: bool = False) -> SweepResult:
     """Run a sweep and write its results to the directory ``out`` (see the module docstring).
 
     Args:
@@ -304,10 +319,26 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
         batch: ``auto``, ``always`` or ``never``: whether runs that vary only numbers of the model are simulated
             together as variants of one compiled model (:mod:`robotdyn.sweep.batched`; ``never``: each run built
             from its parameters).
+        replace: Delete the results of another sweep found in ``out`` (else that is an error: a directory whose
+            rows are not all runs of this sweep, e.g. another specification, or this one after an input changed).
+
+    Raises:
+        OutputError: ``out`` is being written by another sweep (locked), or holds another sweep's results and
+            ``replace`` is false.
 
     Returns:
         A :class:`SweepResult`; after an interruption (Ctrl-C) it holds what was finished, with ``interrupted``
         saying so: running the same sweep again resumes.
+
+    Example:
+        >>> from robotdyn.sweep import load, run
+        >>> from robotdyn.sweep.spec import SweepSpec, parse_axis
+        >>> spec = SweepSpec(robot="quasimoro", axes=[parse_axis("M=4:6:3")], t_end=0.2)
+        >>> result = run(spec, "sweep_out", workers=0, progress=False, plot=False)
+        >>> result.total, result.statuses
+        (3, {'ok': 3, 'stopped': 0, 'error': 0})
+        >>> load("sweep_out").sort_values("M")["M"].tolist()
+        [4.0, 5.0, 6.0]
     """
     if batch not in MODES:
         raise RobotDynError(f"batch = {batch!r}; expected one of {', '.join(MODES)}")
@@ -321,7 +352,25 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
         raise RobotDynError(f"workers = {workers}: more local worker processes than this machine runs usefully; "
                             f"expected at most {max_local_workers()} ({WORKERS_PER_CPU} per CPU), or a scheduler")
     out = sweep_store.prepare(out)
+    held = sweep_store.lock(out)  # one sweep at a time per directory
+    try:
+        return _run_locked(spec, p, out, start, phases, workers, scheduler, chunk_size, progress, retry_errors, plot,
+                           client, batch, replace)
+    finally:
+        held.release()
+
+
+def _run_locked(spec, p, out, start, phases, workers, scheduler, chunk_size, progress, retry_errors, plot, client,
+                batch, replace) -> SweepResult:
+    """:func:`run` once the sweep directory ``out`` is locked."""
     done = sweep_store.finished(out)
+    other = sweep_store.foreign(out, done, {r.run_id for r in p.runs}, spec.to_dict())
+    if other is not None:
+        if not replace:
+            raise OutputError(f"sweep directory {str(out)!r} holds another sweep ({other}); expected a new directory, "
+                              "or --replace (run(..., replace=True)) to delete its results")
+        sweep_store.clear(out)
+        done = {}
     todo = [r for r in p.runs if r.run_id not in done or (retry_errors and done[r.run_id] == "error")]
     resumed = len(p.runs) - len(todo)
     sweep_store.write_json(out / "sweep.json", {"spec": spec.to_dict(), "runs": len(p.runs)})

@@ -69,7 +69,16 @@ class SweepSpecError(InputError):
 @dataclass(frozen=True)
 class Axis:
     """One varied quantity: explicit ``values`` (numbers or choices), or a range [``low``, ``high``] in the
-    parameter's unit with ``n`` grid points (linear, or geometric with ``log``); sampled when the sweep samples."""
+    parameter's unit with ``n`` grid points (linear, or geometric with ``log``); sampled when the sweep samples.
+
+    Attributes:
+        name: The parameter's name (or ``torque_scale``).
+        values: Explicit values (numbers, unit strings or choices); empty for a range.
+        low: Lower end of a range (``None`` with values).
+        high: Upper end of a range.
+        n: Grid points of a range (``None``: sampled only).
+        log: Geometric grid / log-uniform samples instead of linear.
+    """
 
     name: str
     values: tuple = ()
@@ -92,7 +101,11 @@ class Axis:
         return (np.geomspace if self.log else np.linspace)(self.low, self.high, self.n).tolist()
 
     def scale(self, u: np.ndarray) -> np.ndarray:
-        """Map uniform samples u in [0, 1) onto the range (log-uniform with ``log``)."""
+        """Map uniform samples u in [0, 1) onto the range (log-uniform with ``log``).
+
+        Args:
+            u: Uniform samples in [0, 1).
+        """
         if self.log:
             return np.exp(np.log(self.low) + u * (np.log(self.high) - np.log(self.low)))
         return self.low + u * (self.high - self.low)
@@ -101,7 +114,29 @@ class Axis:
 @dataclass
 class SweepSpec:
     """A sweep: the robot (a registered name, or a constraint file), the axes and how to combine them, and the
-    settings of each run (duration, samples, tolerances, summarised columns). See the module docstring."""
+    settings of each run (duration, samples, tolerances, summarised columns). See the module docstring.
+
+    Attributes:
+        robot: A registered robot's name (or ``None`` with ``constraints``).
+        constraints: A constraint file's path.
+        urdf: The constraint file's description, overriding its ``urdf``.
+        xacro_args: Xacro arguments by name.
+        fixed: Parameters held at one value (name -> value text).
+        axes: The varied :class:`Axis` objects.
+        scenarios: Scenario names (default: the robot's first).
+        terrains: Terrain names or tables (default: the robot's own).
+        sample: ``grid``, ``random`` or ``lhs``.
+        n: Number of samples (random, lhs).
+        seed: Seed of the samples.
+        t_end: Duration [s] of each run (``None``: the scenario's).
+        n_out: Output samples of each run (``None``: the scenario's).
+        rtol: Integrator relative tolerance (``None``: default).
+        atol: Integrator absolute tolerance (``None``: default).
+        columns: Columns whose max and min are kept (default: every q and nu column).
+        trajectories: Also keep every run's trajectory.
+        plot_column: The column of ``summary.png`` (``None``: :func:`~robotdyn.sweep.plot.default_column`).
+        time_limit: Wall-clock limit [s] of one run (0 or ``None``: none).
+    """
 
     robot: str | None = None
     constraints: str | None = None
@@ -129,7 +164,11 @@ class SweepSpec:
                 f"sample={self.sample!r}" + (f", n={self.n}, seed={self.seed}" if self.sample != "grid" else "") + ")")
 
     def merged(self, **changes) -> SweepSpec:
-        """A copy with the non-empty ``changes`` applied; axes given replace the axes of the same name."""
+        """A copy with the non-empty ``changes`` applied; axes given replace the axes of the same name.
+
+        Args:
+            **changes: Fields to replace (empty values are ignored; ``axes`` replace the axes of the same name).
+        """
         changes = {k: v for k, v in changes.items() if v not in (None, [], {}, ())}
         axes = changes.pop("axes", [])
         names = {a.name for a in axes}
@@ -145,7 +184,16 @@ class SweepSpec:
 @dataclass(frozen=True)
 class RunInput:
     """One run: its position in the sweep, its id (a hash of everything that determines its result), the
-    scenario, the terrain label, the torque scale and the varied parameter values (name, value) pairs."""
+    scenario, the terrain label, the torque scale and the varied parameter values (name, value) pairs.
+
+    Attributes:
+        run_id: 16 hex digits, a hash of the run's inputs (:func:`run_id`).
+        index: Position in the sweep.
+        scenario: The scenario's name.
+        terrain: The terrain label (``None``: the robot's own).
+        torque_scale: The factor on the scenario's torques.
+        params: (name, value) pairs of the varied parameters.
+    """
 
     run_id: str
     index: int
@@ -157,7 +205,16 @@ class RunInput:
 
 def parse_value(text, unit: str, where: str) -> float:
     """A number, optionally followed by its unit (which must be the parameter's; degrees are accepted for an
-    angle in rad): ``0.3``, ``"0.3 m"``, ``"5 deg"``."""
+    angle in rad): ``0.3``, ``"0.3 m"``, ``"5 deg"``.
+
+    Args:
+        text: A number, or a string: a number optionally followed by a unit.
+        unit: The parameter's unit.
+        where: The entry's name, for messages.
+
+    Returns:
+        The value [unit].
+    """
     if isinstance(text, bool):
         raise SweepSpecError(f"{where} = {text!r}; expected a number [{unit or '-'}]")
     if isinstance(text, (int, float)):
@@ -180,7 +237,14 @@ def parse_value(text, unit: str, where: str) -> float:
 
 def parse_axis(text: str) -> Axis:
     """``NAME=LO:HI`` (a range), ``NAME=LO:HI:N`` (N grid points), ``...:log`` (geometric/log-uniform) or
-    ``NAME=V1,V2,...`` (values); values keep their unit text until checked against the robot."""
+    ``NAME=V1,V2,...`` (values); values keep their unit text until checked against the robot.
+
+    Args:
+        text: The ``--vary`` argument.
+
+    Returns:
+        The :class:`Axis` (values still as text).
+    """
     if "=" not in text:
         raise SweepSpecError(f"--vary {text!r}; expected NAME=LO:HI[:N][:log] or NAME=V1,V2,...")
     name, rhs = (s.strip() for s in text.split("=", 1))
@@ -209,7 +273,14 @@ def _count(x, where: str) -> int:
 
 def from_toml(path) -> SweepSpec:
     """Read and check the structure of a sweep file (names and values are checked against the robot by
-    :func:`expand`). Relative ``constraints``/``urdf`` paths are taken from the file's directory."""
+    :func:`expand`). Relative ``constraints``/``urdf`` paths are taken from the file's directory.
+
+    Args:
+        path: The sweep TOML file.
+
+    Returns:
+        The :class:`SweepSpec`.
+    """
     from ..input_files import read_text, resolved
 
     path = Path(path)
@@ -285,7 +356,12 @@ def _toml_axis(path: Path, name: str, v) -> Axis:
 
 def resolve_axis(axis: Axis, parameter) -> Axis:
     """Check an axis against the robot's :class:`~robotdyn.robot.Parameter` (``None`` for the torque scale):
-    units, finiteness, the parameter's own bounds and choices; returns it with plain values."""
+    units, finiteness, the parameter's own bounds and choices; returns it with plain values.
+
+    Args:
+        axis: The :class:`Axis` as parsed.
+        parameter: The robot's :class:`~robotdyn.robot.Parameter` (``None`` for the torque scale).
+    """
     where = f"parameters.{axis.name}"
     unit = "-" if parameter is None else parameter.unit
 
@@ -312,7 +388,12 @@ def resolve_axis(axis: Axis, parameter) -> Axis:
 
 def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
     """The parameter points of the sweep: the grid of every axis, or ``spec.n`` random/LHS samples of the ranged
-    axes (seeded) crossed with the grid of the axes given as values."""
+    axes (seeded) crossed with the grid of the axes given as values.
+
+    Args:
+        spec: The :class:`SweepSpec` (its ``sample``, ``n`` and ``seed``).
+        axes: The resolved axes.
+    """
     if spec.sample not in SAMPLERS:
         raise SweepSpecError(f"sample = {spec.sample!r}; expected one of {', '.join(SAMPLERS)}")
     if isinstance(spec.seed, bool) or not isinstance(spec.seed, int) or not 0 <= spec.seed <= MAX_SEED:
@@ -358,7 +439,14 @@ def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
 
 
 def run_id(identity: dict) -> str:
-    """A 16-hex-digit id of a run from the canonical JSON of its inputs (floats by their exact ``repr``)."""
+    """A 16-hex-digit id of a run from the canonical JSON of its inputs (floats by their exact ``repr``).
+
+    Args:
+        identity: Everything that determines a run's result (JSON-serialisable).
+
+    Returns:
+        The id (16 hex digits).
+    """
     text = json.dumps(identity, sort_keys=True, default=repr, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 

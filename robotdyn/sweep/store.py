@@ -5,7 +5,13 @@ Layout of a sweep directory::
     runs/part-<hash>.parquet            one file per finished chunk: one row per run (inputs and outputs)
     trajectories/run_id=<id>/part-0.parquet   each run's trajectory (optional; a Hive-partitioned dataset)
     results.parquet                     this sweep's rows, in run order (rewritten at the end of every session)
-    sweep.json                          the specification last run, and its run count
+    sweep.json                          the specification last run, its run count and its run ids' digest
+    sweep.lock                          locked (flock) while a sweep writes the directory: pid, host, start
+
+A second sweep writing the same directory meanwhile is refused in one line naming the lock's holder
+(:func:`lock`). A directory whose rows are not all runs of the sweep being started holds another sweep (or this
+one with changed inputs: every run id hashes its inputs) and is refused unless replaced (:func:`foreign`,
+:func:`clear`).
 
 Every file is written to a temporary name and renamed (:func:`robotdyn.output.atomic_output`), trajectories before
 the chunk's row file, so a row file on disk means its runs are complete. Rows are keyed by ``run_id``, a hash of
@@ -16,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from pathlib import Path
 
 from ..errors import OutputError
@@ -28,7 +35,12 @@ RESULTS = "results.parquet"
 
 def schema(fields: list[tuple[str, str, str]], metadata: dict | None = None):
     """A pyarrow schema from (column, type, unit) triples, type one of ``float``, ``int``, ``str``; each field
-    carries its unit in its metadata (``unit``)."""
+    carries its unit in its metadata (``unit``).
+
+    Args:
+        fields: (column, type, unit) triples.
+        metadata: Schema-level metadata (default ``None``).
+    """
     import pyarrow as pa
 
     types = {"float": pa.float64(), "int": pa.int64(), "str": pa.string()}
@@ -37,13 +49,91 @@ def schema(fields: list[tuple[str, str, str]], metadata: dict | None = None):
 
 
 def prepare(out) -> Path:
-    """Create the sweep directory (and ``runs/``); an existing file in the way is a one-line error."""
+    """Create the sweep directory (and ``runs/``); an existing file in the way is a one-line error.
+
+    Args:
+        out: The sweep directory.
+    """
     out = Path(out)
     try:
         (out / RUNS).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot create sweep directory {str(out)!r}: {exc.strerror or exc}") from None
     return out
+
+
+LOCK = "sweep.lock"
+
+
+class Lock:
+    """The exclusive lock of a sweep directory (:func:`lock`); :meth:`release` gives it up."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
+
+    def release(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)  # closing the descriptor releases the flock
+            self.fd = None
+
+
+def lock(out: Path) -> Lock:
+    """Lock the sweep directory ``out`` for this process (``flock`` on ``out/sweep.lock``, released when the
+    process ends, however it ends) and write who holds it into the file.
+
+    Raises:
+        OutputError: Another process holds the lock (naming its pid, host and start time).
+    """
+    import fcntl
+    import socket
+    import time
+
+    path = out / LOCK
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666)
+    except OSError as exc:
+        raise OutputError(f"cannot lock sweep directory {str(out)!r}: {exc.strerror or exc}") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        try:
+            holder = os.pread(fd, 300, 0).decode(errors="replace").strip() or "another process"
+        finally:
+            os.close(fd)
+        raise OutputError(f"sweep directory {str(out)!r} is being written by {holder}; expected one sweep at a time "
+                          "per directory (wait for it, or give another --out)") from None
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"pid {os.getpid()} on {socket.gethostname()} since "
+                  f"{time.strftime('%Y-%m-%d %H:%M:%S', time.localtime())}\n".encode(), 0)
+    return Lock(fd)
+
+
+def foreign(out: Path, done: dict[str, str], ids: set[str], spec: dict) -> str | None:
+    """Why the directory ``out`` holds another sweep than the one whose run ids are ``ids`` and specification
+    ``spec`` (its rows on disk, ``done``, include runs that are not this sweep's), or ``None`` if it does not."""
+    others = [i for i in done if i not in ids]
+    if not others:
+        return None
+    previous = None
+    try:
+        previous = json.loads((out / "sweep.json").read_text()).get("spec")
+    except (OSError, ValueError, AttributeError):
+        pass
+    why = (": the same specification, so an input changed since it ran (a file the description includes, the "
+           "constraint file, or robotdyn's version)") if previous == json.loads(json.dumps(spec, default=str)) else ""
+    return f"{len(others)} of its {len(done)} finished runs are not runs of this sweep{why}"
+
+
+def clear(out: Path) -> None:
+    """Delete a sweep's results from ``out`` (row files, trajectories, results, plot, description); other files
+    are left alone."""
+    import shutil
+
+    for path in _parts(out):
+        path.unlink()
+    shutil.rmtree(out / TRAJECTORIES, ignore_errors=True)
+    for name in (RESULTS, "summary.png", "sweep.json"):
+        (out / name).unlink(missing_ok=True)
 
 
 def _write(table, path: Path, what: str) -> None:
@@ -54,7 +144,14 @@ def _write(table, path: Path, what: str) -> None:
 
 
 def write_chunk(out: Path, rows: list[dict], trajectories: list[dict | None], schema) -> Path:
-    """Write a finished chunk: its trajectories (if any), then its row file; returns the row file's path."""
+    """Write a finished chunk: its trajectories (if any), then its row file; returns the row file's path.
+
+    Args:
+        out: The sweep directory.
+        rows: The chunk's result rows.
+        trajectories: Each row's trajectory columns (``None``: not kept).
+        schema: The results' pyarrow schema (:func:`schema`).
+    """
     import pyarrow as pa
 
     for row, traj in zip(rows, trajectories):
@@ -99,7 +196,11 @@ def _parts(out: Path) -> list[Path]:
 
 
 def finished(out: Path) -> dict[str, str]:
-    """The runs with a row on disk: run_id -> status (``ok``, ``stopped`` or ``error``)."""
+    """The runs with a row on disk: run_id -> status (``ok``, ``stopped`` or ``error``).
+
+    Args:
+        out: The sweep directory.
+    """
     import pyarrow.parquet as pq
 
     done: dict[str, str] = {}
@@ -115,7 +216,13 @@ def finished(out: Path) -> dict[str, str]:
 
 def consolidate(out: Path, order: dict[str, int], schema):
     """Gather this sweep's rows (the run ids in ``order``) from the row files, sorted by run order, and write
-    them to ``results.parquet``; returns the table."""
+    them to ``results.parquet``; returns the table.
+
+    Args:
+        out: The sweep directory.
+        order: Run index by run id (the runs of this sweep).
+        schema: The results' pyarrow schema (:func:`schema`).
+    """
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
@@ -141,12 +248,25 @@ def consolidate(out: Path, order: dict[str, int], schema):
 
 
 def write_json(path: Path, data: dict) -> None:
+    """Write ``data`` as indented JSON to ``path``, atomically.
+
+    Args:
+        path: The JSON file.
+        data: The data (non-JSON values written as strings).
+    """
     with atomic_output(path, "sweep description") as tmp:
         tmp.write_text(json.dumps(data, indent=2, default=str))
 
 
 def load(out):
-    """A sweep's results as a pandas DataFrame (one row per run, in run order)."""
+    """A sweep's results as a pandas DataFrame (one row per run, in run order).
+
+    Args:
+        out: A sweep directory written by ``robotdyn sweep`` (or :func:`robotdyn.sweep.runner.run`).
+
+    Returns:
+        A pandas DataFrame.
+    """
     import pyarrow.parquet as pq
 
     path = Path(out) / RESULTS
@@ -156,7 +276,12 @@ def load(out):
 
 
 def load_trajectory(out, run_id: str):
-    """One run's trajectory (t, coordinates, velocities, energy, residual) as a pandas DataFrame."""
+    """One run's trajectory (t, coordinates, velocities, energy, residual) as a pandas DataFrame.
+
+    Args:
+        out: A sweep directory run with ``--trajectories``.
+        run_id: The run's id (``run_id`` column).
+    """
     import pyarrow.parquet as pq
 
     path = Path(out) / TRAJECTORIES / f"run_id={run_id}" / "part-0.parquet"
@@ -166,4 +291,5 @@ def load_trajectory(out, run_id: str):
     return pq.read_table(path).to_pandas()
 
 
-__all__ = ["schema", "prepare", "write_chunk", "finished", "consolidate", "load", "load_trajectory"]
+__all__ = ["schema", "prepare", "lock", "foreign", "clear", "write_chunk", "finished", "consolidate", "load",
+           "load_trajectory"]

@@ -3,7 +3,7 @@
 - :mod:`robotdyn.robots.adaptable_wheel.model`: what robotdyn derives from ``urdf/adaptable_wheel.urdf.xacro`` -- ``SPEC`` (Table 1), the
   terrains, ``SCENARIOS``.
 - :mod:`robotdyn.robots.adaptable_wheel.paper`: the paper's closed forms (eqs 1, 3-35) and Table 2, transcribed
-  (``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``).
+  (Mardani & Ebrahimi 2016, ``docs/bibliography.md``).
 - :mod:`robotdyn.robots.adaptable_wheel.missions`: the kinematic missions of section 7, solved by the paper's inverse kinematics.
 - :mod:`robotdyn.robots.adaptable_wheel.dynamics`: the model driven along those missions, with inertia or sideways friction (beyond the paper).
 - :mod:`robotdyn.robots.adaptable_wheel.comparison`: ``compare``, the model against the paper, and the ``ik`` CLI

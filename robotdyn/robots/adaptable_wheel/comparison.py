@@ -1,7 +1,7 @@
 """Adaptable-wheel tricycle: the model against the paper (:func:`compare`) and the functions that bring both together.
 
 Model: :mod:`robotdyn.robots.adaptable_wheel.model` (Pinocchio, ``urdf/adaptable_wheel.urdf.xacro``). Paper: :mod:`robotdyn.robots.adaptable_wheel.paper` (eqs 1, 3-35, Table 2 of
-``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``) and its missions (:mod:`robotdyn.robots.adaptable_wheel.missions`, section 7).
+Mardani & Ebrahimi 2016, ``docs/bibliography.md``) and its missions (:mod:`robotdyn.robots.adaptable_wheel.missions`, section 7).
 :func:`model_configuration` puts an IK solution of the paper into the model's coordinates,
 :func:`model_static_check` tests eqs 25-34 against the model's generalised equilibrium, :func:`compare` the printed
 numbers of section 7 and Table 2. The ``ik`` CLI subcommand shows the paper's IK and statics beside the model's
@@ -35,7 +35,11 @@ from .paper import (
 
 
 def euler_zyx(R: np.ndarray) -> tuple[float, float, float]:
-    """(yaw, pitch, roll) [rad] with :math:`R = R_z(yaw) R_y(pitch) R_x(roll)` (the floating root's convention)."""
+    """(yaw, pitch, roll) [rad] with :math:`R = R_z(yaw) R_y(pitch) R_x(roll)` (the floating root's convention).
+
+    Args:
+        R: A rotation matrix (3, 3).
+    """
     return float(np.arctan2(R[1, 0], R[0, 0])) + 0.0, float(np.arcsin(-np.clip(R[2, 0], -1, 1))) + 0.0, float(
         np.arctan2(R[2, 1], R[2, 2]))
 
@@ -46,6 +50,15 @@ def model_configuration(robot: Robot, cmd: Commands, x: np.ndarray, spins: np.nd
     The body pose comes from eqs 4-6 (converted to the root's Z-Y-X Euler angles), q_i from x and the radius
     coordinates from the coupling law (eq 1). Wheel spin angles are ``spins`` (default 0; they do not change the
     contact geometry of a round wheel).
+
+    Args:
+        robot: The adaptable-wheel :class:`~robotdyn.robot.Robot`.
+        cmd: The six :class:`~robotdyn.robots.adaptable_wheel.paper.Commands`.
+        x: An IK solution (beta_fr, beta_fl, beta_r, q_fr, q_fl, q_r) [rad] (eq 16).
+        spins: Wheel spin angles (3,) [rad] (default ``None``: zero).
+
+    Returns:
+        Natural coordinates (n,) [m, rad].
     """
     R, d = body_pose(cmd, robot.terrain)
     q = robot.neutral()
@@ -71,6 +84,12 @@ def model_static_check(robot: Robot, cmd: Commands, x: np.ndarray, res: StaticRe
     2. Virtual work by finite differences: :math:`t_i = -F_i\\cdot\\partial p_i/\\partial q_i`, where
        :math:`p_i(q_i)` is the material rim point at the contact (wheel-fixed direction), computed from the
        model's kinematics with the radius coordinate set by the coupling, at :math:`q_i \\pm \\varepsilon`.
+
+    Args:
+        robot: The adaptable-wheel :class:`~robotdyn.robot.Robot`.
+        cmd: The six :class:`~robotdyn.robots.adaptable_wheel.paper.Commands`.
+        x: An IK solution (beta_fr, beta_fl, beta_r, q_fr, q_fl, q_r) [rad] (eq 16).
+        res: The :class:`~robotdyn.robots.adaptable_wheel.paper.StaticResult` of eqs 25-34 at that configuration.
 
     Returns:
         dict with ``tau`` (6, model order of motors), ``residual``, ``tau_fd`` (3,).
@@ -127,6 +146,14 @@ def compare(robot: Robot | None = None, runs: dict | None = None) -> Comparison:
 
     Tolerances: angles read off the figures or printed to 5 deg: 2.5 deg; torques printed to 0.1 N m: 0.05 N m;
     the "4" N m of section 7: 0.5; convergence: the paper's criterion 1e-5.
+
+    Args:
+        robot: The robot (default ``None``: built with the default parameters).
+        runs: Mission runs by name (:func:`~robotdyn.robots.adaptable_wheel.missions.run_mission`; default ``None``:
+            run here).
+
+    Returns:
+        The :class:`~robotdyn.interfaces.comparison.Comparison`.
     """
     robot = robot or Robot(SPEC)
     params = {k: v for k, v in robot.params.items() if k != "terrain"}
@@ -166,7 +193,11 @@ def compare(robot: Robot | None = None, runs: dict | None = None) -> Comparison:
 
 # ------------------------------------------------------------------------------------------------------ CLI
 def cmd_ik(args) -> int:
-    """``robotdyn ik adaptable_wheel --commands x_d y_d h_CG q_xd q_yd q_zd``: eqs 4-24 and the static torques."""
+    """``robotdyn ik adaptable_wheel --commands x_d y_d h_CG q_xd q_yd q_zd``: eqs 4-24 and the static torques.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+    """
     import json
 
     from ...cli.commands import _jsonable
@@ -237,7 +268,12 @@ def cmd_ik(args) -> int:
 
 
 def register_cli(subparsers, parents) -> None:
-    """Add ``robotdyn ik ROBOT --commands ...`` (or ``--mission NAME``)."""
+    """Add ``robotdyn ik ROBOT --commands ...`` (or ``--mission NAME``).
+
+    Args:
+        subparsers: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     name = "ik" if "ik" not in subparsers.choices else "wheel-ik"
     p = subparsers.add_parser(name, parents=parents,
                               help="adaptable_wheel: inverse kinematics (eqs 4-24) and static torques")

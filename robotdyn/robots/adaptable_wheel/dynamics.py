@@ -5,7 +5,7 @@ The paper stops at kinematics and statics; here the model of :mod:`robotdyn.robo
 torques with inertia (:func:`mission_dynamics`, contact forces chosen as in eqs 28-30), or the wheels slide sideways
 under a friction law (:func:`mission_friction`). Both report the paper's eq 35 and eqs 25-34 beside the model's
 torques. Discussion: ``docs/errata/adaptable_wheel.md``
-(``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``).
+(Mardani & Ebrahimi 2016, ``docs/bibliography.md``).
 """
 
 from __future__ import annotations
@@ -43,7 +43,13 @@ def _commands_at(run: IKRun, t: float) -> Commands:
 
 
 def body_coordinates(run: IKRun, t: float, terrain: Terrain) -> np.ndarray:
-    """(x, y, z, yaw, pitch, roll) of the body at time t from the commands (eqs 4-6)."""
+    """(x, y, z, yaw, pitch, roll) of the body at time t from the commands (eqs 4-6).
+
+    Args:
+        run: An :class:`~robotdyn.robots.adaptable_wheel.missions.IKRun`.
+        t: Time [s] in the run's interval.
+        terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
+    """
     R, d = body_pose(_commands_at(run, t), terrain)
     return np.concatenate([d, euler_zyx(R)])
 
@@ -100,6 +106,8 @@ class MissionModel:
     Args:
         run: An :class:`IKRun` (its mission fixes the terrain).
         params: Parameter overrides (e.g. ``m_wheel``, ``I_adjust``).
+        run: An :class:`~robotdyn.robots.adaptable_wheel.missions.IKRun` (its mission fixes the terrain).
+        params: Parameter overrides (default ``None``).
     """
 
     def __init__(self, run: IKRun, params: dict | None = None) -> None:
@@ -117,7 +125,12 @@ class MissionModel:
         self.lateral_rows = [i for i, c in enumerate(labels) if c.endswith(".lateral")]
 
     def ik_at(self, t: float, guess=None) -> tuple[Commands, np.ndarray]:
-        """Commands and IK solution at any time t of the run."""
+        """Commands and IK solution at any time t of the run.
+
+        Args:
+            t: Time [s] in the run's interval.
+            guess: Initial IK guess (6,) [rad] (default ``None``: the nearest step's solution).
+        """
         cmd = _commands_at(self.run, t)
         if guess is None:
             i = int(np.clip(round(t / self.run.mission.dt), 0, len(self.run.t) - 1))
@@ -125,7 +138,11 @@ class MissionModel:
         return cmd, solve_ik(cmd, self.p, self.slip.terrain, guess)[0]
 
     def state(self, t: float) -> tuple[Commands, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(commands, IK solution, q, v, a) at time t (natural coordinates of the model)."""
+        """(commands, IK solution, q, v, a) at time t (natural coordinates of the model).
+
+        Args:
+            t: Time [s] in the run's interval.
+        """
         from ...reduction.reduced_dynamics import reduce
 
         cmd, x = self.ik_at(t)
@@ -135,7 +152,11 @@ class MissionModel:
         return cmd, x, q, red.v, red.S @ nudot + red.w
 
     def at(self, t: float) -> dict:
-        """Torques, contact forces and checks at time t (see :class:`DynamicsRun` for the meaning)."""
+        """Torques, contact forces and checks at time t (see :class:`DynamicsRun` for the meaning).
+
+        Args:
+            t: Time [s] in the run's interval.
+        """
         rolling, pr = self.rolling, self.p
         cmd, x, q, v, a = self.state(t)
         tau_rnea = pin.rnea(rolling.model, rolling.data, q, v, a)

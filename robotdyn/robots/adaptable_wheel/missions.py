@@ -1,6 +1,6 @@
 """Adaptable-wheel tricycle: the kinematic missions of section 7, solved by the paper's inverse kinematics.
 
-Paper: ``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``, section 7 and Table 1 (mission 1: a circle
+Paper: Mardani & Ebrahimi 2016, ``docs/bibliography.md``, section 7 and Table 1 (mission 1: a circle
 on the rough terrain; mission 2: a straight run across a ramp, path and heading not printed: ours) and the
 flowchart of Fig. 8 (:func:`run_mission`: eqs 15-24 at every step, the yaw by eqs 18-23). The computation is the
 paper's (:mod:`robotdyn.robots.adaptable_wheel.paper`); only the parameter defaults and the terrain come from the model's ``SPEC``.
@@ -58,9 +58,17 @@ class IKRun:
     """Inverse kinematics along a mission (one row per time step).
 
     Attributes:
-        t: Times [s]. beta, q: (N, 3) eq 16's unknowns per wheel (fr, fl, r) [rad]. RT: (N, 3) radii [m].
-        error: (N,) ||C|| (eq 24). yaw: (N,) q_zd [rad]. cg: (N, 3) CG position [m].
-        contacts: (N, 3, 3) contact points [m]. nfev: (N,) residual evaluations of the root finder.
+        mission: The :class:`Mission` solved.
+        t: Times (N,) [s].
+        beta: (N, 3) eq 16's contact angles per wheel (fr, fl, r) [rad].
+        q: (N, 3) eq 16's adjustment angles per wheel (fr, fl, r) [rad].
+        RT: (N, 3) total wheel radii [m].
+        error: (N,) ||C|| (eq 24).
+        yaw: (N,) q_zd [rad].
+        cg: (N, 3) CG position [m], world frame.
+        contacts: (N, 3, 3) contact points [m], world frame.
+        nfev: (N,) residual evaluations of the root finder.
+        commands: The :class:`~robotdyn.robots.adaptable_wheel.paper.Commands` of each step.
     """
 
     mission: Mission
@@ -80,6 +88,14 @@ def run_mission(mission: Mission | str, params: dict | None = None, tol: float =
     """Inverse kinematics at every step of a mission (the flowchart of Fig. 8).
 
     Each step solves eq 15 by :func:`solve_ik` from the previous step's solution and updates q_zd by eqs 18-23.
+
+    Args:
+        mission: A :class:`Mission` or its name (:data:`MISSIONS`).
+        params: Parameter overrides (default ``None``).
+        tol: Required ||C|| of each step's IK (eq 24).
+
+    Returns:
+        The :class:`IKRun`.
 
     Raises:
         MechanismRangeError, ConstraintError: as :func:`solve_ik`, with the time of the failing step.

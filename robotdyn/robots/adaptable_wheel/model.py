@@ -2,7 +2,7 @@
 
 Description: ``urdf/adaptable_wheel.urdf.xacro``. Paper the parameters come from: A. Mardani, S. Ebrahimi, "A Novel
 Multimode Mobile Robot with Adaptable Wheel Geometry for Maneuverability Improvement"
-(``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``), Table 1.
+(Mardani & Ebrahimi 2016, ``docs/bibliography.md``), Table 1.
 
 Model (derived by Pinocchio from the description): floating body (x, y, z, yaw, pitch, roll; Z-Y-X Euler) with
 three wheels fr, fl, r at the eq-8 positions, each with a spin joint ``theta_<i>`` (wheel motor), an adjustment
@@ -94,7 +94,8 @@ SPEC = RobotSpec(
     title="Tricycle with adaptable-radius wheels on rough terrain (Mardani & Ebrahimi 2016)",
     xacro="adaptable_wheel.urdf.xacro",
     root="floating",
-    paper="mardani_ebrahimi_2016_adaptable_wheel_robot.txt",
+    paper=("Mardani & Ebrahimi 2016, "
+           "A novel multimode mobile robot with adaptable wheel geometry for maneuverability improvement"),
     parameters=[
         Parameter("m", 10.0, "kg", "total mass (Table 1)", positive=True),
         Parameter("m_wheel", 0.0, "kg", "mass of each wheel hub (paper: all mass lumped in the body)"),

@@ -1,7 +1,7 @@
 """Adaptable-wheel tricycle: the paper's closed forms and printed values, transcribed (no robotdyn model here).
 
 Paper: A. Mardani, S. Ebrahimi, "A Novel Multimode Mobile Robot with Adaptable Wheel Geometry for Maneuverability
-Improvement" (``shared/papers/mardani_ebrahimi_2016_adaptable_wheel_robot.txt``): the radius law of eq 1 and its
+Improvement" (Mardani & Ebrahimi 2016, ``docs/bibliography.md``): the radius law of eq 1 and its
 derivative (eq 33), the wheel offsets of eq 8, the inverse kinematics of eqs 3-17 and 24 (:func:`solve_ik`, eq 24's
 Newton-Raphson replaced by scipy's hybrid root finder), the yaw update of eqs 18-23, the statics of eqs 25-34
 (:func:`static_torques`; the free contact-force components of eqs 28-30 are chosen by the generic
@@ -31,29 +31,60 @@ IK_TOL = 1e-10
 
 
 def radius_law(q: float, w: float) -> float:
-    """Eq 1: close-loop pattern radius :math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)` [m] for adjustment angle q [rad]."""
+    """Eq 1: close-loop pattern radius :math:`R_{ch} = w\\cos(q/2)\\cos(\\pi/6)` [m] for adjustment angle q [rad].
+
+    Args:
+        q: Adjustment angle q [rad] (0 to pi).
+        w: The pattern width w [m].
+
+    Returns:
+        R_ch [m].
+    """
     return w * np.cos(0.5 * q) * _COS30
 
 
 def radius_law_d(q: float, w: float) -> float:
-    """Eq 33: :math:`dR_{ch}/dq = -\\tfrac12 w\\sin(q/2)\\cos(\\pi/6)` [m/rad]."""
+    """Eq 33: :math:`dR_{ch}/dq = -\\tfrac12 w\\sin(q/2)\\cos(\\pi/6)` [m/rad].
+
+    Args:
+        q: Adjustment angle q [rad] (0 to pi).
+        w: The pattern width w [m].
+    """
     return -0.5 * w * np.sin(0.5 * q) * _COS30
 
 
 def radius_law_dd(q: float, w: float) -> float:
-    """:math:`d^2R_{ch}/dq^2 = -\\tfrac14 w\\cos(q/2)\\cos(\\pi/6)` [m/rad^2]."""
+    """:math:`d^2R_{ch}/dq^2 = -\\tfrac14 w\\cos(q/2)\\cos(\\pi/6)` [m/rad^2].
+
+    Args:
+        q: Adjustment angle q [rad] (0 to pi).
+        w: The pattern width w [m].
+    """
     return -0.25 * w * np.cos(0.5 * q) * _COS30
 
 
 def offsets(p: dict) -> dict[str, np.ndarray]:
-    """Eq 8: wheel centres in the body frame X_CG Y_CG Z_CG [m] (Lx, Ly read per ``L_reading``)."""
+    """Eq 8: wheel centres in the body frame X_CG Y_CG Z_CG [m] (Lx, Ly read per ``L_reading``).
+
+    Args:
+        p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: w, Lx, Ly, L_reading, R_ru [m], m
+            [kg], g [m/s^2], mu).
+
+    Returns:
+        Wheel centre (3,) [m] by wheel (fr, fl, r).
+    """
     s = 1.0 if p["L_reading"] == "half" else 0.5
     lx, ly = s * p["Lx"], s * p["Ly"]
     return {"fr": np.array([lx, -ly, 0.0]), "fl": np.array([lx, ly, 0.0]), "r": np.array([-lx, 0.0, 0.0])}
 
 
 def q_range_radius(p: dict) -> tuple[float, float]:
-    """Smallest and largest total radius R_T [m] over the adjustment range q in [0, pi] (eq 1)."""
+    """Smallest and largest total radius R_T [m] over the adjustment range q in [0, pi] (eq 1).
+
+    Args:
+        p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: w, Lx, Ly, L_reading, R_ru [m], m
+            [kg], g [m/s^2], mu).
+    """
     return p["R_ru"], p["R_ru"] + p["w"] * _COS30
 
 
@@ -78,7 +109,13 @@ _SIGN = {"fr": -1.0, "r": -1.0, "fl": 1.0}  # eq 11: translation (0, -+R_T, 0) i
 
 
 def paper_normal(terrain: Terrain, x: float, y: float) -> np.ndarray:
-    """Eq 3 (read as :math:`N = (-f_x, -f_y, 1)`, not normalised)."""
+    """Eq 3 (read as :math:`N = (-f_x, -f_y, 1)`, not normalised).
+
+    Args:
+        terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
+        x: World x [m].
+        y: World y [m].
+    """
     fx, fy = terrain.gradient(x, y)
     return np.array([-fx, -fy, 1.0])
 
@@ -86,7 +123,16 @@ def paper_normal(terrain: Terrain, x: float, y: float) -> np.ndarray:
 @dataclass
 class Commands:
     """The six commands of section 3 at one instant: path point (x_d, y_d) [m], height h_CG [m] along the normal,
-    and the body angles q_xd, q_yd, q_zd [rad] of eq 4 (rotations about fixed Y, then X, then Z)."""
+    and the body angles q_xd, q_yd, q_zd [rad] of eq 4 (rotations about fixed Y, then X, then Z).
+
+    Attributes:
+        xd: Path point x_d [m].
+        yd: Path point y_d [m].
+        h: Height h_CG [m] of the CG along the surface normal.
+        qx: Body angle q_xd [rad] (about fixed X).
+        qy: Body angle q_yd [rad] (about fixed Y).
+        qz: Body angle q_zd [rad] (about Z).
+    """
 
     xd: float
     yd: float
@@ -98,7 +144,15 @@ class Commands:
 
 def body_pose(cmd: Commands, terrain: Terrain) -> tuple[np.ndarray, np.ndarray]:
     """Eqs 4-6: rotation :math:`R_{CG}^0 = R_y(q_{yd}) R_x(q_{xd}) R_z(q_{zd})` and CG position
-    :math:`d_{CG}^0 = [x_d, y_d, f(x_d, y_d)] + h_{CG}\\,n(x_d, y_d)` (world frame, m)."""
+    :math:`d_{CG}^0 = [x_d, y_d, f(x_d, y_d)] + h_{CG}\\,n(x_d, y_d)` (world frame, m).
+
+    Args:
+        cmd: The six :class:`~robotdyn.robots.adaptable_wheel.paper.Commands`.
+        terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
+
+    Returns:
+        ``(R_CG^0, d_CG^0)``.
+    """
     R = _ry(cmd.qy) @ _rx(cmd.qx) @ _rz(cmd.qz)
     n = terrain.normal(cmd.xd, cmd.yd)
     d = np.array([cmd.xd, cmd.yd, terrain.height(cmd.xd, cmd.yd)]) + cmd.h * n
@@ -107,7 +161,19 @@ def body_pose(cmd: Commands, terrain: Terrain) -> tuple[np.ndarray, np.ndarray]:
 
 def contact_frame(R_cg: np.ndarray, d_cg: np.ndarray, offset: np.ndarray, tag: str, beta: float,
                   RT: float) -> tuple[np.ndarray, np.ndarray]:
-    """Eqs 7-11: rotation :math:`R_{3i}^0` and origin :math:`d_{3i}^0` of the contact frame of wheel ``tag``."""
+    """Eqs 7-11: rotation :math:`R_{3i}^0` and origin :math:`d_{3i}^0` of the contact frame of wheel ``tag``.
+
+    Args:
+        R_cg: The body rotation R_CG^0 (3, 3) (eq 4).
+        d_cg: The CG position d_CG^0 (3,) [m], world frame (eqs 5-6).
+        offset: The wheel centre in the body frame (3,) [m] (eq 8).
+        tag: The wheel: ``fr``, ``fl`` or ``r``.
+        beta: The wheel's contact angle beta_i [rad].
+        RT: The wheel's total radius R_T [m].
+
+    Returns:
+        ``(R_3i^0, d_3i^0)`` (3x3, 3 [m]).
+    """
     R3 = R_cg @ _R2[tag] @ _rz(beta)
     d3 = d_cg + R_cg @ offset + R3 @ np.array([0.0, _SIGN[tag] * RT, 0.0])
     return R3, d3
@@ -115,14 +181,39 @@ def contact_frame(R_cg: np.ndarray, d_cg: np.ndarray, offset: np.ndarray, tag: s
 
 def wheel_constraints(R_cg, d_cg, offset, tag, beta, RT, terrain) -> np.ndarray:
     """Eqs 12 and 14 of one wheel: :math:`C_i = d_{3i}(3) - f(d_{3i}(1), d_{3i}(2))` and
-    :math:`CC_i = [1\\,0\\,0] (R_{3i}^0)^T N` at the contact point."""
+    :math:`CC_i = [1\\,0\\,0] (R_{3i}^0)^T N` at the contact point.
+
+    Args:
+        R_cg: The body rotation R_CG^0 (3, 3) (eq 4).
+        d_cg: The CG position d_CG^0 (3,) [m], world frame (eqs 5-6).
+        offset: The wheel centre in the body frame (3,) [m] (eq 8).
+        tag: The wheel: ``fr``, ``fl`` or ``r``.
+        beta: The wheel's contact angle beta_i [rad].
+        RT: The wheel's total radius R_T [m].
+        terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
+
+    Returns:
+        ``(C_i [m], CC_i)``.
+    """
     R3, d3 = contact_frame(R_cg, d_cg, offset, tag, beta, RT)
     return np.array([d3[2] - terrain.height(d3[0], d3[1]), R3[:, 0] @ paper_normal(terrain, d3[0], d3[1])])
 
 
 def ik_residual(x: np.ndarray, R_cg, d_cg, p: dict, terrain: Terrain) -> np.ndarray:
     """Eq 15: :math:`C = [C_{fr}, C_{fl}, C_r, CC_{fr}, CC_{fl}, CC_r]` for the unknowns of eq 16,
-    :math:`x = [\\beta_{fr}, \\beta_{fl}, \\beta_r, q_{fr}, q_{fl}, q_r]` (rad)."""
+    :math:`x = [\\beta_{fr}, \\beta_{fl}, \\beta_r, q_{fr}, q_{fl}, q_r]` (rad).
+
+    Args:
+        x: An IK solution (beta_fr, beta_fl, beta_r, q_fr, q_fl, q_r) [rad] (eq 16).
+        R_cg: The body rotation R_CG^0 (3, 3) (eq 4).
+        d_cg: The CG position d_CG^0 (3,) [m], world frame (eqs 5-6).
+        p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: w, Lx, Ly, L_reading, R_ru [m], m
+            [kg], g [m/s^2], mu).
+        terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
+
+    Returns:
+        C (6,).
+    """
     off = offsets(p)
     out = np.empty(6)
     for k, tag in enumerate(_WHEELS):
@@ -204,13 +295,30 @@ def solve_ik(cmd: Commands, p: dict, terrain: Terrain, guess: np.ndarray | None 
 
 def yaw_update(qz: float, path_angle_change: float, R_cg: np.ndarray, dqx: float, dqy: float) -> float:
     """Eqs 18-23 over one step: :math:`\\Delta q_{zd} = (\\Delta q_{path} - R_{CG}^0(3,1{:}2)[\\Delta q_{xd},
-    \\Delta q_{yd}]) / R_{CG}^0(3,3)` (eq 22 times dt; q_path is the path tangent's direction, eq 18)."""
+    \\Delta q_{yd}]) / R_{CG}^0(3,3)` (eq 22 times dt; q_path is the path tangent's direction, eq 18).
+
+    Args:
+        qz: The current q_zd [rad].
+        path_angle_change: Change of the path tangent's direction over the step [rad].
+        R_cg: The body rotation R_CG^0 (3, 3) (eq 4).
+        dqx: Change of q_xd over the step [rad].
+        dqy: Change of q_yd over the step [rad].
+
+    Returns:
+        The new q_zd [rad].
+    """
     return qz + (path_angle_change - R_cg[2, :2] @ np.array([dqx, dqy])) / R_cg[2, 2]
 
 
 # ------------------------------------------------------------------------------------------ statics (sec 5)
 def paper_torque_eq35(q, p: dict):
-    """Eq 35 as printed: :math:`t_i = -0.5\\,m g w \\sin(q_i/2)\\cos(\\pi/6) / 3` [N m] (flat-ground worst case)."""
+    """Eq 35 as printed: :math:`t_i = -0.5\\,m g w \\sin(q_i/2)\\cos(\\pi/6) / 3` [N m] (flat-ground worst case).
+
+    Args:
+        q: Adjustment angle(s) q_i [rad].
+        p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: w, Lx, Ly, L_reading, R_ru [m], m
+            [kg], g [m/s^2], mu).
+    """
     return -0.5 * p["m"] * p["g"] * p["w"] * np.sin(0.5 * np.asarray(q)) * _COS30 / 3.0
 
 
@@ -250,6 +358,20 @@ def static_torques(cmd: Commands, x: np.ndarray, p: dict, terrain: Terrain,
     the CG (kinetostatics: minus the inertial forces). The free components are fixed by minimising the friction
     forces subject to :math:`F_i\\cdot n_i \\ge 0` (eq 28) and :math:`|F_t| \\le \\mu F_n` (eq 30); then
     eq 31 and eq 34, :math:`t_i = -0.5 F_i^{3i}(2)\\, w \\sin(q_i/2)\\cos(\\pi/6)`.
+
+    Args:
+        cmd: The six :class:`~robotdyn.robots.adaptable_wheel.paper.Commands`.
+        x: An IK solution (beta_fr, beta_fl, beta_r, q_fr, q_fl, q_r) [rad] (eq 16).
+        p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: w, Lx, Ly, L_reading, R_ru [m], m
+            [kg], g [m/s^2], mu).
+        terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
+        extra_force: An extra force on the body at the CG (3,) [N], world frame (default ``None``: none).
+        extra_moment: An extra moment about the CG (3,) [N m] (default ``None``: none).
+        objective: What the free contact-force components minimise
+            (:func:`robotdyn.contact.statics.solve_contact_forces`; default ``friction``).
+
+    Returns:
+        The :class:`StaticResult`.
     """
     R_cg, d_cg = body_pose(cmd, terrain)
     off = offsets(p)

@@ -4,7 +4,7 @@
   wheel-speed profile and kinematic runs, ``TERRAINS``, ``SCENARIOS``, the ``linkage-posture`` CLI, the
   posture-versus-rigid-chassis study.
 - :mod:`robotdyn.robots.linkage_suspension.paper`: the paper's closed forms (Table 1, eqs 1-4, 10) and section 3's printed numbers, transcribed
-  (``shared/papers/chen_linkage_suspension_six_wheel.txt``).
+  (Chen et al., ``docs/bibliography.md``).
 - :mod:`robotdyn.robots.linkage_suspension.comparison`: ``compare``, the model against the paper (``docs/errata/linkage_suspension.md``).
 
 The names of all three are re-exported here (``robotdyn.robots.module("linkage_suspension")``).

@@ -2,7 +2,7 @@
 
 Model: :mod:`robotdyn.robots.linkage_suspension.model` (Pinocchio, ``urdf/linkage_suspension.urdf.xacro``) -- its frames, wheel-centre velocities,
 contact angles (the ``model_*`` helpers here) and kinematic runs. Paper: :mod:`robotdyn.robots.linkage_suspension.paper` (Table 1, eqs 1-4, 10 and
-section 3 of ``shared/papers/chen_linkage_suspension_six_wheel.txt``); eq 9 (rolling) is checked against the model's
+section 3 of Chen et al., ``docs/bibliography.md``); eq 9 (rolling) is checked against the model's
 rolling constraints. Verdicts and evidence: ``docs/errata/linkage_suspension.md``.
 """
 
@@ -40,7 +40,13 @@ def _fk(robot: Robot, q: np.ndarray, v: np.ndarray | None = None) -> None:
 
 
 def model_R_A(robot: Robot, q: np.ndarray, axle: str = "axle3") -> np.ndarray:
-    """Placement of a wheel-axle frame A_i in the body frame R, from the model's own frames (4x4)."""
+    """Placement of a wheel-axle frame A_i in the body frame R, from the model's own frames (4x4).
+
+    Args:
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad].
+        axle: The axle frame's name (``axle1`` ... ``axle6``).
+    """
     _fk(robot, q)
     fid = robot.model.getFrameId
     return (robot.data.oMf[fid("body")].inverse() * robot.data.oMf[fid(axle)]).homogeneous
@@ -48,6 +54,12 @@ def model_R_A(robot: Robot, q: np.ndarray, axle: str = "axle3") -> np.ndarray:
 
 def model_wheel_centre_velocity(robot: Robot, q: np.ndarray, v: np.ndarray, axle: str = "axle3"):
     """Wheel-centre velocity in R axes and the body's (v0, w0) in R axes (the quantities of eq 5), from Pinocchio.
+
+    Args:
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad].
+        v: Full velocities (n,) [m/s, rad/s].
+        axle: The axle frame's name (``axle1`` ... ``axle6``).
 
     Returns:
         ``(vc, v0, w0)`` [m/s, m/s, rad/s].
@@ -75,7 +87,11 @@ def _random_q(robot: Robot, rng) -> np.ndarray:
 
 
 def random_dimensions(rng) -> dict[str, float]:
-    """Random Table 1 lengths [m] for the eq (3)-(4) and (10) comparisons."""
+    """Random Table 1 lengths [m] for the eq (3)-(4) and (10) comparisons.
+
+    Args:
+        rng: A ``numpy.random.Generator``.
+    """
     return {"a1": rng.uniform(-0.1, 0.1), "d1": rng.uniform(0.02, 0.2), "a5": rng.uniform(0.1, 0.3),
             "d5": rng.uniform(0.15, 0.3), "a6": rng.uniform(0.08, 0.2), "a7": rng.uniform(0.08, 0.2)}
 
@@ -104,6 +120,12 @@ def kinematics_comparison(cmp: Comparison, dims: int = 3, states: int = 20, seed
 
     Each row's model value is the model at the first sample; the verdict uses the largest deviation over
     ``dims x states`` samples (tolerance 1e-9: exact up to round-off).
+
+    Args:
+        cmp: The :class:`~robotdyn.interfaces.comparison.Comparison` the rows are added to.
+        dims: Number of random sets of dimensions.
+        states: Number of random states per set.
+        seed: Seed of the samples.
     """
     rng = np.random.default_rng(seed)
     eq3, eq4, fix, eq10 = _Worst(), _Worst(), _Worst(), _Worst()
@@ -160,7 +182,16 @@ def kinematics_comparison(cmp: Comparison, dims: int = 3, states: int = 20, seed
 
 
 def contact_angle(robot: Robot, q: np.ndarray, wheel: int) -> float:
-    """Contact angle delta_i of eq (1): rotation about the axle y_Ai taking z_Ai to the terrain normal [rad]."""
+    """Contact angle delta_i of eq (1): rotation about the axle y_Ai taking z_Ai to the terrain normal [rad].
+
+    Args:
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad].
+        wheel: The wheel's number i (1 to 6).
+
+    Returns:
+        delta_i [rad].
+    """
     kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
     con = next(c for c in robot.constraints if c.name == f"wheel{wheel}")
     n = con.contact(kin)["n"]
@@ -176,6 +207,12 @@ def rolling_comparison(cmp: Comparison, robot: Robot, states: int = 12, seed: in
     random positions, with random independent velocities; v = S nu satisfies every constraint row.
     Rows compare the printed eq (9) (phi' = the wheel's spin relative to its carrier) and the same formula with
     the wheel's absolute rate about its axle; then a straight run on flat ground with rollers at rho = 0.4 rad.
+
+    Args:
+        cmp: The :class:`~robotdyn.interfaces.comparison.Comparison` the rows are added to.
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+        states: Number of random states.
+        seed: Seed of the states.
     """
     from ...constraints.posture import set_terrain, solve_posture
 
@@ -225,7 +262,12 @@ def rolling_comparison(cmp: Comparison, robot: Robot, states: int = 12, seed: in
 
 def section3_comparison(cmp: Comparison, robot: Robot) -> dict[str, dict]:
     """Section 3: straight line and pivot steering under the wheel-speed profile (Figs. 6-12), on flat ground
-    (the paper's XOZ plane)."""
+    (the paper's XOZ plane).
+
+    Args:
+        cmp: The :class:`~robotdyn.interfaces.comparison.Comparison` the rows are added to.
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+    """
     from ...constraints.posture import set_terrain
 
     old = robot.terrain
@@ -250,7 +292,14 @@ def section3_comparison(cmp: Comparison, robot: Robot) -> dict[str, dict]:
 
 
 def compare(robot: Robot | None = None) -> Comparison:
-    """Eqs (3), (4), (9), (10) and section 3 against the model (see ``docs/errata/linkage_suspension.md``)."""
+    """Eqs (3), (4), (9), (10) and section 3 against the model (see ``docs/errata/linkage_suspension.md``).
+
+    Args:
+        robot: The robot (default ``None``: built with the default parameters).
+
+    Returns:
+        The :class:`~robotdyn.interfaces.comparison.Comparison`.
+    """
     robot = robot or Robot(SPEC)
     cmp = Comparison("Linkage-suspension six-wheel robot (Chen et al.): paper vs model")
     kinematics_comparison(cmp)

@@ -1,7 +1,7 @@
 """Six-wheel mobile robot with linkage suspension (Chen, Wang, Zhong, Zhu, Wang): the model side.
 
 Paper: "Kinematics Analysis and Simulation of Mobile Robot Based on Linkage Suspension"
-(``shared/papers/chen_linkage_suspension_six_wheel.txt``). Description: ``urdf/linkage_suspension.urdf.xacro``
+(Chen et al., ``docs/bibliography.md``). Description: ``urdf/linkage_suspension.urdf.xacro``
 (the mechanism, our reading of Figs. 1-3, and the dimensions, our own: the paper prints none).
 
 Coordinates: floating root (x, y, z, yaw, pitch, roll) of the body frame R (origin at the body's centre of gravity,
@@ -45,7 +45,8 @@ SPEC = RobotSpec(
     title="Six-wheel robot with linkage suspension on uneven terrain (Chen et al., wheel-centre kinematics)",
     xacro="linkage_suspension.urdf.xacro",
     root="floating",
-    paper="chen_linkage_suspension_six_wheel.txt",
+    paper=("Chen, Wang, Zhong, Zhu & Wang, "
+           "Kinematics analysis and simulation of mobile robot based on linkage suspension"),
     parameters=[
         Parameter("a1", 0.05, "m", "Table 1: rocker pivot D ahead of the body frame R (an offset: 0 or < 0, behind R, are valid geometries)"),
         Parameter("d1", 0.10, "m", "Table 1: rocker pivot D below R (an offset: any sign)"),
@@ -112,6 +113,10 @@ def wheel_speed(t: float, peak: float = PEAK_SPEED) -> tuple[float, float]:
 
     The ramps are half-cosine blends (the paper says the acceleration 'shows a trigonometric function tendency'
     during the ramps); any ramp symmetric about its midpoint gives the same distance.
+
+    Args:
+        t: Time [s].
+        peak: Peak wheel speed [rad/s].
     """
     t0, t1, t2, t3, _ = PROFILE
     if t <= t0 or t >= t3:
@@ -127,7 +132,11 @@ def wheel_speed(t: float, peak: float = PEAK_SPEED) -> tuple[float, float]:
 
 def profile_distance(peak_speed: float) -> float:
     """Distance [m] covered under the section 3 profile by a point whose peak speed is ``peak_speed`` [m/s]:
-    the hold lasts t2 - t1 and each symmetric ramp counts for half its duration."""
+    the hold lasts t2 - t1 and each symmetric ramp counts for half its duration.
+
+    Args:
+        peak_speed: The point's peak speed [m/s].
+    """
     t0, t1, t2, t3, _ = PROFILE
     return peak_speed * ((t1 - t0) / 2 + (t2 - t1) + (t3 - t2) / 2)
 
@@ -136,6 +145,14 @@ def kinematic_run(robot: Robot, direction: tuple[float, float], q0: np.ndarray |
                   rtol: float = 1e-8) -> dict[str, np.ndarray]:
     """Drive the middle wheels with the section 3 profile (times ``direction`` = signs for phi2, phi5) and integrate
     q' = S(q) nu kinematically, as the paper's ADAMS motion drivers do.
+
+    Args:
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+        direction: Signs (+1 or -1) of the right and left middle wheel speeds (phi2, phi5): equal for a straight
+            run, opposite for pivot steering.
+        q0: Initial configuration (default ``None``: the neutral one).
+        n_out: Number of output samples.
+        rtol: Integrator tolerance.
 
     Returns:
         dict with ``t`` [s], ``q`` (N, n), ``com``, ``vcom``, ``acom`` (N, 3) of the whole robot's centre of mass
@@ -168,7 +185,11 @@ def kinematic_run(robot: Robot, direction: tuple[float, float], q0: np.ndarray |
 
 
 def centroid_circle_radius(run: dict[str, np.ndarray]) -> float:
-    """Half the horizontal extent of the centre-of-mass path of a pivot-steering run [m] (Fig. 12)."""
+    """Half the horizontal extent of the centre-of-mass path of a pivot-steering run [m] (Fig. 12).
+
+    Args:
+        run: A :func:`kinematic_run` result.
+    """
     return float(np.mean(np.ptp(run["com"][:, :2], axis=0)) / 2)
 
 
@@ -188,7 +209,22 @@ SPEED_GAIN = 2.0
 
 @dataclass
 class TerrainScenario(Scenario):
-    """A scenario on a named terrain, starting from the posture solved at ``start`` (x, y, yaw)."""
+    """A scenario on a named terrain, starting from the posture solved at ``start`` (x, y, yaw).
+
+    Attributes:
+        name: Identifier (``robotdyn simulate ROBOT --scenario NAME``).
+        description: One line, citing the paper's section.
+        t_end: Default duration [s].
+        torque: Motor torques ``tau(t, q, nu)`` (or a profile; ``None``: unactuated).
+        q0: Initial coordinates by name (the posture is solved from them).
+        nu0: Initial independent velocities by name.
+        n_out: Default number of output samples.
+        plot: Columns to plot.
+        zoom: Length [s] of the zoomed window in plots (``None``: none).
+        references: Horizontal reference lines per plotted column.
+        terrain: The terrain's name (:data:`TERRAINS`).
+        start: Body x [m], y [m] and yaw [rad] at which the posture is solved.
+    """
 
     terrain: str = "flat"
     start: dict[str, float] = field(default_factory=lambda: {"x": 0.0, "y": 0.0, "yaw": 0.0})
@@ -268,7 +304,12 @@ def _cmd_posture(args) -> int:
 
 
 def register_cli(subparsers, parents) -> None:
-    """``robotdyn linkage-posture``: the posture on an example terrain (and the reduced dynamics there)."""
+    """``robotdyn linkage-posture``: the posture on an example terrain (and the reduced dynamics there).
+
+    Args:
+        subparsers: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     p = subparsers.add_parser("linkage-posture", parents=[parents[0]],
                               help="linkage_suspension: posture on a terrain (and M_r, C_r, g_r there)")
     p.add_argument("--terrain", default="bump", help=f"one of {', '.join(TERRAINS)}")
@@ -284,7 +325,18 @@ def register_cli(subparsers, parents) -> None:
 def side_bump(height: float = 0.06, x0: float = 0.0, length: float = 0.5, width: float = 0.12,
               side_width: float = 0.04) -> Terrain:
     """A smooth plateau of ``height`` [m] for x in [x0, x0 + length] under the right-hand wheels only (y < 0):
-    :math:`z = h\\,s(x)\\,\\tfrac12(1 - \\tanh(y / w_y))`, s a tanh plateau of ramp width ``width``."""
+    :math:`z = h\\,s(x)\\,\\tfrac12(1 - \\tanh(y / w_y))`, s a tanh plateau of ramp width ``width``.
+
+    Args:
+        height: Plateau height h [m].
+        x0: World x [m] where it starts.
+        length: Its length along x [m].
+        width: Ramp width of the tanh plateau along x [m].
+        side_width: Width w_y [m] of the side transition across y = 0.
+
+    Returns:
+        The :class:`~robotdyn.constraints.terrain.FunctionTerrain`.
+    """
     from ...constraints.terrain import FunctionTerrain
 
     bx = BumpTerrain(height, x0, width, length)
@@ -309,7 +361,15 @@ def side_bump(height: float = 0.06, x0: float = 0.0, length: float = 0.5, width:
 
 
 def contact_gaps(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Signed distance-like contact residuals of the six wheels (> 0: off the ground) [m]."""
+    """Signed distance-like contact residuals of the six wheels (> 0: off the ground) [m].
+
+    Args:
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad].
+
+    Returns:
+        The six residuals [m].
+    """
     kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.nq))
     return np.array([c.rows(kin).residual[-1] for c in robot.constraints if c.name.startswith("wheel")])
 
@@ -317,6 +377,12 @@ def contact_gaps(robot: Robot, q: np.ndarray) -> np.ndarray:
 def rigid_chassis_posture(robot: Robot, x: float, y: float = 0.0, yaw: float = 0.0) -> np.ndarray:
     """Posture of the same robot with its suspension locked at the nominal angles, resting on the terrain:
     the lowest body height (minimum potential energy) over (z, pitch, roll) with no wheel below the surface.
+
+    Args:
+        robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+        x: Body x [m].
+        y: Body y [m].
+        yaw: Body yaw [rad].
 
     Returns:
         q with the suspension coordinates at their neutral values.

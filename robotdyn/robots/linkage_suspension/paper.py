@@ -1,7 +1,7 @@
 """Linkage-suspension six-wheel robot: the paper's closed forms and printed values, transcribed (no model here).
 
 Paper: Chen, Wang, Zhong, Zhu, Wang, "Kinematics Analysis and Simulation of Mobile Robot Based on Linkage
-Suspension" (``shared/papers/chen_linkage_suspension_six_wheel.txt``): the D-H rows of Table 1 (eq 3's product
+Suspension" (Chen et al., ``docs/bibliography.md``): the D-H rows of Table 1 (eq 3's product
 R -> A3), the contact rotation of eq 1, the omni-wheel attitude of eq 2, the entries of eq 4 exactly as printed
 (with single-typo readings, :func:`eq4_readings`), the left-hand side of eq 10 as printed (and eq 5 evaluated with
 Table 1's own axes, :func:`corrected_eq10_joint_terms`), and the numbers section 3 prints (Figs. 7, 8, 12).
@@ -21,25 +21,55 @@ PIVOT_TURNS = 2.0
 
 
 def dh(alpha: float, a: float, d: float, theta: float) -> np.ndarray:
-    """Standard Denavit-Hartenberg transform Rot_z(theta) Trans_z(d) Trans_x(a) Rot_x(alpha) (4x4)."""
+    """Standard Denavit-Hartenberg transform Rot_z(theta) Trans_z(d) Trans_x(a) Rot_x(alpha) (4x4).
+
+    Args:
+        alpha: Link twist [rad].
+        a: Link length [m].
+        d: Link offset [m].
+        theta: Joint angle [rad].
+
+    Returns:
+        The 4x4 transform.
+    """
     ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(theta), np.sin(theta)
     return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1.0]])
 
 
 def table1_R_A3(p: dict, theta1: float, beta1: float) -> np.ndarray:
-    """R -> A3 (right rear wheel axle) from the D-H rows of Table 1: D, B2, A3 (4x4, independent of the URDF)."""
+    """R -> A3 (right rear wheel axle) from the D-H rows of Table 1: D, B2, A3 (4x4, independent of the URDF).
+
+    Args:
+        p: Table 1 lengths as a plain dict [m]: a1, d1, a5, d5, a6, a7.
+        theta1: The rocker angle theta1 [rad] (Table 1).
+        beta1: The bogie angle beta1 [rad] (Table 1).
+    """
     return dh(np.pi / 2, p["a1"], -p["d1"], 0.0) @ dh(0.0, p["a5"], p["d5"], 1.5 * np.pi - theta1) @ dh(
         -np.pi / 2, -p["a7"], 0.0, beta1)
 
 
 def eq1(delta: float) -> np.ndarray:
-    """Eq (1): A_i -> C_i rotation by the contact angle delta (as printed; a rotation about y)."""
+    """Eq (1): A_i -> C_i rotation by the contact angle delta (as printed; a rotation about y).
+
+    Args:
+        delta: The contact angle delta [rad].
+
+    Returns:
+        The 3x3 rotation.
+    """
     c, s = np.cos(delta), np.sin(delta)
     return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
 
 
 def eq2(rho: float) -> np.ndarray:
-    """Eq (2): the omni wheel's attitude matrix H (as printed; a rotation by rho about the wheel frame's z)."""
+    """Eq (2): the omni wheel's attitude matrix H (as printed; a rotation by rho about the wheel frame's z).
+
+    Args:
+        rho: The omni wheel's roller angle rho [rad].
+
+    Returns:
+        The 3x3 matrix H.
+    """
     c, s = np.cos(rho), np.sin(rho)
     return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
 
@@ -49,6 +79,13 @@ def paper_eq4(p: dict, theta1: float, beta1: float, rho: float, delta: float) ->
 
     The printed list has a 'cosh rho' in T13 and labels the third-row, third-column entry 'T32' a second time;
     both are transcribed literally (T33 is the second 'T32').
+
+    Args:
+        p: Table 1 lengths as a plain dict [m]: a1, d1, a5, d5, a6, a7.
+        theta1: The rocker angle theta1 [rad] (Table 1).
+        beta1: The bogie angle beta1 [rad] (Table 1).
+        rho: The roller angle rho [rad].
+        delta: The contact angle delta [rad].
     """
     a1, d1, a5, d5, a7 = (p[k] for k in ("a1", "d1", "a5", "d5", "a7"))
     f = beta1 - theta1
@@ -70,7 +107,15 @@ def paper_eq4(p: dict, theta1: float, beta1: float, rho: float, delta: float) ->
 
 
 def eq4_readings(p: dict, theta1: float, beta1: float, rho: float, delta: float) -> dict[str, tuple[str, float]]:
-    """Candidate corrections of the printed eq (4) entries (each a single, named typo)."""
+    """Candidate corrections of the printed eq (4) entries (each a single, named typo).
+
+    Args:
+        p: Table 1 lengths as a plain dict [m]: a1, d1, a5, d5, a6, a7.
+        theta1: The rocker angle theta1 [rad] (Table 1).
+        beta1: The bogie angle beta1 [rad] (Table 1).
+        rho: The roller angle rho [rad].
+        delta: The contact angle delta [rad].
+    """
     a5, a7, d1 = p["a5"], p["a7"], p["d1"]
     f = beta1 - theta1
     cd, sd, cr, sr, cf, sf = np.cos(delta), np.sin(delta), np.cos(rho), np.sin(rho), np.cos(f), np.sin(f)
@@ -89,6 +134,11 @@ def paper_eq10_lhs(p: dict, theta1: float, beta1: float, v0: np.ndarray, w0: np.
 
     Args:
         v0, w0: Body velocity and angular velocity (phi_0x, phi_0y, phi_0z) in R axes.
+        p: Table 1 lengths as a plain dict [m]: a1, d1, a5, d5, a6, a7.
+        theta1: The rocker angle theta1 [rad] (Table 1).
+        beta1: The bogie angle beta1 [rad] (Table 1).
+        theta1_dot: Rocker rate [rad/s].
+        beta1_dot: Bogie rate [rad/s].
     """
     a1, d1, a5, d5, a7 = (p[k] for k in ("a1", "d1", "a5", "d5", "a7"))
     f = beta1 - theta1
@@ -105,7 +155,13 @@ def paper_eq10_lhs(p: dict, theta1: float, beta1: float, v0: np.ndarray, w0: np.
 
 def corrected_eq10_joint_terms(p: dict, theta1: float, beta1: float) -> tuple[np.ndarray, np.ndarray]:
     """Eq (5) evaluated with Table 1's own axes (omega1 = +theta1' y_R, omega2 = -beta1' y_R): the columns
-    multiplying theta1' and beta1' (R axes)."""
+    multiplying theta1' and beta1' (R axes).
+
+    Args:
+        p: Table 1 lengths as a plain dict [m]: a1, d1, a5, d5, a6, a7.
+        theta1: The rocker angle theta1 [rad] (Table 1).
+        beta1: The bogie angle beta1 [rad] (Table 1).
+    """
     a5, a7 = p["a5"], p["a7"]
     f = beta1 - theta1
     return (np.array([a7 * np.cos(f) - a5 * np.cos(theta1), 0.0, a5 * np.sin(theta1) + a7 * np.sin(f)]),

@@ -3,7 +3,7 @@
 - :mod:`robotdyn.robots.mmr12_eod.model`: what robotdyn derives from ``urdf/mmr12_eod.urdf.xacro`` -- ``SPEC``, the control ``SCENARIOS``
   (Table 4 tracking, manipulation, lifting), the climbing balance, the ``fk`` CLI hook.
 - :mod:`robotdyn.robots.mmr12_eod.paper`: the paper's closed forms (eqs 1-2, 3-5, 10-14, 26) and printed transforms (eqs 27-31), transcribed
-  (``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``).
+  (Zúñiga-Avilés et al. 2014, ``docs/bibliography.md``).
 - :mod:`robotdyn.robots.mmr12_eod.comparison`: ``compare``, the model against the paper (``docs/errata/mmr12_eod.md``).
 
 The names of all three are re-exported here (``robotdyn.robots.module("mmr12_eod")``).

@@ -3,7 +3,7 @@
 Model: :mod:`robotdyn.robots.mmr12_eod.model` (Pinocchio, ``urdf/mmr12_eod.urdf.xacro``) -- the lift, frame poses and numerical IK computed
 on it (``model_*``, :func:`ik_cases`), and the model states matching each printed transform
 (:func:`printed_states`). Paper: :mod:`robotdyn.robots.mmr12_eod.paper` (eqs 1-2, 3-5, 10-14, 26-31 of
-``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``). Verdicts and evidence: ``docs/errata/mmr12_eod.md``.
+Zúñiga-Avilés et al. 2014, ``docs/bibliography.md``). Verdicts and evidence: ``docs/errata/mmr12_eod.md``.
 """
 
 from __future__ import annotations
@@ -25,7 +25,16 @@ from .paper import (
 
 def model_lift(robot: Robot, theta_C: float, arm: int = 1) -> float:
     """Delta lambda_C from the model: how far the platform must rise for arm ``arm``'s tip wheel (radius r) at
-    angle theta_C to touch the ground, i.e. max(0, r - z_tip) with z_tip the tip-frame height at lambda_C = 0."""
+    angle theta_C to touch the ground, i.e. max(0, r - z_tip) with z_tip the tip-frame height at lambda_C = 0.
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        theta_C: The arm angle theta_C [rad].
+        arm: The lifting arm's number (1 to 4).
+
+    Returns:
+        Delta lambda_C [m].
+    """
     from ...description.kinematics import frame_pose
 
     q = state(robot, lambda_C=0.0, **{f"theta_C{arm}": theta_C})
@@ -37,6 +46,9 @@ def printed_states(p: dict) -> dict[str, tuple[dict, dict, str, str]]:
     """For each printed transform (eqs 27-31): parameter overrides, coordinate values, model frame, reading.
 
     The coordinate values are the ones printed beside each equation (sec 3); Delta lambda_C comes from eq 26.
+
+    Args:
+        p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
     """
     h = np.pi / 2
     lift = paper_delta_lambda(p, h)  # eq 26 at theta_C1 = pi/2, r = 0.08: 0.37
@@ -59,7 +71,12 @@ def printed_states(p: dict) -> dict[str, tuple[dict, dict, str, str]]:
 
 
 def model_printed(robot: Robot, key: str) -> np.ndarray:
-    """The model's pose for printed equation ``key`` (see :func:`printed_states`)."""
+    """The model's pose for printed equation ``key`` (see :func:`printed_states`).
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        key: The printed equation's key (:func:`printed_states`).
+    """
     from ...description.kinematics import frame_pose
 
     overrides, values, frame, _ = printed_states(robot.params)[key]
@@ -84,6 +101,11 @@ def ik_cases(robot: Robot, n: int = 5, seed: int = 0) -> list[dict]:
     theta3) are drawn at random; the numerical IK (scipy, bounded least squares) then finds the platform position
     (x, y) putting the end effector E on the target. A second, fully numerical IK solves (x, y, psi, theta1,
     lambda2, theta3) from the neutral posture with minimum change.
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        n: Number of targets.
+        seed: Seed of the targets and arm values.
     """
     from ...description.kinematics import position_ik
 
@@ -108,6 +130,14 @@ def compare(robot: Robot | None = None, states: int = 50, seed: int = 0) -> Comp
 
     Closed forms are compared at ``states`` random configurations (worst deviation reported, tolerance 1e-9);
     printed numbers with half a unit of their last printed digit.
+
+    Args:
+        robot: The robot (default ``None``: built with the default parameters).
+        states: Number of random configurations.
+        seed: Seed of the configurations.
+
+    Returns:
+        The :class:`~robotdyn.interfaces.comparison.Comparison`.
     """
     robot = robot or Robot(SPEC)
     p = robot.params

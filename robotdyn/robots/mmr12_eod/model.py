@@ -2,7 +2,7 @@
 
 Paper: L. A. Zuniga-Aviles, J. C. Pedraza-Ortega et al., "HTG-Based Kinematic Modeling for Positioning of a
 Multi-Articulated Wheeled Mobile Manipulator", J. Intell. Robot. Syst. (2014)
-(``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``). Description: ``urdf/mmr12_eod.urdf.xacro``, built from
+(Zúñiga-Avilés et al. 2014, ``docs/bibliography.md``). Description: ``urdf/mmr12_eod.urdf.xacro``, built from
 Table 2's Denavit-Hartenberg rows (Paul's convention) so that every HTG frame of eq (2) is a named frame.
 
 Coordinates (natural, m and rad): the planar root (x, y, psi) of the ground footprint under the platform frame C,
@@ -41,7 +41,8 @@ SPEC = RobotSpec(
     title="MMR12-EOD: differential-drive mobile manipulator, 4 lifting arms, RPRR arm (Zuniga-Aviles, HTG)",
     xacro="mmr12_eod.urdf.xacro",
     root="planar",
-    paper="zuniga_aviles_2014_mmr12_eod_htg.txt",
+    paper=("Zúñiga-Avilés et al. 2014, "
+           "HTG-based kinematic modeling for positioning of a multi-articulated wheeled mobile manipulator"),
     parameters=[
         Parameter("lambda_C0", 0.15, "m", "height of C over the ground = drive-wheel radius (sec 3, conclusion)",
                   positive=True),
@@ -100,7 +101,15 @@ SPEC = RobotSpec(
 
 # ------------------------------------------------------------------------------------------- configurations
 def state(robot: Robot, **values: float) -> np.ndarray:
-    """Natural coordinates: the robot's neutral configuration with the given coordinates overridden."""
+    """Natural coordinates: the robot's neutral configuration with the given coordinates overridden.
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        **values: Coordinate values by name [m or rad].
+
+    Returns:
+        Natural coordinates (n,).
+    """
     q = robot.neutral()
     for label, value in values.items():
         q[robot.coordinate_index(label)] = value
@@ -109,7 +118,12 @@ def state(robot: Robot, **values: float) -> np.ndarray:
 
 # ------------------------------------------------------------------------------------------------- CLI
 def register_cli(subparsers, parents) -> None:
-    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.description.kinematics`)."""
+    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.description.kinematics`).
+
+    Args:
+        subparsers: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     from ...cli.fk import register_fk_cli
 
     register_fk_cli(subparsers, parents)
@@ -139,7 +153,12 @@ def _quintic(t: float, T: float, a, b) -> tuple[np.ndarray, np.ndarray, np.ndarr
 def table4_reference(name: str, omega: float = 0.5) -> Callable:
     """Table 4's platform references as t -> (p_d, p_d', p_d'') of the controlled point [m]:
     ``orientation`` (turning about the centre x = y = 0: P on a circle of radius LOOK_AHEAD at omega rad/s),
-    ``straight`` (x = 30, y = t), ``sinusoid`` (x = 40 cos 0.25t + 2.5t, y = 30 sin 0.25t)."""
+    ``straight`` (x = 30, y = t), ``sinusoid`` (x = 40 cos 0.25t + 2.5t, y = 30 sin 0.25t).
+
+    Args:
+        name: ``orientation``, ``straight`` or ``sinusoid``.
+        omega: Turning rate of the orientation task [rad/s].
+    """
     L = LOOK_AHEAD
     if name == "orientation":
         return lambda t: (L * np.array([np.cos(omega * t), np.sin(omega * t)]),
@@ -161,7 +180,13 @@ def _hold_task(robot: Robot, labels, q0):
 
 
 def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
-    """Eqs 23-25 for a Table 4 trajectory: P tracks the reference, every other actuated joint holds its value."""
+    """Eqs 23-25 for a Table 4 trajectory: P tracks the reference, every other actuated joint holds its value.
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        name: The Table 4 trajectory (:func:`table4_reference`).
+        q0: The configuration whose joint values are held (default ``None``: the neutral one).
+    """
     from ...simulation.control import LinearisingController, PointTask
 
     q0 = robot.neutral() if q0 is None else q0
@@ -173,7 +198,12 @@ def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
 
 def platform_initial(robot: Robot, name: str) -> tuple[np.ndarray, np.ndarray]:
     """Start on the reference: P at p_d(0), heading along p_d'(0) (or along +x at rest), wheels rolling at the
-    reference speed (at rest for the orientation task)."""
+    reference speed (at rest for the orientation task).
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        name: The Table 4 trajectory (:func:`table4_reference`).
+    """
     pd, vd, _ = table4_reference(name)(0.0)
     speed = float(np.linalg.norm(vd))
     psi = float(np.arctan2(vd[1], vd[0])) if name != "orientation" else 0.0
@@ -192,7 +222,12 @@ MANIPULATION_TARGET = np.array([2.0, 2.0, 1.5])
 
 def manipulation_goal(robot: Robot, q0: np.ndarray | None = None):
     """A final configuration putting E on MANIPULATION_TARGET: numerical IK over (x, y, theta3) with the heading
-    kept and the boom raised to theta1 = 2.7 rad, lambda2 = 1.1 m (inside the joint ranges)."""
+    kept and the boom raised to theta1 = 2.7 rad, lambda2 = 1.1 m (inside the joint ranges).
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        q0: The starting configuration (default ``None``: :func:`manipulation_initial`).
+    """
     from ...description.kinematics import position_ik
 
     q0 = manipulation_initial(robot)[0] if q0 is None else q0
@@ -205,7 +240,13 @@ def manipulation_goal(robot: Robot, q0: np.ndarray | None = None):
 def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float = 10.0):
     """End effector E to MANIPULATION_TARGET along a rest-to-rest quintic over T s (primary output, eq 25); arms,
     theta4 and the load hold; in the null space, (theta1, lambda2, theta3) follow quintics to the IK goal posture
-    so that the joints stay in range and the platform drives the rest."""
+    so that the joints stay in range and the platform drives the rest.
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        q0: The starting configuration (default ``None``: :func:`manipulation_initial`).
+        T: Duration of the quintic [s].
+    """
     from ...simulation.control import CoordinateTask, LinearisingController, PointTask
     from ...description.kinematics import frame_pose
 
@@ -224,7 +265,11 @@ def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float
 
 
 def manipulation_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
-    """At the origin, heading 45 degrees towards the wall target, arm in the neutral posture, at rest."""
+    """At the origin, heading 45 degrees towards the wall target, arm in the neutral posture, at rest.
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+    """
     return state(robot, psi=np.pi / 4), np.zeros(robot.mobility)
 
 
@@ -236,7 +281,14 @@ of the arms: the constraint block is singular there); lambda_C0 + Delta lambda_C
 
 def lift_spec(spec: RobotSpec = SPEC) -> RobotSpec:
     """The robot standing on its four lifting-arm tip wheels (frictionless supports, normal rows only), drive
-    wheels in the air: the lifting configuration of sec 2.11 d (Fig. 5)."""
+    wheels in the air: the lifting configuration of sec 2.11 d (Fig. 5).
+
+    Args:
+        spec: The robot's :class:`~robotdyn.robot.RobotSpec`.
+
+    Returns:
+        The lifting :class:`~robotdyn.robot.RobotSpec`.
+    """
     return dataclasses.replace(
         spec,
         name=f"{spec.name}_lifting",
@@ -246,25 +298,49 @@ def lift_spec(spec: RobotSpec = SPEC) -> RobotSpec:
 
 
 def lift_robot(robot: Robot | None = None) -> Robot:
-    """The lifting configuration of ``robot`` (same parameters)."""
+    """The lifting configuration of ``robot`` (same parameters).
+
+    Args:
+        robot: The robot whose parameters are kept (default ``None``: the defaults).
+
+    Returns:
+        The lifting :class:`~robotdyn.robot.Robot`.
+    """
     params = robot.params if robot is not None else None
     return Robot(lift_spec(robot.spec if robot is not None else SPEC), params)
 
 
 def contact_angle(p: dict) -> float:
-    """Arm angle [rad] at which the tip wheels touch the ground with the drive wheels still on it (eq 1 = 0)."""
+    """Arm angle [rad] at which the tip wheels touch the ground with the drive wheels still on it (eq 1 = 0).
+
+    Args:
+        p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
+
+    Returns:
+        The angle [rad].
+    """
     return float(np.arcsin((p["lambda_C0"] - p["r"]) / p["l_cs1"]))
 
 
 def lifting_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
-    """All four arms at the contact angle, lambda_C = 0, at rest."""
+    """All four arms at the contact angle, lambda_C = 0, at rest.
+
+    Args:
+        robot: The lifting robot (:func:`lift_robot`).
+    """
     th = contact_angle(robot.params)
     return state(robot, lambda_C=0.0, **{f"theta_C{i}": th for i in _ARMS}), np.zeros(robot.mobility)
 
 
 def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
     """Arm 1 (the others follow through the contacts) along a quintic from the contact angle to ``end`` in T s,
-    the manipulator, load and wheels hold; x, y, psi are unactuated (free on frictionless tips)."""
+    the manipulator, load and wheels hold; x, y, psi are unactuated (free on frictionless tips).
+
+    Args:
+        robot: The lifting robot (:func:`lift_robot`).
+        T: Duration of the quintic [s].
+        end: Final arm angle [rad].
+    """
     from ...simulation.control import CoordinateTask, LinearisingController
 
     q0 = lifting_initial(robot)[0]
@@ -283,6 +359,11 @@ def climbing_balance(robot: Robot, slope: float, mu: float | None = None) -> dic
     heading is the flat-ground model with gravity tilted by the slope, and the reduced gravity of the two
     wheel coordinates, (g_R + g_L) / R, is the force the wheels must push with to hold the robot (no climbing in the
     simulator: the planar root keeps the platform parallel to the ground; rolling resistance mu N is not modelled).
+
+    Args:
+        robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+        slope: Slope angle psi [rad] (abs(slope) < pi/2).
+        mu: Rolling-resistance coefficient (default ``None``: the robot's parameter ``mu``).
 
     Returns:
         ``mass`` [kg], ``F_paper`` = m g (sin + mu cos) [N], ``F_gravity_paper`` = m g sin [N],
@@ -317,7 +398,15 @@ def climbing_robot(slope: float, robot: Robot | None = None) -> Robot:
     """The robot holding itself on a ramp of ``slope`` [rad] (rising along world x): floating root, the two drive
     wheels rolling without slipping and the rear arms' tip wheels (3, 4) as frictionless supports, the front arms
     raised (sec 2.11 e's climbing with the arms as outriggers; the real robot's tracks are not in the
-    description)."""
+    description).
+
+    Args:
+        slope: Ramp angle [rad] (abs(slope) < pi/2).
+        robot: The robot whose parameters are kept (default ``None``: the defaults).
+
+    Returns:
+        The climbing :class:`~robotdyn.robot.Robot`.
+    """
     from ...constraints.terrain import RampTerrain
 
     if not np.isfinite(slope) or abs(slope) >= np.pi / 2:
@@ -333,7 +422,15 @@ def climbing_robot(slope: float, robot: Robot | None = None) -> Robot:
 def climbing_state(robot: Robot, slope: float) -> np.ndarray:
     """The climbing posture on the ramp of :func:`climbing_robot`: facing uphill (pitch = -slope about the ramp
     line through the origin), rear arms at the contact angle (their tips and the drive wheels on the ramp), front
-    arms :data:`CLIMB_ARMS_UP` higher, manipulator neutral."""
+    arms :data:`CLIMB_ARMS_UP` higher, manipulator neutral.
+
+    Args:
+        robot: The climbing robot (:func:`climbing_robot`).
+        slope: Ramp angle [rad].
+
+    Returns:
+        Natural coordinates (n,).
+    """
     th = contact_angle(robot.params)
     return state(robot, pitch=-slope, theta_C1=th - CLIMB_ARMS_UP, theta_C2=th - CLIMB_ARMS_UP, theta_C3=th,
                  theta_C4=th)
@@ -342,7 +439,12 @@ def climbing_state(robot: Robot, slope: float) -> np.ndarray:
 def climbing_forces(slope: float, robot: Robot | None = None):
     """Contact forces holding the robot at rest on a ramp of ``slope`` [rad] (:func:`climbing_robot`, every motor
     holding its coordinate): the :class:`~robotdyn.contact.contact_forces.ConstraintForces` (drive-wheel traction and
-    loads, tip loads, ``minimum_mu``: the smallest friction coefficient that holds the robot there)."""
+    loads, tip loads, ``minimum_mu``: the smallest friction coefficient that holds the robot there).
+
+    Args:
+        slope: Ramp angle [rad] (abs(slope) < pi/2).
+        robot: The robot whose parameters are kept (default ``None``: the defaults).
+    """
     climber = climbing_robot(slope, robot)
     zero = np.zeros(climber.mobility)
     return climber.contact_forces(climbing_state(climber, slope), zero, nudot=zero)

@@ -2,7 +2,7 @@
 
 Paper: L. A. Zuniga-Aviles, J. C. Pedraza-Ortega et al., "HTG-Based Kinematic Modeling for Positioning of a
 Multi-Articulated Wheeled Mobile Manipulator", J. Intell. Robot. Syst. (2014)
-(``shared/papers/zuniga_aviles_2014_mmr12_eod_htg.txt``): Paul's link transform of Table 2, the lift of eqs 1/26,
+(Zúñiga-Avilés et al. 2014, ``docs/bibliography.md``): Paul's link transform of Table 2, the lift of eqs 1/26,
 A_C and the HTG product of sec 2.7.1, X_M of eq 2 as printed, the platform rates of eqs 12-14, the inverse
 kinematics of eqs 3-5, 10-11 (eqs 6-9 use undefined symbols: not transcribed) and the matrices printed as
 eqs 27-31. Each function takes the parameters as a plain dict (Table 2 names of :data:`.model.SPEC`).
@@ -14,7 +14,17 @@ import numpy as np
 
 
 def dh(theta: float, lam: float, l: float, alpha: float) -> np.ndarray:
-    """Paul's link transform A = Rot(z, theta) Trans(0, 0, lambda) Trans(l, 0, 0) Rot(x, alpha) (Table 2)."""
+    """Paul's link transform A = Rot(z, theta) Trans(0, 0, lambda) Trans(l, 0, 0) Rot(x, alpha) (Table 2).
+
+    Args:
+        theta: Joint angle theta [rad].
+        lam: Offset lambda along z [m].
+        l: Length l along x [m].
+        alpha: Twist alpha [rad].
+
+    Returns:
+        The 4x4 transform.
+    """
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
     return np.array([[ct, -st * ca, st * sa, l * ct], [st, ct * ca, -ct * sa, l * st], [0.0, sa, ca, lam],
                      [0.0, 0.0, 0.0, 1.0]])
@@ -27,14 +37,31 @@ def _trans(x: float, y: float, z: float) -> np.ndarray:
 
 
 def paper_delta_lambda(p: dict, theta_C1: float, r: float | None = None) -> float:
-    """Eqs (1)/(26): Delta lambda_C = l_CS1 sin(theta_C1) - lambda_C0 + r when >= 0, else 0 [m]."""
+    """Eqs (1)/(26): Delta lambda_C = l_CS1 sin(theta_C1) - lambda_C0 + r when >= 0, else 0 [m].
+
+    Args:
+        p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
+        theta_C1: Arm angle theta_C1 [rad].
+        r: Tip wheel radius [m] (default ``None``: ``p['r']``).
+    """
     r = p["r"] if r is None else r
     value = p["l_cs1"] * np.sin(theta_C1) - p["lambda_C0"] + r
     return float(value) if value >= 0 else 0.0
 
 
 def paper_A_C(p: dict, x: float, y: float, phi: float, dlam: float) -> np.ndarray:
-    """Sec 2.7.1 a): A_C = Trans(x_C0, y_C0, z_C0) Rot(z, phi) Trans(0, 0, Delta lambda_C), z_C0 = lambda_C0."""
+    """Sec 2.7.1 a): A_C = Trans(x_C0, y_C0, z_C0) Rot(z, phi) Trans(0, 0, Delta lambda_C), z_C0 = lambda_C0.
+
+    Args:
+        p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
+        x: Platform x [m].
+        y: Platform y [m].
+        phi: Platform heading phi [rad].
+        dlam: Platform lift Delta lambda_C [m] (eq 26).
+
+    Returns:
+        The 4x4 transform.
+    """
     return _trans(x, y, p["lambda_C0"]) @ dh(phi, 0.0, 0.0, 0.0) @ _trans(0.0, 0.0, dlam)
 
 
@@ -43,6 +70,22 @@ def paper_htg_chain(p: dict, x, y, phi, dlam, theta1, lambda2, theta3, theta4, l
 
     Rows: 0 (alpha pi/2, l = -l0, lambda0, theta 0), 1 (alpha pi/2, theta1), 2 (alpha -pi/2, lambda2),
     3 (alpha pi/2, l3, theta3), 4 (theta4), E (lambda5), E_muP (lambda6), E_muR (alpha pi/2, theta_mu).
+
+    Args:
+        p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
+        x: Platform x [m].
+        y: Platform y [m].
+        phi: Platform heading phi [rad].
+        dlam: Platform lift Delta lambda_C [m] (eq 26).
+        theta1: Manipulator joint 1 angle theta1 [rad] (Table 2's DH angle).
+        lambda2: Prismatic joint 2 extension lambda2 [m].
+        theta3: Joint 3 angle theta3 [rad].
+        theta4: Joint 4 angle theta4 [rad].
+        lambda6: Load joint E_muP extension lambda6 [m].
+        theta_mu: Load joint E_muR angle theta_mu [rad].
+
+    Returns:
+        X_M (4x4).
     """
     h = np.pi / 2
     chain = [dh(0.0, p["lambda0"], -p["l0"], h), dh(theta1, 0.0, 0.0, h), dh(0.0, lambda2, 0.0, -h),
@@ -55,7 +98,23 @@ def paper_htg_chain(p: dict, x, y, phi, dlam, theta1, lambda2, theta3, theta4, l
 
 
 def paper_X_M(p: dict, x, y, phi, dlam, theta1, lambda2, theta3, theta4, lambda6) -> np.ndarray:
-    """Eq (2) exactly as printed: X_M = GT_4 E E_mu (load frame in global coordinates)."""
+    """Eq (2) exactly as printed: X_M = GT_4 E E_mu (load frame in global coordinates).
+
+    Args:
+        p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
+        x: Platform x [m].
+        y: Platform y [m].
+        phi: Platform heading phi [rad].
+        dlam: Platform lift Delta lambda_C [m] (eq 26).
+        theta1: Manipulator joint 1 angle theta1 [rad] (Table 2's DH angle).
+        lambda2: Prismatic joint 2 extension lambda2 [m].
+        theta3: Joint 3 angle theta3 [rad].
+        theta4: Joint 4 angle theta4 [rad].
+        lambda6: Load joint E_muP extension lambda6 [m].
+
+    Returns:
+        X_M (4x4).
+    """
     SC, CC = np.sin(phi), np.cos(phi)
     S1, C1 = np.sin(theta1), np.cos(theta1)
     S13, C13 = np.sin(theta1 + theta3), np.cos(theta1 + theta3)
@@ -71,7 +130,17 @@ def paper_X_M(p: dict, x, y, phi, dlam, theta1, lambda2, theta3, theta4, lambda6
 
 
 def paper_platform_rates(p: dict, phi: float, thR_dot: float, thL_dot: float) -> np.ndarray:
-    """Eqs (12)-(14) solved for (x', y', phi') given the wheel rates (r of eqs 13-14 = the drive-wheel radius)."""
+    """Eqs (12)-(14) solved for (x', y', phi') given the wheel rates (r of eqs 13-14 = the drive-wheel radius).
+
+    Args:
+        p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
+        phi: Platform heading phi [rad].
+        thR_dot: Right wheel rate [rad/s].
+        thL_dot: Left wheel rate [rad/s].
+
+    Returns:
+        (x', y', phi') [m/s, m/s, rad/s].
+    """
     R, b = p["lambda_C0"], p["b"]
     phidot = R / (2 * b) * (thR_dot - thL_dot)  # eq 14
     v = thR_dot * R - phidot * b  # eq 13: x' cos + y' sin = theta_r' r - phi' b

@@ -1,7 +1,7 @@
 """Omni caster platform: the model against the paper (:func:`compare`) and the functions that bring both together.
 
 Model: :mod:`robotdyn.robots.omni_caster.model` (Pinocchio, ``urdf/omni_caster.urdf.xacro``). Paper: :mod:`robotdyn.robots.omni_caster.paper` (eqs 12-19, 43, 48-51, 60,
-A7-A9 and the printed matrices of section 5 of ``shared/papers/chung_yi_omni_caster_dynamics.txt``). Here too:
+A7-A9 and the printed matrices of section 5 of Chung, Yi, Kim & Han, ``docs/bibliography.md``). Here too:
 :func:`offset_link_correction`, the velocity terms eq 43 leaves out, derived by us (not printed in the paper), and
 the least-squares search for a configuration reproducing the printed I_uu* (:func:`fit_printed_matrix`).
 Verdicts and evidence: ``docs/errata/omni_caster.md``.
@@ -40,6 +40,12 @@ def offset_link_correction(p: dict, phi, nu) -> np.ndarray:
     Derived here (see the errata): with e the unit vector A_i -> O_i, the link's mass centre moves at
     v = r theta' e - p eta' (k x e), so its inertia forces on (eta, theta) are m2 (p^2 eta'' - p r theta' eta',
     r^2 theta'' + r p eta'^2); the velocity products are missing from eq (43)-(49). Returns sum_i G_i^T of them.
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        phi: Steering angles (phi1, phi2, phi3) [rad].
+        nu: The platform twist u' = (v_cx, v_cy, omega) [m/s, m/s, rad/s] in platform axes.
     """
     out = np.zeros(3)
     m2, pp, r = p["m_link"], p["p"], p["r"]
@@ -55,6 +61,10 @@ def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
 
     eta_i' is the offset link's absolute yaw rate (its frame Jacobian), theta_i', phi_i' the joint rates; all from
     S of the operational projection (the model's constraint Jacobians).
+
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+        q: Natural coordinates (n,) [m, rad].
     """
     from ...constraints.constraint import KinematicState
 
@@ -71,6 +81,13 @@ def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
 def fit_printed_matrix(p: dict, free: tuple[str, ...] = (), starts: int = 60, seed: int = 0) -> dict:
     """Least-squares search for steering angles (and optionally parameters ``free``) reproducing the printed
     with-wheel I_uu* (6 independent entries) through the eq-48 transcription.
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        free: Names of parameters fitted too (default: none).
+        starts: Number of random starting points.
+        seed: Seed of the starting points.
 
     Returns:
         dict with ``phi`` [rad], ``params`` (the fitted free ones), ``residual`` (entries, printed - fit) and
@@ -104,6 +121,14 @@ def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Com
     Closed forms are compared at ``states`` random steering configurations (random pose too); each such row shows
     the worst entry and uses a tolerance of 1e-10 (relative to the entries' scale for eq 15-17, whose entries
     are O(1/r)).
+
+    Args:
+        robot: The robot (default ``None``: built with the paper's parameters).
+        states: Number of random steering configurations.
+        seed: Seed of those configurations.
+
+    Returns:
+        The :class:`~robotdyn.interfaces.comparison.Comparison`.
     """
     robot = robot or Robot(SPEC)
     p = robot.params

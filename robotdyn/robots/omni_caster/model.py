@@ -3,7 +3,7 @@
 Description: ``urdf/omni_caster.urdf.xacro`` (Fig. 2, Tables 1-2); Pinocchio derives the dynamics from it.
 Paper the parameters and manoeuvres come from: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free
 dynamic modeling including wheel dynamics for an omni-directional mobile robot with three caster wheels"
-(``shared/papers/chung_yi_omni_caster_dynamics.txt``).
+(Chung, Yi, Kim & Han, ``docs/bibliography.md``).
 
 Coordinates: (x, y, psi) of the platform centre C and heading (world, m and rad), the steering angles phi_i
 (platform relative to offset link i, eq 9-11: omega = eta_i' + phi_i') and the wheel angles theta_i.
@@ -39,7 +39,8 @@ SPEC = RobotSpec(
     title="Omnidirectional platform on three active caster wheels (Chung, Yi, Kim, Han)",
     xacro="omni_caster.urdf.xacro",
     root="planar",
-    paper="chung_yi_omni_caster_dynamics.txt",
+    paper=("Chung, Yi, Kim & Han, Singularity-free dynamic modeling including wheel dynamics "
+           "for an omni-directional mobile robot with three caster wheels"),
     parameters=[
         Parameter("l", 0.173, "m", "distance A1A2 between the front steering axes (Table 1)", positive=True),
         Parameter("a", 0.05, "m", "A1, A2 lie a behind C along -j (Table 1, eq 6-7; an offset: 0 or < 0 valid)"),
@@ -78,7 +79,18 @@ def noc_spec() -> RobotSpec:
 
 
 def steering_configuration(robot: Robot, phi, psi: float = 0.0, x: float = 0.0, y: float = 0.0) -> np.ndarray:
-    """Natural coordinates with the given steering angles (phi1, phi2, phi3) [rad], wheel angles zero."""
+    """Natural coordinates with the given steering angles (phi1, phi2, phi3) [rad], wheel angles zero.
+
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+        phi: Steering angles (phi1, phi2, phi3) [rad].
+        psi: Platform heading [rad].
+        x: Platform x [m].
+        y: Platform y [m].
+
+    Returns:
+        Natural coordinates (n,).
+    """
     phi = np.asarray(phi, float)
     if phi.shape != (3,) or not np.all(np.isfinite(phi)):
         raise InputError(f"steering angles {phi.tolist()}; expected 3 finite angles (phi1, phi2, phi3) in rad")
@@ -97,6 +109,11 @@ def _anchor(p: dict, i: int) -> tuple[float, float]:
 
 def noc_report(robot: Robot, noc: Robot, phi) -> dict:
     """Both formulations at one steering configuration: condition numbers and reduced inertias (NaN-free).
+
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+        noc: The same robot in the paper's NOC coordinates (:func:`noc_spec`).
+        phi: Steering angles (phi1, phi2, phi3) [rad].
 
     Returns:
         dict with ``phi``, ``op_M`` (I_uu*, always finite), ``op_condition``, ``noc_M`` (``None`` when the NOC
@@ -127,6 +144,11 @@ def beta_profile(t, T: float, total: float = 2 * np.pi) -> tuple[np.ndarray, np.
 
     With total = 2 pi and T = 60 s the coefficients are the paper's a3 = 20 pi / 60^3, a4 = -30 pi / 60^4,
     a5 = 12 pi / 60^5. Returns (beta, beta', beta'') [rad, rad/s, rad/s^2]; constant outside [0, T].
+
+    Args:
+        t: Time(s) [s].
+        T: Duration of the motion [s].
+        total: Total angle [rad].
     """
     s = np.clip(np.asarray(t, float) / T, 0.0, 1.0)
     inside = (np.asarray(t, float) >= 0) & (np.asarray(t, float) <= T)
@@ -145,6 +167,12 @@ def path_state(kind: str, t, params: dict | None = None) -> dict:
     angle between the global X-axis and the local unit vector i"), centre (-R, 0); on the ellipse
     C = (A (cos beta - 1), B sin beta), beta from eq (61) with T = 30 s, and either j along the tangent
     (``heading="tangent"``, psi = tangent angle - pi/2, default) or a fixed heading psi = 0 (``"fixed"``).
+
+    Args:
+        kind: ``circle`` or ``ellipse``.
+        t: Time(s) [s].
+        params: Overrides of the path's constants (:data:`CIRCLE` or :data:`ELLIPSE`: R, A, B [m], T [s], heading)
+            (default ``None``).
 
     Returns:
         dict with ``pose`` (x, y, psi), ``nu`` = u' = (v_cx, v_cy, omega) in body axes and ``nudot`` = u''
@@ -192,6 +220,15 @@ def steady_steering(p: dict, u, trailing: bool = True) -> np.ndarray:
     Geometry (independent of the model's Jacobians): the wheel centre O_i = A_i + d e_i must move along e_i
     (e_i the unit vector A_i -> O_i, at angle -phi_i in platform axes), i.e. (v_A x e)_z = omega d. ``trailing``
     picks the root with the wheel behind its steering axis (a passive caster's stable alignment).
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        u: The platform twist u' = (v_cx, v_cy, omega) [m/s, m/s, rad/s] in platform axes.
+        trailing: Pick the root with the wheel behind its steering axis.
+
+    Returns:
+        Steering angles (phi1, phi2, phi3) [rad].
     """
     vx, vy, w = np.asarray(u, float)
     out = np.zeros(3)
@@ -218,6 +255,14 @@ def plan(robot: Robot, kind: str, n: int = 301, params: dict | None = None, rtol
     constant: the paper's "keeps the original configuration"). q' = S(q) u'(t) is integrated with
     ``solve_ivp`` (DOP853); the platform pose that results must equal the prescribed one (checked in the tests).
 
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+        kind: ``circle`` or ``ellipse``.
+        n: Number of output samples.
+        params: Overrides of the path's constants (as :func:`path_state`).
+        rtol: Integrator tolerance (relative and absolute).
+        t_end: Stop at this time [s] (default ``None``: the path's T).
+
     Returns:
         dict with ``t`` (n,), ``q`` (n, nq), ``nu``, ``nudot`` (n, 3), ``pose`` (n, 3, prescribed), ``sol`` (dense).
         ``t_end`` (default T) stops early (a section of the manoeuvre).
@@ -243,7 +288,12 @@ def plan(robot: Robot, kind: str, n: int = 301, params: dict | None = None, rtol
 
 
 def operational_forces(robot: Robot, pl: dict) -> np.ndarray:
-    """Eq (47) along a plan: T_u = I_uu* u'' + u'^T P_uuu* u' (F_x, F_y [N], M_z [N m]) at each sample (n, 3)."""
+    """Eq (47) along a plan: T_u = I_uu* u'' + u'^T P_uuu* u' (F_x, F_y [N], M_z [N m]) at each sample (n, 3).
+
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+        pl: A :func:`plan`.
+    """
     out = np.zeros((len(pl["t"]), 3))
     for k in range(len(pl["t"])):
         red = robot.reduced(pl["q"][k], pl["nu"][k])
@@ -252,14 +302,31 @@ def operational_forces(robot: Robot, pl: dict) -> np.ndarray:
 
 
 def kinetic_energy(robot: Robot, q: np.ndarray, nu: np.ndarray) -> float:
-    """Kinetic energy [J] of the whole mechanism (Pinocchio, full velocities v = S nu)."""
+    """Kinetic energy [J] of the whole mechanism (Pinocchio, full velocities v = S nu).
+
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+        q: Natural coordinates (n,) [m, rad].
+        nu: The platform twist u' = (v_cx, v_cy, omega) [m/s, m/s, rad/s] in platform axes.
+
+    Returns:
+        The kinetic energy [J].
+    """
     return robot.energy(q, robot.reduced(q, nu).v) - robot.energy(q, np.zeros(robot.nq))
 
 
 def wheel_mass_params(total: float, m_pl: float) -> dict:
     """Parameters for the paper's sweep: three wheels of total mass ``total`` (each a disc of radius r:
     axle inertia m r^2 / 2, diametral m r^2 / 4 -- Table 2's values at 0.5 kg), platform mass ``m_pl``;
-    offset links as Table 2."""
+    offset links as Table 2.
+
+    Args:
+        total: Total mass of the three wheels [kg].
+        m_pl: Platform mass [kg].
+
+    Returns:
+        Parameter values by name.
+    """
     r = SPEC.parameter("r").default
     m = total / 3.0
     return {"m_pl": m_pl, "m_wheel": m, "I_wheel_axle": m * r**2 / 2, "I_wheel_diam": m * r**2 / 4}
@@ -271,6 +338,11 @@ class PathScenario(Scenario):
     The six motors (three drives, three steering) produce T_u = B_r tau; tau is the least-squares (minimum-norm)
     solution of B_r(q) tau = I_uu*(q) u''(t) + u'^T P_uuu*(q) u' at the simulated state, so the platform
     twist follows the plan while the casters self-align kinematically. Initial steering: :func:`steady_steering`.
+
+    Args:
+        kind: ``circle`` or ``ellipse`` (also the scenario's name).
+        description: One line, citing the paper's section.
+        t_end: Default duration [s].
     """
 
     def __init__(self, kind: str, description: str, t_end: float) -> None:
@@ -283,7 +355,14 @@ class PathScenario(Scenario):
         return steering_configuration(robot, steady_steering(robot.params, u)), np.zeros(3)
 
     def torque_law(self, robot):
-        """tau(t, q, nu) for ``robot``."""
+        """tau(t, q, nu) for ``robot``.
+
+        Args:
+            robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+
+        Returns:
+            tau(t, q, nu) [N m], one per motor.
+        """
         def torque(t, q, nu):
             red = robot.reduced(q, nu)
             T_u = red.M @ path_state(self.kind, t)["nudot"] + red.h
@@ -319,6 +398,12 @@ RESTITUTION = 0.8
 
 def impulse_ellipses(robot: Robot, e: float = RESTITUTION, speed: float = 1.0, samples: int = 361) -> dict:
     """The impulse curves of Figs. 16-19: :math:`|F(a)|` for unit-speed head-on impacts of the platform centre.
+
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
+        e: Coefficient of restitution (0 to 1).
+        speed: Approach speed [m/s].
+        samples: Number of directions over [0, 2 pi].
 
     Returns:
         {figure: (angles [rad], magnitudes [N s])} for :data:`IMPULSE_CONFIGS`.
@@ -369,7 +454,12 @@ def _cmd_impulse(args) -> int:
 
 
 def register_cli(subparsers, parents) -> None:
-    """``robotdyn impulse ROBOT --q ... --direction ... [--e 0.8] [--speed 1 | --v ...]``."""
+    """``robotdyn impulse ROBOT --q ... --direction ... [--e 0.8] [--speed 1 | --v ...]``.
+
+    Args:
+        subparsers: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     p = subparsers.add_parser("impulse", parents=parents,
                               help="impulse of a frictionless impact on a fixed surface (eq 60 of Chung et al.)")
     p.add_argument("--q", nargs="+", required=True, help="natural coordinates, in the order info lists them")

@@ -1,7 +1,7 @@
 """Omni caster platform: the paper's closed forms and printed numbers, transcribed (no robotdyn model here).
 
 Paper: J. H. Chung, B.-J. Yi, W. K. Kim, S.-Y. Han, "Singularity-free dynamic modeling including wheel dynamics
-for an omni-directional mobile robot with three caster wheels" (``shared/papers/chung_yi_omni_caster_dynamics.txt``):
+for an omni-directional mobile robot with three caster wheels" (Chung, Yi, Kim & Han, ``docs/bibliography.md``):
 the chain Jacobians [iG_phi^u] of eqs 12-14 and their inverses [iG_u^phi] of eqs 15-17 (with the erratum of
 eq 16 as an option), the Hessian of eqs 18-19, the chain inertia of eq 43, the platform inertia of eq 50, the
 operational-space inertia I_uu* of eqs 48/51 and bias of eq 49, the impulse of eq 60, the NOC Jacobians of
@@ -18,7 +18,17 @@ _CHAINS = (1, 2, 3)
 
 
 def paper_forward(p: dict, i: int, phi: float) -> np.ndarray:
-    """[iG_phi^u] of eq (12)-(14) as printed: u' = G (eta_i', theta_i', phi_i')."""
+    """[iG_phi^u] of eq (12)-(14) as printed: u' = G (eta_i', theta_i', phi_i').
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        i: The chain number 1, 2 or 3 (Fig. 2).
+        phi: The chain's steering angle phi_i [rad].
+
+    Returns:
+        The 3x3 matrix.
+    """
     d, r, a, l, b = p["d"], p["r"], p["a"], p["l"], p["b"]
     s, c = np.sin(phi), np.cos(phi)
     if i == 1:
@@ -35,6 +45,13 @@ def paper_inverse(p: dict, i: int, phi: float, corrected: bool = True) -> np.nda
         corrected: Apply the erratum of eq (16), entry (1, 3): the paper prints ``l/2 r cos phi2 - a r sin phi2``;
             the inverse of eq (13) (and the model) give ``-l/2 r cos phi2 - a r sin phi2`` (the chain-2 mirror of
             eq 15, l -> -l). ``False`` returns the matrix as printed.
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        i: The chain number 1, 2 or 3 (Fig. 2).
+        phi: The chain's steering angle phi_i [rad].
+
+    Returns:
+        The 3x3 matrix.
     """
     d, r, a, l, b = p["d"], p["r"], p["a"], p["l"], p["b"]
     s, c = np.sin(phi), np.cos(phi)
@@ -58,18 +75,36 @@ def paper_chain_inertia(p: dict) -> np.ndarray:
     """[iI_phi_phi*] of eq (43): diag(m2 p^2 + I_z1 + I_z2, 3/2 m1 r^2 + m2 r^2, 0), (eta, theta, phi) order.
 
     As printed, 3/2 m1 r^2 assumes the wheel's axle inertia is m1 r^2 / 2 (true of Table 2's values).
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
     """
     m1, m2, r = p["m_wheel"], p["m_link"], p["r"]
     return np.diag([m2 * p["p"] ** 2 + p["I_wheel_diam"] + p["I_link_z"], 1.5 * m1 * r**2 + m2 * r**2, 0.0])
 
 
 def paper_platform_inertia(p: dict) -> np.ndarray:
-    """[pl I_uu*] of eq (50): diag(m_pl, m_pl, m_pl b^2 / 2)."""
+    """[pl I_uu*] of eq (50): diag(m_pl, m_pl, m_pl b^2 / 2).
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+    """
     return np.diag([p["m_pl"], p["m_pl"], 0.5 * p["m_pl"] * p["b"] ** 2])
 
 
 def paper_inertia(p: dict, phi) -> np.ndarray:
-    """I_uu* of eq (48) with (51): sum_i G_i^T I_phiphi G_i + pl I_uu*, G_i of eq (15)-(17) (corrected (16))."""
+    """I_uu* of eq (48) with (51): sum_i G_i^T I_phiphi G_i + pl I_uu*, G_i of eq (15)-(17) (corrected (16)).
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        phi: Steering angles (phi1, phi2, phi3) [rad].
+
+    Returns:
+        I_uu* (3, 3) [kg, kg m, kg m^2].
+    """
     I = paper_chain_inertia(p)
     out = paper_platform_inertia(p).copy()
     for i in _CHAINS:
@@ -90,6 +125,16 @@ def paper_bias(p: dict, phi, nu, platform_terms: bool = True) -> np.ndarray:
 
     The paper does not print the platform's [pl P_uuu*]; with ``platform_terms`` it is taken as the Newton-Euler
     terms of a rigid body in body axes, m_pl (-omega v_cy, omega v_cx, 0) (our reading, see the errata).
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        phi: Steering angles (phi1, phi2, phi3) [rad].
+        nu: The platform twist u' = (v_cx, v_cy, omega) [m/s, m/s, rad/s] in platform axes.
+        platform_terms: Include the platform's own velocity products (our reading; the paper prints none).
+
+    Returns:
+        The velocity-product forces (3,) [N, N, N m].
     """
     phi = np.asarray(phi, float)
     nu = np.asarray(nu, float)
@@ -109,7 +154,17 @@ def paper_bias(p: dict, phi, nu, platform_terms: bool = True) -> np.ndarray:
 
 
 def paper_impulse(I_uu: np.ndarray, n, u_dot, e: float) -> float:
-    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.contact.impulse)."""
+    """Eq (60): F = -(1 + e) u'^T n / (n^T I_uu*^-1 n) (transcribed separately from robotdyn.contact.impulse).
+
+    Args:
+        I_uu: The operational-space inertia I_uu* (3, 3).
+        n: The impact direction (3,) in the twist's coordinates.
+        u_dot: The twist before impact (3,).
+        e: Coefficient of restitution (0 to 1).
+
+    Returns:
+        The impulse F [N s].
+    """
     n = np.asarray(n, float)
     return float(-(1 + e) * np.dot(u_dot, n) / (n @ np.linalg.inv(I_uu) @ n))
 
@@ -119,6 +174,11 @@ def paper_noc_jacobians(p: dict, phi) -> tuple[np.ndarray, np.ndarray]:
     """J_p (6x6) and J_a (6x3) of eq (A7)-(A8) from the columns ig_j of eq (12)-(14).
 
     Dependent rates (eta1', phi1', eta2', phi2', eta3', theta3'), independent (theta1', theta2', phi3'), eq (A9).
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        phi: Steering angles (phi1, phi2, phi3) [rad].
     """
     g = {i: paper_forward(p, i, phi[i - 1]) for i in _CHAINS}
     z = np.zeros(3)
@@ -133,6 +193,11 @@ def paper_noc_map(p: dict, phi) -> np.ndarray:
 
     The NOC model exists iff K is invertible (equivalently det J_p != 0); then its inertia is
     K^-T I_uu* K^-1 (the same kinetic energy in other velocities).
+
+    Args:
+        p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
+            m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+        phi: Steering angles (phi1, phi2, phi3) [rad].
     """
     return np.vstack([paper_inverse(p, 1, phi[0])[1], paper_inverse(p, 2, phi[1])[1], paper_inverse(p, 3, phi[2])[2]])
 

@@ -3,7 +3,7 @@
 - :mod:`robotdyn.robots.quasimoro.model`: what robotdyn derives from ``urdf/quasimoro.urdf.xacro`` -- ``SPEC`` (parameters of section 3,
   wheels, motors), the torque pulse of eq 19 and the two section-3 manoeuvres (``SCENARIOS``), ``drift``.
 - :mod:`robotdyn.robots.quasimoro.paper`: the paper's closed forms (eqs 23-31) and printed values, transcribed
-  (``shared/papers/staicu_quasimoro_virtual_powers.txt``).
+  (Staicu, ``docs/bibliography.md``).
 - :mod:`robotdyn.robots.quasimoro.comparison`: ``compare``, the model against the paper (``docs/errata/quasimoro.md``).
 
 The names of all three are re-exported here (``robotdyn.robots.module("quasimoro")``).

@@ -1,7 +1,7 @@
 """Quasimoro: the model against the paper (:func:`compare`) and the model-side helper it needs.
 
 Brings :mod:`robotdyn.robots.quasimoro.model` (Pinocchio's reduced dynamics of ``urdf/quasimoro.urdf.xacro``) and :mod:`robotdyn.robots.quasimoro.paper` (eqs 23-31
-of ``shared/papers/staicu_quasimoro_virtual_powers.txt``) together; disagreements are discussed in
+of Staicu, ``docs/bibliography.md``) together; disagreements are discussed in
 ``docs/errata/quasimoro.md``.
 """
 
@@ -22,7 +22,12 @@ from .paper import (
 
 
 def model_equations(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, dict[tuple[int, int], np.ndarray], np.ndarray]:
-    """The model's (M_r, velocity-product coefficients, g_r) at q, from the Pinocchio path."""
+    """The model's (M_r, velocity-product coefficients, g_r) at q, from the Pinocchio path.
+
+    Args:
+        robot: The Quasimoro :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (x, y, psi, theta1, theta2, theta3) [m, rad].
+    """
     red = robot.reduced(q, np.zeros(3))
     quad = quadratic_coefficients(lambda nu: robot.reduced(q, nu).h, 3)
     return red.M, quad, red.g
@@ -33,6 +38,15 @@ def compare(robot: Robot | None = None, trajectory=None, states: int = 50, seed:
 
     Coefficients are compared at ``states`` random inclinations theta3; each row shows the paper's and the
     model's value at the inclination where they differ most (tolerance 1e-9, i.e. exact up to round-off). The steady theta3 amplitude comes from the rectilinear run (``trajectory``, simulated if None).
+
+    Args:
+        robot: The Quasimoro robot (default ``None``: built with the default parameters).
+        trajectory: The rectilinear run (default ``None``: simulated here).
+        states: Number of random inclinations theta3 at which the coefficients are compared.
+        seed: Seed of those inclinations.
+
+    Returns:
+        The :class:`~robotdyn.interfaces.comparison.Comparison`.
     """
     robot = robot or Robot(SPEC)
     p = robot.params

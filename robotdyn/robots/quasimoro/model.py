@@ -2,7 +2,7 @@
 
 Description: ``urdf/quasimoro.urdf.xacro``; Pinocchio derives the dynamics from it (nothing here is a closed form).
 Paper the parameters and manoeuvres come from: Şt. Staicu, "Dynamics of Angeles's Quasimoro mobile robot using
-principle of virtual powers" (``shared/papers/staicu_quasimoro_virtual_powers.txt``): parameter values of
+principle of virtual powers" (Staicu, ``docs/bibliography.md``): parameter values of
 section 3, the torque pulse of eq 19, the two manoeuvres of section 3 (1° rectilinear, 2° pure rotation).
 
 Coordinates (x, y, psi) of the axle midpoint C2 and yaw; theta1, theta2 the wheel angles relative to the axle
@@ -26,7 +26,7 @@ SPEC = RobotSpec(
     title="Quasimoro: two wheels plus a pendulum body (Staicu, virtual powers)",
     xacro="quasimoro.urdf.xacro",
     root="planar",
-    paper="staicu_quasimoro_virtual_powers.txt",
+    paper="Staicu, Dynamics of Angeles's Quasimoro mobile robot using principle of virtual powers",
     parameters=[
         Parameter("m", 0.5, "kg", "mass of each wheel"),
         Parameter("M", 5.0, "kg", "mass of the intermediate body", positive=True),
@@ -57,7 +57,14 @@ def _pulse(t: float) -> float:
 
 def pulse(signs: tuple[float, float]) -> Sine:
     """Eq 19 on both motors as a torque profile (compiled: robotdyn.simulation.torque_profile): m_i = sign_i m° sin(pi t) for
-    0 <= t <= 1 s, zero afterwards."""
+    0 <= t <= 1 s, zero afterwards.
+
+    Args:
+        signs: The sign (+1 or -1) of each motor's pulse (m1, m2).
+
+    Returns:
+        A :class:`~robotdyn.simulation.torque_profile.Sine` profile [N m].
+    """
     return Sine([signs[0] * PULSE_AMPLITUDE, signs[1] * PULSE_AMPLITUDE], np.pi, start=0.0, stop=1.0)
 
 
@@ -83,12 +90,26 @@ SCENARIOS = {
 
 
 def steady_amplitude(traj, name: str = "theta3", after: float = 10.0) -> float:
-    """Half the peak-to-peak range of a coordinate after time ``after`` [s]."""
+    """Half the peak-to-peak range of a coordinate after time ``after`` [s].
+
+    Args:
+        traj: The :class:`~robotdyn.simulation.trajectory.Trajectory`.
+        name: The coordinate's name.
+        after: Start of the steady window [s].
+
+    Returns:
+        The half range [unit of the coordinate].
+    """
     x = traj.column(name)[traj.t >= after]
     return 0.5 * float(x.max() - x.min())
 
 
 def drift(robot: Robot, traj) -> float:
-    """Largest violation of the integrated constraint psi = rho (theta2 - theta1) (eq 11) along a run [rad]."""
+    """Largest violation of the integrated constraint psi = rho (theta2 - theta1) (eq 11) along a run [rad].
+
+    Args:
+        robot: The Quasimoro :class:`~robotdyn.robot.Robot` (its rho).
+        traj: Its :class:`~robotdyn.simulation.trajectory.Trajectory`.
+    """
     rho = robot.params["rho"]
     return float(np.max(np.abs(traj.column("psi") - rho * (traj.column("theta2") - traj.column("theta1")))))

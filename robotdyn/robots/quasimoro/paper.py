@@ -1,7 +1,7 @@
 """Quasimoro: the paper's closed forms, transcribed as printed (no robotdyn model computation here).
 
 Paper: Şt. Staicu, "Dynamics of Angeles's Quasimoro mobile robot using principle of virtual powers"
-(``shared/papers/staicu_quasimoro_virtual_powers.txt``): the coefficients A11..A19 of eq 24 with the symmetries of
+(Staicu, ``docs/bibliography.md``): the coefficients A11..A19 of eq 24 with the symmetries of
 eq 26, the rows of eqs 23, 25, 28, the rectilinear torque of eq 29, the pure-rotation inertia of eq 31 and the
 steady inclination amplitude read off Fig. 5 (section 3). Each function takes the parameters as a plain dict
 (m, M, J1, J2, r, d, rho, g), so it can be read line by line against the paper.
@@ -45,6 +45,11 @@ _PRODUCTS = [(0, 1), (1, 2), (0, 2), (0, 0), (1, 1), (2, 2)]
 def paper_equations(p: dict, theta3: float) -> tuple[np.ndarray, dict[tuple[int, int], np.ndarray], np.ndarray]:
     """The paper's reduced model in nu = (theta1_dot, theta2_dot, theta3_dot), rows = eqs 23, 25, 28.
 
+    Args:
+        p: The parameters as a plain dict: m [kg], M [kg], J1 [kg m^2], J2 [kg m^2], r [m], d [m], rho [-] (and g
+            [m/s^2] where gravity enters).
+        theta3: Body inclination [rad].
+
     Returns:
         ``(M, quad, grav)``: the 3x3 inertia matrix, the velocity-product coefficient vectors
         ``{(i, j): 3-vector}`` and the gravity vector, so that row i reads
@@ -65,7 +70,19 @@ def paper_equations(p: dict, theta3: float) -> tuple[np.ndarray, dict[tuple[int,
 
 
 def paper_rectilinear_torque(p: dict, theta3: float, theta1_ddot: float, theta3_dot: float, theta3_ddot: float) -> float:
-    """Eq 29: m1 = m2 = (3m + M) r^2 th1''/2 + M r d (th3'' cos th3 - th3'^2 sin th3)/2 (rectilinear motion)."""
+    """Eq 29: m1 = m2 = (3m + M) r^2 th1''/2 + M r d (th3'' cos th3 - th3'^2 sin th3)/2 (rectilinear motion).
+
+    Args:
+        p: The parameters as a plain dict: m [kg], M [kg], J1 [kg m^2], J2 [kg m^2], r [m], d [m], rho [-] (and g
+            [m/s^2] where gravity enters).
+        theta3: Body inclination [rad].
+        theta1_ddot: Wheel angular acceleration [rad/s^2].
+        theta3_dot: Inclination rate [rad/s].
+        theta3_ddot: Inclination acceleration [rad/s^2].
+
+    Returns:
+        Each motor's torque m1 = m2 [N m].
+    """
     m, M, r, d = p["m"], p["M"], p["r"], p["d"]
     return 0.5 * (3 * m + M) * r**2 * theta1_ddot + 0.5 * M * r * d * (
         theta3_ddot * np.cos(theta3) - theta3_dot**2 * np.sin(theta3)
@@ -73,5 +90,13 @@ def paper_rectilinear_torque(p: dict, theta3: float, theta1_ddot: float, theta3_
 
 
 def paper_rotation_inertia(p: dict) -> float:
-    """Eq 31: :math:`m_1 = |m_2|` = [m r^2 (3/2 + rho^2) + 2 rho^2 J1] th1'' (pure rotation, theta3 = 0)."""
+    """Eq 31: :math:`m_1 = |m_2|` = [m r^2 (3/2 + rho^2) + 2 rho^2 J1] th1'' (pure rotation, theta3 = 0).
+
+    Args:
+        p: The parameters as a plain dict: m [kg], M [kg], J1 [kg m^2], J2 [kg m^2], r [m], d [m], rho [-] (and g
+            [m/s^2] where gravity enters).
+
+    Returns:
+        The factor of th1'' in m1 [kg m^2].
+    """
     return p["m"] * p["r"] ** 2 * (1.5 + p["rho"] ** 2) + 2 * p["rho"] ** 2 * p["J1"]

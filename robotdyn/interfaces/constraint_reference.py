@@ -1,0 +1,197 @@
+"""The constraint file's reference: every key of :data:`~robotdyn.interfaces.constraint_schema.SCHEMA` with its
+type, what it expects (units and ranges, from the schema), its default and an example, as rows or a Markdown table.
+
+The documentation site builds its file-format page from :func:`markdown_table`, so the page cannot drift from the
+schema: a key added to the schema without an entry in :data:`KEYS` (or an entry here for a key the schema no
+longer has) makes :func:`rows` raise, which fails the documentation build and ``tests/test_docs_site.py``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .constraint_schema import SCHEMA
+
+KEYS: dict[str, tuple[str, str, str]] = {
+    # key path: (what it is, default, example)
+    "name": ("the robot's name (shown by info, used in sweeps)", "the file's stem", 'name = "my_rover"'),
+    "title": ("one line describing the robot", "stem and description file", 'title = "Differential drive, two casters"'),
+    "paper": ("a short reference of the paper the robot comes from", "none", 'paper = "Author 2024, Title"'),
+    "urdf": ("the URDF or Xacro description: relative to the file, absolute, or package://PKG/path",
+             "required unless given separately (--urdf)", 'urdf = "rover.urdf.xacro"'),
+    "root": ("the joint between the world and the root link: fixed; planar (x, y, psi); floating (x, y, z, yaw, "
+             "pitch, roll)", "planar", 'root = "floating"'),
+    "package_dirs": ("directories searched for ROS packages ($(find PKG), package://PKG), relative to the file; "
+                     "ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are searched too", "[]", 'package_dirs = ["../ws/src"]'),
+    "packages": ("ROS packages by name: directory of each, relative to the file", "{}",
+                 '[packages]\nmy_description = "../my_description"'),
+    "root_height": ("planar root: height of the root link above the ground", "auto (from the wheels at the neutral "
+                    "configuration)", "root_height = 0.1"),
+    "massless": ("links whose URDF inertial is ignored", "[]", 'massless = ["sensor_link"]'),
+    "independent": ("the coordinates (labels or joint names) whose velocities are the independent ones; as many as "
+                    "the mobility", "chosen automatically (info prints the choice)",
+                    'independent = ["theta_R", "theta_L"]'),
+    "xacro_args": ("fixed xacro arguments of the description", "{}", 'xacro_args = { wheel_radius = "0.1" }'),
+    "labels": ("display names of coordinates, by joint", "the joint names", 'labels = { wheel_right_joint = "theta_R" }'),
+    "neutral": ("a valid configuration, by coordinate name", "all zero", "neutral = { z = 0.1 }"),
+    "locked": ("joints held fixed at a value (glob patterns allowed)", "{}", 'locked = { "arm_*" = 0.0 }'),
+    "terrain": ("the ground", "flat, z = 0", '[terrain]\nkind = "ramp"\nslope = 0.1'),
+    "terrain.kind": ("flat (height) | ramp (slope, heading) | bump (height, x0, width, length) | sine (amplitude, kx, "
+                     "ky, phase)", "flat", 'kind = "bump"'),
+    "terrain.height": ("flat, ramp: ground height at the origin; bump: bump height (required by bump)", "0", "height = 0.05"),
+    "terrain.slope": ("ramp: rise over run", "required by ramp", "slope = 0.1"),
+    "terrain.heading": ("ramp: direction of steepest ascent from the x axis", "0", "heading = 0.5"),
+    "terrain.x0": ("bump: position of the rise along x", "0", "x0 = 1.0"),
+    "terrain.width": ("bump: width of the smooth rise (a tanh profile)", "0.1", "width = 0.05"),
+    "terrain.length": ("bump: length of the plateau before it comes back down", "none (a step up)", "length = 0.3"),
+    "terrain.amplitude": ("sine: amplitude", "required by sine", "amplitude = 0.02"),
+    "terrain.kx": ("sine: wave number along x", "required by sine", "kx = 6.0"),
+    "terrain.ky": ("sine: wave number along y", "0", "ky = 0.0"),
+    "terrain.phase": ("sine: phase", "0", "phase = 0.0"),
+    "twist": ("independent velocities that are a frame's twist instead of `independent`", "none",
+              '[twist]\nframe = "base_link"\ncomponents = ["vx", "wz"]'),
+    "twist.frame": ("the frame whose twist is used", "required in [twist]", 'frame = "base_link"'),
+    "twist.components": ("components of the twist (vx vy vz wx wy wz)", '["vx", "vy", "wz"]', 'components = ["vx", "wz"]'),
+    "twist.axes": ("the axes the twist is expressed in: body (the frame's own) or world", "body", 'axes = "world"'),
+    "twist.names": ("display names of the components", "the components", 'names = ["v", "omega"]'),
+    "parameters": ("numbers that wheels and the description (xacro arguments) refer to; what sweeps vary", "[]",
+                   '[[parameters]]\nname = "r"\ndefault = 0.1\nunit = "m"'),
+    "parameters[].name": ("the parameter's name (a xacro argument of the description when xacro = true)", "required",
+                          'name = "chassis_mass"'),
+    "parameters[].default": ("its value in its unit, or one of its choices", "required", "default = 4.0"),
+    "parameters[].unit": ("its unit (shown by info; sweeps accept values with units)", '""', 'unit = "kg"'),
+    "parameters[].description": ("one line", '""', 'description = "mass of the chassis"'),
+    "parameters[].choices": ("the allowed values of a word-valued parameter", "none (a number)",
+                             'choices = ["com", "origin"]'),
+    "parameters[].xacro": ("pass it to the description as a xacro argument (so a sweep can vary a URDF mass, "
+                           "length, inertia)", "true when the Xacro declares an argument of that name",
+                           "xacro = true"),
+    "parameters[].minimum": ("the smallest physical value (masses and inertias: 0 by default)", "none",
+                             "minimum = 0.0"),
+    "wheels": ("the wheels touching the ground, one table each", "[]", '[[wheels]]\nname = "left"\n'
+               'joint = "left_wheel_joint"\nradius = 0.1'),
+    "wheels[].name": ("the wheel's name (CSV columns <name>.normal, forces tables)", "the frame name", 'name = "left"'),
+    "wheels[].joint": ("the wheel's spin joint; its child link's origin is the wheel centre", "one of joint or frame",
+                       'joint = "left_wheel_joint"'),
+    "wheels[].frame": ("the wheel centre's frame (a ball or a fixed caster: no spin joint)", "one of joint or frame",
+                       'frame = "ball_link"'),
+    "wheels[].radius": ("the radius, a number or a parameter name", "required", 'radius = "r"'),
+    "wheels[].axis": ("the axle in the wheel frame", "the spin joint's axis", "axis = [0, 1, 0]"),
+    "wheels[].kind": ("standard (rolls without slipping) | omni (with roller_angle) | caster (a wheel on a steering "
+                      "joint of the URDF) | support (touches the ground only: normal row, frictionless, e.g. a ball "
+                      "caster or a skid)", "standard", 'kind = "support"'),
+    "wheels[].roller_angle": ("omni: angle of the rollers' axes", "0", 'roller_angle = "45 deg"'),
+    "wheels[].radius_joint": ("a prismatic joint that sets the radius (adaptable wheels)", "none",
+                              'radius_joint = "leg_joint"'),
+    "wheels[].mu": ("friction coefficient (traction checks; the limit of the coulomb and linear laws)", "none (not "
+                    "checked)", "mu = 0.8"),
+    "wheels[].friction": ("rolling (no slip) | coulomb (regularised) | linear (brush tyre) | stick_slip",
+                          "rolling", 'friction = "coulomb"'),
+    "wheels[].slip_velocity": ("coulomb: regularisation velocity", "1e-3", "slip_velocity = 0.001"),
+    "wheels[].stiffness": ("linear: force per unit load per m/s of slip", "required by linear", "stiffness = 5.0"),
+    "wheels[].slip": ("with a friction law: both directions, or lateral only (rolls along its rolling direction)",
+                      "both", 'slip = "lateral"'),
+    "closures": ("loop closures: two frames held together", "[]",
+                 '[[closures]]\nframe1 = "a"\nframe2 = "b"\ncomponents = "x y z"'),
+    "closures[].name": ("the closure's name", "none", 'name = "rocker"'),
+    "closures[].frame1": ("the first frame (components are in its axes)", "required", 'frame1 = "link_a_end"'),
+    "closures[].frame2": ("the second frame", "required", 'frame2 = "link_b_end"'),
+    "closures[].components": ("the closed components, a subset of x y z rx ry rz in frame1's axes", '"x y z"',
+                              'components = "x z"'),
+    "motors": ("the actuated joints, in the order of the torques", "[]",
+               '[[motors]]\nname = "tau_L"\njoint = "left_wheel_joint"'),
+    "motors[].name": ("the motor's name (torque tables, CSV)", "the joint name", 'name = "tau_L"'),
+    "motors[].joint": ("the driven joint", "required", 'joint = "left_wheel_joint"'),
+    "motors[].reaction": ("the frame the motor reacts on", "the joint's parent", 'reaction = "base_link"'),
+    "scenarios": ("constant-torque manoeuvres for simulate and sweeps", "[]",
+                  '[[scenarios]]\nname = "spin"\nt_end = 2.0\ntorque = [0.5, -0.5]'),
+    "scenarios[].name": ("the scenario's name (--scenario NAME)", "required", 'name = "spin"'),
+    "scenarios[].description": ("one line", "constant torques [...]", 'description = "turn on the spot"'),
+    "scenarios[].t_end": ("duration", "required", "t_end = 2.0"),
+    "scenarios[].torque": ("constant torques, in motor order or by motor name (motors not named: 0)", "all zero",
+                           "torque = { tau_L = 0.5 }"),
+    "scenarios[].q0": ("initial coordinates by name (others: neutral)", "the neutral configuration",
+                       "q0 = { psi = 0.5 }"),
+    "scenarios[].nu0": ("initial independent velocities by name (with [twist]: by component name)", "zero",
+                        "nu0 = { theta_R = 1.0 }"),
+}
+"""What each key is, its default and an example: the part of the reference the schema cannot say."""
+
+
+@dataclass(frozen=True)
+class KeyRow:
+    """One key of the constraint file: ``key`` its path (``wheels[].radius`` for a key of every ``[[wheels]]``
+    table), ``type`` its TOML type, ``expected`` what the schema accepts (units, ranges), ``required`` whether the
+    table must have it, ``description``, ``default`` and ``example`` (TOML)."""
+
+    key: str
+    type: str
+    expected: str
+    required: bool
+    description: str
+    default: str
+    example: str
+
+
+def _type(schema: dict) -> str:
+    """The TOML type(s) a schema entry accepts."""
+    names = {"string": "string", "number": "number", "boolean": "boolean", "array": "array", "object": "table",
+             "integer": "integer"}
+    if "enum" in schema:
+        return "string: " + " | ".join(map(str, schema["enum"]))
+    if "const" in schema:
+        return f'"{schema["const"]}"'
+    if "anyOf" in schema:
+        return " or ".join(dict.fromkeys(_type(s) for s in schema["anyOf"]))
+    kind = schema.get("type")
+    if isinstance(kind, list):
+        return " or ".join(names[k] for k in kind)
+    if kind == "array":
+        items = schema.get("items", {})
+        if items.get("type") == "object":
+            return "array of tables"
+        return f"array of {_type(items) if items else 'values'}s"
+    return names.get(kind, "value")
+
+
+def _walk(schema: dict, prefix: str = "", required=()):
+    for key, sub in schema.get("properties", {}).items():
+        path = f"{prefix}{key}"
+        yield path, sub, key in required
+        if sub.get("type") == "object" and "properties" in sub:
+            yield from _walk(sub, f"{path}.", sub.get("required", ()))
+        elif sub.get("type") == "array" and sub.get("items", {}).get("type") == "object":
+            yield from _walk(sub["items"], f"{path}[].", sub["items"].get("required", ()))
+
+
+def rows() -> list[KeyRow]:
+    """Every key of the schema, in the schema's order.
+
+    Raises:
+        KeyError: the schema and :data:`KEYS` disagree (a key missing on either side), naming the keys.
+    """
+    found = list(_walk(SCHEMA, required=SCHEMA.get("required", ())))
+    paths = [p for p, _, _ in found]
+    missing, extra = [p for p in paths if p not in KEYS], [p for p in KEYS if p not in paths]
+    if missing or extra:
+        raise KeyError(f"constraint-file reference out of date: keys of the schema without an entry in KEYS: "
+                       f"{missing}; entries of KEYS that the schema does not have: {extra}")
+    return [KeyRow(p, _type(s), str(s.get("expected", "")), req, *KEYS[p]) for p, s, req in found]
+
+
+def markdown_table() -> str:
+    """The reference as one Markdown table: key and type, what it is and what it accepts (units, ranges), default,
+    example."""
+
+    def cell(text: str) -> str:
+        return text.replace("|", "\\|").replace("\n", "<br>")
+
+    lines = ["| key (type) | what it is; what it accepts (units, range) | default | example |", "|---|---|---|---|"]
+    for r in rows():
+        default = "**required**" if r.required else cell(r.default)
+        lines.append(f"| `{r.key}`<br>({cell(r.type)}) | {cell(r.description)}; accepts {cell(r.expected)} | {default} | "
+                     f"<code>{cell(r.example)}</code> |")
+    return "\n".join(lines)
+
+
+__all__ = ["KEYS", "KeyRow", "rows", "markdown_table"]

@@ -1,0 +1,82 @@
+"""`simulate --plot` draws the x-y path of any planar/floating root; the traction plot draws every wheel that can
+slip, drive wheels first, and the smallest mu of the best split where the wheels' own friction is undetermined
+(the Quasimoro figure's friction panel used to be empty)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+import robotdyn
+from robotdyn.contact.traction import Traction
+from robotdyn.interfaces.constraint_file import load_robot
+from robotdyn.interfaces.plotting import plot_path, plot_traction, plot_trajectory, pose_columns, wheel_order
+from robotdyn.simulation.trajectory import Trajectory
+
+ROOT = Path(__file__).resolve().parents[1]
+DIFF_DRIVE = ROOT / "examples/ros_ws/src/demo_description/robotdyn/diff_drive.toml"
+
+
+def _circle(coordinates, velocity_names):
+    """A root driving a quarter circle of radius 2 m, heading tangent: x = 2 sin s, y = 2 (1 - cos s), psi = s."""
+    t = np.linspace(0.0, 1.0, 21)
+    s = 0.5 * np.pi * t
+    q = np.zeros((t.size, len(coordinates)))
+    q[:, 0], q[:, 1], q[:, 2] = 2 * np.sin(s), 2 * (1 - np.cos(s)), s
+    nu = np.zeros((t.size, len(velocity_names)))
+    return Trajectory(t, q, nu, np.zeros_like(t), np.zeros_like(t), list(coordinates), list(velocity_names))
+
+
+def test_pose_columns_of_planar_and_fixed_roots():
+    robot = robotdyn.load("quasimoro")
+    traj = _circle(robot.coordinates, robot.velocity_names)
+    assert pose_columns(robot, traj) == ("x", "y", "psi")
+    fixed = robotdyn.load("linkage_suspension")
+    assert fixed.spec.root == "fixed" or pose_columns(fixed, _circle(fixed.coordinates, fixed.velocity_names))
+
+
+def test_path_panel_draws_the_root_path_and_heading():
+    robot = robotdyn.load("quasimoro")
+    traj = _circle(robot.coordinates, robot.velocity_names)
+    fig = plot_trajectory(traj, robot.velocity_names[:1], None, pose=pose_columns(robot, traj))
+    (ax,) = [a for a in fig.axes if a.get_title() == "path in the world x-y plane"]
+    x, y = ax.lines[0].get_data()
+    np.testing.assert_allclose(x, 2 * np.sin(0.5 * np.pi * traj.t))
+    np.testing.assert_allclose(y, 2 * (1 - np.cos(0.5 * np.pi * traj.t)))
+    arrows = ax.collections[0]  # heading arrows: unit vectors (cos psi, sin psi); the last one points along +y
+    np.testing.assert_allclose(arrows.U[-1], 0.0, atol=1e-12)
+    np.testing.assert_allclose(arrows.V[-1], 1.0)
+    assert plot_path(traj, "x", "y", "psi") is not None
+
+
+def _traction(wheels, determined, minimum):
+    n = 5
+    t = np.linspace(0, 1, n)
+    normal = np.full((n, len(wheels)), 20.0)
+    return Traction(t, list(wheels), normal, np.zeros_like(normal), np.zeros_like(normal),
+                    np.full(len(wheels), np.nan), np.array(determined), minimum_mu=minimum)
+
+
+def test_friction_panel_shows_the_best_split_when_the_wheels_share_a_force():
+    """Quasimoro's two wheels share one lateral force: their own required mu is undetermined, the minimum mu of
+    the best split is not; the panel must draw it (it was empty)."""
+    minimum = np.array([0.0, 0.005, 0.0103, 0.004, 0.0])
+    fig = plot_traction(_traction(["wheel_A", "wheel_B"], [False, False], minimum))
+    ax_mu = fig.axes[1]
+    drawn = [line for line in ax_mu.lines if len(line.get_xdata())]
+    assert len(drawn) == 1
+    np.testing.assert_allclose(drawn[0].get_ydata(), minimum)
+    assert "0.0103" in drawn[0].get_label()
+
+
+def test_drive_wheels_first_and_supports_only_in_the_load_panel():
+    robot = load_robot(DIFF_DRIVE)
+    order, supports = wheel_order(robot, ["caster", "left", "right"])
+    assert order == ["left", "right", "caster"] and supports == {"caster"}
+    tr = _traction(["caster", "left", "right"], [True, True, True], None)
+    tr.required_mu[:, 1:] = 0.2
+    fig = plot_traction(tr, robot=robot)
+    ax_n, ax_mu = fig.axes[:2]
+    assert [line.get_label() for line in ax_n.lines[:3]] == ["left", "right", "caster (support, frictionless)"]
+    assert [line.get_label() for line in ax_mu.lines if len(line.get_xdata())] == ["left", "right"]

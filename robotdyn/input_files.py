@@ -66,6 +66,14 @@ def regular_file(path, what: str, max_bytes: int) -> os.stat_result:
 def read_text(path, what: str, max_bytes: int) -> str:
     """The UTF-8 text of a regular file of at most ``max_bytes`` bytes (see :func:`regular_file`).
 
+    Args:
+        path: The file.
+        what: What the file is, for the message (e.g. ``"sweep file"``).
+        max_bytes: Largest size read [bytes].
+
+    Returns:
+        The file's text.
+
     Raises:
         InputError: As :func:`regular_file`; also a file that grew beyond ``max_bytes`` while it was read, or that
             is not UTF-8 text.

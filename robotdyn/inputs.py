@@ -27,6 +27,10 @@ def refuse_together(args, *flags: str) -> None:
     """Refuse options that exclude each other when more than one was given (argparse names, e.g. ``"tau_set"``;
     given means neither None, False nor empty).
 
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+        flags: The options' argparse names.
+
     Raises:
         InputError: ``--a and --tau-set exclude each other; expected one of them``.
     """

@@ -174,6 +174,10 @@ _LINK = re.compile(r"<link[\s/>]")
 def check_size(urdf: str, name: str) -> None:
     """Refuse an expanded description beyond :data:`MAX_DESCRIPTION_BYTES` or :data:`MAX_LINKS` links.
 
+    Args:
+        urdf: The expanded URDF text.
+        name: The description's file name, for the message.
+
     Raises:
         DescriptionError: Naming the description, its size or link count, and the limit.
     """

@@ -114,6 +114,14 @@ def visible_output(path, what: str = "output file") -> Iterator[tuple[Path, obje
     The ``.partial`` file is locked (``flock``) while written: a second run writing the same target is refused in
     one line; a ``.partial`` left by a killed run is not locked and is overwritten.
 
+    Args:
+        path: The target file (``str`` or :class:`~pathlib.Path`); its directory must exist and be writable.
+        what: What it is, for messages (default ``"output file"``).
+
+    Yields:
+        ``(partial, f)``: the path of ``<path>.partial`` and its binary file object, empty, open for reading and
+        writing.
+
     Raises:
         OutputError: The target or its ``.partial`` file cannot be written, or another process is writing them.
     """

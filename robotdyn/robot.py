@@ -277,6 +277,8 @@ class Robot:
         params: Resolved parameter values.
         model, data: The Pinocchio model and data (natural coordinates, nq == nv).
         constraints, motors: The constraint and motor objects.
+        implausible_inertias: Links whose inertia is implausible for their mass and size, with their share of the
+            effective mass (:mod:`robotdyn.description.inertia_check`; a warning names them on load).
     """
 
     def __init__(self, spec: RobotSpec, params: dict | None = None, terrain: Terrain | None = None) -> None:
@@ -333,6 +335,11 @@ class Robot:
         self.operational = spec.operational.build(self.description) if spec.operational is not None else None
         if self.operational is not None:
             self.velocity_names = list(self.operational.names)
+        from .description.inertia_check import implausible_inertias, message
+
+        self.implausible_inertias = implausible_inertias(self)  # placeholder inertias (issue 24): data, and a warning
+        if self.implausible_inertias:
+            warnings.warn(message(self.implausible_inertias), RobotDynWarning, stacklevel=2)
 
     def __getstate__(self) -> dict:
         """Pickle without the per-thread caches (Pinocchio data and compiled models are rebuilt on use)."""
@@ -499,6 +506,22 @@ class Robot:
         """
         return as_vector(tau, len(self.motors), "tau", [m.name for m in self.motors], MAX_FORCE, "N m or N")
 
+    def _state(self, q, nu, tau=None, what: str = "nu") -> tuple:
+        """``q``, ``nu`` (and ``tau``) as float arrays, their lengths checked (a wrong length is a one-line
+        :class:`~robotdyn.errors.InputError` from :meth:`check_q`/:meth:`check_nu`/:meth:`check_tau`, never
+        numpy's shape error deep inside); values are not range-checked here (the API's hot path)."""
+        q_, nu_ = np.asarray(q, float), np.asarray(nu, float)
+        if q_.shape != (self.nq,):
+            self.check_q(q)
+        if nu_.shape != (self.mobility,):
+            self.check_nu(nu, what)
+        if tau is None:
+            return q_, nu_
+        tau_ = np.asarray(tau, float)
+        if tau_.shape != (len(self.motors),):
+            self.check_tau(tau)
+        return q_, nu_, tau_
+
     # ------------------------------------------------------------------------------------------ constraints
     def constraint_rows(self, kin: KinematicState) -> ConstraintRows:
         """All constraint rows at the state of ``kin``.
@@ -630,6 +653,7 @@ class Robot:
             The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` (``M``, ``h``, ``g``, ``B``, ``S``, ...).
 
         Raises:
+            InputError: ``q`` or ``nu`` of the wrong length (one line naming the entries expected).
             NonFiniteError: The state gives non-finite numbers.
 
         Example:
@@ -641,7 +665,7 @@ class Robot:
             >>> bool(abs(red.M - red.M.T).max() < 1e-12)  # symmetric
             True
         """
-        q, nu = np.asarray(q, float), np.asarray(nu, float)
+        q, nu = self._state(q, nu)
         return checked(reduce(self, q, nu, coriolis), q, nu)
 
     def full(self, q, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -679,6 +703,7 @@ class Robot:
             The independent accelerations (k,) [m/s^2, rad/s^2].
 
         Raises:
+            InputError: ``q``, ``nu`` or ``tau`` of the wrong length (one line naming the entries expected).
             NonFiniteError: The accelerations are not finite.
 
         Example:
@@ -690,15 +715,17 @@ class Robot:
             >>> bool(abs(nudot[0] - nudot[1]) < 1e-12)  # equal torques: the wheels accelerate alike
             True
         """
+        q, nu, tau = self._state(q, nu, tau)
         if sliding_now(self):
-            return forward_sliding(self, np.asarray(q, float), np.asarray(nu, float), np.asarray(tau, float)).nudot
+            return forward_sliding(self, q, nu, tau).nudot
         red = self.reduced(q, nu)
-        out = solve_mass(red.M, red.B @ np.asarray(tau, float) - red.h)
+        out = solve_mass(red.M, red.B @ tau - red.h)
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
                                  "what double precision holds)")
         if check:
             self._warn_dropped(red, out)
+            self.warn_conditioning(red, out)
         return out
 
     def dynamics_derivatives(self, q, nu, tau):
@@ -706,7 +733,23 @@ class Robot:
         independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
         :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (Python path; see
         :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`, and with slipping wheels
-        :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`)."""
+        :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] in the order of :attr:`coordinates`, on the holonomic constraint
+                manifold for ``dq_manifold`` to be the derivative along it.
+            nu: Independent velocities (k,) [m/s, rad/s] in the order of :attr:`velocity_names`.
+            tau: Motor torques/forces (n_motors,) [N m or N] in the order of :attr:`motors`.
+
+        Returns:
+            A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`.
+
+        Raises:
+            InputError: Wrong sizes, or a constraint without derivatives (a stick-slip wheel, exact Coulomb
+                friction, a user's own constraint class).
+            SingularConstraintError: Slipping wheels whose coupled system is singular (Painlevé).
+            NonFiniteError: A non-finite result.
+        """
         if sliding_now(self):
             from .contact.sliding_derivatives import sliding_derivatives
 
@@ -714,6 +757,50 @@ class Robot:
         from .reduction.dynamics_derivatives import dynamics_derivatives
 
         return dynamics_derivatives(self, q, nu, tau)
+
+    def conditioning(self, q, nu, tau=None) -> list:
+        """The ill-conditioned parts of the reduced solve at (q, nu) (the projection's :math:`A_d`, the reduced
+        mass matrix :math:`S^TMS`) that make its results (with motor torques ``tau``: the accelerations they
+        give) beyond what the state can produce, as data: a list of
+        :class:`~robotdyn.reduction.conditioning.IllConditioned`, empty where they are within it
+        (:mod:`robotdyn.reduction.conditioning`).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as :attr:`coordinates`.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as :attr:`velocity_names`.
+            tau: Motor torques/forces (motors,) [N m or N], ordered as the motors (default ``None``: the
+                accelerations are not judged, only the parts' conditioning).
+
+        Returns:
+            The ill-conditioned parts, a list of :class:`~robotdyn.reduction.conditioning.IllConditioned`.
+        """
+        from .reduction.conditioning import ill_conditioned
+
+        red = self.reduced(q, nu)
+        nudot = None if tau is None else solve_mass(red.M, red.B @ np.asarray(tau, float) - red.h)
+        return ill_conditioned(red, self.velocity_names, nudot)
+
+    def warn_conditioning(self, red, nudot=None, extra: list | None = None, forward: bool = True) -> list:
+        """Warn (one :class:`~robotdyn.errors.RobotDynWarning`) when the results of ``red`` (with the accelerations
+        ``nudot`` computed from it) are beyond what the state can produce (:mod:`robotdyn.reduction.conditioning`).
+
+        Args:
+            red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` the results come from.
+            nudot: The independent accelerations (k,) [m/s^2, rad/s^2] computed from it (default ``None``: only
+                the parts' conditioning is judged).
+            extra: Ill-conditioned parts found by the caller (e.g. the force system), added where not already found.
+            forward: Whether ``nudot`` was solved from the mass matrix (else its conditioning is not a cause).
+
+        Returns:
+            The parts found (a list of :class:`~robotdyn.reduction.conditioning.IllConditioned`; empty: no warning).
+        """
+        from .reduction.conditioning import ill_conditioned, message
+
+        found = ill_conditioned(red, self.velocity_names, nudot, forward)
+        found += [e for e in (extra or []) if e.part not in {f.part for f in found}]
+        if found:
+            warnings.warn(message(found), RobotDynWarning, stacklevel=3)
+        return found
 
     def redundant_row_violations(self, q, nu, nudot=None) -> list:
         """The constraint rows dropped as redundant at q that the velocities ``nu`` (and the accelerations
@@ -751,6 +838,9 @@ class Robot:
             :math:`B_r\\tau = Q` in least squares, and the norm of what the motors cannot produce (0 when the
             motion is feasible).
 
+        Raises:
+            InputError: ``q``, ``nu`` or ``nudot`` of the wrong length (one line naming the entries expected).
+
         Example:
             >>> import robotdyn
             >>> robot = robotdyn.load("quasimoro")
@@ -760,8 +850,11 @@ class Robot:
             [0.1, 0.1]
         """
         red = self.reduced(q, nu)
-        Q = red.M @ np.asarray(nudot, float) + red.h
-        self._warn_dropped(red, np.asarray(nudot, float))
+        nudot = np.asarray(nudot, float)
+        if nudot.shape != (self.mobility,):
+            self.check_nu(nudot, "nudot")
+        Q = red.M @ nudot + red.h
+        self._warn_dropped(red, nudot)
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)
@@ -822,8 +915,11 @@ class Robot:
 
     def mobility_check(self) -> tuple[int, list[str]]:
         """The mobility n - rank A at the neutral configuration, and plain-language notes where the wheels lock
-        the base (no admissible motion turns it, or moves it at all), e.g. a skid-steer base whose non-steering
-        wheels roll without slipping."""
+        the base (no admissible motion turns it, or moves it at all, at the neutral configuration and at the other
+        admissible ones :func:`~robotdyn.constraints.base_mobility.reachable_motion` finds), e.g. a skid-steer base
+        whose non-steering wheels roll without slipping, or where that holds only at the neutral configuration
+        (steerable wheels parallel there); and joint-origin angles that look like a rounded multiple of pi/2
+        (:mod:`robotdyn.description.rounded_angles`)."""
         A = self.rows_at(self.neutral()).A
         rank = int(np.linalg.matrix_rank(A)) if A.size else 0
         notes = []
@@ -833,12 +929,32 @@ class Robot:
             names = self.description.joint_names
             yaw = names.index("psi" if "psi" in names else "yaw")
             xy = [names.index("x"), names.index("y")]
+            from .constraints.base_mobility import reachable_motion
+
             if not np.any(np.abs(null[:, yaw]) > 1e-9):
-                notes.append("the base cannot turn: in every motion its wheels allow (rolling without slipping) the "
-                             "yaw rate is zero, so turning requires slip; give the wheels a friction law "
-                             "(friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and friction')")
+                elsewhere = reachable_motion(self, names[yaw])
+                if elsewhere is None:
+                    notes.append("the base cannot turn: in every motion its wheels allow (rolling without slipping) "
+                                 "the yaw rate is zero, at the neutral configuration and at the other admissible "
+                                 "ones searched (steering moved), so turning requires slip; give the wheels a "
+                                 "friction law (friction = 'linear' or 'coulomb', README: 'Wheel forces, slip and "
+                                 "friction')")
+                else:
+                    moved = self._moved(elsewhere)
+                    notes.append("the base cannot turn at the neutral configuration (e.g. its steerable wheels are "
+                                 f"parallel there), but it can without slip at other admissible ones, e.g. {moved}: "
+                                 "steer the wheels first")
             if not np.any(np.abs(null[:, xy]) > 1e-9):
-                notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+                if all(reachable_motion(self, names[i]) is None for i in xy):
+                    notes.append("the base cannot translate: its wheels allow no horizontal motion of the base")
+                else:
+                    notes.append("the base cannot translate at the neutral configuration, but it can at other "
+                                 "admissible ones (steer the wheels first)")
+        from .description.rounded_angles import hint, rounded_angles
+
+        rounded = rounded_angles(self.description.urdf)
+        if rounded:
+            notes.append(hint(rounded))
         nearby = self._nearby_rank(rank)
         if nearby > rank:
             notes.append(f"the mobility changes at the neutral configuration: {self.nq - rank} here, "
@@ -847,6 +963,11 @@ class Robot:
                          "and velocities or accelerations that leave this configuration violate them (robotdyn warns, "
                          "naming the row: Robot.redundant_row_violations)")
         return self.nq - rank, notes
+
+    def _moved(self, q) -> str:
+        """The coordinates of q that differ from the neutral configuration, as text (name = value rad/m)."""
+        q0 = self.neutral()
+        return ", ".join(f"{c} = {x:.3g}" for c, x, x0 in zip(self.coordinates, q, q0) if abs(x - x0) > 1e-3)
 
     def _nearby_rank(self, rank: int, samples: int = 3, step: float = 0.1) -> int:
         """The largest rank of the constraint rows at a few valid configurations near the neutral one, to tell a
@@ -889,6 +1010,7 @@ class Robot:
             "root_height": self.description.root_height,
             "root_height_source": self.root_height_source,
             "visual_warnings": report.warnings if report is not None else [],
+            "implausible_inertias": [vars(f) for f in self.implausible_inertias],  # warned on load, not repeated
             "robot": self.spec.name,
             "title": self.spec.title,
             "paper": self.spec.paper,

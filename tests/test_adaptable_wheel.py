@@ -439,8 +439,8 @@ def test_mission1_lateral_friction_energy_balance(friction_run):
 
 
 def test_mission1_impossible_with_lateral_friction(friction_run):
-    """The finding of the errata: with a real lateral law the commanded motion needs friction far beyond mu = 1
-    (the rigid model balances the lateral forces only through the terrain's tilt, with traction of ~1 kN), and on
+    """The finding of the errata: with a real lateral law the commanded motion needs |f_t| / f_n far beyond mu = 1
+    (not a threshold on mu: no mu makes it consistent, tests/test_errata.py) (the rigid model balances the lateral forces only through the terrain's tilt, with traction of ~1 kN), and on
     flat ground no torques and contact forces realise it at all (rank 14 of 15: lateral sliding friction sums to
     mu (f_fr + f_fl - f_r), which the pitch balance forces to zero, while the path needs m v^2 / rho = 10 N)."""
     from dataclasses import replace

@@ -377,6 +377,8 @@ def test_compare_verdicts(robot):
     assert verdict["eq 16 as printed"] == "differs"
     assert verdict["eq 49 + derived offset-link terms (worst deviation)"] == "reproduced"
     assert verdict["sec 5 printed with-wheel I_uu*"] == "differs"
+    assert verdict["sec 5 with-wheel I_uu* as a steady turn, steering term Table 2's"] == "differs"
+    assert verdict["sec 5 with-wheel I_uu* as a steady turn, wheel and steering terms fitted"] == "reproduced"
 
 
 def test_circle_wheel_mass_sweep_affects_y_and_moment_not_x(robot):

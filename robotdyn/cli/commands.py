@@ -204,9 +204,14 @@ def cmd_dump(args) -> int:
     red = robot.reduced(q, nu, coriolis=True)
     names = robot.velocity_names
     motors = [m.name for m in robot.motors]
+    from ..reduction.conditioning import mass_condition
+
+    mass_cond = mass_condition(red.M)[0]  # the other conditioning that matters (robotdyn.reduction.conditioning)
     out = {"coordinates": names, "q": q, "q_names": robot.coordinates, "M": red.M, "C": red.C, "g": red.g,
-           "B": red.B, "motors": motors, "S": red.S, "condition": red.projection.condition}
-    text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g})",
+           "B": red.B, "motors": motors, "S": red.S, "condition": red.projection.condition,
+           "mass_matrix_condition": mass_cond}
+    text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g}, "
+            f"S^T M S condition {mass_cond:.3g})",
             _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
             _vector_text("g", names, red.g),
             _matrix_text("B", names, motors, red.B) if motors else "B: none (the robot has no motors)"]
@@ -221,6 +226,7 @@ def cmd_dump(args) -> int:
         tau = _torques(robot, args.tau, args.tau_set)
         nudot = solve_mass(red.M, red.B @ tau - red.h)
         out["a"] = nudot
+        out["ill_conditioned"] = [vars(f) for f in robot.warn_conditioning(red, nudot)]
         text.append(_vector_text("a (independent accelerations)", names, nudot))
     from ..constraints.redundancy import message, violations
 
@@ -703,9 +709,13 @@ def _one_line_warnings() -> None:
 
     default = warnings.showwarning
 
+    shown = set()
+
     def show(message, category, filename, lineno, file=None, line=None):
         if issubclass(category, RobotDynWarning):
-            print(f"robotdyn: warning: {message}", file=sys.stderr)
+            if str(message) not in shown:  # once per run, wherever it was raised from (e.g. a robot built twice)
+                shown.add(str(message))
+                print(f"robotdyn: warning: {message}", file=sys.stderr)
         else:
             default(message, category, filename, lineno, file, line)
 

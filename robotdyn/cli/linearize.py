@@ -11,7 +11,24 @@ from ..inputs import MAX_POSITION, as_vector
 
 def cmd_linearize(args) -> int:
     """``robotdyn linearize ROBOT [--q ...] [--set NAME=VALUE] [--v ...] [--tau ...] [--states ...]
-    [--lqr-q ... --lqr-r ...]``."""
+    [--lqr-q ... --lqr-r ...]``: the linearised reduced dynamics (A, B, eigenvalues of A; with ``--lqr-q``/``--lqr-r``
+    an LQR gain and the closed-loop eigenvalues) about a state, printed as text or (``--json``) as JSON.
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``): ``q`` natural coordinates in the order ``info``
+            lists them [m, rad] (default: the neutral configuration), ``set`` NAME=VALUE overrides, ``v`` the
+            independent velocities [m/s, rad/s] (default zeros), ``tau``/``tau_set`` the motor torques [N m or N]
+            (default zeros), ``states`` the states to keep, ``lqr_q``/``lqr_r`` the LQR weights (one per kept state,
+            >= 0; one per motor, > 0).
+
+    Returns:
+        The exit status, 0.
+
+    Raises:
+        RobotDynError: Bad input (a coordinate off the holonomic constraints, a wrong number of values, only one
+            of ``--lqr-q``/``--lqr-r``, a negative state weight or a non-positive input weight), which
+            :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
+    """
     from ..reduction.linearization import linearize, lqr
     from .commands import _emit, _load, _matrix_text, _numbers, _torques, _vector_text
 
@@ -56,7 +73,12 @@ def cmd_linearize(args) -> int:
 
 
 def register(sub, parents) -> None:
-    """Add the ``linearize`` subcommand."""
+    """Add the ``linearize`` subcommand.
+
+    Args:
+        sub: The CLI's subparsers (``argparse`` action).
+        parents: Parsers whose arguments it inherits (the common and robot arguments).
+    """
     p = sub.add_parser("linearize", parents=parents,
                        help="linearised state-space model (A, B, eigenvalues; optional LQR gain) about a state")
     p.add_argument("--q", nargs="+", help="natural coordinates, in the order info lists them (default: the neutral "

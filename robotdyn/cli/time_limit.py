@@ -22,7 +22,11 @@ EXIT_STATUS = 124
 
 
 class Limit:
-    """The limit of one run: :meth:`start` arms it, :attr:`reached` says whether it stopped the run."""
+    """The limit of one run: :meth:`start` arms it, :attr:`reached` says whether it stopped the run.
+
+    Args:
+        seconds: The wall-clock limit [s], or None for no limit (then :meth:`start` arms nothing).
+    """
 
     def __init__(self, seconds: float | None) -> None:
         self.seconds, self.reached, self.armed = seconds, False, False
@@ -40,7 +44,15 @@ class Limit:
             self.armed = False
 
     def reason(self, partial: str | None) -> str | None:
-        """A partial run's note, saying that the time limit stopped it (the note itself if it did not)."""
+        """A partial run's note, saying that the time limit stopped it (the note itself if it did not).
+
+        Args:
+            partial: The partial run's note (its first "interrupted" is replaced by the time limit when the limit
+                was reached), or None for a complete run.
+
+        Returns:
+            The note, rewritten if the limit stopped the run; None (or the empty note) unchanged.
+        """
         if not (self.reached and partial):
             return partial
         return partial.replace("interrupted", f"time limit of {self.seconds:g} s reached", 1)
@@ -55,6 +67,12 @@ class Limit:
 def wall_clock_limit(seconds: float | None) -> Iterator[Limit]:
     """A :class:`Limit` whose timer (a ``SIGALRM`` raising ``KeyboardInterrupt``) is disarmed, and the previous
     handler restored, when the block ends (``seconds`` None: no limit).
+
+    Args:
+        seconds: The wall-clock limit [s], a positive finite number, or None for no limit.
+
+    Yields:
+        The run's :class:`Limit` (not yet started: the caller calls :meth:`Limit.start` when the run begins).
 
     Raises:
         InputError: A limit asked for outside the main thread (signals reach the main thread only), or not a

@@ -73,7 +73,15 @@ class FramePass:
 
     def velocity(self, fid: int) -> tuple[np.ndarray, np.ndarray]:
         """World-axes (LOCAL_WORLD_ALIGNED) frame velocity :math:`V = J x` (6,) and :math:`\\partial V/\\partial q`
-        at fixed x (6 x n): linear rows the frame origin's velocity, angular rows the angular velocity."""
+        at fixed x (6 x n): linear rows the frame origin's velocity, angular rows the angular velocity.
+
+        Args:
+            fid: The Pinocchio frame id (``model.getFrameId(name)``).
+
+        Returns:
+            ``(V, dV)``: V (6,) [m/s, rad/s] in world axes (linear first, then angular) and its q-derivative
+            (6 x n) at fixed x, both cached per frame.
+        """
         if fid not in self._vel:
             dq, _ = pin.getFrameVelocityDerivatives(self.model, self.data, fid, LOCAL)[:2]
             local = pin.getFrameVelocity(self.model, self.data, fid, LOCAL).vector
@@ -85,19 +93,43 @@ class FramePass:
         return self._vel[fid]
 
     def local_velocity(self, fid: int) -> tuple[np.ndarray, np.ndarray]:
-        """Body-axes (LOCAL) frame velocity (6,) and its q-derivative at fixed x (6 x n)."""
+        """Body-axes (LOCAL) frame velocity (6,) and its q-derivative at fixed x (6 x n).
+
+        Args:
+            fid: The Pinocchio frame id (``model.getFrameId(name)``).
+
+        Returns:
+            ``(V, dV)``: the twist (6,) [m/s, rad/s] in the frame's own axes (linear first, then angular) and its
+            q-derivative (6 x n) at fixed x.
+        """
         dq = pin.getFrameVelocityDerivatives(self.model, self.data, fid, LOCAL)[0]
         return pin.getFrameVelocity(self.model, self.data, fid, LOCAL).vector.copy(), dq
 
     def local_acceleration(self, fid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Body-axes spatial acceleration at :math:`\\dot v = 0` (6,: the time derivative of the body twist, i.e.
-        :math:`\\dot J_{\\text{LOCAL}} x`) and its derivatives in q and in x (6 x n each)."""
+        :math:`\\dot J_{\\text{LOCAL}} x`) and its derivatives in q and in x (6 x n each).
+
+        Args:
+            fid: The Pinocchio frame id (``model.getFrameId(name)``).
+
+        Returns:
+            ``(a, da_dq, da_dx)``: the spatial acceleration (6,) [m/s^2, rad/s^2] in the frame's own axes (linear
+            first, then angular) and its derivatives in q and in x (6 x n each).
+        """
         _, a_dq, a_dv, _ = pin.getFrameAccelerationDerivatives(self.model, self.data, fid, LOCAL)
         return pin.getFrameAcceleration(self.model, self.data, fid, LOCAL).vector.copy(), a_dq, a_dv
 
     def acceleration(self, fid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """World-axes classical acceleration at :math:`\\dot v = 0` (6,: origin's linear acceleration and angular
-        acceleration, :math:`\\dot J x` of the LOCAL_WORLD_ALIGNED Jacobian) and its derivatives in q and in x."""
+        acceleration, :math:`\\dot J x` of the LOCAL_WORLD_ALIGNED Jacobian) and its derivatives in q and in x.
+
+        Args:
+            fid: The Pinocchio frame id (``model.getFrameId(name)``).
+
+        Returns:
+            ``(a, da_dq, da_dx)``: the classical acceleration (6,) [m/s^2, rad/s^2] in world axes (linear first,
+            then angular) and its derivatives in q and in x (6 x n each), cached per frame.
+        """
         if fid not in self._acc:
             vdq, vdv = pin.getFrameVelocityDerivatives(self.model, self.data, fid, LOCAL)[:2]
             vl = pin.getFrameVelocity(self.model, self.data, fid, LOCAL).vector
@@ -119,9 +151,21 @@ class FramePass:
 def wheel_geometry_dq(wheel: RollingWheel, kin0: KinematicState) -> dict:
     """Configuration derivatives (3 x n each) of a wheel's contact geometry: axle ``a``, unit vector ``u`` from the
     contact point to the centre, normal ``n``, contact frame columns ``t1``, ``t2``, the vector ``r = p - c``,
-    and the radius row ``R`` (1 x n). The rate formulas of
+    and the radius row ``R`` (n,). The rate formulas of
     :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact` with :math:`v` replaced by the identity
-    (every rate there is linear in v)."""
+    (every rate there is linear in v).
+
+    Args:
+        wheel: The rolling wheel.
+        kin0: Kinematics at the configuration q (its ``geometry`` cache holds the result, keyed by the wheel).
+
+    Returns:
+        A dict of derivatives with respect to the natural coordinates, all vectors in world axes: ``a``, ``u``,
+        ``n``, ``t1``, ``t2`` (3 x n, unit vectors' rates per unit of each coordinate), ``r`` (3 x n, [m] per unit
+        of each coordinate), ``R``
+        (n,: 1 at the joint-driven radius coordinate, else zeros) and ``E``, the tuple (``t1``, ``t2``, ``n``) of
+        the contact frame's columns.
+    """
     key = (id(wheel), "geometry_dq")
     if key in kin0.geometry:
         return kin0.geometry[key]
@@ -155,7 +199,18 @@ def wheel_geometry_dq(wheel: RollingWheel, kin0: KinematicState) -> dict:
 def wheel_velocity_dq(wheel: RollingWheel, fpass: FramePass, directions: np.ndarray | None = None) -> np.ndarray:
     """:math:`\\partial(A x)/\\partial q` (rows x n) of a rolling wheel at fixed x = ``fpass.x``:
     :math:`A x = D E^T s`, :math:`s = v_c(x) + \\omega(x)\\times r - u\\,x_R` (``directions``: D, default the
-    wheel's own rows; e.g. the tangential rows (t1, t2) of a slipping wheel)."""
+    wheel's own rows; e.g. the tangential rows (t1, t2) of a slipping wheel).
+
+    Args:
+        wheel: The rolling wheel.
+        fpass: The frame pass at (q, x); x (n,) [m/s, rad/s] is held fixed.
+        directions: D (rows x 3), the rows' coefficients of the contact frame's columns (t1, t2, n); default
+            None: the wheel's own rows.
+
+    Returns:
+        The derivative (rows x n) of the rows' contact-frame velocity components [m/s] per unit of each
+        coordinate (m or rad).
+    """
     kin0 = fpass.kin0
     geo = wheel._geometry(kin0)
     E, R, u = geo[9], geo[2], geo[4]
@@ -176,7 +231,18 @@ def terrain_normal_dp(terrain, p: np.ndarray, numerical: set[str] | None = None,
     (:attr:`~robotdyn.constraints.terrain.Terrain.third`):
     :math:`\\partial_\\alpha N = [-(N_\\alpha n^T + nN_\\alpha^T)D + (I - nn^T)\\partial_\\alpha D]/\\|m\\| -
     N\\,(n^TD_\\alpha)/\\|m\\|`; a terrain without them: Richardson-extrapolated central differences of its
-    ``normal_derivative`` (reported in ``numerical``)."""
+    ``normal_derivative`` (reported in ``numerical``).
+
+    Args:
+        terrain: The :class:`~robotdyn.constraints.terrain.Terrain` (with or without ``third``).
+        p: The ground point (3,) in world coordinates [m]; only its x and y are used.
+        numerical: A set to which a note is added when the derivatives are finite differences (default None: no
+            note).
+        name: The constraint's name, for that note.
+
+    Returns:
+        The array (2, 3, 3) [1/m^2]: index 0 the derivative along world x, index 1 along world y.
+    """
     x, y = float(p[0]), float(p[1])
     if terrain.third is not None:
         fx, fy = terrain.gradient(x, y)
@@ -211,15 +277,24 @@ def terrain_normal_dp(terrain, p: np.ndarray, numerical: set[str] | None = None,
 
 
 def wheel_drift_dq(wheel: RollingWheel, fpass: FramePass, numerical: set[str] | None = None) -> np.ndarray:
-    """:math:`\\\\partial\\\\gamma/\\\\partial q` at fixed v = ``fpass.x`` of a rolling wheel, analytic: the drift of
+    """:math:`\\partial\\gamma/\\partial q` at fixed v = ``fpass.x`` of a rolling wheel, analytic: the drift of
     :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.drift`,
-    :math:`D(\\\\dot E^T s + E^T(a_c^0 + \\\\dot\\\\omega^0\\\\times r + \\\\omega\\\\times\\\\dot r - \\\\dot u\\\\dot R))`,
+    :math:`D(\\dot E^T s + E^T(a_c^0 + \\dot\\omega^0\\times r + \\omega\\times\\dot r - \\dot u\\dot R))`,
     differentiated term by term: the geometry through :func:`wheel_geometry_dq`, the frame's velocity and classical
     acceleration through Pinocchio's derivatives, and the rates of
-    :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact` (:math:`K\\\\dot u = P(Q_aN(\\\\dot c - \\\\dot R u)
-    + r_c)`, :math:`K = I + RPQ_aN`, :math:`\\\\dot n = N(\\\\dot c - R\\\\dot u - \\\\dot R u)`, :math:`\\\\dot t_1`,
-    :math:`\\\\dot t_2`) by the product rule. On curved terrain :math:`\\\\partial N/\\\\partial q` needs the terrain's
-    third derivatives (:func:`terrain_normal_dp`); on planes N = 0."""
+    :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact` (:math:`K\\dot u = P(Q_aN(\\dot c - \\dot R u)
+    + r_c)`, :math:`K = I + RPQ_aN`, :math:`\\dot n = N(\\dot c - R\\dot u - \\dot R u)`, :math:`\\dot t_1`,
+    :math:`\\dot t_2`) by the product rule. On curved terrain :math:`\\partial N/\\partial q` needs the terrain's
+    third derivatives (:func:`terrain_normal_dp`); on planes N = 0.
+
+    Args:
+        wheel: The rolling wheel.
+        fpass: The frame pass at (q, v); v = ``fpass.x`` (n,) [m/s, rad/s] is held fixed.
+        numerical: A set to which a note is added if the terrain has no third derivatives (default None: no note).
+
+    Returns:
+        The derivative (rows x n) of the wheel's drift rows [m/s^2] per unit of each coordinate (m or rad).
+    """
     kin0 = fpass.kin0
     c, a, R, n, u, p, nw, phi, N, E, nc1 = wheel._geometry(kin0)
     g = wheel_geometry_dq(wheel, kin0)
@@ -306,7 +381,16 @@ def wheel_drift_dq(wheel: RollingWheel, fpass: FramePass, numerical: set[str] | 
 # -------------------------------------------------------------------------------------------- loop closures
 def closure_velocity_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
     """:math:`\\partial(A x)/\\partial q` of a loop closure at fixed x (see the formulas of
-    :mod:`robotdyn.constraints.loop_closure`; :math:`\\partial(R_1^T y)/\\partial q = R_1^T[y]_\\times J_{1,\\omega}`)."""
+    :mod:`robotdyn.constraints.loop_closure`; :math:`\\partial(R_1^T y)/\\partial q = R_1^T[y]_\\times J_{1,\\omega}`).
+
+    Args:
+        closure: The loop closure.
+        fpass: The frame pass at (q, x); x (n,) [m/s, rad/s] is held fixed.
+
+    Returns:
+        The derivative (rows x n) of the closed components' rows (in frame1's axes, in the order of the
+        closure's ``components``).
+    """
     kin0 = fpass.kin0
     M1, J1 = kin0.pose(closure.f1)
     M2, J2 = kin0.pose(closure.f2)
@@ -326,7 +410,16 @@ def closure_velocity_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
 def closure_drift_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
     """:math:`\\partial\\gamma/\\partial q` at fixed v = ``fpass.x`` of a loop closure, analytic: the drift of
     :meth:`~robotdyn.constraints.loop_closure.LoopClosure.drift` differentiated through the frames' velocities and
-    classical accelerations (Pinocchio's velocity and acceleration derivatives)."""
+    classical accelerations (Pinocchio's velocity and acceleration derivatives).
+
+    Args:
+        closure: The loop closure.
+        fpass: The frame pass at (q, v); v = ``fpass.x`` (n,) [m/s, rad/s] is held fixed.
+
+    Returns:
+        The derivative (rows x n) of the closed components' drift rows (in frame1's axes, in the order of the
+        closure's ``components``).
+    """
     kin0 = fpass.kin0
     M1, J1 = kin0.pose(closure.f1)
     M2, J2 = kin0.pose(closure.f2)
@@ -366,7 +459,16 @@ def _third(coupling: JointCoupling, qr: float) -> tuple[float, bool]:
 
 
 def coupling_velocity_dq(coupling: JointCoupling, kin0: KinematicState, x: np.ndarray) -> np.ndarray:
-    """:math:`\\partial(A x)/\\partial q = -f''(q_r)\\,x_r\\,e_r^T`."""
+    """:math:`\\partial(A x)/\\partial q = -f''(q_r)\\,x_r\\,e_r^T` of a joint coupling (its one row).
+
+    Args:
+        coupling: The joint coupling.
+        kin0: Kinematics at the configuration q (q_r read from ``kin0.q``).
+        x: The velocity (n,) [m/s, rad/s] held fixed.
+
+    Returns:
+        The derivative (1 x n), non-zero only in the reference coordinate's column.
+    """
     out = np.zeros((1, kin0.model.nv))
     out[0, coupling.j] = -float(coupling.ddlaw(float(kin0.q[coupling.j]))) * x[coupling.j]
     return out
@@ -377,8 +479,12 @@ def kind(constraint, sliding: bool = False) -> str:
     """The derivative rule that serves a constraint: ``wheel``, ``closure`` or ``coupling``.
 
     Args:
+        constraint: One constraint of the robot.
         sliding: Accept wheels under a friction law (their rows are the normal row only; the caller adds the
             friction, :mod:`robotdyn.contact.sliding_derivatives`).
+
+    Returns:
+        ``"wheel"``, ``"closure"`` or ``"coupling"``.
 
     Raises:
         InputError: A constraint without derivatives here (a wheel under a friction law unless ``sliding``, a
@@ -399,7 +505,19 @@ def kind(constraint, sliding: bool = False) -> str:
 
 
 def velocity_dq(constraints, fpass: FramePass) -> np.ndarray:
-    """All rows' :math:`\\partial(A x)/\\partial q` (m x n) at fixed x = ``fpass.x``, stacked in constraint order."""
+    """All rows' :math:`\\partial(A x)/\\partial q` (m x n) at fixed x = ``fpass.x``, stacked in constraint order.
+
+    Args:
+        constraints: The constraints (rolling wheels, also under a friction law, loop closures, joint couplings),
+            in the order of the rows of A.
+        fpass: The frame pass at (q, x).
+
+    Returns:
+        The derivative (m x n); (0 x n) for no constraints.
+
+    Raises:
+        InputError: A constraint without a derivative rule (see :func:`kind`).
+    """
     parts = []
     for c in constraints:
         k = kind(c, sliding=True)
@@ -416,7 +534,21 @@ def velocity_dq(constraints, fpass: FramePass) -> np.ndarray:
 def drift_dq(constraints, fpass: FramePass, numerical: set[str]) -> np.ndarray:
     """All rows' :math:`\\partial\\gamma/\\partial q` (m x n) at fixed v = ``fpass.x``, stacked in constraint order,
     analytic (the pieces that are not, a terrain without third derivatives or a coupling law other than a
-    :class:`~robotdyn.constraints.joint_coupling.CosineLaw`, are named in ``numerical``)."""
+    :class:`~robotdyn.constraints.joint_coupling.CosineLaw`, are named in ``numerical``).
+
+    Args:
+        constraints: The constraints (rolling wheels, also under a friction law, loop closures, joint couplings),
+            in the order of the rows of A.
+        fpass: The frame pass at (q, v).
+        numerical: A set to which a note is added, naming the constraint, for each piece taken by finite
+            differences.
+
+    Returns:
+        The derivative (m x n); (0 x n) for no constraints.
+
+    Raises:
+        InputError: A constraint without a derivative rule (see :func:`kind`).
+    """
     q, v = fpass.kin0.q, fpass.x
     n = fpass.model.nv
     parts = []

@@ -125,6 +125,15 @@ class RampTerrain(Terrain):
         return np.zeros((2, 2))
 
     def third(self, x: float, y: float) -> np.ndarray:
+        """Third derivatives :math:`f_{ijk}` (2, 2, 2) [1/m^2] of the height, zero on a plane.
+
+        Args:
+            x: World x of the point [m].
+            y: World y of the point [m].
+
+        Returns:
+            The array (2, 2, 2), indices in the order (x, y) [1/m^2]: zeros.
+        """
         return np.zeros((2, 2, 2))
 
     @property
@@ -175,6 +184,16 @@ class BumpTerrain(Terrain):
         return -self.h * (1.0 - t * t) * (1.0 - 3.0 * t * t) / self.w**3
 
     def third(self, x: float, y: float) -> np.ndarray:
+        """Third derivatives :math:`f_{ijk}` (2, 2, 2) [1/m^2] of the height, non-zero only in
+        :math:`f_{xxx}` (the step varies along x only).
+
+        Args:
+            x: World x of the point [m].
+            y: World y of the point [m].
+
+        Returns:
+            The array (2, 2, 2), indices in the order (x, y) [1/m^2]: only ``[0, 0, 0]`` non-zero.
+        """
         out = np.zeros((2, 2, 2))
         out[0, 0, 0] = self._step3(x, self.x0) - (0.0 if self.length is None else self._step3(x, self.x0 + self.length))
         return out
@@ -228,6 +247,16 @@ class SineTerrain(Terrain):
         return s * np.outer(k, k)
 
     def third(self, x: float, y: float) -> np.ndarray:
+        """Third derivatives :math:`f_{ijk}` (2, 2, 2) [1/m^2] of the height,
+        :math:`-A\\cos(k_x x + k_y y + \\varphi)\\,k_i k_j k_k` with :math:`k = (k_x, k_y)`.
+
+        Args:
+            x: World x of the point [m].
+            y: World y of the point [m].
+
+        Returns:
+            The array (2, 2, 2), indices in the order (x, y) [1/m^2].
+        """
         k = np.array([self.kx, self.ky])
         return -self.a * np.cos(self._arg(x, y)) * np.einsum("i,j,k->ijk", k, k, k)
 

@@ -116,6 +116,9 @@ class ConstraintForces:
         closures: Loop-closure forces/moments by closure name, then component (x, y, z [N]; rx, ry, rz [N m]).
         condition: Condition number of the rows' rank-r part (large: nearly redundant rows, ill-determined forces).
         undetermined_reason: Why rows are undetermined (empty when all are determined).
+        ill_conditioned: The ill-conditioned parts of the solve
+            (:class:`~robotdyn.reduction.conditioning.IllConditioned`; a warning names them), empty when well
+            conditioned.
         notes: How the forces were obtained where that is not the model itself (e.g. a planar model's loads from
             its floating twin).
     """
@@ -133,6 +136,7 @@ class ConstraintForces:
     undetermined_reason: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     condition: float = 1.0
+    ill_conditioned: list = field(default_factory=list)
     _tangential: list = field(default_factory=list, repr=False)  # per wheel: (row indices, D, friction or None)
 
     @property
@@ -190,6 +194,7 @@ class ConstraintForces:
             "closures": self.closures,
             "rank": self.rank,
             "condition": self.condition,
+            "ill_conditioned": [vars(f) for f in self.ill_conditioned],
             "rows_count": len(self.labels),
             "undetermined_combinations": [
                 {lab: float(c) for lab, c in zip(self.labels, col) if abs(c) > DETERMINED_TOL}
@@ -295,6 +300,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
     q = robot.check_q(q)
     nu = robot.check_nu(nu, "v")
     red = robot.reduced(q, nu)
+    forward = nudot is None  # accelerations solved from the mass matrix (its conditioning then matters)
     friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
     if sliding_now(robot):
         if nudot is not None:
@@ -320,6 +326,10 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
     out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
     if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
         out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
+    from ..reduction.conditioning import WARN_CONDITION, IllConditioned
+
+    system = [IllConditioned("force system", out.condition)] if out.condition > WARN_CONDITION else []
+    out.ill_conditioned = robot.warn_conditioning(red, nudot, system, forward)
     return out
 
 

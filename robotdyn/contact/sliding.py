@@ -273,6 +273,8 @@ class SlidingInverse:
         residual: :math:`\\|K x - b\\|` of the least-squares solve [N, N m] (0: the motion is exactly realisable by
             these motors and contacts).
         rank: Rank of K; below its column count the torques and forces are not all determined.
+        condition: 2-norm condition number of K (largest over smallest singular value; large: the force system is
+            nearly singular and its torques and loads are ill-determined).
     """
 
     tau: np.ndarray
@@ -282,6 +284,7 @@ class SlidingInverse:
     force: np.ndarray
     residual: float
     rank: int
+    condition: float = 1.0
 
 
 def inverse(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> SlidingInverse:
@@ -317,10 +320,11 @@ def inverse(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> SlidingInvers
     B = input_matrix(robot.motors, kin)
     K = np.hstack([B, G])
     b = pin.rnea(model, data, q, v, a)
-    x, _, rank, _ = np.linalg.lstsq(K, b, rcond=None)
+    x, _, rank, sv = np.linalg.lstsq(K, b, rcond=None)
     n_tau = B.shape[1]
     lam = x[n_tau:]
     normal = lam[normal_row]
     return SlidingInverse(x[:n_tau], dict(zip(rows.labels, lam.tolist())), normal, slip, -normal[:, None] * coef,
-                          float(np.linalg.norm(K @ x - b)), int(rank))
+                          float(np.linalg.norm(K @ x - b)), int(rank),
+                          float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf"))
 

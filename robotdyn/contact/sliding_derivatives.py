@@ -40,7 +40,18 @@ TANGENT = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 def law_jacobian(wheel: SlippingWheel, s: np.ndarray, numerical: set[str]) -> np.ndarray:
     """:math:`\\partial c/\\partial s` (2, 2) of a slipping wheel's friction coefficient
-    :meth:`~robotdyn.contact.sliding.SlippingWheel.friction_coefficient` at slip s (free directions only)."""
+    :meth:`~robotdyn.contact.sliding.SlippingWheel.friction_coefficient` at slip s (free directions only).
+
+    Args:
+        wheel: The slipping wheel (its friction law and its free slip directions).
+        s: The slip velocity (2,) [m/s] of the contact point along the contact frame's (t1, t2).
+        numerical: A set to which a note naming the wheel is added when the law's derivative is taken by central
+            differences (a law other than :class:`~robotdyn.contact.friction.RegularisedCoulomb` and
+            :class:`~robotdyn.contact.friction.LinearTyre`).
+
+    Returns:
+        The Jacobian (2, 2) [s/m], rows and columns along (t1, t2), zero in the wheel's blocked directions.
+    """
     f = wheel._free
     x = s * f
     law = wheel.law
@@ -64,9 +75,21 @@ def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
     """:math:`\\dot\\nu` and its derivatives in q, :math:`\\nu`, :math:`\\tau` for a robot with slipping wheels
     (Python path; the same contents as :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`).
 
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` whose slipping wheels (those sliding now) have a smooth friction
+            law (regularised Coulomb, linear tyre, or another smooth law by finite differences).
+        q: Natural coordinates (n,) [m, rad], in the order of ``robot.coordinates``.
+        nu: Independent velocities (k,) in the order of ``robot.velocity_names`` [m/s, rad/s].
+        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+
+    Returns:
+        A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`.
+
     Raises:
         InputError: A stick-slip wheel or a law without a derivative (exact Coulomb friction).
         SingularConstraintError: The coupled system is singular (Painlevé), as in the forward dynamics.
+        ConstraintError: A slipping wheel's normal row is redundant here (its load undetermined).
+        NonFiniteError: A non-finite result.
     """
     q, nu, tau = robot.check_q(q), robot.check_nu(nu), robot.check_tau(tau)
     wheels = sliding_now(robot)

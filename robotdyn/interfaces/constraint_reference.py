@@ -120,9 +120,17 @@ KEYS: dict[str, tuple[str, str, str]] = {
 
 @dataclass(frozen=True)
 class KeyRow:
-    """One key of the constraint file: ``key`` its path (``wheels[].radius`` for a key of every ``[[wheels]]``
-    table), ``type`` its TOML type, ``expected`` what the schema accepts (units, ranges), ``required`` whether the
-    table must have it, ``description``, ``default`` and ``example`` (TOML)."""
+    """One key of the constraint file, as a row of the reference.
+
+    Attributes:
+        key: Its path, e.g. ``wheels[].radius`` for a key of every ``[[wheels]]`` table.
+        type: Its TOML type(s), e.g. ``number`` or ``string: a | b`` for a choice.
+        expected: What the schema accepts (units, ranges).
+        required: Whether its table must have it.
+        description: What it is.
+        default: Its default when absent (text, as the reference prints it).
+        example: A TOML example of it.
+    """
 
     key: str
     type: str

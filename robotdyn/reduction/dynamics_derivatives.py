@@ -102,6 +102,12 @@ def position_coordinates(A_h: np.ndarray, prefer: np.ndarray | None = None) -> t
     The dependent coordinates (one per independent row) are chosen by QR with column pivoting among ``prefer``
     (e.g. the projection's dependent velocities) when those span the rows, else among all columns.
 
+    Args:
+        A_h: The holonomic constraint rows (m_h, n) at q, columns in the order of the natural coordinates
+            (redundant rows allowed).
+        prefer: Indices into q (any order) among which to choose the dependent coordinates first, or None
+            (default: all columns).
+
     Returns:
         ``(positions, tangent)``: indices (p,) and T (n, p) with :math:`A_h T = 0`, identity on ``positions``.
     """
@@ -183,7 +189,19 @@ def motor_rows(robot, kin0: KinematicState, passes: list[FramePass], tau: np.nda
     """:math:`S^T\\,\\partial(B(q)\\tau)/\\partial q` at fixed S (k, n): row l is the q-derivative of
     :math:`s_l^T B\\tau = \\sum_j \\tau_j(\\omega_{\\text{child}}(s_l) - \\omega_{\\text{reaction}}(s_l))\\cdot\\hat a_j`
     (:mod:`robotdyn.reduction.actuation`), :math:`\\partial\\hat a/\\partial q = -[\\hat a]_\\times J_\\omega`.
-    Motors without a reaction body have constant columns (no term)."""
+    Motors without a reaction body have constant columns (no term).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (its model and motors).
+        kin0: Kinematics at q (joint axes in world axes).
+        passes: Frame passes at the velocities :math:`s_l` (n,) [m/s, rad/s], e.g. the columns of S (then the
+            result is :math:`S^T\\,\\partial(B\\tau)/\\partial q`), or the unit vectors (then
+            :math:`\\partial(B\\tau)/\\partial q` itself).
+        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+
+    Returns:
+        The derivative (len(passes), n) [N m or N per unit of each coordinate].
+    """
     model = robot.model
     out = np.zeros((len(passes), model.nv))
     for j, m in enumerate(robot.motors):
@@ -210,7 +228,14 @@ class Pieces(SimpleNamespace):
 
     def Aq(self, nudot: np.ndarray) -> np.ndarray:
         """:math:`\\partial a/\\partial q` at fixed :math:`\\dot\\nu`, :math:`a = S\\dot\\nu + w`:
-        :math:`-K^{-1}(\\partial(Ka)/\\partial q + dg)` (n, n)."""
+        :math:`-K^{-1}(\\partial(Ka)/\\partial q + dg)` (n, n).
+
+        Args:
+            nudot: :math:`\\dot\\nu` (k,) [m/s^2, rad/s^2], held fixed.
+
+        Returns:
+            The derivative (n, n) of the full accelerations [m/s^2, rad/s^2] per unit of each coordinate.
+        """
         k = len(nudot)
         dKa_A = self.dA_w + sum(nudot[l] * self.dA_cols[l] for l in range(k))
         if self.P.twist is None:
@@ -221,7 +246,20 @@ class Pieces(SimpleNamespace):
 
 def pieces(robot, q: np.ndarray, nu: np.ndarray) -> Pieces:
     """The :class:`Pieces` at (q, nu) (q, nu already validated; slipping wheels' normal rows are ordinary rows
-    here: :mod:`robotdyn.contact.sliding_derivatives` adds their friction)."""
+    here: :mod:`robotdyn.contact.sliding_derivatives` adds their friction).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], already checked (``robot.check_q``).
+        nu: Independent velocities (k,) [m/s, rad/s] in the order of ``robot.velocity_names``, already checked.
+
+    Returns:
+        The :class:`Pieces`.
+
+    Raises:
+        InputError: A constraint without a derivative rule
+            (:func:`~robotdyn.constraints.row_derivatives.kind`).
+    """
     model = robot.model
     n = model.nv
     constraints = list(robot.constraints)
@@ -278,7 +316,22 @@ def pieces(robot, q: np.ndarray, nu: np.ndarray) -> Pieces:
 
 
 def result(robot, pc: Pieces, nudot, dq, dnu, dtau) -> DynamicsDerivatives:
-    """Assemble a :class:`DynamicsDerivatives` (independent position coordinates, the tangent, finiteness)."""
+    """Assemble a :class:`DynamicsDerivatives` (independent position coordinates, the tangent, finiteness).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (names of coordinates, velocities, motors).
+        pc: The :class:`Pieces` at the state.
+        nudot: :math:`\\dot\\nu` (k,) [m/s^2, rad/s^2].
+        dq: :math:`\\partial\\dot\\nu/\\partial q` (k, n).
+        dnu: :math:`\\partial\\dot\\nu/\\partial\\nu` (k, k) [1/s].
+        dtau: :math:`\\partial\\dot\\nu/\\partial\\tau` (k, n_motors).
+
+    Returns:
+        The :class:`DynamicsDerivatives`.
+
+    Raises:
+        NonFiniteError: ``nudot``, ``dq``, ``dnu``, ``dtau`` or :math:`\\partial\\dot q/\\partial q` not finite.
+    """
     hol = pc.rows0.holonomic
     prefer = pc.P.dep if pc.P.twist is None else None
     positions, T = position_coordinates(pc.rows0.A[hol], prefer)

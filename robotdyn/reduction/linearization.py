@@ -34,11 +34,16 @@ class LinearModel:
     """:math:`\\delta\\dot x = A\\,\\delta x + B\\,\\delta\\tau` about :math:`(x_0, \\tau_0)`.
 
     Attributes:
-        A: (n_x, n_x) [1/s and 1/s^2 blocks]. B: (n_x, n_motors).
-        states: Names of the states (position coordinates, then velocities). inputs: Motor names.
-        x0: The operating state (n_x,). tau0: The operating torques (n_motors,).
-        xdot0: :math:`\\dot x` at the operating point (zero at an equilibrium).
-        q0: The full natural coordinates of the operating point (n,).
+        A: (n_x, n_x), rows and columns in the order of ``states``: blocks [1/s] (positions by positions),
+            [-] (positions by velocities), [1/s^2] (velocities by positions), [1/s] (velocities by velocities).
+        B: (n_x, n_motors), columns in the order of ``inputs``: zero position rows, then
+            :math:`M_r^{-1}B_r` (each velocity's acceleration per unit input, e.g. [rad/s^2 per N m]).
+        states: Names of the states (position coordinates, then velocities).
+        inputs: Motor names, in the order of ``robot.motors``.
+        x0: The operating state (n_x,) [m, rad, m/s, rad/s].
+        tau0: The operating torques (n_motors,) [N m or N].
+        xdot0: :math:`\\dot x` at the operating point (n_x,) [m/s, rad/s, m/s^2, rad/s^2] (zero at an equilibrium).
+        q0: The full natural coordinates of the operating point (n,) [m, rad].
         position_index: For each position state, its index in q.
         numerical: Pieces of the derivatives computed by finite differences (see
             :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`).
@@ -66,6 +71,12 @@ class LinearModel:
     def restrict(self, keep: list[str]) -> LinearModel:
         """The model on the states named in ``keep`` (in the model's order), the others dropped.
 
+        Args:
+            keep: Names of the states to keep (any order; the result keeps the model's order).
+
+        Returns:
+            A new :class:`LinearModel` (the inputs, ``tau0`` and ``q0`` unchanged).
+
         Raises:
             InputError: An unknown state name.
         """
@@ -80,7 +91,15 @@ class LinearModel:
                            self.numerical, self.velocities)
 
     def state(self, q, nu) -> np.ndarray:
-        """The model's state vector x (n_x,) of a robot state (q, nu)."""
+        """The model's state vector x (n_x,) of a robot state (q, nu).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] in the order of ``robot.coordinates``.
+            nu: Independent velocities (k,) [m/s, rad/s] in the order of :attr:`velocities`.
+
+        Returns:
+            x (n_x,): the kept position coordinates then the kept velocities, in the order of :attr:`states`.
+        """
         q, nu = np.asarray(q, float), np.asarray(nu, float)
         return np.concatenate([q[self.position_index], nu[self._velocity_index()]])
 
@@ -96,10 +115,15 @@ def linearize(robot, q, nu, tau) -> LinearModel:
         robot: A :class:`~robotdyn.robot.Robot` (rolling and slipping wheels, loop closures, couplings, operational
             velocities): its :meth:`~robotdyn.robot.Robot.dynamics_derivatives`.
         q: Natural coordinates (n,) on the holonomic manifold [m, rad].
-        nu: Independent velocities (k,). tau: Motor torques (n_motors,) [N m or N].
+        nu: Independent velocities (k,) [m/s, rad/s] in the order of ``robot.velocity_names``.
+        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
 
     Returns:
         A :class:`LinearModel` in the state (independent positions, independent velocities).
+
+    Raises:
+        InputError: Wrong sizes, or a constraint without derivatives (e.g. stick-slip or exact Coulomb friction).
+        NonFiniteError: A non-finite derivative at this state.
     """
     D = robot.dynamics_derivatives(q, nu, tau)
     P, T = D.positions, D.tangent
@@ -117,8 +141,15 @@ def lqr(model: LinearModel, Q, R) -> tuple[np.ndarray, np.ndarray]:
     """The LQR gain K (u = -K dx minimises :math:`\\int dx^TQdx + du^TRdu`) and the closed-loop eigenvalues.
 
     Args:
-        model: The linear model. Q: (n_x, n_x) or its diagonal (n_x,), positive semidefinite.
-        R: (n_u, n_u) or its diagonal, positive definite.
+        model: The linear model (e.g. restricted with :meth:`LinearModel.restrict`).
+        Q: The state weights (n_x, n_x), or its diagonal (n_x,), positive semidefinite, in the order of
+            ``model.states``.
+        R: The input weights (n_u, n_u), or its diagonal (n_u,), positive definite, in the order of
+            ``model.inputs``.
+
+    Returns:
+        ``(K, closed)``: the gain K (n_u, n_x) [N m or N per unit of each state] and the closed-loop eigenvalues
+        of :math:`A - BK` (n_x,) [1/s], sorted by real part then imaginary part.
 
     Raises:
         InputError: Wrong shapes, or no stabilising solution (an unstabilisable mode: restrict the model to the
@@ -145,7 +176,15 @@ def lqr(model: LinearModel, Q, R) -> tuple[np.ndarray, np.ndarray]:
 
 
 def lqr_torque(model: LinearModel, K: np.ndarray):
-    """A torque law ``tau(t, q, nu) = tau0 - K (x(q, nu) - x0)`` for :func:`robotdyn.simulation.engine.simulate`."""
+    """A torque law ``tau(t, q, nu) = tau0 - K (x(q, nu) - x0)`` for :func:`robotdyn.simulation.engine.simulate`.
+
+    Args:
+        model: The linear model the gain was computed for (its ``x0``, ``tau0`` and :meth:`LinearModel.state`).
+        K: The gain (n_motors, n_x), e.g. from :func:`lqr`.
+
+    Returns:
+        The callable ``torque(t, q, nu)`` -> (n_motors,) [N m or N] (t [s], q (n,), nu (k,)).
+    """
     x0, tau0 = model.x0.copy(), model.tau0.copy()
 
     def torque(t: float, q: np.ndarray, nu: np.ndarray) -> np.ndarray:

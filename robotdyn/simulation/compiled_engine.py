@@ -226,7 +226,15 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
 
 
 def at_time(exc: RobotDynError, t: float) -> RobotDynError:
-    """The same error (class and attributes) with the simulated time where it happened in front of its message."""
+    """The same error (class and attributes) with the simulated time where it happened in front of its message.
+
+    Args:
+        exc: The error raised at that time.
+        t: The simulated time [s] at which it happened.
+
+    Returns:
+        A shallow copy of ``exc`` whose message reads ``at t = ... s: <message>`` (``exc`` itself is unchanged).
+    """
     import copy
 
     out = copy.copy(exc)
@@ -238,7 +246,20 @@ def stuck(robot, state, t: float, reason: str) -> RobotDynError:
     """The one-line error where the compiled engine's projection stops working at time t even after the Python
     path re-chose its rows at ``state`` = (q, nu) (e.g. a steerable base leaving its parallel-wheel configuration,
     where the mobility changes): the Python path's own error there without its cached row choice (the scipy
-    engine's error at that state), with the time; else a message naming the reason."""
+    engine's error at that state), with the time; else a message naming the reason.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` being simulated (its cached row choice is cleared).
+        state: ``(q, nu)``, natural coordinates (n,) [m, rad] and independent velocities (k,) [m/s, rad/s], where
+            the Python path last re-chose its rows, or None if it never did.
+        t: The simulated time [s] where the compiled engine stopped.
+        reason: The compiled engine's own message, quoted when nothing better is known.
+
+    Returns:
+        The error to raise (not raised here): the Python path's error at ``state`` with the time in front, a
+        :class:`~robotdyn.errors.SingularConstraintError` when the rows' rank no longer leaves the mobility, or
+        else a :class:`~robotdyn.errors.RobotDynError` naming ``reason``.
+    """
     from ..fast.dispatch import use_compiled
 
     if state is not None:

@@ -270,7 +270,12 @@ def stiff_slip_warning(robot, duration: float) -> None:
     :class:`~robotdyn.contact.friction.RegularisedCoulomb`: :math:`k = \\mu / v_s`), so a wheel carrying its share
     m of the weight (load m g) relaxes its slip at the rate :math:`k g` [1/s] at least (its own spin inertia only
     makes the mode faster). An explicit (or Adams) stepper needs steps of about :math:`1/(k g)`: a run of T seconds
-    at least :math:`k g T` of them (e.g. k = 1e12 s/m: 1e13 steps a second, a run that never ends)."""
+    at least :math:`k g T` of them (e.g. k = 1e12 s/m: 1e13 steps a second, a run that never ends).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (its slipping wheels' friction laws and its gravity [m/s^2]).
+        duration: The simulated duration T [s] of the run.
+    """
     import warnings
 
     from ..errors import RobotDynWarning

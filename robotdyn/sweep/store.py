@@ -66,7 +66,11 @@ LOCK = "sweep.lock"
 
 
 class Lock:
-    """The exclusive lock of a sweep directory (:func:`lock`); :meth:`release` gives it up."""
+    """The exclusive lock of a sweep directory (:func:`lock`); :meth:`release` gives it up.
+
+    Args:
+        fd: The open descriptor of ``sweep.lock`` that holds the ``flock`` (closing it releases the lock).
+    """
 
     def __init__(self, fd: int) -> None:
         self.fd = fd
@@ -80,6 +84,12 @@ class Lock:
 def lock(out: Path) -> Lock:
     """Lock the sweep directory ``out`` for this process (``flock`` on ``out/sweep.lock``, released when the
     process ends, however it ends) and write who holds it into the file.
+
+    Args:
+        out: The sweep directory (existing).
+
+    Returns:
+        The held :class:`Lock`.
 
     Raises:
         OutputError: Another process holds the lock (naming its pid, host and start time).
@@ -110,7 +120,18 @@ def lock(out: Path) -> Lock:
 
 def foreign(out: Path, done: dict[str, str], ids: set[str], spec: dict) -> str | None:
     """Why the directory ``out`` holds another sweep than the one whose run ids are ``ids`` and specification
-    ``spec`` (its rows on disk, ``done``, include runs that are not this sweep's), or ``None`` if it does not."""
+    ``spec`` (its rows on disk, ``done``, include runs that are not this sweep's), or ``None`` if it does not.
+
+    Args:
+        out: The sweep directory (its ``sweep.json`` says which specification wrote it).
+        done: The runs with a row on disk, run_id -> status (:func:`finished`).
+        ids: The run ids of this sweep.
+        spec: This sweep's specification as a dict (``SweepSpec.to_dict()``).
+
+    Returns:
+        A one-line reason (how many finished runs are not this sweep's, and whether the specification is the
+        same so an input changed), or None if every finished run is one of this sweep's.
+    """
     others = [i for i in done if i not in ids]
     if not others:
         return None
@@ -126,7 +147,11 @@ def foreign(out: Path, done: dict[str, str], ids: set[str], spec: dict) -> str |
 
 def clear(out: Path) -> None:
     """Delete a sweep's results from ``out`` (row files, trajectories, results, plot, description); other files
-    are left alone."""
+    are left alone.
+
+    Args:
+        out: The sweep directory.
+    """
     import shutil
 
     for path in _parts(out):

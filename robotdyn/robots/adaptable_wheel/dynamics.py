@@ -239,6 +239,7 @@ class FrictionRun:
         rank: (N,) rank of the system (15 when regular).
         power: (N, 2) motor power and friction power [W] (their sum is dE/dt).
         energy: (N,) the robot's total energy [J].
+        condition: (N,) 2-norm condition number of the system (large: nearly singular, loads ill-determined).
     """
 
     t: np.ndarray
@@ -252,6 +253,7 @@ class FrictionRun:
     rank: np.ndarray
     power: np.ndarray
     energy: np.ndarray
+    condition: np.ndarray | None = None
 
 
 def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None = None, every: int = 1) -> FrictionRun:
@@ -272,7 +274,7 @@ def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None =
     idx = np.arange(0, len(run.t), every)
     n = len(idx)
     out = FrictionRun(run.t[idx], *(np.zeros((n, k)) for k in (6, 3, 3, 3, 3, 3)), np.zeros(n), np.zeros(n, int),
-                      np.zeros((n, 2)), np.zeros(n))
+                      np.zeros((n, 2)), np.zeros(n), np.zeros(n))
     for row, i in enumerate(idx):
         _, _, q, v, a = mm.state(run.t[i])
         inv = inverse(robot, q, v, a)
@@ -283,7 +285,7 @@ def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None =
         with np.errstate(divide="ignore", invalid="ignore"):
             out.required_mu[row] = np.where(inv.normal > 0, np.hypot(out.longitudinal[row], out.lateral[row])
                                             / inv.normal, np.inf)
-        out.residual[row], out.rank[row] = inv.residual, inv.rank
+        out.residual[row], out.rank[row], out.condition[row] = inv.residual, inv.rank, inv.condition
         out.power[row] = inv.tau @ (input_matrix(robot.motors, kin).T @ v), float(np.sum(inv.force * inv.slip))
         out.energy[row] = robot.energy(q, v)
     return out

@@ -3,7 +3,8 @@
 Model: :mod:`robotdyn.robots.omni_caster.model` (Pinocchio, ``urdf/omni_caster.urdf.xacro``). Paper: :mod:`robotdyn.robots.omni_caster.paper` (eqs 12-19, 43, 48-51, 60,
 A7-A9 and the printed matrices of section 5 of Chung, Yi, Kim & Han, ``docs/bibliography.md``). Here too:
 :func:`offset_link_correction`, the velocity terms eq 43 leaves out, derived by us (not printed in the paper), and
-the least-squares search for a configuration reproducing the printed I_uu* (:func:`fit_printed_matrix`).
+the least-squares search for a configuration reproducing the printed I_uu* (:func:`fit_printed_matrix`), and the
+fit of a steady turn with the wheel and steering terms of eq 43 (:func:`fit_steady_turn`).
 Verdicts and evidence: ``docs/errata/omni_caster.md``.
 """
 
@@ -21,6 +22,7 @@ from .model import (
     SPEC,
     noc_report,
     noc_spec,
+    steady_steering,
     steering_configuration,
 )
 from .paper import (
@@ -115,6 +117,85 @@ def fit_printed_matrix(p: dict, free: tuple[str, ...] = (), starts: int = 60, se
             "max_abs": float(np.abs(r).max())}
 
 
+PRINTED_ROUNDING = np.array([5e-5, 5e-5, 5e-6, 5e-5, 5e-5, 5e-5])
+"""Half a unit of the last printed digit of the with-wheel I_uu*'s upper-triangle entries (xx, xy, xw, yy, yw, ww):
+5.4329, 0.0537, -0.00078, 7.5379, 0.0107, 0.0397."""
+
+
+def terms_params(p: dict, wheel: float, steering: float) -> dict:
+    """Parameters with eq 43's wheel term ``wheel`` = I_theta / r^2 = I_axle / r^2 + m_wheel + m_link and steering
+    term ``steering`` = I_eta / d^2 = (m_link p^2 + I_wheel_diam + I_link_z) / d^2 [kg], reached by changing only
+    the offset link's mass and its mass-centre offset p (Table 2's wheel kept: a wheel heavier without more axle
+    inertia than 2 I_diam allows is not a rigid body).
+
+    Args:
+        p: The model's parameters by name (Table 2's values and units: kg, m, kg m^2).
+        wheel: Eq 43's wheel term I_theta / r^2 [kg].
+        steering: Eq 43's steering term I_eta / d^2 [kg].
+
+    Returns:
+        A copy of ``p`` with ``m_link`` [kg] and ``p`` [m] (the offset link's mass and mass-centre offset) set.
+
+    Raises:
+        ValueError: No positive link mass and real offset give these terms.
+    """
+    m_link = wheel - p["I_wheel_axle"] / p["r"] ** 2 - p["m_wheel"]
+    offset2 = (steering * p["d"] ** 2 - p["I_wheel_diam"] - p["I_link_z"]) / m_link
+    if m_link <= 0 or offset2 < 0:
+        raise ValueError(f"wheel term {wheel} / steering term {steering}: no link mass and offset give them")
+    return {**p, "m_link": float(m_link), "p": float(np.sqrt(offset2))}
+
+
+def fit_steady_turn(p: dict, free_terms: bool = True, start=(-1.0, 0.0)) -> dict:
+    """The steady turn (trailing casters at zero steering rate,
+    :func:`~robotdyn.robots.omni_caster.model.steady_steering`) whose I_uu* (eq 48 transcription) best matches the
+    printed with-wheel matrix (its entries' rounding: :data:`PRINTED_ROUNDING`).
+
+    Args:
+        p: Parameters (Table 1-2).
+        free_terms: Fit eq 43's wheel and steering terms too, each entry weighted by its rounding, then the
+            largest weighted residual minimised; else only the turn centre by unweighted least squares, the
+            steering term Table 2's and the wheel term the one the steering-invariant trace needs (as the first
+            errata fit did: 0.8548 kg, a heavier wheel of Table 2's inertias).
+        start: Initial turn centre (X, Y) in platform axes [m].
+
+    Returns:
+        dict with ``wheel``, ``steering`` [kg], ``centre`` (X, Y) [m], ``radius`` [m], ``phi`` [rad], ``residual``
+        (fit - printed, 6 entries) and ``ratio`` (the residuals' magnitudes over the rounding, 6 entries; all <= 1:
+        reproduced).
+    """
+    from scipy.optimize import least_squares, minimize
+
+    iu = np.triu_indices(3)
+    table_steering = (p["m_link"] * p["p"] ** 2 + p["I_wheel_diam"] + p["I_link_z"]) / p["d"] ** 2
+    table_wheel = 1.5 * p["m_wheel"] + p["m_link"]  # eq 43 (3/2 m1 r^2 + m2 r^2) / r^2: the transcription's
+
+    # without free terms: the wheel term the steering-invariant trace of the xy block needs, 2 m_pl + 3 (a + b)
+    trace_wheel = (PRINTED_WITH_WHEELS[0, 0] + PRINTED_WITH_WHEELS[1, 1] - 2 * p["m_pl"]) / 3 - table_steering
+
+    def unpack(x):
+        return (x[0], x[1], x[2:4]) if free_terms else (trace_wheel, table_steering, x[0:2])
+
+    def res(x):
+        wheel, steering, (X, Y) = unpack(x)
+        pp = terms_params(p, wheel, steering) if free_terms else {**p, "m_wheel": p["m_wheel"] + (wheel - table_wheel) / 1.5}
+        phi = steady_steering(pp, np.array([Y, -X, 1.0]))
+        return (paper_inertia(pp, phi) - PRINTED_WITH_WHEELS)[iu], phi
+
+    if not free_terms:  # unweighted least squares over the turn centre, as the first errata fit
+        x = least_squares(lambda x: res(x)[0], np.asarray(start, float), x_scale=0.1).x
+    else:
+        fit = least_squares(lambda x: res(x)[0] / PRINTED_ROUNDING, np.r_[table_wheel, table_steering, start])
+        # then the largest rounding-scaled residual itself (the printed entries are rounded, not noisy)
+        best = minimize(lambda x: np.abs(res(x)[0] / PRINTED_ROUNDING).max(), fit.x, method="Nelder-Mead",
+                        options={"xatol": 1e-10, "fatol": 1e-10, "maxiter": 4000})
+        x = best.x if np.abs(res(best.x)[0] / PRINTED_ROUNDING).max() < np.abs(fit.fun).max() else fit.x
+    r, phi = res(x)
+    wheel, steering, centre = unpack(x)
+    return {"wheel": float(wheel), "steering": float(steering), "centre": np.asarray(centre, float),
+            "radius": float(np.hypot(*centre)), "phi": phi, "residual": r, "ratio": np.abs(r) / PRINTED_ROUNDING}
+
+
 def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Comparison:
     """The paper's closed forms and printed numbers against the model (see ``docs/errata/omni_caster.md``).
 
@@ -171,6 +252,12 @@ def compare(robot: Robot | None = None, states: int = 100, seed: int = 0) -> Com
     fit = fit_printed_matrix(p, starts=20)
     cmp.add("sec 5 printed with-wheel I_uu*: best fit over steering angles (max |residual|)", 0.0, fit["max_abs"],
             5e-4, "phi = (" + ", ".join(f"{np.degrees(x):.1f}" for x in fit["phi"]) + ") deg")
+    for free, what in ((False, "steering term Table 2's"), (True, "wheel and steering terms fitted")):
+        turn = fit_steady_turn(p, free)
+        cmp.add(f"sec 5 with-wheel I_uu* as a steady turn, {what}: max |residual| / printed rounding", 0.0,
+                float(turn["ratio"].max()), 1.0,
+                f"radius {turn['radius']:.3f} m, wheel term {turn['wheel']:.4f} kg, steering term "
+                f"{turn['steering']:.4f} kg")
     from ...contact.impulse import impulse_curve
 
     for name, deg in IMPULSE_CONFIGS.items():

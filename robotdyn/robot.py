@@ -56,6 +56,8 @@ class Parameter:
             is used only by the robot's Python or constraint file, e.g. g).
         minimum: The smallest physical value in ``unit`` (default ``None``: 0 for masses and inertias, else none).
         positive: Whether the value must be > 0 (a length such as a radius, a link length or a track).
+        maximum: The largest physical value in ``unit`` (``None``: only the unit's limit,
+            :data:`PARAMETER_LIMITS`), e.g. :data:`~robotdyn.inputs.MAX_FRICTION` for a friction coefficient.
     """
 
     name: str

@@ -16,6 +16,28 @@ MAX_ACCELERATION = 1e9
 """Largest magnitude of an acceleration [m/s^2 or rad/s^2] accepted as input."""
 MAX_FORCE = 1e9
 """Largest magnitude of a motor torque [N m] or force [N] accepted as input."""
+MAX_ANGLE = 2 * np.pi
+"""Largest magnitude of an angle given as a setting [rad] (an orientation, a roller or rocker angle, a heading):
+one turn; beyond it a value is almost always a unit mistake (degrees) or garbage."""
+MAX_FRICTION = 1e6
+"""Largest friction coefficient accepted (as the constraint file's wheel ``mu``)."""
+
+
+def refuse_together(args, *flags: str) -> None:
+    """Refuse options that exclude each other when more than one was given (argparse names, e.g. ``"tau_set"``;
+    given means neither None, False nor empty).
+
+    Args:
+        args: The parsed command line (``argparse.Namespace``).
+        flags: The options' argparse names.
+
+    Raises:
+        InputError: ``--a and --tau-set exclude each other; expected one of them``.
+    """
+    given = [f for f in flags if getattr(args, f, None) not in (None, False, [], ())]
+    if len(given) > 1:
+        names = [f"--{f.replace('_', '-')}" for f in given]
+        raise InputError(f"{' and '.join(names)} exclude each other; expected one of them")
 
 
 def as_vector(values, n: int, what: str, names: Sequence[str] | None = None,

@@ -24,7 +24,7 @@ from .description.urdf import _ROOT_CHAINS, URDF_DIR, Description, build_descrip
 from .reduction.dynamics import energy
 from .errors import ConstraintError, DescriptionError, InputError, NonFiniteError, RobotDynWarning
 from .contact.friction import make_law
-from .inputs import MAX_ACCELERATION, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector
+from .inputs import MAX_ACCELERATION, MAX_ANGLE, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector
 from .constraints.loop_closure import LoopClosure
 from .reduction.projection import auto_independent
 from .fast.dispatch import reduce
@@ -36,8 +36,9 @@ from .contact.stick_slip_wheel import StickSlipWheel
 from .constraints.terrain import FlatTerrain, Terrain
 
 
-PARAMETER_LIMITS = {"m": 1e4, "kg": 1e9, "kg m^2": 1e9, "m/s^2": 1e4, "rad": 1e6}
-"""Largest magnitude of a parameter by unit (beyond these no robot is described: the dynamics only overflow)."""
+PARAMETER_LIMITS = {"m": 1e4, "kg": 1e9, "kg m^2": 1e9, "m/s^2": 1e4, "rad": MAX_ANGLE}
+"""Largest magnitude of a parameter by unit (beyond these no robot is described: the dynamics only overflow; an
+angle beyond one turn is a unit mistake)."""
 
 
 @dataclass
@@ -55,6 +56,8 @@ class Parameter:
             is used only by the robot's Python or constraint file, e.g. g).
         minimum: The smallest physical value in ``unit`` (default ``None``: 0 for masses and inertias, else none).
         positive: Whether the value must be > 0 (a length such as a radius, a link length or a track).
+        maximum: The largest physical value in ``unit`` (``None``: only the unit's limit,
+            :data:`PARAMETER_LIMITS`), e.g. :data:`~robotdyn.inputs.MAX_FRICTION` for a friction coefficient.
     """
 
     name: str
@@ -65,6 +68,7 @@ class Parameter:
     xacro: bool = True
     minimum: float | None = None  # smallest physical value (default: 0 for masses and inertias, by their unit)
     positive: bool = False  # the value must be > 0 (a length such as a radius, a link length or a track)
+    maximum: float | None = None  # largest physical value (e.g. a friction coefficient: MAX_FRICTION)
 
     def convert(self, value) -> float | str:
         """Validate and convert a user value.
@@ -95,6 +99,9 @@ class Parameter:
         low = self.minimum if self.minimum is not None else (0.0 if self.unit in ("kg", "kg m^2") else None)
         if low is not None and out < low:
             raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a value >= {low:g} "
+                             f"({self.description or self.name})")
+        if self.maximum is not None and out > self.maximum:
+            raise InputError(f"parameter {self.name} = {out:g} {self.unit}; expected a value <= {self.maximum:g} "
                              f"({self.description or self.name})")
         limit = PARAMETER_LIMITS.get(self.unit)
         if limit is not None and abs(out) > limit:
@@ -372,6 +379,12 @@ class Robot:
         kw = dict(axis=w.axis, terrain=None, radius_joint=w.radius_joint, name=w.name)
         kw["terrain"] = self.terrain
         name = w.name or w.frame
+        if self.model.existFrame(w.frame):  # the body the wheel turns with: a mass with its inertia, or neither
+            body = self.model.inertias[self.model.frames[self.model.getFrameId(w.frame)].parentJoint]
+            if body.mass == 0 and np.max(np.abs(body.inertia)) > 0:
+                raise InputError(f"wheel {name!r}: its body has mass 0 but an inertia (largest entry "
+                                 f"{np.max(np.abs(body.inertia)):.3g} kg m^2); expected a positive mass with its "
+                                 "inertia, or a massless wheel (mass and inertia 0)")
         if w.mu is not None and not (np.isfinite(float(w.mu)) and float(w.mu) >= 0):
             raise InputError(f"wheel {name!r}: mu = {w.mu}; expected a friction coefficient >= 0")
         if w.friction not in ("rolling", None):

@@ -45,6 +45,7 @@ class Case:
 
 DIR = object()
 FIFO = object()
+LOOP = object()
 CASES: list[Case] = []
 
 
@@ -583,6 +584,284 @@ dd_case("simulate-t-end-1e300", "--t-end", urdf_text(), ("simulate", "--scenario
                                                          "1e300"))
 
 
+# -------------------------------------------------------------------------------- issue 24: cases named there
+SKID_ARGS = ["--constraints", str(SKID)]
+case("i24-dump-forces-full", ["dump", "quasimoro", "--full", "--v", *["0"] * 6, "--tau", *["0"] * 6, "--forces"],
+     "--forces")
+case("i24-dump-a-tau-set", ["dump", "quasimoro", "--v", "0", "0", "0", "--a", "0", "0", "0", "--tau-set", "m1=1"],
+     "--tau-set")
+case("i24-linkage-posture-v-words", ["linkage-posture", "--v", "a", "b"], "--v")
+case("i24-impulse-speed-1e308", ["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "1", "0", "0",
+                                 "--speed", "1e308"], "--speed")
+case("i24-impulse-speed-and-v", ["impulse", "omni_caster", "--q", *["0"] * 9, "--direction", "1", "0", "0",
+                                 "--speed", "2", "--v", "1", "0", "0"], "--speed")
+case("i24-ik-mission-and-commands", ["ik", "adaptable_wheel", "--mission", "mission1", "--commands", *["0"] * 6],
+     "--commands")
+case("i24-ik-angle-one-turn", ["ik", "adaptable_wheel", "--commands", "0", "0", "0.3", "0", "0", "100"], "q_zd")
+for robot in ("adaptable_wheel", "mmr12_eod"):  # the robots with a friction parameter mu
+    case(f"i24-{robot}-mu-negative", ["info", robot, "--param", "mu=-1"], "mu")
+    case(f"i24-{robot}-mu-1e300", ["info", robot, "--param", "mu=1e300"], "mu")
+case("i24-sweep-mu-negative", ["sweep", "adaptable_wheel", "--vary", "mu=-1,-0.5", "--workers", "0", "--out",
+                               "{d}/s"], "mu")
+case("i24-linkage-rocker-1e6", ["info", "linkage_suspension", "--param", "theta0=1e6"], "theta0")
+case("i24-sweep-angle-1e300", ["sweep", "linkage_suspension", "--vary", "theta0=1e300 rad", "--workers", "0",
+                               "--out", "{d}/s"], "theta0")
+for word in ("1-1", "r+r", "pi", "math.pi", "e", "1e5j"):  # values xacro would evaluate inside ${...}
+    case(f"i24-xacro-arg-word-{word}", ["info", *SKID_ARGS, "--xacro-arg", f"m_body={word}"], "m_body")
+toml_case("i24-xacro-args-word-pi", "m_body", _skid(xacro_args={"m_body": "pi"}))
+toml_case("i24-root-height-floating", "root_height", _skid(root_height=0.1))
+toml_case("i24-roller-angle-1e300-rad", "roller_angle", _skid(**{"wheels.0.kind": "omni", "wheels.0.roller_angle":
+                                                                 "1e300 rad", "wheels.0.friction": None,
+                                                                 "wheels.0.stiffness": None, "wheels.0.mu": None}))
+case("i24-sweep-scheduler-ucx", ["sweep", "quasimoro", "--workers", "0", "--out", "{d}/s", "--scheduler",
+                                 "ucx://127.0.0.1:9"], "ucx://127.0.0.1:9")
+case("i24-sweep-scheduler-tls", ["sweep", "quasimoro", "--workers", "0", "--out", "{d}/s", "--scheduler",
+                                 "tls://127.0.0.1:9"], "tls://127.0.0.1:9")
+case("i24-sweep-spec-fifo", ["sweep", "--spec", "{d}/fifo.toml", "--workers", "0", "--out", "{d}/s"], "fifo.toml",
+     {"fifo.toml": FIFO})
+case("i24-sweep-spec-dev-zero", ["sweep", "--spec", "/dev/zero", "--workers", "0", "--out", "{d}/s"], "/dev/zero")
+case("i24-sweep-spec-height-nan", ["sweep", "--spec", "{d}/nan.toml", "--workers", "0", "--out", "{d}/s"], "height",
+     {"nan.toml": 'robot = "quasimoro"\nterrains = [{kind = "flat", height = nan}]\n[parameters]\nM = [4.0, 5.0]\n'})
+case("i24-constraints-package-loop", ["info", *SKID_ARGS, "--package", "{d}/loop"], "loop", {"loop": LOOP})
+case("i24-constraints-fifo", ["info", "--constraints", "{d}/fifo.toml"], "fifo.toml", {"fifo.toml": FIFO})
+case("i24-constraints-loop", ["info", "--constraints", "{d}/loop"], "loop", {"loop": LOOP})
+case("i24-package-dirs-loop", ["info", "--constraints", "{d}/robot.toml"], "loop", {
+    "loop": LOOP, "robot.toml": SKID.read_text().replace('urdf = "skid_steer.urdf.xacro"',
+                                                        f'urdf = "{SKID_XACRO}"\npackage_dirs = ["loop"]')})
+case("i24-sweep-constraints-loop", ["sweep", "--constraints", "{d}/loop", "--workers", "0", "--out", "{d}/s"], "loop",
+     {"loop": LOOP})
+case("i24-sweep-spec-constraints-loop", ["sweep", "--spec", "{d}/spec.toml", "--workers", "0", "--out", "{d}/s"],
+     "loop", {"loop": LOOP, "spec.toml": 'constraints = "loop"\n'})
+dd_case("i24-wheel-mass-1e-300", "mass", urdf_text(wheel_mass="1e-300"))
+dd_case("i24-wheel-zero-mass-with-inertia", "left", urdf_text(wheel_mass="0"))
+dd_case("i24-links-3000", "links", urdf_text(extra="".join(
+    f'<link name="x{i}"/><joint name="xj{i}" type="fixed"><parent link="arm"/><child link="x{i}"/></joint>'
+    for i in range(3000))))
+
+
+# ----------------------------------------------------------- generated: every flag of every subcommand (item 7)
+GENERATED_ROBOT = {"impulse": "omni_caster", "ik": "adaptable_wheel", "list": None, "linkage-posture": None}
+"""The robot each command's generated cases use (default quasimoro; None: the command takes none)."""
+GENERATED_BASE = {**REQUIRED, "ik": [], "sweep": ["--out", "{d}/s", "--workers", "0", "--quiet", "--no-plot"]}
+"""What each command needs besides the flag under test (so that a case fails for that flag only)."""
+FLAG_CASES: dict = {
+    # flag: (the bad arguments, texts the one line may name: any one of them), for every command taking the flag
+    "ROBOT": (["nosuchrobot"], ("nosuchrobot",)),
+    "--urdf": (["--urdf", "{d}/nosuch.urdf"], ("--urdf",)),
+    "--xacro-arg": (["--xacro-arg", "r"], ("--xacro-arg", "xacro argument")),
+    "--constraints": (["--constraints", "{d}/nosuch.toml"], ("nosuch.toml", "--constraints")),
+    "--param": (["--param", "nosuch=1"], ("nosuch",)),
+    "--package": (["--package", "{d}/nosuchdir"], ("--package", "nosuchdir")),
+    "--twist": (["--twist", "nosuchframe"], ("nosuchframe", "--twist")),
+    "--q": (["--q", "abc"], ("q",)),
+    "--set": (["--set", "nosuchcoord=1"], ("nosuchcoord",)),
+    "--v": (["--v", "abc"], ("v",)),
+    "--a": (["--a", "abc"], ("a",)),
+    "--tau": (["--tau", "abc"], ("tau",)),
+    "--tau-set": (["--tau-set", "nosuchmotor=1"], ("nosuchmotor",)),
+    "--scenario": (["--scenario", "nosuchscenario"], ("nosuchscenario",)),
+    "--t-end": (["--t-end", "abc"], ("--t-end",)),
+    "--csv": (["--csv", "{d}/no/dir/x.csv"], ("x.csv", "--csv")),
+    "--plot": (["--plot", "{d}/p.xyz"], ("p.xyz",)),
+    "--traction-plot": (["--traction-plot", "{d}/p.xyz"], ("p.xyz",)),
+    "--stabilisation": (["--stabilisation", "-1"], ("--stabilisation",)),
+    "--mu": (["--mu", "-1"], ("--mu",)),
+    "--html": (["--html", "{d}/no/dir/v.html"], ("v.html",)),
+    "--spec": (["--spec", "{d}/nosuch.toml"], ("nosuch.toml",)),
+    "--vary": (["--vary", "M"], ("--vary",)),
+    "--terrain": (["--terrain", "lunar"], ("lunar",)),
+    "--sample": (["--sample", "sobol"], ("--sample",)),
+    "--n": (["--n", "many"], ("--n",)),
+    "--seed": (["--seed", "-1"], ("seed",)),
+    "--n-out": (["--n-out", "0"], ("--n-out",)),
+    "--rtol": (["--rtol", "-1"], ("rtol",)),
+    "--atol": (["--atol", "nan"], ("atol",)),
+    "--column": (["--column", "nosuchcolumn"], ("nosuchcolumn",)),
+    "--plot-column": (["--plot-column", "nosuchcolumn"], ("nosuchcolumn",)),
+    "--out": (["--out", "{d}/file.txt"], ("file.txt",)),
+    "--workers": (["--workers", "-3"], ("--workers",)),
+    "--scheduler": (["--scheduler", "http://127.0.0.1:9"], ("http://127.0.0.1:9",)),
+    "--chunk-size": (["--chunk-size", "0"], ("--chunk-size",)),
+    "--time-limit": (["--time-limit", "-1"], ("time_limit",)),
+    "--batch": (["--batch", "sometimes"], ("--batch",)),
+    "--commands": (["--commands", "a"], ("commands",)),
+    "--mission": (["--mission", "nosuchmission"], ("--mission",)),
+    "--x": (["--x", "far"], ("--x",)),
+    "--y": (["--y", "far"], ("--y",)),
+    "--yaw": (["--yaw", "far"], ("--yaw",)),
+    "--frame": (["--frame", "nosuchframe"], ("nosuchframe",)),
+    "--base": (["--base", "nosuchframe"], ("nosuchframe",)),
+    "--direction": (["--direction", "abc"], ("direction",)),
+    "--e": (["--e", "-0.5"], ("--e",)),
+    "--speed": (["--speed", "-1"], ("--speed",)),
+    "--states": (["--states", "nosuchstate"], ("nosuchstate",)),
+    "--lqr-q": (["--lqr-q", "abc"], ("lqr",)),
+    "--lqr-r": (["--lqr-r", "abc"], ("lqr",)),
+}
+FLAG_CASE_OVERRIDES: dict = {  # (command, flag): a different bad use where the generic one does not fit
+    ("sweep", "--t-end"): (["--t-end", "nan"], ("t_end",)),
+    ("sweep", "--scenario"): (["--scenario", "nosuchscenario", "--vary", "M=4,5"], ("nosuchscenario",)),
+    ("linkage-posture", "--v"): (["--v", "a", "b"], ("--v",)),
+    ("linkage-posture", "--terrain"): (["--terrain", "lunar"], ("lunar",)),
+}
+SWITCHES = ("--json", "--full", "--forces", "--quiet", "--frames", "--open", "--trajectories", "--no-plot",
+            "--retry-errors", "--replace")
+"""Flags without a value: their bad use is a value (``--json=1``, refused by argparse)."""
+
+
+def _parser_flags() -> dict[str, list[str]]:
+    """Every command's flags (and ``ROBOT`` for its robot argument), from the CLI's own parser with the robot
+    modules' commands: a flag added to any parser appears here."""
+    import argparse
+
+    from robotdyn.cli.commands import build_parser
+
+    parser = build_parser()
+    parser.robot_commands()
+    out = {}
+    for name, sub in parser.commands.items():
+        flags = []
+        for action in sub._actions:
+            if isinstance(action, argparse._HelpAction):
+                continue
+            flags.append(max(action.option_strings, key=len) if action.option_strings else action.metavar or
+                         action.dest.upper())
+        out[name] = flags
+    return out
+
+
+def _flag_case(command: str, flag: str) -> tuple[list[str], tuple[str, ...]]:
+    if flag in SWITCHES:
+        return [f"{flag}=1"], (flag,)
+    return FLAG_CASE_OVERRIDES.get((command, flag)) or FLAG_CASES[flag]
+
+
+GENERATED_FLAGS: list[tuple[str, str]] = []
+for _command, _flags in _parser_flags().items():
+    for _flag in _flags:
+        if (_command, _flag) in GENERATED_FLAGS:
+            continue
+        GENERATED_FLAGS.append((_command, _flag))
+        if _flag not in SWITCHES and (_command, _flag) not in FLAG_CASE_OVERRIDES and _flag not in FLAG_CASES:
+            continue  # (reported by test_every_flag_has_a_bad_input_case)
+        _bad, _needles = _flag_case(_command, _flag)
+        _robot = GENERATED_ROBOT.get(_command, "quasimoro")
+        _base = list(GENERATED_BASE.get(_command, []))
+        _flag_names = {a for a in _bad if a.startswith("--")} | {_flag}
+        for _given in _flag_names:  # the base's own use of the flag under test is dropped
+            if _given in _base:
+                i = _base.index(_given)
+                j = i + 1
+                while j < len(_base) and not _base[j].startswith("--"):
+                    j += 1
+                del _base[i:j]
+        if _flag == "ROBOT":
+            _argv = [_command, *_bad, *_base]
+        elif _flag in ("--constraints", "--urdf") or _robot is None:
+            _argv = [_command, *_base, *_bad]
+        else:
+            _argv = [_command, _robot, *_base, *_bad]
+        case(f"gen-{_command}-{_flag.lstrip('-').lower()}", _argv, "|".join(_needles), {"file.txt": "x"})
+
+
+# ------------------------------------------------- generated: every key of the constraint file's schema (item 7)
+def _schema_keys(schema: dict, path: tuple = ()):
+    """(path, schema) of every key of the constraint-file schema, tables and arrays of tables descended."""
+    for key, sub in schema.get("properties", {}).items():
+        yield path + (key,), sub
+        if sub.get("type") == "object" and "properties" in sub:
+            yield from _schema_keys(sub, path + (key,))
+        if sub.get("type") == "array" and "properties" in sub.get("items", {}):
+            yield from _schema_keys(sub["items"], path + (key, 0))
+
+
+def _bad_value(sub: dict):
+    """A value the schema entry ``sub`` refuses: an unknown choice, a non-finite number, a wrong type."""
+    if "enum" in sub:
+        return "nosuch_value"
+    kind = sub.get("type")
+    if kind == "number":
+        return float("nan")
+    if kind == "string":
+        return 3
+    if kind == "boolean":
+        return "yes"
+    if kind in ("array", "object"):
+        return "x" if kind == "array" and sub.get("items", {}).get("type") != "string" else 3
+    if "anyOf" in sub:
+        return [[1]]  # (no alternative of this schema is a list of lists)
+    raise KeyError(f"no bad value for the schema entry {sub!r}")
+
+
+_SCHEMA_BASES = {  # a valid table to corrupt, for the tables that the skid-steer example does not have
+    "closures": {"frame1": "front_axle", "frame2": "chassis"},
+    "terrain": {"kind": "ramp"},
+    "twist": {"frame": "chassis"},
+}
+
+
+def _schema_case(path: tuple, sub: dict) -> None:
+    data = _skid()
+    bad = _bad_value(sub)
+    node = data
+    for i, key in enumerate(path[:-1]):
+        if isinstance(key, int):
+            continue
+        if key not in node or (isinstance(path[i + 1], int) and not node[key]):
+            node[key] = [dict(_SCHEMA_BASES[key])] if isinstance(path[i + 1], int) else dict(_SCHEMA_BASES[key])
+        node = node[key][0] if isinstance(path[i + 1], int) else node[key]
+    node[path[-1]] = bad
+    toml_case("gen-" + ".".join(str(k) for k in path), str(path[-1]), data)
+
+
+from robotdyn.interfaces.constraint_schema import SCHEMA  # noqa: E402
+
+SCHEMA_KEYS = [path for path, _ in _schema_keys(SCHEMA)]
+SCHEMA_KEYS_WITHOUT_CASE = []
+for _path, _sub in _schema_keys(SCHEMA):
+    try:
+        _schema_case(_path, _sub)
+    except KeyError:  # a kind of entry the generator cannot corrupt yet (test_every_schema_key_has_a_case)
+        SCHEMA_KEYS_WITHOUT_CASE.append(_path)
+
+# --------------------------------------------------------- generated: every key of the sweep file (item 7)
+SPEC_BASE = 'robot = "quasimoro"\nt_end = 0.2\n'
+SPEC_CASES = {  # key: (TOML lines replacing or adding that key, the text the one line names)
+    "robot": ("robot = 3", "robot"),
+    "constraints": ('constraints = "nosuch.toml"', "constraint"),
+    "urdf": ("urdf = 3", "urdf"),
+    "xacro_args": ("xacro_args = [1]", "xacro_args"),
+    "fixed": ("fixed = [1]", "fixed"),
+    "parameters": ("parameters = [1, 2]", "parameters"),
+    "scenarios": ("scenarios = 3", "scenarios"),
+    "terrains": ("terrains = 3", "terrains"),
+    "sample": ('sample = "sobol"', "sample"),
+    "n": ('n = "many"', "n ="),
+    "seed": ("seed = -1\nsample = \"random\"\nn = 2\nparameters = {d = {min = 0.1, max = 0.3}}", "seed"),
+    "t_end": ('t_end = "long"', "t_end"),
+    "n_out": ("n_out = 0", "n_out"),
+    "rtol": ("rtol = -1.0", "rtol"),
+    "atol": ("atol = nan", "atol"),
+    "columns": ("columns = 3", "columns"),
+    "trajectories": ('trajectories = "yes"', "trajectories"),
+    "plot_column": ("plot_column = 3", "plot_column"),
+    "time_limit": ("time_limit = -1.0", "time_limit"),
+    "parameters.min": ('parameters = {M = {min = "abc", max = 6.0, n = 3}}', "M"),
+    "parameters.max": ("parameters = {M = {min = 4.0, max = nan, n = 3}}", "M"),
+    "parameters.n": ("parameters = {M = {min = 4.0, max = 6.0, n = 0}}", "n ="),
+    "parameters.scale": ('parameters = {M = {min = 4.0, max = 6.0, n = 3, scale = "cubic"}}', "scale"),
+}
+for _key, (_lines, _needle) in SPEC_CASES.items():
+    _text = SPEC_BASE
+    for _line in _lines.splitlines():
+        _name = _line.split("=")[0].strip()
+        _text = "\n".join(x for x in _text.splitlines() if x.split("=")[0].strip() != _name) + "\n" + _line + "\n"
+    if _key == "constraints":
+        _text = _text.replace('robot = "quasimoro"\n', "")
+    case(f"gen-spec-{_key}", ["sweep", "--spec", "{d}/spec.toml", "--workers", "0", "--quiet", "--no-plot",
+                              "--out", "{d}/s"], _needle, {"spec.toml": _text})
+
+
 def _materialise(c: Case, tmp_path: Path) -> list[str]:
     for name, content in c.files.items():
         p = tmp_path / name
@@ -590,6 +869,8 @@ def _materialise(c: Case, tmp_path: Path) -> list[str]:
             p.mkdir()
         elif content is FIFO:
             os.mkfifo(p)
+        elif content is LOOP:  # a symbolic link to itself
+            p.symlink_to(name)
         elif isinstance(content, bytes):
             p.write_bytes(content)
         else:
@@ -612,6 +893,34 @@ def test_corpus_size():
     commands = {c.argv[0] for c in CASES if c.argv}
     assert commands >= {"info", "dump", "simulate", "compare", "view", "sweep", "list", "ik", "linkage-posture",
                         "fk", "impulse"}
+
+
+def test_every_flag_has_a_bad_input_case():
+    """Every flag of every subcommand (read from the CLI's parsers, the robot modules' commands included) has a
+    generated bad-input case: a flag added without one fails here."""
+    missing = [f"{command} {flag}" for command, flag in GENERATED_FLAGS
+               if flag not in SWITCHES and flag not in FLAG_CASES and (command, flag) not in FLAG_CASE_OVERRIDES]
+    assert not missing, f"flags without a bad-input case (add them to FLAG_CASES or SWITCHES): {missing}"
+    ids = {c.id for c in CASES}
+    assert all(f"gen-{command}-{flag.lstrip('-').lower()}" in ids for command, flag in GENERATED_FLAGS)
+    assert len(GENERATED_FLAGS) >= 100
+
+
+def test_every_schema_key_has_a_case():
+    """Every key of the constraint file (read from its schema, tables and arrays of tables descended) has a
+    generated case: a key added to the schema without a way to corrupt it fails here."""
+    assert not SCHEMA_KEYS_WITHOUT_CASE, SCHEMA_KEYS_WITHOUT_CASE
+    ids = {c.id for c in CASES}
+    assert all("toml-gen-" + ".".join(map(str, path)) in ids for path in SCHEMA_KEYS)
+    assert {p[-1] for p in SCHEMA_KEYS} >= {"radius", "mu", "t_end", "frame1", "kind", "slope", "components"}
+
+
+def test_every_sweep_file_key_has_a_case():
+    """Every key of the sweep file (robotdyn.sweep.spec.TOP_KEYS, and the keys of a range) has a case."""
+    from robotdyn.sweep.spec import RANGE_KEYS, TOP_KEYS
+
+    assert set(TOP_KEYS) <= set(SPEC_CASES), set(TOP_KEYS) - set(SPEC_CASES)
+    assert {f"parameters.{k}" for k in RANGE_KEYS} <= set(SPEC_CASES)
 
 
 def test_control_is_valid(tmp_path, capsys):
@@ -648,7 +957,8 @@ def test_bad_input_is_refused_in_one_line(c: Case, tmp_path, capsys, monkeypatch
     assert rc == 2, f"{c.id}: exit status {rc}; stderr {err!r}; stdout {out[:300]!r}"
     assert len(lines) == 1 and lines[0].startswith("robotdyn: error: "), f"{c.id}: stderr {err!r}"
     assert "Traceback" not in err
-    assert _names(c.needle.replace("{d}", str(tmp_path)), lines[0]), f"{c.id}: {c.needle!r} not in {lines[0]!r}"
+    assert any(_names(n.replace("{d}", str(tmp_path)), lines[0]) for n in c.needle.split("|")), \
+        f"{c.id}: {c.needle!r} not in {lines[0]!r}"
 
 
 def _names(needle: str, message: str) -> bool:

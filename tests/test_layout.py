@@ -15,7 +15,7 @@ PKG = Path(__file__).resolve().parents[1] / "robotdyn"
 
 # pipeline order: a module of stage i may import from stages <= i only
 STAGES = [
-    ("foundation", ["errors", "inputs", "output", "_lazy"]),
+    ("foundation", ["errors", "inputs", "input_files", "output", "_lazy"]),
     ("description", ["description"]),
     ("constraints", ["constraints"]),
     ("reduction", ["reduction"]),

@@ -88,6 +88,8 @@ def _jsonable(x):
 
 
 def _matrix_text(name: str, rows: list[str], cols: list[str], A: np.ndarray) -> str:
+    if not rows or not cols:  # e.g. B of a robot without motors: said, not an empty grid
+        return f"{name}: (none: {len(rows)} x {len(cols)})"
     w = max(14, *(len(c) + 2 for c in cols))  # a '-1.23457e-05' (12 characters) keeps a space on its left
     left = max(14, *(len(r) for r in rows)) if rows else 14  # long row names keep the columns aligned
     lines = [f"{name}:", " " * left + "".join(f"{c:>{w}}" for c in cols)]
@@ -169,6 +171,12 @@ def cmd_dump(args) -> int:
         The exit status, 0. Errors raise :class:`~robotdyn.errors.RobotDynError`, which
         :func:`~robotdyn.cli.commands.main` prints in one line with status 2.
     """
+    from ..inputs import refuse_together
+
+    refuse_together(args, "a", "tau_set")  # (--a and --tau: argparse's own group)
+    if args.full and args.forces:
+        raise RobotDynError("--forces and --full exclude each other: the contact forces are those of the constrained "
+                            "robot; expected --forces without --full")
     _, robot = _load(args)
     q = robot.neutral() if args.q is None else as_vector(args.q, robot.nq, "q", robot.coordinates, MAX_POSITION)
     for name, x in _numbers(args.set, "--set", "a value in m or rad").items():
@@ -205,7 +213,8 @@ def cmd_dump(args) -> int:
     text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g}, "
             f"S^T M S condition {mass_cond:.3g})",
             _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
-            _vector_text("g", names, red.g), _matrix_text("B", names, motors, red.B)]
+            _vector_text("g", names, red.g),
+            _matrix_text("B", names, motors, red.B) if motors else "B: none (the robot has no motors)"]
     from ..contact.sliding import sliding_now
 
     sliding = bool(sliding_now(robot))  # wheels under a friction law: their forces in every solve below
@@ -219,7 +228,8 @@ def cmd_dump(args) -> int:
             tau, resid = inv.tau, inv.residual
         out.update(tau=Q, motor_torques=dict(zip(motors, tau)), motor_residual=resid)
         text += [_vector_text("tau (generalised forces M a + C v + g)", names, Q),
-                 _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
+                 _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau) if motors else
+                 f"motor torques: none (the robot has no motors; residual {resid:.3g})"]
     elif args.tau is not None or args.tau_set:
         tau = _torques(robot, args.tau, args.tau_set)
         nudot = robot.forward_dynamics(q, nu, tau, check=False) if sliding else solve_mass(red.M, red.B @ tau - red.h)
@@ -751,6 +761,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("robotdyn: interrupted", file=sys.stderr)
         return 130
+    except RuntimeError as exc:  # Path.resolve() of a loop of symbolic links (Python < 3.13) where no check caught it
+        if "Symlink loop" not in str(exc):
+            raise
+        print(f"robotdyn: error: {exc}: a loop of symbolic links; expected a file or directory that exists",
+              file=sys.stderr)
+        return 2
     except RecursionError:  # a nesting deeper than any valid input (e.g. a hostile TOML or XML file)
         print("robotdyn: error: input nested too deeply; expected a robot description or constraint file of "
               "ordinary depth", file=sys.stderr)

@@ -114,6 +114,17 @@ def cmd_sweep(args) -> int:
         if value is not None and value < (0 if flag == "workers" else 1):
             raise InputError(f"--{flag.replace('_', '-')} {value}; expected a whole number >= "
                              f"{0 if flag == 'workers' else 1}")
+    from ..sweep.runner import WORKERS_PER_CPU, max_local_workers
+
+    if args.workers is not None and args.workers > max_local_workers() and args.scheduler is None:
+        raise InputError(f"--workers {args.workers}: more worker processes than this machine runs usefully; expected "
+                         f"at most {max_local_workers()} ({WORKERS_PER_CPU} per CPU), or a cluster: --scheduler "
+                         "ADDRESS")
+    for flag, value, where in (("--twist", args.twist, "[twist] frame = ..."),
+                               ("--package", args.package, "[packages] NAME = DIR or package_dirs = [DIR]")):
+        if value:  # not carried to the runs: refused rather than silently ignored
+            raise InputError(f"{flag}: a sweep does not take it (its runs would not see it); expected {where} in "
+                             "the constraint file of the sweep (constraints = FILE)")
     spec = spec_from_args(args)
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops the sweep like Ctrl-C: results kept
         signal.signal(signal.SIGTERM, _interrupt)

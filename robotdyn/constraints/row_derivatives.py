@@ -7,7 +7,7 @@ These are the constraint-side pieces of the chain rule through the projection
 
 .. math:: \\frac{\\partial \\gamma}{\\partial v} = \\dot A + \\frac{\\partial (A v)}{\\partial q}\\Big|_{v},
 
-which needs no second-order geometry (``shared/notes/rolling-contact-and-projection.md``).
+which needs no second-order geometry (the rolling contact's drift: the concepts page ``docs/concepts.md``).
 
 Frame kinematics derivatives come from Pinocchio's own algorithms (``computeForwardKinematicsDerivatives`` and
 ``getFrameVelocityDerivatives`` / ``getFrameAccelerationDerivatives`` in LOCAL axes, rotated to world axes here:

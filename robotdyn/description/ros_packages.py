@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 import sysconfig
 import threading
 import xml.etree.ElementTree as ET
@@ -31,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import DescriptionError
+from ..input_files import resolved
 
 MISSING_ROOT = "/nonexistent-ros-package"
 """What ``$(find NAME)`` of a package that was not found expands to (``MISSING_ROOT/NAME``), so that expansion can
@@ -58,14 +60,30 @@ class MissingPackagesError(DescriptionError):
         super().__init__(f"{context}packages not found: {', '.join(self.names)}; {HINT}")
 
 
+MAX_MANIFEST_BYTES = 1_000_000
+"""Largest ``package.xml`` read (a manifest is a few kB; a larger file, a FIFO or a device is not a manifest)."""
+MAX_CRAWL_DIRECTORIES = 20_000
+"""Most directories crawled below one search directory (a ROS workspace has a few hundred): beyond it the search
+directory is refused in one line rather than crawled for minutes."""
+
+
 def package_name(directory: Path) -> str | None:
-    """The ``<name>`` in ``directory/package.xml``, or None (no file, or not a package manifest).
+    """The ``<name>`` in ``directory/package.xml``, or None (no file, not a regular file of at most
+    :data:`MAX_MANIFEST_BYTES`, or not a package manifest). A FIFO or a device named ``package.xml`` is never
+    opened (reading it would block or never end).
 
     Args:
         directory: A directory that may hold a ``package.xml``.
     """
+    manifest = directory / "package.xml"
     try:
-        root = ET.parse(directory / "package.xml").getroot()
+        st = os.stat(manifest)
+    except OSError:
+        return None
+    if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_MANIFEST_BYTES:
+        return None
+    try:
+        root = ET.parse(manifest).getroot()
     except (OSError, ET.ParseError):
         return None
     name = root.findtext("name")
@@ -75,24 +93,46 @@ def package_name(directory: Path) -> str | None:
 def crawl(root: Path, depth: int = MAX_DEPTH) -> dict[str, Path]:
     """All packages under ``root`` (name -> directory), the first found winning, as ``rospkg`` crawls.
 
+    The walk is bounded and loop-safe: each directory is visited once (by device and inode, so symbolic links
+    back up the tree or to itself are not followed again), at most ``depth`` levels down and at most
+    :data:`MAX_CRAWL_DIRECTORIES` directories in all.
+
     Args:
         root: The directory crawled.
         depth: Largest depth of subdirectories searched.
 
     Returns:
         Package directory by name.
+
+    Raises:
+        DescriptionError: More than :data:`MAX_CRAWL_DIRECTORIES` directories below ``root``.
     """
     found: dict[str, Path] = {}
+    seen: set[tuple[int, int]] = set()
 
     def walk(d: Path, level: int) -> None:
+        try:
+            st = os.stat(d)
+        except OSError:
+            return
+        key = (st.st_dev, st.st_ino)
+        if key in seen or not stat.S_ISDIR(st.st_mode):
+            return
+        seen.add(key)
+        if len(seen) > MAX_CRAWL_DIRECTORIES:
+            raise DescriptionError(f"ROS package search directory {str(root)!r}: more than "
+                                   f"{MAX_CRAWL_DIRECTORIES:,} directories below it; expected a workspace or a "
+                                   "directory of packages (or give the package itself: --package NAME=DIR)")
         name = package_name(d)
         if name is not None:
             found.setdefault(name, d)
             return
-        if level >= depth or any((d / m).exists() for m in _IGNORE_MARKERS):
+        if level >= depth or any(os.path.lexists(d / m) for m in _IGNORE_MARKERS):
             return
         try:
-            subdirs = sorted(p for p in d.iterdir() if p.is_dir() and not p.name.startswith(".") and p.name not in _SKIP)
+            with os.scandir(d) as entries:
+                subdirs = sorted(Path(e.path) for e in entries if not e.name.startswith(".") and e.name not in _SKIP
+                                 and _is_dir(e))
         except OSError:
             return
         for sub in subdirs:
@@ -101,6 +141,13 @@ def crawl(root: Path, depth: int = MAX_DEPTH) -> dict[str, Path]:
     if root.is_dir():
         walk(root, 0)
     return found
+
+
+def _is_dir(entry: os.DirEntry) -> bool:
+    try:
+        return entry.is_dir()
+    except OSError:  # a link loop, a vanished entry
+        return False
 
 
 def _env_paths(variable: str) -> list[Path]:
@@ -139,12 +186,12 @@ class PackageIndex:
         """
         explicit = {}
         for name, d in (packages or {}).items():
-            path = Path(os.path.expanduser(str(d))).resolve()
+            path = resolved(d, f"package {name}")
             if not path.is_dir():
                 raise DescriptionError(f"package {name} = {d}: no such directory; expected the package's directory "
                                        "(the one holding its package.xml)")
             explicit[str(name)] = path
-        search = [Path(os.path.expanduser(str(d))).resolve() for d in dirs]
+        search = [resolved(d, "package search directory") for d in dirs]
         prefixes = []
         if environment:
             search += _env_paths("ROS_PACKAGE_PATH")

@@ -49,20 +49,30 @@ _ROOT_CHAINS = {
 
 
 _PLAIN_WORD = re.compile(r"[A-Za-z0-9_./:+-]*")
+XACRO_NAMES = frozenset(
+    ["list", "dict", "map", "len", "str", "float", "int", "bool", "True", "False", "min", "max", "round", "sorted",
+     "range", "python", "math", "xacro", "load_yaml", "abs_filename", "dotify"]
+    + [k for k in math.__dict__ if not k.startswith("_")])
+"""The names xacro 2 binds inside ``${...}`` (``xacro.create_global_symbols``: Python builtins, everything of
+:mod:`math` such as ``pi`` and ``e``, xacro's own): a word among them is a value there, not a word."""
 
 
-def xacro_value(name: str, value) -> str:
+def xacro_value(name: str, value, properties=()) -> str:
     """A value for a ``xacro:arg`` as data, never as code.
 
     xacro substitutes ``$(arg name)`` textually, also inside ``${...}`` expressions, which it evaluates: a value is
-    therefore handed over only as a number (finite, in Python's canonical form) or a plain word (letters, digits
-    and ``_ . / : + -``, no ``__``: a choice, a frame name, a ``package://`` path). Anything else raises
-    :class:`~robotdyn.errors.InputError` before xacro sees it. (A Xacro *file* is code by design: only expand
-    descriptions you trust.)
+    therefore handed over only as a number (finite, in Python's canonical form) or a plain word that no
+    expression can read as anything but a name: letters, digits and ``_ . / : + -``, no ``__``; not starting with
+    a digit or a point (``1e5j``, ``.5.5``); no ``+`` or ``-`` unless it is a path (holding ``/``: ``1-1``,
+    ``r+r`` would be sums); not a name that xacro binds (:data:`XACRO_NAMES`: ``pi``, ``e``, ``max``, ``math.pi``)
+    nor one of the description's ``properties``. A choice, a frame name and a ``package://`` path pass.
+    Anything else raises :class:`~robotdyn.errors.InputError` before xacro sees it. (A Xacro *file* is code by
+    design: only expand descriptions you trust.)
 
     Args:
-        name: The argument's name, for messages.
-        value: A number or a plain word.
+        name: The argument's name (for the message).
+        value: A number, bool or string.
+        properties: Names of the ``xacro:property`` s of the description (a word naming one would be its value).
     """
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -75,13 +85,22 @@ def xacro_value(name: str, value) -> str:
     try:
         x = float(text)
     except ValueError:
-        if _PLAIN_WORD.fullmatch(text) and "__" not in text:
-            return text
-        raise InputError(f"xacro argument {name} = {text!r}; expected a number or a plain word (letters, digits and "
-                         "_ . / : + -): robotdyn hands xacro data, never expressions") from None
+        if not _PLAIN_WORD.fullmatch(text) or "__" in text:
+            raise InputError(f"xacro argument {name} = {text!r}; expected a number or a plain word (letters, digits "
+                             "and _ . / : + -): robotdyn hands xacro data, never expressions") from None
+        head = text.split(".")[0].split("/")[0]
+        if (text[:1].isdigit() or text[:1] == "." or ("/" not in text and ("+" in text or "-" in text))
+                or head in XACRO_NAMES or head in set(properties)):
+            raise InputError(f"xacro argument {name} = {text!r}: xacro would evaluate it inside ${{...}} (an "
+                             "expression, or a name it binds); expected a number, or a word that is only a name "
+                             "(a choice, a frame, a package:// path)") from None
+        return text
     if not np.isfinite(x):
         raise InputError(f"xacro argument {name} = {text!r}; expected a finite number")
     return text if _PLAIN_WORD.fullmatch(text) else repr(x)
+
+
+_PROPERTY = re.compile(r"<xacro:property\s+name=[\"']([^\"']+)[\"']")
 
 
 def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packages=None) -> str:
@@ -103,13 +122,21 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
     from . import cache as description_cache
     from .ros_packages import PackageIndex
 
+    from ..input_files import regular_file
+
     path = Path(path)
     if not path.is_file():
         raise DescriptionError(f"description file not found: {path}")
-    mappings = {str(k): xacro_value(str(k), v) for k, v in (args or {}).items()}
+    try:  # a regular file of bounded size (60 MB ran past a minute)
+        regular_file(path, "description", MAX_DESCRIPTION_BYTES)
+    except InputError as exc:
+        raise DescriptionError(str(exc)) from None
+    properties = _PROPERTY.findall(path.read_text(errors="replace")) if args else ()
+    mappings = {str(k): xacro_value(str(k), v, properties) for k, v in (args or {}).items()}
     index = packages if packages is not None else PackageIndex.create()
     cached = description_cache.lookup(path, mappings, index)
     if cached is not None:
+        check_size(cached, path.name)
         return cached
     import xacro
 
@@ -129,11 +156,40 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
                 raise MissingPackagesError(needed, f"cannot expand xacro {path.name}: ") from None
             raise DescriptionError(f"cannot expand xacro {path.name}: {msg}") from None
     urdf = doc.toxml()
+    check_size(urdf, path.name)
     description_cache.store(path, mappings, index, read, urdf)
     return urdf
 
 
-_CHECKS = 2
+MAX_DESCRIPTION_BYTES = 10_000_000
+"""Largest description accepted [bytes], as a file and expanded (real robots' URDFs are well under 1 MB; meshes are
+separate files): a larger one is refused before it is parsed."""
+MAX_LINKS = 300
+"""Most links of a description (humanoids and mobile manipulators have 50 to 150; a chain of 300 takes 15 s to
+load): a larger tree is refused in one line before the model is built (3000 links ended in a MemoryError after
+54 s)."""
+_LINK = re.compile(r"<link[\s/>]")
+
+
+def check_size(urdf: str, name: str) -> None:
+    """Refuse an expanded description beyond :data:`MAX_DESCRIPTION_BYTES` or :data:`MAX_LINKS` links.
+
+    Args:
+        urdf: The expanded URDF text.
+        name: The description's file name, for the message.
+
+    Raises:
+        DescriptionError: Naming the description, its size or link count, and the limit.
+    """
+    if len(urdf) > MAX_DESCRIPTION_BYTES:
+        raise DescriptionError(f"description {name}: {len(urdf):,} characters expanded; expected at most "
+                               f"{MAX_DESCRIPTION_BYTES:,}")
+    links = len(_LINK.findall(urdf))
+    if links > MAX_LINKS:
+        raise DescriptionError(f"description {name}: {links:,} links; expected at most {MAX_LINKS:,} (a robot's tree)")
+
+
+_CHECKS = 3
 """Revision of robotdyn's own checks in :func:`_validate_with_yourdfpy` (raise it when they change, so that the
 cache of validated texts does not skip a new check)."""
 
@@ -185,6 +241,9 @@ def validate_urdf(urdf: str) -> None:
         pass
 
 
+MIN_MASS = 1e-9
+"""Smallest non-zero link mass accepted [kg] (a microgram: dummy links of real descriptions weigh 1e-9 kg and more);
+below it a mass is 0 in effect but its inertia's inverse overflows the dynamics."""
 MAX_DESCRIPTION_LENGTH = 1e6
 """Largest offset or size in a description [m] (beyond it the kinematics lose every digit)."""
 
@@ -237,6 +296,9 @@ def _check_numbers(urdf: str) -> None:
                     m = _numbers(mass, "value", 1, f"{name} mass")
                     if m and m[0] < 0:
                         raise DescriptionError(f"{name} mass: value={m[0]:g} kg; expected a mass >= 0")
+                    if m and 0 < m[0] < MIN_MASS:  # (a wheel of 1e-300 kg gave accelerations of 1e302)
+                        raise DescriptionError(f"{name} mass: value={m[0]:g} kg; expected 0 (a massless link) or at "
+                                               f"least {MIN_MASS:g} kg")
                     total += m[0] if m else 0.0
                 inertia = el.find("inertial/inertia")
                 if inertia is not None:

@@ -95,6 +95,8 @@ import numpy as np
 
 from ..description.urdf import _ROOT_CHAINS, ROOT_KINDS, expand_xacro
 from ..errors import InputError, RobotDynError, RobotDynWarning
+from ..inputs import MAX_ANGLE
+from ..input_files import resolved
 from ..contact.friction import LAWS, make_law
 from ..robot import Closure, MotorSpec, Parameter, Robot, RobotSpec, Wheel
 from ..description.ros_packages import HINT, PackageIndex
@@ -280,7 +282,10 @@ class _Reader:
             if not match:
                 self.fail(where, f"{what} = {x!r}; expected a number in rad or a string like '45 deg' or '0.79 rad'")
             value = self.number(where, float(match.group(1)), what)
-            return float(np.radians(value)) if match.group(2) == "deg" else value
+            value = float(np.radians(value)) if match.group(2) == "deg" else value
+            if abs(value) > MAX_ANGLE:  # (1e300 rad was accepted)
+                self.fail(where, f"{what} = {x!r}; expected an angle within one turn (|angle| <= 360 deg)")
+            return value
         value = self.number(where, x, what)
         if abs(value) > np.pi:
             self.fail(where, f"{what} = {value:g}; a bare number is in rad and expected in [-pi, pi]: write "
@@ -457,13 +462,16 @@ def read(
     """
     path = Path(path)
     r = _Reader(path)
-    if not path.is_file():
+    from ..input_files import read_text
+
+    if not path.exists() and not path.is_symlink():
         raise ConstraintFileError(f"constraint file not found: {path}")
-    if path.stat().st_size > MAX_FILE_BYTES:
-        raise ConstraintFileError(f"{path}: {path.stat().st_size:,} bytes; expected a constraint file of at most "
-                                  f"{MAX_FILE_BYTES:,} bytes")
+    try:  # a regular file of bounded size, read at most that far (a FIFO would block, a device never end)
+        text = read_text(path, "constraint file", MAX_FILE_BYTES)
+    except InputError as exc:
+        raise ConstraintFileError(str(exc)) from None
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConstraintFileError(f"{path}: not valid TOML: {exc}") from None
     except UnicodeDecodeError:
@@ -586,16 +594,24 @@ def _description(cx: _Context, urdf, xacro_args, package_dirs, packages) -> None
     """``package_dirs``, ``[packages]``, ``urdf``, ``root`` and ``[xacro_args]``: sets ``cx.pdirs``, ``cx.named``,
     ``cx.index``, ``cx.desc``, ``cx.root``, ``cx.xargs`` and ``cx.declared`` (the description's Xacro arguments)."""
     r, data, base = cx.r, cx.data, cx.base
-    pdirs = [str((base / d).resolve()) for d in r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")]
-    pdirs += [str(Path(d).resolve()) for d in package_dirs]
+    listed = r.strings("package_dirs", data.get("package_dirs", []), "package_dirs")
+    try:  # a loop of symbolic links is one line naming the entry (never a RuntimeError)
+        pdirs = [str(resolved(base / d, "package_dirs")) for d in listed]
+        pdirs += [str(resolved(d, "--package")) for d in package_dirs]
+    except InputError as exc:
+        r.fail("package_dirs", str(exc))
     for d in pdirs:
         if not Path(d).is_dir():
             r.fail("package_dirs", f"{d}: no such directory; expected directories holding ROS packages (or --package "
                                    "DIR)")
     pkg_table = data.get("packages", {})
     r.keys("packages", pkg_table, list(pkg_table))
-    named = {k: str((base / r.string(f"packages.{k}", v, "directory")).resolve()) for k, v in pkg_table.items()}
-    named.update({k: str(Path(v).resolve()) for k, v in packages.items()})
+    dirs = {k: r.string(f"packages.{k}", v, "directory") for k, v in pkg_table.items()}
+    try:
+        named = {k: str(resolved(base / v, f"packages.{k}")) for k, v in dirs.items()}
+        named.update({k: str(resolved(v, f"--package {k}")) for k, v in packages.items()})
+    except InputError as exc:
+        r.fail("packages", str(exc))
     try:
         index = PackageIndex.create(named, pdirs)
     except RobotDynError as exc:
@@ -933,6 +949,9 @@ def _root_height(cx: _Context) -> float | None:
     root_height = r.number("root_height", root_height, "root_height")
     if cx.root == "fixed":
         r.fail("root_height", "a fixed root has no height; expected root = 'planar' or 'floating'")
+    if cx.root == "floating":  # (it was ignored): a floating root's height is a coordinate
+        r.fail("root_height", f"{root_height:g} m: a floating root's height is its coordinate z; expected neutral = "
+                              f"{{ z = {root_height:g} }} (and q0 of the scenarios), or root = 'planar'")
     if abs(root_height) > MAX_RADIUS:
         r.fail("root_height", f"{root_height:g} m; expected the root link's height above the ground in m")
     return root_height

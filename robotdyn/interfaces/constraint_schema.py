@@ -237,6 +237,22 @@ def _parent_expected(error: jsonschema.ValidationError) -> str | None:
     return None
 
 
+def terrain_problem(table: dict) -> str | None:
+    """The first problem of a terrain table ``{kind = ..., ARG = number, ...}`` (a sweep's terrain) against the
+    constraint file's ``[terrain]`` schema (the same ranges: finite heights, positive widths, bounded slopes), as
+    one line, or None.
+
+    Args:
+        table: ``{"kind": KIND, ARG: number, ...}``.
+
+    Returns:
+        The problem in one line, or None when the table is valid.
+    """
+    errors = sorted(_VALIDATOR.evolve(schema=SCHEMA["properties"]["terrain"]).iter_errors(table),
+                    key=lambda e: [str(k) for k in e.absolute_path])
+    return None if not errors else _message(errors[0], table)
+
+
 def schema_problem(data: dict) -> str | None:
     """The first problem of a parsed constraint file against :data:`SCHEMA` as one line, or None.
 
@@ -254,4 +270,4 @@ def schema_problem(data: dict) -> str | None:
     return _message(errors[0], data)
 
 
-__all__ = ["SCHEMA", "schema_problem", "MAX_RADIUS", "MAX_LENGTH", "MAX_DURATION", "MAX_ENTRIES"]
+__all__ = ["SCHEMA", "schema_problem", "terrain_problem", "MAX_RADIUS", "MAX_LENGTH", "MAX_DURATION", "MAX_ENTRIES"]

@@ -70,14 +70,26 @@ def _digest(path) -> str:
 
 def _source(spec: SweepSpec) -> tuple[dict, dict]:
     """The robot's source (what workers load) and its identity (what run ids hash)."""
+    if spec.urdf is not None and spec.constraints is None and spec.robot is None:
+        raise SweepSpecError(f"urdf = {spec.urdf!r} (--urdf) needs constraints = FILE (--constraints): the wheels, "
+                             "closures and motors of the robot")
     if (spec.robot is None) == (spec.constraints is None):
         raise SweepSpecError("give either a robot name (robot = ...) or a constraint file (constraints = ...), "
                              "exactly one")
     if spec.robot is not None:
         if spec.urdf is not None:
             raise SweepSpecError("urdf = ... goes with constraints = FILE, not with a registered robot")
+        if spec.xacro_args:
+            raise SweepSpecError(f"xacro argument {next(iter(spec.xacro_args))!r} (--xacro-arg, xacro_args) is for "
+                                 "your own robot's description (constraints = FILE); a built-in robot's numbers are "
+                                 "its parameters: --param NAME=VALUE or --vary NAME=...")
         return {"robot": spec.robot}, {"robot": spec.robot}
-    path = Path(spec.constraints).resolve()
+    from ..input_files import resolved
+
+    try:
+        path = resolved(spec.constraints, "constraints")
+    except InputError as exc:
+        raise SweepSpecError(str(exc)) from None
     if not path.is_file():
         raise SweepSpecError(f"constraint file {spec.constraints!r} not found")
     source = {"constraints": str(path), "urdf": spec.urdf, "xacro_args": dict(spec.xacro_args),
@@ -113,6 +125,11 @@ def _terrain(mod, item, scenarios) -> tuple[str, tuple]:
         values = {k: float(v) for k, v in args.items()}
     except (TypeError, ValueError):
         raise SweepSpecError(f"terrain {item!r}: arguments must be numbers") from None
+    from ..interfaces.constraint_schema import terrain_problem
+
+    problem = terrain_problem({"kind": kind, **values})  # the constraint file's ranges: finite, widths > 0, ...
+    if problem is not None:
+        raise SweepSpecError(f"terrain {item!r}: {problem}")
     label = kind + ("(" + ", ".join(f"{k}={v!r}" for k, v in values.items()) + ")" if values else "")
     definition = ("kind", kind, values)
     try:
@@ -179,6 +196,8 @@ def plan(spec: SweepSpec) -> Plan:
     names = robot.coordinates + robot.velocity_names
     columns = spec.columns or names
     for c in columns:
+        if columns.count(c) > 1:  # (two columns of one name would make every results file of the sweep unreadable)
+            raise SweepSpecError(f"column {c!r} listed {columns.count(c)} times; expected distinct columns")
         if c not in names:
             raise SweepSpecError(f"unknown column {c!r}; expected one of {', '.join(names)}")
     tolerances = {}

@@ -138,6 +138,85 @@ def _worker_info() -> str:
     return robotdyn.__version__
 
 
+WORKERS_PER_CPU = 4
+"""Most local Dask worker processes per CPU (beyond it they only wait for each other; 100,000 hung the start)."""
+
+
+def max_local_workers() -> int:
+    """The largest number of worker processes of a local cluster: :data:`WORKERS_PER_CPU` per CPU here."""
+    import os
+
+    return WORKERS_PER_CPU * (os.cpu_count() or 1)
+
+
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+"""Address schemes of a Dask scheduler (``inproc``: a cluster of threads in this process, from the API)."""
+
+
+def _short(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def _probe(scheduler: str):
+    """Check that ``scheduler`` is a Dask scheduler that answers, within :data:`CONNECT_TIMEOUT` in all (Dask's
+    own connect waits for the handshake without a limit: a server that accepts and never answers hung it); returns
+    the :class:`distributed.security.Security` to connect with.
+
+    Raises:
+        RobotDynError: One line naming the address: an unknown or unusable scheme (``ucx://`` without its backend,
+            ``tls://`` without certificates), nothing listening, no answer in time, or an answer that is not a
+            Dask scheduler's (an HTTP server, garbage).
+    """
+    import asyncio
+    import importlib.util
+
+    from dask.utils import parse_timedelta
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address
+    from distributed.security import Security
+
+    def fail(why: str):
+        raise RobotDynError(f"cannot reach the Dask scheduler at {scheduler!r} ({why}); expected an address like "
+                            "tcp://HOST:8786 of a running scheduler")
+
+    try:
+        scheme, _ = parse_address(scheduler)
+    except (ValueError, TypeError) as exc:
+        fail(_short(exc))
+    if scheme not in SCHEMES:
+        fail(f"unknown address scheme {scheme!r}; expected one of {', '.join(s + '://' for s in SCHEMES)}")
+    if scheme == "ucx" and not any(importlib.util.find_spec(m) for m in ("distributed_ucxx", "ucp")):
+        fail("ucx:// needs Dask's UCX backend (distributed-ucxx), which is not installed")
+    security = Security()
+    if scheme == "inproc":  # this process's own cluster: nothing on the network to probe
+        return security
+    if scheme in ("tls", "wss") and security.tls_client_cert is None and security.tls_ca_file is None:
+        fail(f"{scheme}:// needs TLS certificates, and Dask's configuration gives none (distributed.comm.tls: "
+             "ca-file, client.cert, client.key)")
+    seconds = parse_timedelta(CONNECT_TIMEOUT, default="seconds")
+
+    async def identity():
+        comm = await connect(scheduler, timeout=seconds, **security.get_connection_args("client"))
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    try:
+        reply = asyncio.run(asyncio.wait_for(identity(), seconds))
+    except (TimeoutError, asyncio.TimeoutError):
+        fail(f"no answer within {CONNECT_TIMEOUT}")
+    except MemoryError:  # garbage read as Dask's frame header announces exabytes
+        fail("it answered, but not in Dask's protocol (an HTTP server or another service?)")
+    except Exception as exc:  # noqa: BLE001 - refused, reset, garbage
+        fail(f"{type(exc).__name__}: {_short(exc)}")
+    if not isinstance(reply, dict) or reply.get("type") != "Scheduler":
+        fail(f"it answered, but not as a Dask scheduler ({_short(repr(reply))})")
+    return security
+
+
 def _connect(stack: ExitStack, workers: int, scheduler: str | None):
     """A Dask client: on the cluster of ``scheduler``, or on a new LocalCluster of ``workers`` processes."""
     from dask.distributed import Client, LocalCluster
@@ -145,11 +224,13 @@ def _connect(stack: ExitStack, workers: int, scheduler: str | None):
     import robotdyn
 
     if scheduler is not None:
+        security = _probe(scheduler)
         try:
-            client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT))
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise RobotDynError(f"cannot reach the Dask scheduler at {scheduler!r} ({exc}); expected an address "
-                                "like tcp://HOST:8786 of a running scheduler") from None
+            client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT, security=security))
+        except Exception as exc:  # noqa: BLE001 - whatever the address answered, one line naming it
+            raise RobotDynError(f"cannot reach the Dask scheduler at {scheduler!r} ({type(exc).__name__}: "
+                                f"{_short(exc)}); expected an address like tcp://HOST:8786 of a running "
+                                "scheduler") from None
         try:
             versions = client.run(_worker_info)
         except Exception as exc:
@@ -265,6 +346,11 @@ def run(spec: SweepSpec | str | Path, out="sweep", workers: int = 1, scheduler: 
     start = time.perf_counter()
     p = plan(spec)
     phases = {"plan": time.perf_counter() - start}
+    if scheduler is not None and client is None:
+        _probe(scheduler)  # a wrong address is one line before anything is written or shown
+    elif client is None and workers > max_local_workers():
+        raise RobotDynError(f"workers = {workers}: more local worker processes than this machine runs usefully; "
+                            f"expected at most {max_local_workers()} ({WORKERS_PER_CPU} per CPU), or a scheduler")
     out = sweep_store.prepare(out)
     held = sweep_store.lock(out)  # one sweep at a time per directory
     try:

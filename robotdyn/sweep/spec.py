@@ -46,11 +46,19 @@ DEFAULT_TIME_LIMIT = 600.0
 """Wall-clock limit [s] of one run by default (0 or ``None``: none): a crawling run becomes an error row."""
 MAX_RUNS = 1_000_000
 """Largest number of runs of one sweep (a larger one is refused before anything runs)."""
+MAX_SPEC_BYTES = 1_000_000
+"""Largest sweep file read [bytes] (a sweep file is a few lines; a larger file is refused before it is read)."""
+MAX_TORQUE_SCALE = 1e9
+"""Largest magnitude of the torque scale: :data:`robotdyn.inputs.MAX_FORCE` per N m of the scenario's torques
+(beyond it a torque of 1 N m leaves the range any motor torque is accepted in)."""
+MAX_SEED = 2**63 - 1
 RESERVED = ("run_id", "run_index", "robot", "scenario", "terrain", "status", "error", "t_end", "t_reached", "drift",
             "nfev", "wall", "run_wall")
 """Column names of the results that no varied parameter may take."""
 TOP_KEYS = ("robot", "constraints", "urdf", "xacro_args", "fixed", "parameters", "scenarios", "terrains", "sample",
             "n", "seed", "t_end", "n_out", "rtol", "atol", "columns", "trajectories", "plot_column", "time_limit")
+RANGE_KEYS = ("min", "max", "n", "scale")
+"""The keys of a range of the ``[parameters]`` table."""
 _VALUE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*")
 
 
@@ -273,12 +281,16 @@ def from_toml(path) -> SweepSpec:
     Returns:
         The :class:`SweepSpec`.
     """
+    from ..input_files import read_text, resolved
+
     path = Path(path)
+    try:  # a regular file of bounded size: a FIFO would block, /dev/zero would never end
+        text = read_text(path, "sweep file", MAX_SPEC_BYTES)
+    except InputError as exc:
+        raise SweepSpecError(str(exc)) from None
     try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise SweepSpecError(f"cannot read sweep file {str(path)!r}: {exc.strerror or exc}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        data = tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError) as exc:
         raise SweepSpecError(f"{path}: not valid TOML ({exc})") from None
     for key in data:
         if key not in TOP_KEYS:
@@ -290,7 +302,7 @@ def from_toml(path) -> SweepSpec:
                 raise SweepSpecError(f"{path}: {key} = {data[key]!r}; expected a non-empty string")
             value = data[key]
             if key in ("constraints", "urdf") and not value.startswith("package://"):
-                value = str((path.parent / value).resolve())
+                value = str(resolved(path.parent / value, key))
             setattr(spec, key, value)
     for key in ("xacro_args", "fixed"):
         table = data.get(key, {})
@@ -331,7 +343,7 @@ def _toml_axis(path: Path, name: str, v) -> Axis:
         return Axis(name, tuple(v))
     if not isinstance(v, dict):
         return Axis(name, (v,))
-    allowed = ("min", "max", "n", "scale")
+    allowed = RANGE_KEYS
     for k in v:
         if k not in allowed:
             raise SweepSpecError(f"{where}: unknown key {k!r}; expected {', '.join(allowed)}")
@@ -357,6 +369,8 @@ def resolve_axis(axis: Axis, parameter) -> Axis:
         if parameter is not None and parameter.choices is not None:
             return parameter.convert(x)
         value = parse_value(x, unit if unit != "-" else "", where)
+        if parameter is None and abs(value) > MAX_TORQUE_SCALE:
+            raise SweepSpecError(f"{where} = {x!r}; expected a torque scale of magnitude <= {MAX_TORQUE_SCALE:g}")
         return value if parameter is None else parameter.convert(value)
 
     if parameter is not None and parameter.choices is not None and axis.ranged:
@@ -382,6 +396,8 @@ def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
     """
     if spec.sample not in SAMPLERS:
         raise SweepSpecError(f"sample = {spec.sample!r}; expected one of {', '.join(SAMPLERS)}")
+    if isinstance(spec.seed, bool) or not isinstance(spec.seed, int) or not 0 <= spec.seed <= MAX_SEED:
+        raise SweepSpecError(f"seed = {spec.seed!r}; expected a whole number from 0 to {MAX_SEED}")
     if spec.sample == "grid":
         if spec.n is not None:
             raise SweepSpecError(f"n = {spec.n} samples with sample = 'grid'; expected sample = 'lhs' or 'random' "

@@ -191,8 +191,33 @@ def write_chunk(out: Path, rows: list[dict], trajectories: list[dict | None], sc
     return path
 
 
+_WARNED: set[Path] = set()
+
+
 def _parts(out: Path) -> list[Path]:
-    return sorted((out / RUNS).glob("part-*.parquet"))
+    """The chunk files of a sweep directory that can be read back: a file with two columns of one name (written by a
+    sweep that listed a column twice, before that was refused) cannot, and is left out with a warning (its runs are
+    computed again) rather than failing every later sweep into the directory."""
+    import warnings
+
+    import pyarrow.parquet as pq
+
+    from ..errors import RobotDynWarning
+
+    parts = []
+    for path in sorted((out / RUNS).glob("part-*.parquet")):
+        try:
+            names = pq.read_schema(path).names
+        except Exception:  # unreadable: finished() names it in one line
+            names = []
+        if len(set(names)) < len(names):
+            if path not in _WARNED:  # once per process
+                _WARNED.add(path)
+                warnings.warn(f"results file {str(path)!r} has repeated columns and cannot be read; ignored (its runs "
+                              "are computed again): move it away", RobotDynWarning, stacklevel=2)
+            continue
+        parts.append(path)
+    return parts
 
 
 def finished(out: Path) -> dict[str, str]:
@@ -229,7 +254,11 @@ def consolidate(out: Path, order: dict[str, int], schema):
 
     tables, seen = [], set()
     for path in _parts(out):
-        table = pq.read_table(path)
+        try:
+            table = pq.read_table(path)
+        except Exception as exc:  # a foreign or damaged file: say which, in one line
+            raise OutputError(f"cannot read sweep results {str(path)!r} ({exc}); expected a file written by "
+                              "robotdyn sweep: move it away") from None
         ids = table.column("run_id")
         mask = pc.is_in(ids, value_set=pa.array(sorted(set(order) - seen), pa.string()))
         table = table.filter(mask)

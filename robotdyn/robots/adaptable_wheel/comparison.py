@@ -203,8 +203,17 @@ def cmd_ik(args) -> int:
     from ...cli.commands import _jsonable
     from ...inputs import as_vector, parse_assignments
 
+    from ...inputs import MAX_ANGLE, MAX_POSITION, refuse_together
+
+    for flag in ("urdf", "constraints", "xacro_arg", "package", "twist"):  # ik solves the built-in robot's eqs 4-24
+        if getattr(args, flag, None):
+            raise InputError(f"--{flag.replace('_', '-')}: ik solves {SPEC.name}'s own equations (eqs 4-24); "
+                             "expected --param NAME=VALUE for its numbers")
     if args.robot != SPEC.name:
         raise InputError(f"ik is implemented for {SPEC.name} only, not {args.robot!r}")
+    refuse_together(args, "mission", "commands")
+    if args.csv and not args.mission:
+        raise InputError("--csv writes a mission's steps; expected it with --mission")
     robot = Robot(SPEC, parse_assignments(args.param))
     p = robot.params
     if args.mission:
@@ -227,7 +236,11 @@ def cmd_ik(args) -> int:
     else:
         if args.commands is None:
             raise InputError("ik needs --commands x_d y_d h_CG q_xd q_yd q_zd (m, m, m, rad, rad, rad) or --mission")
-        c = as_vector(args.commands, 6, "commands", ["x_d", "y_d", "h_CG", "q_xd", "q_yd", "q_zd"])
+        c = as_vector(args.commands, 6, "commands", ["x_d", "y_d", "h_CG", "q_xd", "q_yd", "q_zd"], MAX_POSITION)
+        for k, name in enumerate(("q_xd", "q_yd", "q_zd"), start=3):
+            if abs(c[k]) > MAX_ANGLE:
+                raise InputError(f"commands[{name}] = {c[k]:g} rad; expected an angle of magnitude <= {MAX_ANGLE:.6g} "
+                                 "rad (one turn)")
         if c[2] <= 0:
             raise InputError(f"commands[h_CG] = {c[2]:g} m; expected a positive height above the surface")
         cmd = Commands(c[0], c[1], c[2], c[3], c[4], c[5])

@@ -29,6 +29,7 @@ import numpy as np
 
 from ...contact.friction import LinearTyre, RegularisedCoulomb
 from ...constraints.joint_coupling import CosineLaw, JointCoupling
+from ...inputs import MAX_FRICTION
 from ...robot import MotorSpec, Parameter, Robot, RobotSpec
 from ...constraints.rolling_contact import OmniWheel, RollingWheel
 from ...simulation.scenario import Scenario
@@ -106,11 +107,13 @@ SPEC = RobotSpec(
                   choices=("half", "full")),
         Parameter("R_ru", 0.02, "m", "rubber height, added to the pattern radius (Table 1)", minimum=0.0),
         Parameter("body_height", 0.05, "m", "body plate thickness (inertia only; not in the paper)", positive=True),
-        Parameter("mu", 1.0, "-", "static friction coefficient (Table 1)", xacro=False),
+        Parameter("mu", 1.0, "-", "static friction coefficient (Table 1)", xacro=False, minimum=0.0,
+                  maximum=MAX_FRICTION),
         Parameter("g", 9.81, "m/s^2", "gravitational acceleration (not printed in the paper)", xacro=False),
         Parameter("terrain", "rough", "", "rough: Z = sin(0.5(x+y))/15 (Table 1); ramp; flat",
                   choices=("rough", "ramp", "flat"), xacro=False),
-        Parameter("ramp_slope", 0.2, "-", "slope of the ramp terrain (mission 2)", xacro=False),
+        Parameter("ramp_slope", 0.2, "-", "slope of the ramp terrain (mission 2)", xacro=False, minimum=-10.0,
+                  maximum=10.0),
         Parameter("ramp_heading", -np.pi / 2, "rad", "direction in which the ramp rises (mission 2)", xacro=False),
         Parameter("lateral", "rolling", "", "rolling: wheels roll without slipping; slip: lateral row dropped "
                   "(frictionless); coulomb, linear: sideways sliding under that friction law with mu",

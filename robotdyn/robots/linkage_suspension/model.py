@@ -291,7 +291,9 @@ def _cmd_posture(args) -> int:
             f"{post.residual:.2e} after {post.iterations} Newton steps",
             *(f"  {c:<8} {v: .10g}" for c, v in zip(robot.coordinates, post.q) if not c.startswith(("phi", "rod")))]
     if args.v is not None:
-        nu = robot.check_nu([float(x) for x in args.v], "v")
+        from ...inputs import MAX_VELOCITY, as_vector
+
+        nu = robot.check_nu(as_vector(args.v, 2, "--v", ["phi2'", "phi5'"], MAX_VELOCITY, "rad/s"), "v")
         red = robot.reduced(post.q, nu, coriolis=True)
         out.update(M=red.M, C=red.C, g=red.g, B=red.B, mobility=red.projection.mobility)
         names = robot.velocity_names

@@ -27,6 +27,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ...errors import InputError
+from ...inputs import MAX_FRICTION
 from ...robot import MotorSpec, Parameter, Robot, RobotSpec, Wheel
 
 
@@ -66,7 +67,8 @@ SPEC = RobotSpec(
         Parameter("m_link4", 1.5, "kg", "link 4 / gripper mass (assumed)"),
         Parameter("m_load", 10.0, "kg", "load at the end effector (sec 2.1: 10 kg)"),
         Parameter("g", 9.81, "m/s^2", "gravitational acceleration", xacro=False),
-        Parameter("mu", 0.1, "-", "rolling-resistance coefficient of the climbing balance (assumed)", xacro=False),
+        Parameter("mu", 0.1, "-", "rolling-resistance coefficient of the climbing balance (assumed)", xacro=False,
+                  minimum=0.0, maximum=MAX_FRICTION),
     ],
     wheels=[Wheel("W_R", "lambda_C0", name="W_R"), Wheel("W_L", "lambda_C0", name="W_L")],
     motors=[

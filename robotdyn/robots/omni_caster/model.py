@@ -427,11 +427,15 @@ def _cmd_impulse(args) -> int:
     robot.check_constraints(q)
     n = as_vector(args.direction, robot.mobility, "--direction", robot.velocity_names)
     red = robot.reduced(q, np.zeros(robot.mobility))
+    from ...inputs import MAX_VELOCITY, refuse_together
+
+    refuse_together(args, "v", "speed")
     if args.v is not None:
         nu = robot.check_nu(args.v, "--v")
     else:
-        if not (np.isfinite(args.speed) and args.speed > 0):
-            raise InputError(f"--speed {args.speed}; expected a positive speed")
+        args.speed = 1.0 if args.speed is None else args.speed
+        if not (np.isfinite(args.speed) and 0 < args.speed <= MAX_VELOCITY):
+            raise InputError(f"--speed {args.speed:g}; expected a positive speed <= {MAX_VELOCITY:g} m/s")
         nn = np.linalg.norm(n)
         nu = (-args.speed * n / nn if nn > 0 else n) + 0.0  # + 0.0: no negative zeros in the output
     res = impact(red.M, n, nu, args.e)
@@ -462,6 +466,6 @@ def register_cli(subparsers, parents) -> None:
     p.add_argument("--direction", nargs="+", required=True,
                    help="surface normal n in the minimal coordinates (pointing from the surface to the robot)")
     p.add_argument("--e", type=float, default=RESTITUTION, help="coefficient of restitution (default 0.8)")
-    p.add_argument("--speed", type=float, default=1.0, help="head-on approach speed along -n (default 1)")
+    p.add_argument("--speed", type=float, default=None, help="head-on approach speed along -n (default 1)")
     p.add_argument("--v", nargs="+", help="velocity before impact in the minimal coordinates (instead of --speed)")
     p.set_defaults(func=_cmd_impulse)

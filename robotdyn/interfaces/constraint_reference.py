@@ -89,6 +89,11 @@ KEYS: dict[str, tuple[str, str, str]] = {
                           "rolling", 'friction = "coulomb"'),
     "wheels[].slip_velocity": ("coulomb: regularisation velocity", "1e-3", "slip_velocity = 0.001"),
     "wheels[].stiffness": ("linear: force per unit load per m/s of slip", "required by linear", "stiffness = 5.0"),
+    "wheels[].normal_stiffness": ("normal (radial) stiffness k [N/m]: the rigid limit of normal compliance splits the loads "
+                                  "rigid-body dynamics leave open in the ratios of k", "m g / (n * 1 mm): the robot's "
+                                  "weight over its n wheels at 1 mm static deflection", "normal_stiffness = 2.0e5"),
+    "wheels[].normal_damping": ("normal (radial) damping c [N s/m]", "2 * 0.3 * sqrt(k m / n): damping ratio 0.3 on "
+                                "the wheel's share of the mass", "normal_damping = 400.0"),
     "wheels[].slip": ("with a friction law: both directions, or lateral only (rolls along its rolling direction)",
                       "both", 'slip = "lateral"'),
     "closures": ("loop closures: two frames held together", "[]",

@@ -23,6 +23,7 @@ STAGES = [
     ("contact", ["contact"]),
     ("robot", ["robot"]),
     ("simulation", ["simulation"]),
+    ("optimisation", ["optimisation"]),
     ("interfaces", ["interfaces"]),
     ("robots", ["robots", ""]),  # "": the package's own __init__ (robotdyn.load builds a registered robot)
     ("sweep", ["sweep"]),

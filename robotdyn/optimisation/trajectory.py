@@ -228,7 +228,12 @@ class TrajectoryProblem:
         return J[:, :self.nx], J[:, self.nx:]
 
     def defects(self, z: np.ndarray) -> np.ndarray:
-        """Trapezoidal defects (N-1, nx) flattened, for the decision vector ``z = (x_0..x_{N-1}, tau_0..)``."""
+        """Trapezoidal defects :math:`x_{j+1} - x_j - \\tfrac{h}{2}(f_j + f_{j+1})`, (N-1, nx) flattened.
+
+        Args:
+            z: Decision vector (N (nx + m),): the states :math:`x_j = (q_j, \\nu_j)` node after node, then the
+                torques :math:`\\tau_j` node after node [SI units].
+        """
         key = z.tobytes()
         if self._defect_cache[0] == key:
             return self._defect_cache[1]
@@ -255,7 +260,13 @@ class TrajectoryProblem:
         return np.concatenate(rows), np.concatenate(cols)
 
     def jacobian_values(self, z: np.ndarray) -> np.ndarray:
-        """Values of the defects' Jacobian in the order of :meth:`_pattern` (from the node Jacobians)."""
+        """Values of the defects' Jacobian :math:`\\partial(\\text{defects})/\\partial z` at its structural nonzeros,
+        interval after interval (blocks :math:`\\partial/\\partial x_j, \\partial/\\partial x_{j+1},
+        \\partial/\\partial\\tau_j, \\partial/\\partial\\tau_{j+1}`, each row-major), from the node Jacobians.
+
+        Args:
+            z: Decision vector, as for :meth:`defects`.
+        """
         key = z.tobytes()
         if self._jac_cache[0] == key:  # IPOPT asks again at the same point (e.g. after a function evaluation)
             return self._jac_cache[1]
@@ -380,7 +391,7 @@ class TrajectoryProblem:
         lbx[:nx] = ubx[:nx] = x0
         fixed = np.flatnonzero(np.isfinite(self.x_end))
         lbx[(N - 1) * nx + fixed] = ubx[(N - 1) * nx + fixed] = self.x_end[fixed]
-        opts = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.max_iter": int(max_iter),
+        opts = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.constr_viol_tol": tol, "ipopt.max_iter": int(max_iter),
                 "ipopt.print_level": 5 if verbose else 0, "print_time": bool(verbose),
                 "ipopt.sb": "yes", "ipopt.honor_original_bounds": "yes"}
         solver = ca.nlpsol("trajectory", "ipopt", {"x": z, "f": cost, "g": defects(z)}, opts)

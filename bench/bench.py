@@ -350,7 +350,7 @@ def trajectory_optimisation_bench() -> None:
           f"{'dynamics calls':>15}")
     walls = {}
     for derivatives in ("analytic", "finite-difference"):
-        sols = [rest_to_rest(robot=robot, derivatives=derivatives).solve() for _ in range(2)]
+        sols = [rest_to_rest(nodes=21, robot=robot, derivatives=derivatives).solve() for _ in range(2)]
         best = min(sols, key=lambda s: s.wall_time)
         walls[derivatives] = best
         print(f"{derivatives:<18} {best.wall_time:>9.2f} {best.iterations:>11} {best.cost:>17.9f} "

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from ...optimisation.trajectory import TrajectoryProblem, TrajectorySolution
 
-DISTANCE, T_END, NODES, TAU_MAX, PITCH_MAX = 1.0, 3.0, 21, 0.6, 0.06
-"""The example's defaults: 1 m in 3 s on 21 nodes, |tau| <= 0.6 N m, |theta3| <= 0.06 rad."""
+DISTANCE, T_END, NODES, TAU_MAX, PITCH_MAX = 1.0, 3.0, 41, 0.6, 0.06
+"""The example's defaults: 1 m in 3 s on 41 nodes, |tau| <= 0.6 N m, |theta3| <= 0.06 rad."""
 
 
 def rest_to_rest(distance: float = DISTANCE, t_end: float = T_END, nodes: int = NODES, tau_max: float = TAU_MAX,

@@ -105,3 +105,35 @@ def test_robot_with_holonomic_rows_is_refused_in_one_line():
     robot = robotdyn.load("linkage_suspension")
     with pytest.raises(InputError, match="holonomic constraint row"):
         TrajectoryProblem(robot, 1.0, 5, robot.neutral())
+
+
+CLI = ["optimise", "quasimoro", "--t-end", "3", "--nodes", str(NODES), "--end", "x=1", "--end", "y=0", "--end",
+       "psi=0", "--end", "theta3=0", "--bound", f"theta3=-{PITCH}:{PITCH}", "--tau-max", "0.6"]
+
+
+def test_cli_prints_the_apis_optimum_and_writes_the_node_table(analytic, tmp_path, capsys):
+    """One story: ``robotdyn optimise`` solves the same problem as the API (same cost, same node torques)."""
+    import json
+
+    from robotdyn.cli import main
+
+    csv = tmp_path / "nodes.csv"
+    assert main([*CLI, "--json", "--csv", str(csv)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["success"] and abs(out["cost"] - analytic.cost) <= 1e-9
+    table = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert table.shape == (NODES, 1 + 6 + 3 + 2)
+    assert np.allclose(table[:, -2:], analytic.tau, atol=1e-9)
+
+
+@pytest.mark.parametrize("extra, needle", [(["--bound", "theta3=0.1"], "LOWER:UPPER"),
+                                           (["--bound", "theta3=0.1:-0.1"], "LOWER <= UPPER"),
+                                           (["--end", "z=1"], "q_end names 'z'"),
+                                           (["--nodes", "2"], "nodes"),
+                                           (["--derivatives", "exact"], "derivatives")])
+def test_cli_bad_input_one_line_exit_2(extra, needle, capsys):
+    from robotdyn.cli import main
+
+    assert main([*CLI, *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0], err

@@ -130,6 +130,8 @@ def test_cli_prints_the_apis_optimum_and_writes_the_node_table(analytic, tmp_pat
                                            (["--bound", "theta3=0.1:-0.1"], "LOWER <= UPPER"),
                                            (["--end", "z=1"], "q_end names 'z'"),
                                            (["--nodes", "2"], "nodes"),
+                                           (["--tau-max", "nan"], "--tau-max"),
+                                           (["--tau-max", "-1"], "--tau-max"),
                                            (["--derivatives", "exact"], "derivatives")])
 def test_cli_bad_input_one_line_exit_2(extra, needle, capsys):
     from robotdyn.cli import main

@@ -61,6 +61,19 @@ def cmd_optimise(args) -> int:
     return 0
 
 
+def _positive(text: str) -> float:
+    """An argparse type: a finite number > 0 (argparse names the option in its one-line error)."""
+    import argparse
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (np.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}; expected a finite number > 0 [N m or N]")
+    return value
+
+
 def register(sub, parents) -> None:
     """Add the ``optimise`` subcommand."""
     from .commands import _duration
@@ -75,7 +88,7 @@ def register(sub, parents) -> None:
                    help="a final coordinate, e.g. --end x=1 (repeatable; the others are free)")
     p.add_argument("--bound", action="append", default=[], metavar="NAME=LO:HI",
                    help="bounds on a coordinate or velocity at every node, e.g. --bound theta3=-0.06:0.06")
-    p.add_argument("--tau-max", type=float, default=None, help="bound on every motor torque |tau| [N m or N]")
+    p.add_argument("--tau-max", type=_positive, default=None, help="bound on every motor torque |tau| [N m or N]")
     p.add_argument("--derivatives", choices=("analytic", "finite-difference"), default="analytic",
                    help="the constraint Jacobian from the analytic derivatives (default) or finite differences")
     p.add_argument("--csv", help="write the node table (t, q, nu, tau columns) to this CSV file")

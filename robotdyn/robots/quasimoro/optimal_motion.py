@@ -13,7 +13,7 @@ from __future__ import annotations
 from ...optimisation.trajectory import TrajectoryProblem, TrajectorySolution
 
 DISTANCE, T_END, NODES, TAU_MAX, PITCH_MAX = 1.0, 3.0, 41, 0.6, 0.06
-"""The example's defaults: 1 m in 3 s on 41 nodes, |tau| <= 0.6 N m, |theta3| <= 0.06 rad."""
+"""The example's defaults: 1 m in 3 s on 41 nodes, torques within +-0.6 N m, body pitch within +-0.06 rad."""
 
 
 def rest_to_rest(distance: float = DISTANCE, t_end: float = T_END, nodes: int = NODES, tau_max: float = TAU_MAX,

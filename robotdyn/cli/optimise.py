@@ -25,7 +25,14 @@ def _ranges(items, option: str) -> dict[str, tuple[float, float]]:
 
 def cmd_optimise(args) -> int:
     """``robotdyn optimise ROBOT --t-end T [--nodes N] [--q0 ...] [--end NAME=VALUE ...] [--bound NAME=LO:HI ...]
-    [--tau-max X] [--derivatives analytic|finite-difference] [--csv FILE]``."""
+    [--tau-max X] [--derivatives analytic|finite-difference] [--csv FILE]``.
+
+    Args:
+        args: The parsed command line (argparse namespace of :func:`register`'s parser).
+
+    Returns:
+        The exit status (0; a problem IPOPT could not solve raises a one-line error after printing its result).
+    """
     from ..optimisation.trajectory import TrajectoryProblem
     from ..output import atomic_output
     from .commands import _emit, _load, _numbers
@@ -75,7 +82,12 @@ def _positive(text: str) -> float:
 
 
 def register(sub, parents) -> None:
-    """Add the ``optimise`` subcommand."""
+    """Add the ``optimise`` subcommand.
+
+    Args:
+        sub: The ``robotdyn`` parser's subparsers.
+        parents: The parsers whose options every robot command shares (``--json``, ROBOT, ``--urdf`` ...).
+    """
     from .commands import _duration
 
     p = sub.add_parser("optimise", parents=parents,

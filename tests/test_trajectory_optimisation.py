@@ -87,6 +87,10 @@ def test_repr_and_bad_input(robot):
         TrajectoryProblem(robot, 3.0, 2, [0] * 6)
     with pytest.raises(InputError, match="t_end"):
         TrajectoryProblem(robot, float("nan"), 5, [0] * 6)
+    with pytest.raises(InputError, match="t_end"):
+        TrajectoryProblem(robot, "soon", 5, [0] * 6)
+    with pytest.raises(InputError, match="nodes"):
+        TrajectoryProblem(robot, 3.0, "many", [0] * 6)
     with pytest.raises(InputError, match="bounds names 'pitch'"):
         TrajectoryProblem(robot, 3.0, 5, [0] * 6, bounds={"pitch": (-1, 1)})
     with pytest.raises(InputError, match="q_end"):

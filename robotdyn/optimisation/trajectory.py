@@ -123,8 +123,10 @@ class TrajectoryProblem:
         bounds: Bounds on coordinates or velocities at every node, by name {name: (lower, upper)} [SI units].
         derivatives: ``analytic`` (default) or ``finite-difference`` (central differences of the forward dynamics,
             the comparison).
-        guess: Initial guess ``(q (N, n), nu (N, k), tau (N, m))`` (default: coordinates linear from ``q0``
-            towards ``q_end``, at rest, no torque).
+        guess: Initial guess ``(q (N, n), nu (N, k), tau (N, m))`` (default: the coordinates from ``q0`` towards
+            ``q_end`` along a smooth rest-to-rest ramp, the velocities that best follow it through S(q) in least
+            squares, no torque; a guess at rest everywhere can make the defects' Jacobian rank-deficient for
+            nonholonomic robots).
 
     Raises:
         InputError: A wrong size, name or bound, a robot with holonomic rows, non-finite data.
@@ -134,10 +136,10 @@ class TrajectoryProblem:
                  nu_end=None, tau_bounds=None, bounds: dict | None = None, derivatives: str = "analytic",
                  guess=None) -> None:
         self.robot = robot
-        self.t_end = float(t_end)
-        if not (math.isfinite(self.t_end) and self.t_end > 0):
+        self.t_end = _finite(t_end, "t_end")
+        if not self.t_end > 0:
             raise InputError(f"t_end = {t_end!r}; expected a finite duration > 0 [s]")
-        if int(nodes) != nodes or nodes < 3:
+        if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
             raise InputError(f"nodes = {nodes!r}; expected an integer >= 3")
         self.nodes = int(nodes)
         if derivatives not in DERIVATIVES:

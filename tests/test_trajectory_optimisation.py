@@ -177,3 +177,16 @@ def test_small_motion_costs_the_linear_models_minimum_energy(robot):
                           derivatives="finite-difference").solve()
     assert s.success
     assert abs(s.cost - reference) / reference < 0.03, (s.cost, reference)
+
+
+def test_cli_infeasible_problem_is_one_line_exit_2_and_no_file(tmp_path, capsys):
+    """0.01 N m cannot move the robot 1 m in 3 s: IPOPT reports infeasibility; nothing is printed or written."""
+    from robotdyn.cli import main
+
+    csv = tmp_path / "nodes.csv"
+    argv = ["optimise", "quasimoro", "--t-end", "3", "--nodes", "11", "--end", "x=1", "--tau-max", "0.01"]
+    assert main([*argv, "--csv", str(csv)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and not csv.exists()
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and "did not converge" in err[0], err

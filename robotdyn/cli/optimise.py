@@ -31,7 +31,7 @@ def cmd_optimise(args) -> int:
         args: The parsed command line (argparse namespace of :func:`register`'s parser).
 
     Returns:
-        The exit status (0; a problem IPOPT could not solve raises a one-line error after printing its result).
+        The exit status (0; a problem IPOPT could not solve raises a one-line error and prints nothing else).
     """
     from ..optimisation.trajectory import TrajectoryProblem
     from ..output import atomic_output
@@ -46,6 +46,10 @@ def cmd_optimise(args) -> int:
     problem = TrajectoryProblem(robot, args.t_end, args.nodes, q0, q_end=end, tau_bounds=tau, bounds=bounds,
                                 derivatives=args.derivatives)
     s = problem.solve()
+    if not s.success:  # nothing printed or written: an unconverged iterate is not a result
+        raise RobotDynError(f"the optimisation did not converge: IPOPT {s.status} after {s.iterations} iterations "
+                            f"(largest defect {s.max_defect:.2g}; looser bounds, more time or more nodes may make "
+                            "the problem feasible)")
     if args.csv:
         header = ["t"] + s.coordinates + s.velocity_names + [f"tau_{m}" for m in s.motors]
         with atomic_output(args.csv, "CSV file") as tmp:
@@ -62,9 +66,6 @@ def cmd_optimise(args) -> int:
                       f"peak |tau| [N m or N]: {peak}", f"final coordinates: {final}"]
                      + ([f"node table written to {args.csv}"] if args.csv else []))
     _emit(args, out, text)
-    if not s.success:
-        raise RobotDynError(f"the optimisation did not converge: IPOPT {s.status} (looser bounds, more time or "
-                            "more nodes may make the problem feasible)")
     return 0
 
 

@@ -149,6 +149,7 @@ def main() -> None:
     rigid_limit_bench()
     traction_bench()
     simulate_many_bench()
+    trajectory_optimisation_bench()
 
 
 def side_by_side_bench() -> None:
@@ -367,6 +368,44 @@ def simulate_many_bench(runs: int = 10_000) -> None:
         wall = time.perf_counter() - start
         print(f"  {threads} thread(s): {n:,} runs in {wall:.2f} s ({n / wall:,.0f} runs/s; {int(out.ok.sum()):,} ok, "
               f"{out.nfev.mean():.0f} evaluations per run)")
+
+
+def trajectory_optimisation_bench() -> None:
+    """Quasimoro's minimum-effort rest-to-rest motion (1 m in 3 s, 21 nodes, |tau| <= 0.6 N m, |theta3| <= 0.06 rad)
+    on IPOPT, the defects' Jacobian from the analytic derivatives and from central finite differences, side by side
+    (issue 26: target analytic >= 5x faster)."""
+    try:
+        import casadi  # noqa: F401
+    except ImportError:
+        print("\ntrajectory optimisation: skipped (casadi not installed: pip install casadi)")
+        return
+    from robotdyn.robots.quasimoro.optimal_motion import rest_to_rest
+
+    robot = robotdyn.load("quasimoro")
+    q, nu = state(robot)
+    tau = np.array([0.3, -0.2])
+    t_an = timeit(lambda: robot.dynamics_derivatives(q, nu, tau), repeat=3, number=50)
+    t_fw = timeit(lambda: robot.forward_dynamics(q, nu, tau, check=False), repeat=3, number=500)
+    with use_compiled(False):
+        t_fw_py = timeit(lambda: robot.forward_dynamics(q, nu, tau, check=False), repeat=3, number=200)
+    n_in = robot.nq + robot.mobility + len(robot.motors)
+    print(f"\nquasimoro per state: dynamics_derivatives {t_an * 1e3:.2f} ms (Python path); central differences "
+          f"{2 * n_in} x forward_dynamics {t_fw * 1e3:.3f} ms (compiled) = {2 * n_in * t_fw * 1e3:.2f} ms "
+          f"(Python path: {2 * n_in * t_fw_py * 1e3:.2f} ms)")
+    print("quasimoro rest-to-rest 1 m in 3 s, 21 nodes, IPOPT (CasADi), best of 2:")
+    print(f"{'jacobian':<18} {'wall [s]':>9} {'iterations':>11} {'cost [N^2 m^2 s]':>17} {'derivative calls':>17} "
+          f"{'dynamics calls':>15}")
+    walls = {}
+    for derivatives in ("analytic", "finite-difference"):
+        sols = [rest_to_rest(nodes=21, robot=robot, derivatives=derivatives).solve() for _ in range(2)]
+        best = min(sols, key=lambda s: s.wall_time)
+        walls[derivatives] = best
+        print(f"{derivatives:<18} {best.wall_time:>9.2f} {best.iterations:>11} {best.cost:>17.9f} "
+              f"{best.derivative_calls:>17} {best.dynamics_calls:>15}")
+    a, f = walls["analytic"], walls["finite-difference"]
+    print(f"speed-up of analytic over finite differences: {f.wall_time / a.wall_time:.2f}x (target >= 5x; the "
+          "derivatives run on the Python path, the forward dynamics compiled); "
+          f"|cost difference| {abs(a.cost - f.cost):.1e}")
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ STAGES = [
     ("contact", ["contact"]),
     ("robot", ["robot"]),
     ("simulation", ["simulation"]),
+    ("optimisation", ["optimisation"]),
     ("interfaces", ["interfaces"]),
     ("robots", ["robots", ""]),  # "": the package's own __init__ (robotdyn.load builds a registered robot)
     ("sweep", ["sweep"]),
@@ -46,6 +47,7 @@ LAZY_CIRCLES = {
     frozenset({"cli.commands", "cli.sweep"}),  # the sweep subcommand registers itself, and prints with _emit
     frozenset({"cli.commands", "cli.fk"}),
     frozenset({"cli.commands", "cli.linearize"}),  # the linearize subcommand registers itself, prints with _emit
+    frozenset({"cli.commands", "cli.optimise"}),  # the optimise subcommand likewise
     frozenset({"sweep.chunk", "sweep.batched"}),  # a chunk's batched runs; the batch reuses the per-run summary
     # the adaptable wheel's hold scenario (model) starts from the paper's IK placement (comparison, missions)
     frozenset({"robots.adaptable_wheel.model", "robots.adaptable_wheel.comparison", "robots.adaptable_wheel.missions"}),

@@ -128,6 +128,7 @@ SAMPLES = {
     "view": ["view", "quasimoro", "--html", "x.html"],
     "sweep": ["sweep", "quasimoro", "--vary", "M=4,6", "--out", "d"],
     "linearize": ["linearize", "quasimoro", "--set", "theta3=3.14", "--states", "theta3", "theta3_dot"],
+    "optimise": ["optimise", "quasimoro", "--t-end", "3", "--end", "x=1", "--bound", "theta3=-0.06:0.06"],
 }
 
 

@@ -1,4 +1,4 @@
-"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep | linearize`` plus robot-specific commands
+"""Command-line interface: ``robotdyn list | info | dump | simulate | compare | view | sweep | linearize | optimise`` plus robot-specific commands
 (every command has ``--json``).
 
 Robot modules may add their own subcommands by defining ``register_cli(subparsers, parents)``; each such
@@ -570,7 +570,7 @@ HELP_EPILOG = ("file formats (constraint TOML, sweep spec, simulate CSV, sweep P
                "(the documentation site: make docs)")
 """The last line of ``robotdyn --help``: where the file formats are documented."""
 
-BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep", "linearize")
+BUILT_IN = ("list", "info", "dump", "simulate", "compare", "view", "sweep", "linearize", "optimise")
 """The built-in commands (robot modules add theirs, see :func:`_add_robot_commands`)."""
 
 
@@ -626,8 +626,13 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
         register(sub, parents)
 
+    def _add_optimise(sub, parents) -> None:
+        from .optimise import register
+
+        register(sub, parents)
+
     added = {"dump": _add_dump, "simulate": _add_simulate, "view": _add_view, "sweep": _add_sweep,
-             "linearize": _add_linearize}
+             "linearize": _add_linearize, "optimise": _add_optimise}
     for name in BUILT_IN:  # the order of --help
         if not wanted(name):
             continue

@@ -5,6 +5,8 @@
 - :mod:`robotdyn.robots.quasimoro.paper`: the paper's closed forms (eqs 23-31) and printed values, transcribed
   (Staicu, ``docs/bibliography.md``).
 - :mod:`robotdyn.robots.quasimoro.comparison`: ``compare``, the model against the paper (``docs/errata/quasimoro.md``).
+- :mod:`robotdyn.robots.quasimoro.optimal_motion`: ``rest_to_rest``, the minimum-effort motion over a distance with
+  torque and body-pitch bounds (trajectory optimisation; not re-exported: import it from there).
 
 The names of all three are re-exported here (``robotdyn.robots.module("quasimoro")``).
 """

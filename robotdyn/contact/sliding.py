@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..reduction.actuation import input_matrix
+from ..reduction.applied_forces import applied, has_applied
 from ..constraints.constraint import KinematicState
 from ..errors import ConstraintError, InputError, SingularConstraintError
 from .friction import FrictionLaw
@@ -125,7 +126,10 @@ class SlidingState:
         normal: Normal load of each slipping wheel (W,) [N].
         slip: Slip velocity of each slipping wheel (W, 2) [m/s] (t1, t2).
         force: Friction force on each slipping wheel (W, 2) [N] (t1, t2).
-        power: Power of the friction forces :math:`\\sum F_t\\cdot s` [W] (<= 0 while loads are positive).
+        power: Power of the friction forces :math:`\\sum F_t\\cdot s` [W] (<= 0 while loads are positive), the
+            compliant wheels' included.
+        damper_power: Power of joint dampers and compliant contacts' damping [W] (<= 0;
+            :mod:`robotdyn.reduction.applied_forces`).
     """
 
     nudot: np.ndarray
@@ -134,6 +138,7 @@ class SlidingState:
     slip: np.ndarray
     force: np.ndarray
     power: float
+    damper_power: float = 0.0
 
 
 def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingState:
@@ -165,6 +170,9 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     M = pin.crba(model, data, q)
     K = np.hstack([M @ red.S, -G])
     rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
+    app = applied(robot, q, red.v, kin) if has_applied(robot) else None
+    if app is not None:  # joint springs, compliant wheels: known at the state (robotdyn.reduction.applied_forces)
+        rhs += app.Q
     cond = np.linalg.cond(K)
     if not np.isfinite(cond) or cond > PAINLEVE_CONDITION:
         raise painleve_error(wheels, cond)
@@ -172,7 +180,8 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     k = red.S.shape[1]
     normal = sol[k + position]
     force = -normal[:, None] * coef
-    return SlidingState(sol[:k], red, normal, slip, force, float(np.sum(force * slip)))
+    power = float(np.sum(force * slip)) + (app.friction_power if app is not None else 0.0)
+    return SlidingState(sol[:k], red, normal, slip, force, power, app.damper_power if app is not None else 0.0)
 
 
 def painleve_error(wheels, cond: float) -> SingularConstraintError:
@@ -257,6 +266,8 @@ def inverse(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> SlidingInvers
     B = input_matrix(robot.motors, kin)
     K = np.hstack([B, G])
     b = pin.rnea(model, data, q, v, a)
+    if has_applied(robot):
+        b -= applied(robot, q, v, kin).Q
     x, _, rank, _ = np.linalg.lstsq(K, b, rcond=None)
     n_tau = B.shape[1]
     lam = x[n_tau:]

@@ -298,7 +298,7 @@ class Robot:
         if w.contact != "rigid":
             from .contact.compliant_contact import compliant_wheel
 
-            return compliant_wheel(self, w, name, self._value(w.radius), self._value(w.roller_angle), **kw)
+            return compliant_wheel(self, w, self._value(w.radius), self._value(w.roller_angle), **kw)
         if w.mu is not None and not (np.isfinite(float(w.mu)) and float(w.mu) >= 0):
             raise InputError(f"wheel {name!r}: mu = {w.mu}; expected a friction coefficient >= 0")
         if w.friction not in ("rolling", None):

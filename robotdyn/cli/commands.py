@@ -303,6 +303,18 @@ def cmd_simulate(args) -> int:
             f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
     if tr is not None:
         text.append(tr.summary())
+    if "flight" in traj.stats:  # compliant wheels: lift-off and touch-down times (robotdyn.simulation.flight)
+        from ..simulation.flight import flight_summary
+
+        out["flight"] = traj.stats["flight"]
+        lines = flight_summary(traj.stats["flight"], traj.stats.get("airborne", []))
+        text.append("flight phases: " + ("; ".join(lines) if lines else
+                                         "none (every compliant wheel kept its contact)"))
+    if traj.damper_work is not None or traj.friction_work is not None:
+        fw = 0.0 if traj.friction_work is None else float(traj.friction_work[-1])
+        dw = 0.0 if traj.damper_work is None else float(traj.damper_work[-1])
+        out["friction_work"], out["damper_work"] = fw, dw
+        text.append(f"work: friction {fw:.10g} J, dampers {dw:.10g} J (energy change = motor work + these)")
     if switches is not None:
         out["switches"] = switches
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(

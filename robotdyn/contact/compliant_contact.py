@@ -234,7 +234,7 @@ __all__ = ["NormalLaw", "LinearContact", "HuntCrossley", "CompliantWheel", "make
            "CONTACT_LAWS"]
 
 
-def compliant_wheel(robot, w, name: str, radius: float, roller_angle: float, **kwargs) -> CompliantWheel:
+def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> CompliantWheel:
     """A :class:`CompliantWheel` from a spec's :class:`~robotdyn.robot.Wheel` with ``contact = "compliant"``.
 
     The normal law's numbers: the wheel's ``normal_stiffness`` and ``normal_damping``, or the default rule of
@@ -250,6 +250,7 @@ def compliant_wheel(robot, w, name: str, radius: float, roller_angle: float, **k
     from .compliance import STATIC_DEFLECTION, normal_compliance, weight
     from .friction import make_law
 
+    name = w.name or w.frame
     if w.contact != "compliant":
         raise InputError(f"wheel {name!r}: contact = {w.contact!r}; expected 'rigid' or 'compliant'")
     if w.kind not in ("standard", "omni", "support"):

@@ -32,7 +32,7 @@ from ..contact.sliding import lift_off_message, slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
 from ..contact.compliant_contact import compliant_wheels
 from ..reduction.applied_forces import applied, has_applied
-from .flight import STIFF_METHOD, flight_events, flight_phases
+from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .progress import Progress
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
@@ -251,6 +251,7 @@ def simulate(
         stats["offsets"] = offsets
     if flights:
         stats["flight"] = flight_phases(flights, sol.t_events[len(events) - len(flights):], times[-1])
+        stats["airborne"] = airborne(robot, compliant, q0)
     traj = Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
                       robot.units, sol.y[n + k][: len(times)] if (slipping or compliant) else None, robot, torque)
     if forced:

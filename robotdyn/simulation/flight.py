@@ -33,14 +33,19 @@ def flight_events(robot, wheels, n: int) -> list[tuple]:
         n: Number of coordinates (the state's first n entries are q).
     """
     out = []
-    for w in wheels:
-        def depth(t, y, w=w):
-            kin = KinematicState(robot.model, robot.data, y[:n], np.zeros(robot.model.nv))
-            return w.penetration(kin)
+    last: dict = {}  # the penetrations of every wheel at the last configuration asked for (one kinematics pass)
 
+    def depths(q: np.ndarray) -> np.ndarray:
+        key = q.tobytes()
+        if last.get("key") != key:
+            kin = KinematicState(robot.model, robot.data, q, np.zeros(robot.model.nv))
+            last["key"], last["depths"] = key, np.array([w.penetration(kin) for w in wheels])
+        return last["depths"]
+
+    for i, w in enumerate(wheels):
         for kind, direction in (("lift-off", -1.0), ("touch-down", 1.0)):
-            def event(t, y, depth=depth):
-                return depth(t, y)
+            def event(t, y, i=i):
+                return float(depths(np.asarray(y[:n], float))[i])
 
             event.terminal, event.direction = False, direction
             out.append((event, w.name, kind))

@@ -628,5 +628,6 @@ class Robot:
                 for m in self.motors
             ],
             "constraints": [repr(c) for c in self.constraints],
+            "springs": [repr(sp) for sp in getattr(self, "springs", ())],
             "terrain": repr(self.terrain),
         }

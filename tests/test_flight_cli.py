@@ -85,3 +85,21 @@ def test_compiled_engine_refuses_springs_in_one_line():
         simulate(robot, 0.1, q0, nu0, engine="compiled", progress=False)
     traj = simulate(robot, 0.1, q0, nu0, progress=False)  # auto: the Python path
     assert traj.stats["engine"].startswith("scipy") and np.isfinite(traj.q).all()
+
+
+def test_dump_applies_the_springs():
+    """At its design height the sprung car's preloaded springs carry the chassis: zero heave and pitch
+    accelerations at rest, from dump as from the API (dump ignored the springs before: -9.81 m/s^2)."""
+    from robotdyn.interfaces.constraint_file import load_robot
+
+    out = run("dump", "--constraints", str(EXAMPLES / "sprung_car.toml"), "--v", "0", "0", "0", "0", "--tau", "0", "0", "0", "0", "--forces",
+              "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    robot = load_robot(EXAMPLES / "sprung_car.toml")
+    expected = robot.forward_dynamics(robot.neutral(), np.zeros(4), np.zeros(4))
+    assert np.allclose(data["a"], expected, atol=1e-12)
+    assert np.max(np.abs(expected)) < 1e-9
+    total = sum(w["normal"] for w in data["forces"]["wheels"].values())
+    import pinocchio as pin
+    assert total == pytest.approx(pin.computeTotalMass(robot.model) * 9.81, rel=1e-12)

@@ -132,6 +132,7 @@ def cmd_info(args) -> int:
           for a in info["actuators"]),
         "constraints:",
         *(f"  {c}" for c in info["constraints"]),
+        *(["springs and dampers:", *(f"  {sp}" for sp in info["springs"])] if info.get("springs") else []),
         f"terrain: {info['terrain']}",
         "scenarios:",
         *(f"  {k}: {d}" for k, d in info["scenarios"].items()),
@@ -181,7 +182,9 @@ def cmd_dump(args) -> int:
                  _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
     elif args.tau is not None or args.tau_set:
         tau = _torques(robot, args.tau, args.tau_set)
-        nudot = solve_mass(red.M, red.B @ tau - red.h)
+        from ..reduction.applied_forces import reduced_applied
+
+        nudot = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(robot, red, q)[0])  # springs, compliant wheels
         out["a"] = nudot
         text.append(_vector_text("a (independent accelerations)", names, nudot))
     from ..constraints.redundancy import message, violations

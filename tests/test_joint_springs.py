@@ -5,7 +5,8 @@ examples/sprung_car.urdf.xacro (a floating chassis on four vertical suspensions,
   the uprights at their height, so the chassis (mass m_s) is a mass on four parallel springs 4k and dampers 4c:
   z(t) = h - d (1 - e^{-s t} (cos(w_d t) + s/w_d sin(w_d t))), static deflection d = m_s g / (4 k),
   w_n = sqrt(4 k / m_s), s = 4 c / (2 m_s), w_d = sqrt(w_n^2 - s^2);
-- energy: E(t) - E(0) = damper work at every sample (E counting the springs' energy);
+- energy: E(t) - E(0) = damper work at every sample (E counting the springs' energy), and braking:
+  E(t) - E(0) = motor work + damper work, the constant brake torques doing the work tau (phi(t) - phi(0));
 - braking load transfer (examples/sprung_car.toml as shipped): in steady deceleration a (constant pitch), the
   moment balance of the whole car about its centre of mass G (pitch axis y) with the wheels' spin angular momentum
   4 I_w v / R changing at -4 I_w a / R gives the front axle's load
@@ -74,6 +75,12 @@ def test_braking_load_transfer():
     q0, nu0 = sc.initial_state(robot)
     tau = np.asarray(sc.torque(0.0, q0, nu0), float)
     traj = simulate(robot, 3.5, q0, nu0, sc.torque, n_out=51, progress=False)  # (still rolling: 1.5 m/s)
+    # energy at every sample: E(t) - E(0) = motor work + damper work; constant torques do the work tau * (spin angle)
+    spins = [robot.coordinate_index(f"{n}_spin") for n in CORNERS]
+    motor_work = (traj.q[:, spins] - traj.q[0, spins]) @ tau
+    balance = traj.energy - traj.energy[0] - motor_work - traj.damper_work
+    assert np.max(np.abs(balance)) < 1e-7 * abs(motor_work[-1])
+    assert traj.damper_work[-1] < 0
     q, nu = traj.q[-1], traj.nu[-1]
     assert abs(nu[robot.velocity_names.index("pitch_dot")]) < 1e-8  # steady pitch: the moment balance holds
     m = pin.computeTotalMass(robot.model)

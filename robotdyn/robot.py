@@ -33,7 +33,7 @@ from .constraints.rolling_contact import OmniWheel, RollingWheel, SupportWheel
 from .contact.sliding import SlippingWheel, sliding_now
 from .contact.sliding import forward as forward_sliding
 from .contact.stick_slip_wheel import StickSlipWheel
-from .reduction.applied_forces import reduced_applied, stored_energy
+from .contact.applied_forces import reduced_applied, stored_energy
 from .reduction.joint_springs import build_springs
 from .constraints.terrain import FlatTerrain, Terrain
 
@@ -538,7 +538,7 @@ class Robot:
 
     def energy(self, q, v) -> float:
         """Total mechanical energy [J]: kinetic + gravity's potential + the elastic energy of joint springs and
-        compliant contacts (:func:`robotdyn.reduction.applied_forces.stored_energy`)."""
+        compliant contacts (:func:`robotdyn.contact.applied_forces.stored_energy`)."""
         kinetic, potential = energy(self.model, self.data, np.asarray(q, float), np.asarray(v, float))
         if getattr(self, "springs", None) or self._compliant:
             potential += stored_energy(self, q)

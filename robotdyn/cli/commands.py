@@ -182,7 +182,7 @@ def cmd_dump(args) -> int:
                  _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
     elif args.tau is not None or args.tau_set:
         tau = _torques(robot, args.tau, args.tau_set)
-        from ..reduction.applied_forces import reduced_applied
+        from ..contact.applied_forces import reduced_applied
 
         nudot = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(robot, red, q)[0])  # springs, compliant wheels
         out["a"] = nudot

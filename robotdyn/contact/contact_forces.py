@@ -43,7 +43,7 @@ from ..constraints.loop_closure import LoopClosure
 from ..constraints.rolling_contact import RollingWheel
 from .sliding import forward as forward_sliding
 from .sliding import sliding_now, tangential
-from ..reduction.applied_forces import applied, has_applied, reduced_applied
+from .applied_forces import applied, has_applied, reduced_applied
 
 ILL_DETERMINED = 1e3
 """Condition number of the rows above which the forces are flagged as ill-determined (a note, not an error)."""
@@ -335,7 +335,7 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
         B = input_matrix(robot.motors, kin)
         e = pin.rnea(model, data, q, v, a) - B @ tau
         compliant = {}
-        if has_applied(robot):  # joint springs and compliant wheels (robotdyn.reduction.applied_forces)
+        if has_applied(robot):  # joint springs and compliant wheels (robotdyn.contact.applied_forces)
             app = applied(robot, q, v, kin)
             e -= app.Q
             compliant = app.wheels

@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..reduction.actuation import input_matrix
-from ..reduction.applied_forces import applied, has_applied
+from .applied_forces import applied, has_applied
 from ..constraints.constraint import KinematicState
 from ..errors import ConstraintError, InputError, SingularConstraintError
 from .friction import FrictionLaw
@@ -129,7 +129,7 @@ class SlidingState:
         power: Power of the friction forces :math:`\\sum F_t\\cdot s` [W] (<= 0 while loads are positive), the
             compliant wheels' included.
         damper_power: Power of joint dampers and compliant contacts' damping [W] (<= 0;
-            :mod:`robotdyn.reduction.applied_forces`).
+            :mod:`robotdyn.contact.applied_forces`).
     """
 
     nudot: np.ndarray
@@ -171,7 +171,7 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     K = np.hstack([M @ red.S, -G])
     rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
     app = applied(robot, q, red.v, kin) if has_applied(robot) else None
-    if app is not None:  # joint springs, compliant wheels: known at the state (robotdyn.reduction.applied_forces)
+    if app is not None:  # joint springs, compliant wheels: known at the state (robotdyn.contact.applied_forces)
         rhs += app.Q
     cond = np.linalg.cond(K)
     if not np.isfinite(cond) or cond > PAINLEVE_CONDITION:

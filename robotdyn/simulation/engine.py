@@ -31,7 +31,7 @@ from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import lift_off_message, slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
 from ..contact.compliant_contact import compliant_wheels
-from ..reduction.applied_forces import applied, has_applied
+from ..contact.applied_forces import applied, has_applied
 from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .progress import Progress
 from .torque_profile import TorqueProfile, as_profile
@@ -157,7 +157,7 @@ def simulate(
     from scipy.integrate import solve_ivp
 
     slipping = slipping_wheels(robot)
-    forced = has_applied(robot)  # joint springs, compliant wheels (robotdyn.reduction.applied_forces)
+    forced = has_applied(robot)  # joint springs, compliant wheels (robotdyn.contact.applied_forces)
     works = bool(slipping) or forced  # y[n + k:] = (friction work, damper work)
     fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path
     k = robot.mobility

@@ -38,7 +38,7 @@ class Applied:
 
 def has_applied(robot) -> bool:
     """Whether the robot has joint springs or compliant wheels."""
-    from ..contact.compliant_contact import compliant_wheels
+    from .compliant_contact import compliant_wheels
 
     return bool(getattr(robot, "springs", None)) or bool(compliant_wheels(robot))
 
@@ -51,7 +51,7 @@ def applied(robot, q: np.ndarray, v: np.ndarray, kin: KinematicState | None = No
         q: Natural coordinates (n,); v: full velocities (n,).
         kin: The kinematics at (q, v) if already computed (its caches are shared).
     """
-    from ..contact.compliant_contact import compliant_wheels
+    from .compliant_contact import compliant_wheels
 
     q, v = np.asarray(q, float), np.asarray(v, float)
     Q = np.zeros(robot.model.nv)
@@ -74,7 +74,7 @@ def applied(robot, q: np.ndarray, v: np.ndarray, kin: KinematicState | None = No
 
 def stored_energy(robot, q: np.ndarray) -> float:
     """Elastic energy of the joint springs and compliant contacts at q [J]."""
-    from ..contact.compliant_contact import compliant_wheels
+    from .compliant_contact import compliant_wheels
 
     q = np.asarray(q, float)
     out = sum(s.potential(q) for s in getattr(robot, "springs", ()))

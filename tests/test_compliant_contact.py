@@ -35,10 +35,10 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 M, R = 2.0, 0.3  # tests/data/disc.urdf's mass; the wheel radius
 
 
-def disc(g: float = 0.0, **contact) -> Robot:
+def disc(g: float = 0.0, motors=(), **contact) -> Robot:
     wheel = Wheel("disc", R, contact="compliant", friction="coulomb", mu=0.5, **contact)
     spec = RobotSpec(name="disc", title="compliant disc", xacro=DISC, root="planar", wheels=[wheel],
-                     parameters=[Parameter("g", g, "m/s^2", xacro=False)])
+                     parameters=[Parameter("g", g, "m/s^2", xacro=False)], motors=list(motors))
     return Robot(spec)
 
 
@@ -99,10 +99,19 @@ def test_hertz_contact_time_of_hunt_crossley():
 
 
 def test_energy_balance_sliding_landing_with_gravity():
-    robot = disc(g=9.81, normal_stiffness=5.0e4, normal_damping=60.0)
+    """E(t) - E(0) = motor work + friction work + damper work at every sample; the motor on the spin joint applies a
+    constant torque, whose work is tau (spin(t) - spin(0)) exactly."""
+    from robotdyn.robot import MotorSpec
+    from robotdyn.simulation.torque_profile import Constant
+
+    robot = disc(g=9.81, motors=[MotorSpec("m", "spin")], normal_stiffness=5.0e4, normal_damping=60.0)
     q0, nu0 = state(robot, R + 0.02, 0.0, vx=1.0)
-    traj = simulate(robot, 0.4, q0, nu0, n_out=201, rtol=1e-10, atol=1e-13, progress=False)
-    balance = traj.energy - traj.energy[0] - traj.friction_work - traj.damper_work
+    tau = 0.8
+    traj = simulate(robot, 0.4, q0, nu0, Constant([tau]), n_out=201, rtol=1e-10, atol=1e-13, progress=False)
+    spin = traj.q[:, robot.coordinate_index("spin")]
+    motor = tau * (spin - spin[0])
+    assert motor[-1] > 0.1
+    balance = traj.energy - traj.energy[0] - motor - traj.friction_work - traj.damper_work
     assert np.max(np.abs(balance)) < 1e-7 * abs(traj.energy[0])
     assert traj.friction_work[-1] < -1e-3 and traj.damper_work[-1] < -1e-3
     assert np.all(np.diff(traj.friction_work) <= 1e-12) and np.all(np.diff(traj.damper_work) <= 1e-12)

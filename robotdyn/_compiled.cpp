@@ -654,6 +654,7 @@ class Evaluator {
     e_ = data_.tau;  // C v + g (dynamics)
     e_.noalias() += data_.M * a_;
     lambda_from(tau);
+    rigid_limit_split();
     fill_wheel_forces();
     const double* now[7] = {nudot_.data(), lambda_.data(), e_.data(), wl_.data(), ww_.data(), wf_.data(), wp_.data()};
     for (int i = 0; i < 7; ++i)
@@ -676,6 +677,91 @@ class Evaluator {
     lambda_from(tau);
     return py::make_tuple(lambda_, e_, wheel_forces(), A_);
   }
+
+  // The loads rigid-body dynamics leave open, by the rigid limit of the wheels' normal compliance
+  // (robotdyn/contact/rigid_limit.py, the same formulas): lambda + N z with N a basis of the null space of A^T (from
+  // the projection's LU of A_d; with operational velocities a column-pivoting QR of A), z along the directions V_n that move normal loads (an SVD of C N) minimising
+  // sum n_i^2 / k_i: the compatible loads; minimum norm along those that move none; the rows rigid-body dynamics
+  // determine keep their values. Where the compatible loads would pull on a wheel the no-pull split (a
+  // least-distance program) is the Python path's: Fallback. Nothing happens without redundant rows, where a row acts
+  // on no coordinate (a planar root's normal rows), or with the split turned off (set_rigid_limit(false)).
+  void rigid_limit_split() {
+    const int m = nrows();
+    const int nw = static_cast<int>(wheels_.size());
+    if (!rigid_limit_ || static_cast<int>(rows_.size()) >= m || nw == 0 || m == 0) return;
+    const double scale = std::max(1.0, A_.cwiseAbs().maxCoeff());
+    for (int r = 0; r < m; ++r)
+      if (A_.row(r).cwiseAbs().maxCoeff() <= 1e-12 * scale) return;
+    const int nr = static_cast<int>(rows_.size());
+    int d;
+    if (!operational_) {
+      // a basis of null(A^T) from the projection's own LU of A_d: each row j outside the projection's choice is
+      // A_j = c^T A_R with A_d^T c = (A_j on the dependent columns), so e_j - sum_r c_r e_{rows_r} is in null(A^T)
+      d = m - nr;
+      rl_N_.setZero(m, d);
+      rl_in_.assign(m, false);
+      for (int r = 0; r < nr; ++r) rl_in_[rows_[r]] = true;
+      int col = 0;
+      for (int j = 0; j < m; ++j) {
+        if (rl_in_[j]) continue;
+        rl_c_.resize(nr);
+        for (int r = 0; r < nr; ++r) rl_c_[r] = A_(j, dependent_[r]);
+        lu_solve_transposed(lu_, rl_c_);
+        rl_N_(j, col) = 1.0;
+        for (int r = 0; r < nr; ++r) rl_N_(rows_[r], col) = -rl_c_[r];
+        ++col;
+      }
+    } else {
+      rl_qr_.setThreshold(std::max(m, nv_) * std::numeric_limits<double>::epsilon());
+      rl_qr_.compute(A_);
+      d = m - static_cast<int>(rl_qr_.rank());
+      if (d <= 0) return;
+      rl_Q_ = rl_qr_.householderQ();
+      rl_N_ = rl_Q_.rightCols(d);
+    }
+    rl_P_.setZero(nw, d);
+    rl_n0_.setZero(nw);
+    for (int i = 0; i < nw; ++i) {
+      const Wheel& wh = wheels_[i];
+      const int row = geo_[i].row;
+      for (int r = 0; r < wh.D.rows(); ++r) {
+        const double c = wh.D(r, 2);
+        if (c == 0.0) continue;
+        rl_P_.row(i) += c * rl_N_.row(row + r);
+        rl_n0_[i] += c * lambda_[row + r];
+      }
+    }
+    rl_svd_.compute(rl_P_, Eigen::ComputeFullV);
+    const VectorXd& sv = rl_svd_.singularValues();
+    int p = 0;
+    while (p < sv.size() && sv[p] > 1e-9) ++p;
+    if (p == 0) return;
+    const MatrixXd& V = rl_svd_.matrixV();
+    rl_G_.noalias() = rl_P_ * V.leftCols(p);
+    VectorXd rk(nw);
+    for (int i = 0; i < nw; ++i) rk[i] = 1.0 / std::sqrt(i < kstiff_.size() ? kstiff_[i] : 1.0);
+    const MatrixXd Wm = rk.asDiagonal() * rl_G_;
+    const VectorXd y = -(Wm.transpose() * Wm).ldlt().solve(Wm.transpose() * rk.cwiseProduct(rl_n0_));
+    const VectorXd n = rl_n0_ + rl_G_ * y;
+    const double big = std::max(rl_n0_.cwiseAbs().maxCoeff(), n.cwiseAbs().maxCoeff());
+    if (!y.allFinite()) throw Fallback("the rigid limit's split is not finite here");
+    if (n.minCoeff() < -1e-9 * big) throw Fallback("a wheel would pull: the rigid limit's no-pull split is solved on the Python path");
+    rl_saved_ = lambda_;
+    lambda_.noalias() += rl_N_ * (V.leftCols(p) * y);
+    if (d > p) {  // minimum norm along the open directions N V_o (orthonormalised: N need not be orthonormal)
+      rl_oqr_.compute(rl_N_ * V.rightCols(d - p));
+      rl_O_ = rl_oqr_.householderQ() * MatrixXd::Identity(m, d - p);
+      lambda_.noalias() -= rl_O_ * (rl_O_.transpose() * lambda_);
+    }
+    for (int r = 0; r < m; ++r)  // (a row's weight in null(A^T) is zero in every basis)
+      if (rl_N_.row(r).norm() <= 1e-8) lambda_[r] = rl_saved_[r];
+  }
+  void set_normal_stiffness(const Eigen::Ref<const VectorXd>& k) {
+    if (k.size() != static_cast<Eigen::Index>(wheels_.size())) throw std::invalid_argument("one stiffness per wheel");
+    if (!(k.array() > 0.0).all() || !k.allFinite()) throw std::invalid_argument("stiffnesses must be finite and > 0");
+    kstiff_ = k;
+  }
+  void set_rigid_limit(bool on) { rigid_limit_ = on; }
 
   // Per wheel: the force along (t1, t2, n), the same in world axes, the contact frame (rows t1, t2, n: (nw, 9),
   // row-major) and the contact point (nw, 3).
@@ -1460,6 +1546,14 @@ class Evaluator {
   double cond_ = 1.0;
   // slipping wheels' work buffers (slip_rhs_into), the lift-off event's cache and the state of a SlipError
   MatrixXd Ks_, Jt_;
+  bool rigid_limit_ = true;
+  VectorXd kstiff_, rl_n0_, rl_saved_;
+  MatrixXd rl_Q_, rl_N_, rl_P_, rl_G_, rl_O_;
+  VectorXd rl_c_;
+  std::vector<bool> rl_in_;
+  Eigen::ColPivHouseholderQR<MatrixXd> rl_qr_;
+  Eigen::HouseholderQR<MatrixXd> rl_oqr_;
+  Eigen::JacobiSVD<MatrixXd> rl_svd_;
   VectorXd bs_, xs_, slip_normal_;
   Eigen::Matrix<double, Eigen::Dynamic, 2> slip_s_, slip_c_;
   std::vector<int> slip_pos_;
@@ -1524,6 +1618,8 @@ PYBIND11_MODULE(_compiled, m) {
       .def("simulate", &Evaluator::simulate)
       .def("simulate_many", &Evaluator::simulate_many)
       .def("forces", &Evaluator::forces)
+      .def("set_normal_stiffness", &Evaluator::set_normal_stiffness)
+      .def("set_rigid_limit", &Evaluator::set_rigid_limit)
       .def_property_readonly("nudot", &Evaluator::nudot, py::return_value_policy::reference_internal)
       .def_property_readonly("lam", &Evaluator::lam, py::return_value_policy::reference_internal)
       .def_property_readonly("e", &Evaluator::e, py::return_value_policy::reference_internal)

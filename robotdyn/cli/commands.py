@@ -174,9 +174,17 @@ def cmd_dump(args) -> int:
     text = [f"minimal coordinates: {', '.join(names)}  (constraint block condition {red.projection.condition:.3g})",
             _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
             _vector_text("g", names, red.g), _matrix_text("B", names, motors, red.B)]
+    from ..contact.sliding import sliding_now
+
+    sliding = bool(sliding_now(robot))  # wheels under a friction law: their forces in every solve below
     if args.a is not None:
         nudot = robot.check_nu(args.a, "a")
         Q, tau, resid = robot.inverse_dynamics(q, nu, nudot)
+        if sliding:  # the friction forces follow the loads: torques and loads solved together
+            from ..contact.sliding import inverse as inverse_sliding
+
+            inv = inverse_sliding(robot, q, red.v, red.S @ nudot + red.w)
+            tau, resid = inv.tau, inv.residual
         out.update(tau=Q, motor_torques=dict(zip(motors, tau)), motor_residual=resid)
         text += [_vector_text("tau (generalised forces M a + C v + g)", names, Q),
                  _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau)]
@@ -184,7 +192,8 @@ def cmd_dump(args) -> int:
         tau = _torques(robot, args.tau, args.tau_set)
         from ..contact.applied_forces import reduced_applied
 
-        nudot = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(robot, red, q)[0])  # springs, compliant wheels
+        nudot = robot.forward_dynamics(q, nu, tau, check=False) if sliding else \
+            solve_mass(red.M, red.B @ tau - red.h + reduced_applied(robot, red, q)[0])  # springs, compliant wheels
         out["a"] = nudot
         text.append(_vector_text("a (independent accelerations)", names, nudot))
     from ..constraints.redundancy import message, violations
@@ -200,7 +209,8 @@ def cmd_dump(args) -> int:
     if args.forces:
         if args.a is None and args.tau is None and not args.tau_set:
             raise RobotDynError("--forces needs --tau (forward dynamics) or --a (inverse dynamics)")
-        forces = robot.contact_forces(q, nu, tau=tau, nudot=nudot)
+        # with sliding wheels the forces follow from the torques (with --a: those that produce the accelerations)
+        forces = robot.contact_forces(q, nu, tau=tau) if sliding else robot.contact_forces(q, nu, tau=tau, nudot=nudot)
         out["forces"] = forces.as_dict()
         text.append(forces.table())
     _emit(args, out, "\n".join(text))

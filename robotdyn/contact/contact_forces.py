@@ -24,8 +24,11 @@ Redundant rows (r < m). :math:`\\lambda` is then determined only up to the null 
 four-wheel chassis on flat ground is statically indeterminate, and under a planar root the wheels' normal rows do
 not act on any coordinate at all (the model has no vertical motion), so the normal loads are not determined by that
 model. The result reports, per row and per wheel component, whether rigid-body dynamics determine it, and the
-undetermined combinations (the columns of N); the values shown for undetermined rows are the minimum-norm choice,
-one arbitrary member of the family :math:`\\lambda + N z`, and are flagged as such, never presented as the answer.
+undetermined combinations (the columns of N). The open part is then fixed by the rigid limit of the wheels' normal
+compliance (:mod:`robotdyn.contact.rigid_limit`: the split a stiff elastic chassis takes, no wheel pulling), and
+the components it fixes are reported as such (:attr:`WheelForce.compliance`, "rigid limit of compliance"), next to
+those rigid-body dynamics determine; what normal compliance cannot fix (e.g. a lateral squeeze between two wheels
+of one axle) stays open, shown as the minimum-norm choice and flagged, never presented as the answer.
 """
 
 from __future__ import annotations
@@ -44,6 +47,8 @@ from ..constraints.rolling_contact import RollingWheel
 from .sliding import forward as forward_sliding
 from .sliding import sliding_now, tangential
 from .applied_forces import applied, has_applied, reduced_applied
+from . import rigid_limit
+from .compliance import wheel_stiffness
 
 ILL_DETERMINED = 1e3
 """Condition number of the rows above which the forces are flagged as ill-determined (a note, not an error)."""
@@ -63,6 +68,8 @@ class WheelForce:
         determined: (3,) whether rigid-body dynamics determine each component.
         world: (3,) the same force in world axes [N].
         point: (3,) the contact point in world coordinates [m].
+        compliance: (3,) components rigid-body dynamics leave open and the rigid limit of the wheels' normal
+            compliance fixes (:mod:`robotdyn.contact.rigid_limit`).
     """
 
     name: str
@@ -71,6 +78,21 @@ class WheelForce:
     determined: np.ndarray
     world: np.ndarray
     point: np.ndarray
+    compliance: np.ndarray = field(default_factory=lambda: np.zeros(3, bool))
+    frame: np.ndarray | None = field(default=None, repr=False)  # (3, 3) the contact frame, columns t1, t2, n
+
+    @property
+    def known(self) -> np.ndarray:
+        """(3,) components with a value: determined by rigid-body dynamics or by the rigid limit of compliance."""
+        return self.determined | self.compliance
+
+    @property
+    def source(self) -> str:
+        """Which model produced the normal load: ``rigid`` (rigid-body dynamics), ``rigid limit of compliance``,
+        or ``open`` (neither determines it)."""
+        if self.determined[2]:
+            return "rigid"
+        return rigid_limit.MODEL if self.compliance[2] else "open"
 
     @property
     def normal(self) -> float:
@@ -90,11 +112,16 @@ class WheelForce:
 
     @property
     def load_determined(self) -> bool:
-        """Whether the normal load and the friction force are all determined."""
+        """Whether the normal load and the friction force are all determined by rigid-body dynamics."""
         return bool(self.determined.all())
 
+    @property
+    def load_known(self) -> bool:
+        """Whether the normal load and the friction force all have a value (rigid, or rigid limit of compliance)."""
+        return bool(self.known.all())
+
     def __repr__(self) -> str:
-        flag = "" if self.load_determined else ", NOT all determined"
+        flag = "" if self.load_determined else (f", {self.source}" if self.load_known else ", NOT all determined")
         return (f"WheelForce({self.name!r}, long={self.force[0]:.6g} N, lat={self.force[1]:.6g} N, "
                 f"normal={self.force[2]:.6g} N{flag})")
 
@@ -119,6 +146,10 @@ class ConstraintForces:
         undetermined_reason: Why rows are undetermined (empty when all are determined).
         notes: How the forces were obtained where that is not the model itself (e.g. a planar model's loads from
             its floating twin).
+        compliance: (m,) rows rigid-body dynamics leave open that the rigid limit of normal compliance fixes
+            (``lam`` holds its values there).
+        open_space: (m, d') orthonormal combinations that stay open after it (they move no normal load).
+        unloaded: Wheels the rigid limit leaves unloaded (they would pull).
     """
 
     labels: list[str]
@@ -134,7 +165,16 @@ class ConstraintForces:
     undetermined_reason: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     condition: float = 1.0
+    compliance: np.ndarray | None = None
+    open_space: np.ndarray | None = None
+    unloaded: list[str] = field(default_factory=list)
     _tangential: list = field(default_factory=list, repr=False)  # per wheel: (row indices, D, friction or None)
+    _inert: bool = field(default=False, repr=False)  # some row acts on no coordinate (a planar root's normal rows)
+
+    @property
+    def open(self) -> np.ndarray:
+        """(m, d') the combinations still open (the null space itself where no compliance split was made)."""
+        return self.null_space if self.open_space is None else self.open_space
 
     @property
     def all_determined(self) -> bool:
@@ -146,20 +186,23 @@ class ConstraintForces:
         (:math:`\\lambda + N z`) lies inside every wheel's friction cone:
         :math:`\\min_z \\max_i \\|f_{t,i}(z)\\| / f_{n,i}` (a convex problem, solved by SLSQP in epigraph form).
 
-        Equal to the largest per-wheel required mu when every friction force is determined; ``None`` when a
-        normal load is undetermined; ``inf`` when a wheel is not pressed on the ground."""
-        if not self.wheels or not all(w.determined[2] for w in self.wheels):
+        The normal loads are those of the rigid limit of compliance where rigid-body dynamics leave them open, and
+        z then runs over what stays open (:attr:`open`). Equal to the largest per-wheel required mu when every
+        friction force has a value; ``None`` when a normal load has none; ``inf`` when a wheel is not pressed on
+        the ground (a wheel the rigid limit unloads included)."""
+        if not self.wheels or not all(w.known[2] for w in self.wheels):
             return None
         fn = np.array([w.normal for w in self.wheels])
         if np.any(fn <= 0):
             return float("inf")
+        space = self.open
         maps = []  # f_t,i(z) = base_i + T_i z
         for (idx, D, friction), w in zip(self._tangential, self.wheels):
             if friction is not None:
-                maps.append((np.asarray(friction, float), np.zeros((2, self.null_space.shape[1]))))
+                maps.append((np.asarray(friction, float), np.zeros((2, space.shape[1]))))
             else:
-                maps.append((D.T[:2] @ self.lam[idx], D.T[:2] @ self.null_space[idx]))
-        return cone_minimum(maps, fn, self.null_space.shape[1])
+                maps.append((D.T[:2] @ self.lam[idx], D.T[:2] @ space[idx]))
+        return cone_minimum(maps, fn, space.shape[1])
 
     def wheel(self, name: str) -> WheelForce:
         """The force on the wheel called ``name``."""
@@ -177,7 +220,8 @@ class ConstraintForces:
                 w.name: {"longitudinal": float(w.force[0]), "lateral": float(w.force[1]), "normal": w.normal,
                          "determined": {"longitudinal": bool(w.determined[0]), "lateral": bool(w.determined[1]),
                                         "normal": bool(w.determined[2])},
-                         "required_mu": w.required_mu if w.load_determined and w.normal > 0 else None,
+                         "source": w.source,
+                         "required_mu": w.required_mu if w.load_known and w.normal > 0 else None,
                          "world": w.world.tolist(), "contact_point": w.point.tolist()}
                 for w in self.wheels
             },
@@ -190,6 +234,11 @@ class ConstraintForces:
                 for col in self.null_space.T
             ],
             "undetermined_reason": self.undetermined_reason,
+            "open_combinations": [
+                {lab: float(c) for lab, c in zip(self.labels, col) if abs(c) > DETERMINED_TOL}
+                for col in self.open.T
+            ],
+            "unloaded": self.unloaded,
             "notes": self.notes,
             "minimum_mu": self.minimum_mu(),
             "residual": self.residual,
@@ -200,19 +249,27 @@ class ConstraintForces:
         lines = []
         if self.wheels:
             lines.append("contact forces (ground on wheel, contact frame) [N]:")
-            lines.append(f"{'wheel':>16} {'longitudinal':>14} {'lateral':>14} {'normal':>14} {'required mu':>12}")
+            split = any(w.compliance.any() for w in self.wheels)
+            lines.append(f"{'wheel':>16} {'longitudinal':>14} {'lateral':>14} {'normal':>14} {'required mu':>12}"
+                         + (f"  {'load from':<26}" if split else ""))
             for w in self.wheels:
-                cells = [f"{x:>14.6g}" if d else f"{'undetermined':>14}" for x, d in zip(w.force, w.determined)]
-                mu = w.required_mu if w.load_determined else None
+                cells = [f"{x:>14.6g}" if d else f"{'undetermined':>14}" for x, d in zip(w.force, w.known)]
+                mu = w.required_mu if w.load_known else None
                 mu_text = "-" if mu is None else ("lift-off" if w.normal <= 0 else f"{mu:.4g}")
-                lines.append(f"{w.name:>16} " + " ".join(cells) + f" {mu_text:>12}")
+                lines.append(f"{w.name:>16} " + " ".join(cells) + f" {mu_text:>12}"
+                             + (f"  {_source_text(w)}" if split else ""))
         for name, comps in self.closures.items():
             det = {c: d for c, d in zip(self.labels, self.determined)}
             parts = [f"{c}={v:.6g}" if det[f"{name}.{c}"] else f"{c}=undetermined" for c, v in comps.items()]
             lines.append(f"closure {name} (on frame 2's body, frame 1's axes; N, N m): " + ", ".join(parts))
         for reason in self.undetermined_reason:
             lines.append(f"not determined by rigid-body dynamics: {reason}")
-        if self.wheels and not all(w.load_determined for w in self.wheels):
+        if self.wheels and any(w.compliance.any() for w in self.wheels):
+            lines.append(f"loads rigid-body dynamics leave open: {rigid_limit.MODEL} (the split a stiff elastic "
+                         "chassis takes, no wheel pulling; totals, axle and side sums and moments as rigid-body "
+                         "dynamics give them; stiffness ratios from the wheels' normal_stiffness)"
+                         + (f"; unloaded (would pull): {', '.join(self.unloaded)}" if self.unloaded else ""))
+        if self.wheels and not all(w.load_known for w in self.wheels):
             mu = self.minimum_mu()
             if mu is not None:
                 lines.append(f"smallest mu with which some admissible split of the undetermined forces lies in every "
@@ -225,6 +282,13 @@ class ConstraintForces:
         und = int((~self.determined).sum())
         return (f"ConstraintForces(rows={len(self.labels)}, rank={self.rank}, undetermined={und}, "
                 f"wheels={[w.name for w in self.wheels]}, closures={list(self.closures)})")
+
+
+def _source_text(w: WheelForce) -> str:
+    """The table's "load from" cell: the normal load's model, and the tangential components still open."""
+    text = "rigid-body dynamics" if w.source == "rigid" else w.source
+    open_ = [name for name, k in zip(("longitudinal", "lateral"), w.known[:2]) if not k]
+    return text + (f" ({' and '.join(open_)} open)" if open_ else "")
 
 
 def cone_minimum(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: int) -> float:
@@ -261,7 +325,8 @@ def cone_minimum(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: i
     return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
 
 
-def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> ConstraintForces:
+def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, compliance: bool = True
+                      ) -> ConstraintForces:
     """Constraint forces at (q, nu) for given motor torques (forward dynamics) or accelerations (inverse dynamics).
 
     Args:
@@ -274,6 +339,8 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
             too: those torques are used as given, and ``residual`` says whether they produce ``nudot``).
         twin: For a planar-root robot whose normal loads the planar model leaves undetermined, take them from its
             floating twin (:func:`_from_floating_twin`); False keeps the planar model's own answer.
+        compliance: Fix what rigid-body dynamics leave open by the rigid limit of the wheels' normal compliance
+            (:func:`apply_rigid_limit`); False keeps the minimum-norm values, flagged as undetermined.
 
     Returns:
         The :class:`ConstraintForces`.
@@ -282,6 +349,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
     nu = robot.check_nu(nu, "v")
     red = robot.reduced(q, nu)
     friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
+    st = None
     if sliding_now(robot):
         if nudot is not None:
             raise InputError("with slipping wheels the forces follow from motor torques: give tau, not nudot")
@@ -306,7 +374,62 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True) -> 
     out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
     if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
         out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
+    if st is not None and st.lam is not None:  # the loads of the coupled solve (rigid limit with friction)
+        apply_rigid_limit(robot, out, st.lam, st.unloaded)
+    elif compliance and not friction:
+        apply_rigid_limit(robot, out)
     return out
+
+
+def apply_rigid_limit(robot, out: ConstraintForces, lam: np.ndarray | None = None, unloaded: tuple = ()
+                      ) -> ConstraintForces:
+    """Fix the loads that rigid-body dynamics leave open in ``out`` by the rigid limit of the wheels' normal
+    compliance (:func:`robotdyn.contact.rigid_limit.split`), in place: ``lam`` on the rows it fixes, each wheel's
+    force and its ``compliance`` flags, ``compliance``, ``open_space`` and ``unloaded``. The rows rigid-body
+    dynamics determine keep their values bit for bit. Nothing changes where no normal load is open, nor where
+    rows act on no coordinate of the model (a planar root's normal rows: no equilibrium to split; its floating
+    twin's loads are split instead).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (its wheels' normal stiffnesses).
+        out: The forces at a state (``lam`` the minimum-norm multipliers).
+        lam: (m,) multipliers already split (with slipping wheels: :func:`robotdyn.contact.rigid_limit.coupled`,
+            whose friction depends on them); ``None``: split here.
+        unloaded: With ``lam``, the wheels it leaves unloaded.
+    """
+    if out.null_space.shape[1] == 0 or not out.wheels or all(w.determined[2] for w in out.wheels) or out._inert:
+        return out
+    rows = [np.asarray(idx, int) for idx, _, _ in out._tangential]
+    dirs = [np.asarray(D, float) for _, D, _ in out._tangential]
+    C = rigid_limit.normal_map(rows, dirs, len(out.lam))
+    k = wheel_stiffness(robot, [w.name for w in out.wheels])
+    res = rigid_limit.split(out.lam, out.null_space, C, k, out.determined)
+    if lam is not None:
+        given = np.array(lam, float)
+        if res.open.shape[1]:
+            given -= res.open @ (res.open.T @ given)
+        given[out.determined] = out.lam[out.determined]
+        res.lam, res.feasible = given, True
+        res.unloaded = [i for i, w in enumerate(out.wheels) if w.name in unloaded]
+    out.lam, out.compliance, out.open_space = res.lam, res.fixed, res.open
+    out.unloaded = [out.wheels[i].name for i in res.unloaded]
+    for w, idx, D, (_, _, fr) in zip(out.wheels, rows, dirs, out._tangential):
+        force = D.T @ res.lam[idx]
+        if fr is not None:
+            force[:2] += fr
+        if res.open.shape[1]:
+            known = np.linalg.norm(D.T @ res.open[idx], axis=1) <= DETERMINED_TOL
+        else:
+            known = np.ones(3, bool)
+        w.compliance = known & ~w.determined
+        w.force = np.where(w.determined, w.force, force)
+        if w.frame is not None:
+            w.world = w.frame @ w.force
+    if not res.feasible:
+        out.notes.append("no split of the loads pulls on no wheel here (the robot would tip or lift off): the loads "
+                         f"shown are the {rigid_limit.MODEL} without the no-pull condition")
+    return out
+
 
 
 def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
@@ -370,6 +493,9 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
             out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
                                     if f"{c.name}.{comp}" in index}
     out.undetermined_reason = _reasons(A, rows.labels, N)
+    if N.shape[1]:
+        scale = max(np.abs(A).max(initial=0.0), 1.0)
+        out._inert = bool(np.any(np.abs(A).max(axis=1, initial=0.0) <= 1e-12 * scale))
     if not (np.all(np.isfinite(lam)) and np.isfinite(residual)):
         raise NonFiniteError(f"constraint forces at this state are not finite (max |e| = {np.max(np.abs(e)):.3g})")
     return out
@@ -494,7 +620,7 @@ def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict,
     if friction is not None:  # the law's force along its free directions (zero along a rolling one)
         force[:2] += friction
         kind = "slipping"
-    return WheelForce(wheel.name, kind, force, determined, E @ force, np.array(p, float))
+    return WheelForce(wheel.name, kind, force, determined, E @ force, np.array(p, float), frame=np.asarray(E, float))
 
 
 def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
@@ -513,5 +639,6 @@ def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
     if others > 0:
         mixed = sorted({lab for col in N.T for lab, c in zip(labels, col) if abs(c) > DETERMINED_TOL} - set(zero))
         out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: the rows are "
-                   "redundant, e.g. more wheels than a rigid body needs; a compliance model would split them)")
+                   "redundant, e.g. more wheels than a rigid body needs; the normal loads among them are split by "
+                   "the rigid limit of the wheels' normal compliance)")
     return out

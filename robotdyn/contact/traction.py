@@ -48,7 +48,15 @@ class TractionEvent:
 
     def __str__(self) -> str:
         what = f"load {self.value:.4g} N" if self.kind == "lift-off" else f"required mu {self.value:.4g}"
+        if self.wheel == ANY_SPLIT:
+            return (f"slip at t = {self.t:.4g} s: no admissible split of the open forces stays within mu (the "
+                    f"smallest mu that holds is {self.value:.4g})")
         return f"{self.kind} of wheel {self.wheel} at t = {self.t:.4g} s ({what})"
+
+
+ANY_SPLIT = "(every admissible split)"
+"""The :attr:`TractionEvent.wheel` of a slip that no split of the forces rigid-body dynamics leave open avoids
+(the minimum-mu column above the wheels' mu)."""
 
 
 @dataclass
@@ -68,7 +76,11 @@ class Traction:
             is determined (then it is the largest per-wheel required mu) or a normal load is not.
         mu: (W,) the wheels' friction coefficients (``nan``: not given, no slip check).
         undetermined: Wheels whose loads rigid-body dynamics do not determine, with the reason.
-        events: The first lift-off and slip of each wheel, in time order.
+        events: The first lift-off and slip of each wheel (and the first sample where no admissible split holds:
+            wheel :data:`ANY_SPLIT`), in time order.
+        sliding: Wheels whose tangential force follows a friction law (they slip by design: no no-slip check).
+        compliance: Wheels whose normal loads rigid-body dynamics leave open at some sample and the rigid limit of
+            the wheels' normal compliance gives (:mod:`robotdyn.contact.rigid_limit`).
         method: Which pass computed the loads: ``fast`` (:mod:`robotdyn.contact.traction_fast`, a few samples
             possibly by the reference) or ``reference`` (:func:`~robotdyn.contact.contact_forces.constraint_forces`
             at every sample).
@@ -85,13 +97,26 @@ class Traction:
     minimum_mu: np.ndarray | None = None
     events: list[TractionEvent] = field(default_factory=list)
     method: str = "reference"
+    sliding: list[str] = field(default_factory=list)
+    compliance: list[str] = field(default_factory=list)
 
     def broken(self) -> np.ndarray:
-        """(N, W) where the no-slip assumption is broken: load <= 0, or required friction above mu."""
+        """(N, W) where the no-slip assumption is broken: load <= 0, or required friction above mu (every wheel
+        where no admissible split of the open forces stays within mu)."""
         out = self.normal <= 0
-        known = np.isfinite(self.mu) & self.friction_determined
+        rolling = np.array([w not in self.sliding for w in self.wheels], bool)
+        known = np.isfinite(self.mu) & self.friction_determined & rolling
         out[:, known] |= self.required_mu[:, known] > self.mu[known]
+        over = self._split_over()
+        if over is not None:
+            out[over] = True
         return out
+
+    def _split_over(self) -> np.ndarray | None:
+        """(N,) where the minimum-mu column exceeds every wheel's mu (``None``: no such column or no mu)."""
+        if self.minimum_mu is None or not self.wheels or not np.isfinite(self.mu).all():
+            return None
+        return np.asarray(self.minimum_mu, float) > np.max(self.mu)
 
     def columns(self) -> dict[str, np.ndarray]:
         """CSV columns by name: ``<wheel>.normal`` [N] and ``<wheel>.mu_required`` for each determined wheel."""
@@ -108,15 +133,23 @@ class Traction:
         """One line: the extremes per wheel set and the first event (or that the no-slip assumption holds)."""
         parts = []
         if self.wheels:
-            mus = self.required_mu[:, self.friction_determined]
+            rolling = np.array([w not in self.sliding for w in self.wheels], bool)
+            mus = self.required_mu[:, self.friction_determined & rolling]
             finite = mus[np.isfinite(mus)]
             peak = finite.max() if finite.size else float("inf")
+            if self.minimum_mu is not None:  # every wheel's need, the open forces split at best
+                peak = max(peak if finite.size else 0.0, float(np.max(self.minimum_mu)))
             parts.append(f"loads {self.normal.min():.4g}..{self.normal.max():.4g} N"
-                         + (f", required mu up to {peak:.3g}" if self.friction_determined.any() else ""))
+                         + (f", required mu up to {peak:.3g}" if (self.friction_determined & rolling).any()
+                            or self.minimum_mu is not None else ""))
+            if self.compliance:
+                parts.append(f"loads of {', '.join(self.compliance)}: rigid limit of compliance")
             if self.minimum_mu is not None:
                 parts.append(f"with the best split of undetermined forces mu >= {np.max(self.minimum_mu):.3g} suffices")
         if self.events:
             parts.append("first: " + str(self.events[0]))
+        elif self.sliding:
+            parts.append(f"wheels {', '.join(self.sliding)} slide under their friction law (no no-slip check)")
         elif self.wheels:
             checked = "within every wheel's mu" if np.isfinite(self.mu).all() else "loads stay positive"
             if not self.friction_determined.all():
@@ -179,6 +212,10 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
                    _friction_coefficients(robot, wheels, mu), friction_known, undetermined)
     out.minimum_mu = loads.minimum_mu
     out.method = used
+    by_law = {c.name for c in robot.constraints if getattr(c, "sliding", False) or hasattr(c, "law")}
+    out.sliding = [w for w in wheels if w in by_law]  # (they slip by design: their friction is their law's)
+    if loads.compliance is not None:
+        out.compliance = [names[j] for j in keep if loads.compliance[:, j].any()]
     out.events = _events(out)
     return out
 
@@ -200,12 +237,15 @@ def _reference_loads(robot, traj, torque) -> WheelLoads:
             names = names_i
             normal, tangential = np.zeros((N, len(names))), np.zeros((N, len(names)))
             determined = np.zeros((N, len(names), 3), bool)
+            compliance = np.zeros((N, len(names)), bool)
         normal[i], tangential[i], determined[i] = fn, ft, det
+        compliance[i] = [w.compliance[2] for w in forces.wheels]
         if not det.all():
             minimum.append(forces.minimum_mu())
     if normal is None:
         normal, tangential, determined = np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0, 3), bool)
-    out = WheelLoads(names, normal, tangential, determined[:, :, 2], determined.all(axis=2))
+        compliance = np.zeros((0, 0), bool)
+    out = WheelLoads(names, normal, tangential, determined[:, :, 2], determined.all(axis=2), compliance=compliance)
     if minimum and len(minimum) == N and all(m is not None for m in minimum):
         out.minimum_mu = np.array(minimum, float)
     return out
@@ -238,12 +278,18 @@ def _events(tr: Traction) -> list[TractionEvent]:
         idx = np.flatnonzero(fn <= 0)
         if idx.size:
             events.append(TractionEvent("lift-off", name, _crossing(tr.t, fn, idx[0], 0.0), float(fn[idx[0]])))
-        if np.isfinite(tr.mu[j]) and tr.friction_determined[j]:
+        if np.isfinite(tr.mu[j]) and tr.friction_determined[j] and name not in tr.sliding:
             over = np.flatnonzero((fn > 0) & (tr.required_mu[:, j] > tr.mu[j]))
             if over.size:
                 k = over[0]
                 events.append(TractionEvent("slip", name, _crossing(tr.t, tr.required_mu[:, j], k, tr.mu[j]),
                                             float(tr.required_mu[k, j])))
+    over = tr._split_over()
+    if over is not None and over.any():
+        k = int(np.flatnonzero(over)[0])
+        level = float(np.max(tr.mu))
+        events.append(TractionEvent("slip", ANY_SPLIT, _crossing(tr.t, np.asarray(tr.minimum_mu, float), k, level),
+                                    float(tr.minimum_mu[k])))
     return sorted(events, key=lambda e: e.t)
 
 

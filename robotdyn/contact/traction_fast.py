@@ -40,6 +40,8 @@ from ..fast.dispatch import compiled_model
 from ..inputs import MAX_FORCE, MAX_POSITION, MAX_VELOCITY
 from .contact_forces import DETERMINED_TOL, TWIN_RESIDUAL, cone_minimum, constraint_forces, floating_twin
 from .sliding import sliding_now
+from .compliance import wheel_stiffness
+from .rigid_limit import normal_map, split_many
 
 BLOCK = 512
 """Samples evaluated together: bounds the working set of the stacked rows and SVDs (~2 MB on Quasimoro; larger
@@ -60,8 +62,11 @@ class WheelLoads:
         normal: (N, W) normal loads :math:`f_n` [N] (positive: pressed on the ground).
         tangential: (N, W) friction force magnitudes :math:`\\|(f_{t1}, f_{t2})\\|` [N] (the minimum-norm choice
             where not determined).
-        normal_determined: (N, W) whether rigid-body dynamics determine the normal load.
-        load_determined: (N, W) whether they determine all three components.
+        normal_determined: (N, W) whether the normal load has a value: rigid-body dynamics determine it, or the
+            rigid limit of the wheels' normal compliance does (:mod:`robotdyn.contact.rigid_limit`).
+        load_determined: (N, W) whether all three components have one.
+        compliance: (N, W) whether the normal load is the rigid limit of compliance (rigid-body dynamics leave it
+            open).
         minimum_mu: (N,) the smallest friction coefficient over the undetermined splits
             (:meth:`~robotdyn.contact.contact_forces.ConstraintForces.minimum_mu`), or ``None`` where the trajectory
             has none: some sample whose loads are all determined or some normal load that is not.
@@ -75,16 +80,17 @@ class WheelLoads:
     load_determined: np.ndarray
     minimum_mu: np.ndarray | None = None
     fallback: int = 0
+    compliance: np.ndarray | None = None
 
 
 def sample_loads(forces) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]:
-    """One sample's ``(names, normal [N], tangential [N], determined (W, 3))`` from a
+    """One sample's ``(names, normal [N], tangential [N], known (W, 3))`` from a
     :class:`~robotdyn.contact.contact_forces.ConstraintForces` (the reference's values, as
     :attr:`~robotdyn.contact.contact_forces.WheelForce.normal` and ``.tangential``)."""
     wheels = forces.wheels
     return ([w.name for w in wheels], np.array([w.normal for w in wheels], float),
             np.array([w.tangential for w in wheels], float),
-            np.array([w.determined for w in wheels], bool).reshape(len(wheels), 3))
+            np.array([w.known for w in wheels], bool).reshape(len(wheels), 3))
 
 
 def torques(torque, t: np.ndarray, Q: np.ndarray, NU: np.ndarray, motors: int) -> list | np.ndarray:
@@ -155,7 +161,7 @@ def wheel_loads(robot, t, Q, NU, torque=None) -> WheelLoads | None:
         ok &= np.all(np.isfinite(NU) & (np.abs(NU) <= MAX_VELOCITY), axis=1)
     W = len(models[0].wheels)
     out = WheelLoads([w.name for w in models[0].wheels], np.zeros((N, W)), np.zeros((N, W)), np.zeros((N, W), bool),
-                     np.zeros((N, W), bool))
+                     np.zeros((N, W), bool), compliance=np.zeros((N, W), bool))
     if not ok[0]:  # the reference raises there, or the compiled model may have no projection chosen yet
         return None
     robot.reduced(Q[0], NU[0])  # the reference's first step (it chooses the rows the compiled model uses)
@@ -166,8 +172,9 @@ def wheel_loads(robot, t, Q, NU, torque=None) -> WheelLoads | None:
         served = block["served"]
         out.normal[part] = block["force"][:, :, 2]
         out.tangential[part] = np.hypot(block["force"][:, :, 0], block["force"][:, :, 1])
-        out.normal_determined[part] = block["determined"][:, :, 2]
-        out.load_determined[part] = block["determined"].all(axis=2)
+        out.normal_determined[part] = block["known"][:, :, 2]
+        out.load_determined[part] = block["known"].all(axis=2)
+        out.compliance[part] = block["known"][:, :, 2] & ~block["determined"][:, :, 2]
         references = {}
         for j in np.flatnonzero(~served):  # the reference, sample by sample (it raises where it must)
             i = start + j
@@ -178,6 +185,7 @@ def wheel_loads(robot, t, Q, NU, torque=None) -> WheelLoads | None:
                 raise RuntimeError(f"wheels {names} at sample {i}, {out.names} at the others")  # (never: one robot)
             out.normal[i], out.tangential[i], out.normal_determined[i], out.load_determined[i] = (
                 fn, ft, det[:, 2], det.all(axis=1))
+            out.compliance[i] = [w.compliance[2] for w in forces.wheels]
             references[j] = forces
             out.fallback += 1
         minimum.add(part, block, references, out)
@@ -202,6 +210,8 @@ class _Model:
         self.rows = [np.array([rows[lab] for lab in c._labels()], int) for c in self.wheels]
         self.directions = [np.asarray(c._directions, float) for c in self.wheels]
         self.m = len(fast.labels)
+        self.C = normal_map(self.rows, self.directions, self.m)
+        self.k = wheel_stiffness(robot, [c.name for c in self.wheels])
 
     def lift(self, X: np.ndarray) -> np.ndarray:
         """Planar coordinates (or velocities) (B, n) into the twin's (B, n_twin), zero elsewhere."""
@@ -235,6 +245,7 @@ class _Model:
         B, W = len(rows), len(self.wheels)
         force = np.zeros((B, W, 3))
         determined = np.zeros((B, W, 3), bool)
+        known = np.zeros((B, W, 3), bool)
         residual = np.full(B, np.inf)
         groups = []  # (sample indices, b (G, W, 2), T (G, W, 2, d)) per rank
         with np.errstate(all="ignore"):
@@ -256,20 +267,39 @@ class _Model:
                     lam[sel] = lm
                     res = np.einsum("gij,gi->gj", rows[sel], lm) - e[sel]
                     residual[sel] = np.linalg.norm(res, axis=1) / np.maximum(np.linalg.norm(e[sel], axis=1), 1.0)
-                    b = np.zeros((len(sel), W, 2))
-                    T = np.zeros((len(sel), W, 2, Ns.shape[2]))
-                    for w, (ri, D) in enumerate(zip(self.rows, self.directions)):
-                        f = lm[:, ri] @ D  # (G, 3): D^T lambda
-                        force[sel, w] = f
+                    for w, (ri, D) in enumerate(zip(self.rows, self.directions)):  # rigid-body dynamics' own
                         ND = np.einsum("rk,grd->gkd", D, Ns[:, ri, :])  # (G, 3, d): D^T N
                         determined[sel, w] = np.linalg.norm(ND, axis=2) <= DETERMINED_TOL
-                        b[:, w], T[:, w] = f[:, :2], ND[:, :2, :]
-                    groups.append((sel, b, T))
+                    # the open loads by the rigid limit of compliance (as constraint_forces: not where some row acts
+                    # on no coordinate, a planar root's normal rows, nor where every normal load is determined)
+                    scale = np.maximum(np.max(np.abs(rows[sel]), axis=(1, 2)), 1.0)
+                    inert = np.any(np.max(np.abs(rows[sel]), axis=2) <= 1e-12 * scale[:, None], axis=1)
+                    split = (r < self.m) & ~inert & ~determined[sel, :, 2].all(axis=1)
+                    Os, count = Ns, np.full(len(sel), Ns.shape[2])
+                    if split.any():
+                        lr, op, _, cnt = split_many(lm[split], Ns[split], self.C, self.k)
+                        lm, Os, count = lm.copy(), Ns.copy(), count.copy()
+                        lm[split], Os[split], count[split] = lr, op, cnt
+                        lam[sel] = lm
+                    for c in np.unique(count):
+                        g = count == c
+                        Og = Os[g][:, :, :c]
+                        b = np.zeros((int(g.sum()), W, 2))
+                        T = np.zeros((int(g.sum()), W, 2, c))
+                        for w, (ri, D) in enumerate(zip(self.rows, self.directions)):
+                            f = lm[g][:, ri] @ D  # (G, 3): D^T lambda
+                            force[sel[g], w] = f
+                            ND = np.einsum("rk,grd->gkd", D, Og[:, ri, :])  # (G, 3, c): D^T (open directions)
+                            known[sel[g], w] = np.linalg.norm(ND, axis=2) <= DETERMINED_TOL
+                            b[:, w], T[:, w] = f[:, :2], ND[:, :2, :]
+                        groups.append((sel[g], b, T))
             elif idx.size:  # no rows: nothing to solve
                 residual[idx] = np.linalg.norm(e[idx], axis=1) / np.maximum(np.linalg.norm(e[idx], axis=1), 1.0)
                 determined[idx] = True
+                known[idx] = True
             ok &= np.isfinite(residual) & np.all(np.isfinite(lam), axis=1)
-        return {"ok": ok, "force": force, "determined": determined, "residual": residual, "groups": groups}
+        return {"ok": ok, "force": force, "determined": determined, "known": known, "residual": residual,
+                "groups": groups}
 
 
 def _block(robot, models: list, Q, NU, TAU, ok) -> dict:
@@ -306,7 +336,7 @@ def _block(robot, models: list, Q, NU, TAU, ok) -> dict:
             ok[idx] &= np.all(np.isfinite(A[idx]), axis=1)
     own = models[0].forces(Q, V, A, TAU, np.flatnonzero(ok))
     ok &= own["ok"]
-    force, determined, groups = own["force"], own["determined"], own["groups"]
+    force, determined, known, groups = own["force"], own["determined"], own["known"], own["groups"]
     need = ok & ~determined[:, :, 2].all(axis=1)
     if robot.spec.root == "planar" and need.any():  # the loads from the floating twin where the planar ones are
         if models[1] is None:  # undetermined (built at the first such sample, as the reference builds it)
@@ -322,10 +352,12 @@ def _block(robot, models: list, Q, NU, TAU, ok) -> dict:
         use = need & held["ok"] & (held["residual"] <= TWIN_RESIDUAL)
         force = np.where(use[:, None, None], held["force"], force)
         determined = np.where(use[:, None, None], held["determined"], determined)
+        known = np.where(use[:, None, None], held["known"], known)
         groups = [(sel[~use[sel]], b[~use[sel]], T[~use[sel]]) for sel, b, T in groups] + [
             (sel[use[sel]], b[use[sel]], T[use[sel]]) for sel, b, T in held["groups"]]
     groups = [(sel[ok[sel]], b[ok[sel]], T[ok[sel]]) for sel, b, T in groups]
-    return {"served": ok, "force": force, "determined": determined, "groups": [g for g in groups if len(g[0])]}
+    return {"served": ok, "force": force, "determined": determined, "known": known,
+            "groups": [g for g in groups if len(g[0])]}
 
 
 def _twin(robot, own: _Model) -> _Model | bool:

@@ -201,6 +201,10 @@ class CompiledModel:
         for m in robot.motors:
             ev.add_motor(int(m.index), int(m.jid), -1 if m.rid is None else frame(m.rid))
         self.slip_refusal = self._add_slipping(ev, robot)
+        if self.wheels and hasattr(ev, "set_normal_stiffness"):  # the rigid limit of :meth:`forces`' open loads
+            from ..constraints.wheel_compliance import wheel_stiffness
+
+            ev.set_normal_stiffness(wheel_stiffness(robot, [c.name for c in self.wheels]))
         self.operational = getattr(robot, "operational", None)
         if self.operational is not None:
             tw = self.operational.twist
@@ -220,7 +224,11 @@ class CompiledModel:
         sliding = [c for c in robot.constraints if getattr(c, "sliding", False)]  # contact.sliding.sliding_now
         if not sliding:
             return None
-        labels = robot.rows_at(robot.neutral()).labels
+        rows = robot.rows_at(robot.neutral())
+        labels = rows.labels
+        if _loads_open(rows.A, labels, self.wheels):
+            return ("the wheels' normal loads are statically indeterminate (split by the rigid limit of their normal "
+                    "compliance, robotdyn.contact.rigid_limit): simulated on the Python path")
         laws = []
         for c in sliding:
             friction = c.compiled_friction() if hasattr(c, "compiled_friction") else \
@@ -340,12 +348,15 @@ class CompiledModel:
         as :meth:`compute`): ``(nudot, lambda, e, wheel forces (nw, 3) along (t1, t2, n), the same in world axes,
         contact frames (nw, 9: rows t1, t2, n), contact points (nw, 3))``, with
         :math:`A^T\\lambda = e = Ma + Cv + g - B\\tau` solved on the projection's rows by the LU factors of
-        :math:`A_d` (the projection's own factorisation; operational velocities: its :math:`K^{-1}`) and zero on
-        redundant rows (the basic solution: equal to any other on the rows rigid-body dynamics determine;
-        :mod:`robotdyn.contact.contact_forces` reports the others).
+        :math:`A_d` (the projection's own factorisation; operational velocities: its :math:`K^{-1}`); where the
+        rows are redundant, the loads rigid-body dynamics leave open are those of the rigid limit of the wheels'
+        normal compliance (:mod:`robotdyn.contact.rigid_limit`, the same formulas in C++; minimum norm along what
+        normal compliance does not fix), every determined row keeping its value (``rigid_limit(False)``: the basic
+        solution instead, zero on redundant rows).
 
         Raises:
-            robotdyn._compiled.Fallback: As :meth:`evaluate`.
+            robotdyn._compiled.Fallback: As :meth:`evaluate`; also where the compatible loads would pull on a wheel
+                (the no-pull split is :func:`robotdyn.contact.contact_forces.constraint_forces`').
         """
         if self._hint is None:
             self._choose(q, nu)
@@ -356,6 +367,11 @@ class CompiledModel:
                             ev.contact_points)
             self._fgeneration = generation
         return self._fviews
+
+    def rigid_limit(self, on: bool = True) -> None:
+        """Whether :meth:`forces` splits the open loads by the rigid limit of compliance (default) or returns the
+        basic solution (zero on redundant rows)."""
+        self.ev.set_rigid_limit(bool(on))
 
     def forces_at(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau: np.ndarray) -> tuple:
         """The constraint forces at given full velocities v and accelerations a (inverse dynamics):
@@ -377,6 +393,25 @@ class CompiledModel:
         Q, NU = np.ascontiguousarray(Q, float), np.ascontiguousarray(NU, float)
         M, h, g, S, w, B, failed = self.ev.evaluate_many(Q, NU)
         return M.reshape(N, k, k), h, g, S.reshape(N, n, k), w, B.reshape(N, k, -1), list(failed)
+
+
+def _loads_open(A: np.ndarray, labels: list[str], wheels: list) -> bool:
+    """Whether the rows A (m, n) leave some wheel's normal load open (a combination of redundant rows moves it):
+    the wheel constraints' normal components (their ``_labels()`` and ``_directions``) against the null space of
+    :math:`A^T`."""
+    if not len(A):
+        return False
+    _, s, Vt = np.linalg.svd(A.T, full_matrices=True)
+    rank = int(np.sum(s > s.max(initial=0.0) * max(A.shape) * np.finfo(float).eps))
+    if rank == A.shape[0]:
+        return False
+    N = Vt[rank:].T
+    index = {lab: i for i, lab in enumerate(labels)}
+    for c in wheels:
+        idx = [index[lab] for lab in c._labels()]
+        if np.linalg.norm(np.asarray(c._directions, float)[:, 2] @ N[idx]) > 1e-9:
+            return True
+    return False
 
 
 __all__ = ["Fallback", "CompiledModel", "LazyProjection", "why_not", "available"]

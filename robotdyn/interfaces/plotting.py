@@ -94,6 +94,9 @@ def plot_traction(tr, path=None, title: str = ""):
         (line,) = ax_mu.plot(tr.t, mu, lw=1.2, label=name)
         if np.isfinite(tr.mu[j]):
             ax_mu.axhline(tr.mu[j], color=line.get_color(), ls="--", lw=1.0)
+    if getattr(tr, "minimum_mu", None) is not None:  # every wheel's need, the open forces split at best
+        ax_mu.plot(tr.t, np.where(np.isfinite(tr.minimum_mu), tr.minimum_mu, np.nan), color="k", lw=1.4,
+                   label="all wheels, best split (minimum mu)")
     for ax in (ax_n, ax_mu):
         if broken.any():
             ax.fill_between(tr.t, 0, 1, where=broken, transform=ax.get_xaxis_transform(), color="C3", alpha=0.15,

@@ -148,6 +148,7 @@ def main() -> None:
     compiled_forces_bench()
     rigid_limit_bench()
     traction_bench()
+    compliant_bench()
     simulate_many_bench()
     trajectory_optimisation_bench()
 
@@ -346,6 +347,35 @@ def traction_bench() -> None:
               f"{1e6 * t_fast / len(traj.t):>10.1f} {t_ref / t_fast:>8.0f}x "
               f"{float(np.max(np.abs(fast.normal - ref.normal), initial=0.0)):>12.1e} {d_mu:>13.1e}"
               + ("" if fast.method == "fast" else f"   (fast pass not used: {fast.method})"))
+
+
+def compliant_bench() -> None:
+    """The linkage rover over its 5 cm bump, rigid contacts against compliant tyres (about 1 mm static deflection,
+    robotdyn.robots.linkage_suspension.compliant), the same tolerances and samples: whole simulate() calls."""
+    from robotdyn.robot import Robot
+    from robotdyn.robots.linkage_suspension.compliant import bump_run, compliant_spec
+    from robotdyn.robots.linkage_suspension.model import PEAK_SPEED, SPEC
+
+    rigid, soft = Robot(SPEC), Robot(compliant_spec())
+    k = soft.constraints[0].normal_law.stiffness
+    options = dict(rtol=1e-8, atol=1e-10, n_out=101)
+    print(f"\nlinkage rover over the bump (5 cm step), rtol 1e-8, 101 samples; compliant tyres k = {k:.4g} N/m "
+          "(1 mm static deflection) with a linear tyre law, on the Python path (compiled: not available)")
+    print(f"{'run':<44} {'sim [s]':>8} {'wall [s]':>9} {'evals':>7} {'/ rigid':>8} {'/ rigid Py':>11}  flight")
+    for speed, t_end in ((PEAK_SPEED, 2.2), (25.0, 0.45)):
+        walls = {}
+        for name, robot, compiled in (("rigid, compiled", rigid, True), ("rigid, Python path", rigid, False),
+                                      ("compliant (LSODA)", soft, False)):
+            with use_compiled(compiled):
+                start = time.perf_counter()
+                traj = bump_run(robot, t_end, rigid, speed=speed, **options)
+                walls[name] = wall = time.perf_counter() - start
+            flight = traj.stats.get("flight")
+            flights = "-" if flight is None else (f"{len(flight)} events" if flight else "none")
+            ratio = wall / walls["rigid, compiled"]
+            ratio_py = wall / walls.get("rigid, Python path", wall)
+            print(f"{name + f' at {speed:.3g} rad/s':<44} {t_end:>8.3g} {wall:>9.3f} {traj.stats['nfev']:>7} "
+                  f"{ratio:>8.1f} {ratio_py:>11.1f}  {flights}")
 
 
 def simulate_many_bench(runs: int = 10_000) -> None:

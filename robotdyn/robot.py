@@ -33,6 +33,8 @@ from .constraints.rolling_contact import OmniWheel, RollingWheel, SupportWheel
 from .contact.sliding import SlippingWheel, sliding_now
 from .contact.sliding import forward as forward_sliding
 from .contact.stick_slip_wheel import StickSlipWheel
+from .contact.applied_forces import reduced_applied, stored_energy
+from .reduction.joint_springs import build_springs
 from .constraints.terrain import FlatTerrain, Terrain
 
 
@@ -147,6 +149,9 @@ class Wheel:
     slip: str = "both"  # with a friction law: both tangential directions slip, or only the lateral one
     normal_stiffness: float | None = None  # radial (normal) stiffness [N/m]; None: robotdyn.contact.compliance's rule
     normal_damping: float | None = None  # radial (normal) damping [N s/m]; None: robotdyn.contact.compliance's rule
+    contact: str = "rigid"  # rigid (the normal row is a constraint) | compliant (a force law: it can fly and land)
+    contact_law: str = "linear"  # compliant contact's normal law: linear | hunt_crossley (contact.compliant_contact)
+    contact_exponent: float | None = None  # hunt_crossley's exponent n (default 1.5)
 
 
 @dataclass
@@ -237,6 +242,7 @@ class RobotSpec:
     operational: object | None = None
     packages: dict[str, str] = field(default_factory=dict)
     root_height: float | None = 0.0
+    springs: list = field(default_factory=list)  # robotdyn.reduction.joint_springs.JointSpring declarations
 
     def parameter(self, name: str) -> Parameter:
         """The declared parameter called ``name``.
@@ -330,6 +336,7 @@ class Robot:
                 self.spec = spec = replace(spec, root_height=height)
                 self.root_height_source = "found from the wheels"
         self.motors = [Motor(self.description, m.name, m.joint, m.reaction) for m in spec.motors]
+        self.springs = build_springs(self, spec.springs)  # robotdyn.reduction.joint_springs
         if spec.independent is not None:
             self.independent_indices = np.array([self.coordinate_index(c) for c in spec.independent], dtype=int)
         else:
@@ -385,6 +392,10 @@ class Robot:
                 raise InputError(f"wheel {name!r}: its body has mass 0 but an inertia (largest entry "
                                  f"{np.max(np.abs(body.inertia)):.3g} kg m^2); expected a positive mass with its "
                                  "inertia, or a massless wheel (mass and inertia 0)")
+        if w.contact != "rigid":
+            from .contact.compliant_contact import compliant_wheel
+
+            return compliant_wheel(self, w, self._value(w.radius), self._value(w.roller_angle), **kw)
         if w.mu is not None and not (np.isfinite(float(w.mu)) and float(w.mu) >= 0):
             raise InputError(f"wheel {name!r}: mu = {w.mu}; expected a friction coefficient >= 0")
         if w.friction not in ("rolling", None):
@@ -414,6 +425,11 @@ class Robot:
     def nq(self) -> int:
         """Number of natural coordinates (= number of full velocities)."""
         return self.model.nq
+
+    @property
+    def _compliant(self) -> bool:
+        """Whether some wheel's normal contact is a force law (:mod:`robotdyn.contact.compliant_contact`)."""
+        return any(getattr(c, "compliant", False) for c in self.constraints)
 
     @property
     def mobility(self) -> int:
@@ -723,7 +739,7 @@ class Robot:
         if sliding_now(self):
             return forward_sliding(self, q, nu, tau).nudot
         red = self.reduced(q, nu)
-        out = solve_mass(red.M, red.B @ tau - red.h)
+        out = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(self, red, q)[0])
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
                                  "what double precision holds)")
@@ -857,7 +873,7 @@ class Robot:
         nudot = np.asarray(nudot, float)
         if nudot.shape != (self.mobility,):
             self.check_nu(nudot, "nudot")
-        Q = red.M @ nudot + red.h
+        Q = red.M @ nudot + red.h - reduced_applied(self, red, np.asarray(q, float))[0]
         self._warn_dropped(red, nudot)
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
@@ -905,16 +921,19 @@ class Robot:
         return self.reduced(q, nu).v
 
     def energy(self, q, v) -> float:
-        """Total mechanical energy (kinetic + potential) [J].
+        """Total mechanical energy [J]: kinetic + gravity's potential + the elastic energy of joint springs and
+        compliant contacts (:func:`robotdyn.contact.applied_forces.stored_energy`).
 
         Args:
             q: Natural coordinates (n,) [m, rad].
             v: Full velocities (n,) [m/s, rad/s] (e.g. :meth:`velocity`).
 
         Returns:
-            Kinetic plus gravitational potential energy [J] (potential zero at z = 0).
+            Kinetic plus potential energy [J] (gravity's potential zero at z = 0; springs' zero at their rest).
         """
         kinetic, potential = energy(self.model, self.data, np.asarray(q, float), np.asarray(v, float))
+        if getattr(self, "springs", None) or self._compliant:
+            potential += stored_energy(self, q)
         return kinetic + potential
 
     def mobility_check(self) -> tuple[int, list[str]]:
@@ -1030,5 +1049,6 @@ class Robot:
                 for m in self.motors
             ],
             "constraints": [repr(c) for c in self.constraints],
+            "springs": [repr(sp) for sp in getattr(self, "springs", ())],
             "terrain": repr(self.terrain),
         }

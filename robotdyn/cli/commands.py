@@ -153,6 +153,7 @@ def cmd_info(args) -> int:
           for a in info["actuators"]),
         "constraints:",
         *(f"  {c}" for c in info["constraints"]),
+        *(["springs and dampers:", *(f"  {sp}" for sp in info["springs"])] if info.get("springs") else []),
         f"terrain: {info['terrain']}",
         "scenarios:",
         *(f"  {k}: {d}" for k, d in info["scenarios"].items()),
@@ -232,7 +233,10 @@ def cmd_dump(args) -> int:
                  f"motor torques: none (the robot has no motors; residual {resid:.3g})"]
     elif args.tau is not None or args.tau_set:
         tau = _torques(robot, args.tau, args.tau_set)
-        nudot = robot.forward_dynamics(q, nu, tau, check=False) if sliding else solve_mass(red.M, red.B @ tau - red.h)
+        from ..contact.applied_forces import reduced_applied
+
+        nudot = robot.forward_dynamics(q, nu, tau, check=False) if sliding else \
+            solve_mass(red.M, red.B @ tau - red.h + reduced_applied(robot, red, q)[0])  # springs, compliant wheels
         out["a"] = nudot
         out["ill_conditioned"] = [vars(f) for f in robot.warn_conditioning(red, nudot)]
         text.append(_vector_text("a (independent accelerations)", names, nudot))
@@ -380,6 +384,18 @@ def _simulate(args, limit) -> int:
             f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
     if tr is not None:
         text.append(tr.summary())
+    if "flight" in traj.stats:  # compliant wheels: lift-off and touch-down times (robotdyn.simulation.flight)
+        from ..simulation.flight import flight_summary
+
+        out["flight"] = traj.stats["flight"]
+        lines = flight_summary(traj.stats["flight"], traj.stats.get("airborne", []))
+        text.append("flight phases: " + ("; ".join(lines) if lines else
+                                         "none (every compliant wheel kept its contact)"))
+    if traj.damper_work is not None or traj.friction_work is not None:
+        fw = 0.0 if traj.friction_work is None else float(traj.friction_work[-1])
+        dw = 0.0 if traj.damper_work is None else float(traj.damper_work[-1])
+        out["friction_work"], out["damper_work"] = fw, dw
+        text.append(f"work: friction {fw:.10g} J, dampers {dw:.10g} J (energy change = motor work + these)")
     if switches is not None:
         out["switches"] = switches
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(

@@ -46,6 +46,7 @@ from ..constraints.loop_closure import LoopClosure
 from ..constraints.rolling_contact import RollingWheel
 from .sliding import forward as forward_sliding
 from .sliding import sliding_now, tangential
+from .applied_forces import applied, has_applied, reduced_applied
 from . import rigid_limit
 from .compliance import wheel_stiffness
 
@@ -383,7 +384,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         from ..reduction.reduced_dynamics import solve_mass
 
-        nudot = solve_mass(red.M, red.B @ tau - red.h)
+        nudot = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(robot, red, q)[0])
     else:
         nudot = robot.check_nu(nudot, "a")
         if tau is None:
@@ -481,6 +482,11 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
         kin = KinematicState(model, data, q, v)
         B = input_matrix(robot.motors, kin)
         e = pin.rnea(model, data, q, v, a) - B @ tau
+        compliant = {}
+        if has_applied(robot):  # joint springs and compliant wheels (robotdyn.contact.applied_forces)
+            app = applied(robot, q, v, kin)
+            e -= app.Q
+            compliant = app.wheels
         for Jt, force in friction.values():  # the friction forces are applied forces, known once the loads are
             e -= Jt.T @ force
         with np.errstate(all="ignore"):  # an overflow is refused below as a NonFiniteError, in one line
@@ -494,7 +500,12 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
                          "and a little compliance would redistribute them")
     index = {lab: i for i, lab in enumerate(rows.labels)}
     for c in robot.constraints:
-        if isinstance(c, RollingWheel):
+        if getattr(c, "compliant", False):  # its force is its laws' (robotdyn.contact.compliant_contact)
+            st = compliant[c.name]
+            out.wheels.append(WheelForce(c.name, "compliant", st["force"], np.ones(3, bool), st["E"] @ st["force"],
+                                         np.array(st["point"], float)))
+            out._tangential.append(([], np.zeros((0, 3)), st["force"][:2]))
+        elif isinstance(c, RollingWheel):
             fr = friction.get(c.name, (None, None))[1]
             if served is not None:
                 E, p = geometry[id(c)]

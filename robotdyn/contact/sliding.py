@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..reduction.actuation import input_matrix
+from .applied_forces import applied, has_applied
 from ..constraints.constraint import KinematicState
 from ..errors import ConstraintError, InputError, SingularConstraintError
 from .friction import FrictionLaw
@@ -159,7 +160,10 @@ class SlidingState:
         normal: Normal load of each slipping wheel (W,) [N].
         slip: Slip velocity of each slipping wheel (W, 2) [m/s] (t1, t2).
         force: Friction force on each slipping wheel (W, 2) [N] (t1, t2).
-        power: Power of the friction forces :math:`\\sum F_t\\cdot s` [W] (<= 0 while loads are positive).
+        power: Power of the friction forces :math:`\\sum F_t\\cdot s` [W] (<= 0 while loads are positive), the
+            compliant wheels' included.
+        damper_power: Power of joint dampers and compliant contacts' damping [W] (<= 0;
+            :mod:`robotdyn.contact.applied_forces`).
     """
 
     nudot: np.ndarray
@@ -170,6 +174,7 @@ class SlidingState:
     power: float
     lam: np.ndarray | None = None  # (m,) every row's multiplier where the loads are split by the rigid limit
     unloaded: tuple = ()  # wheels the rigid limit leaves unloaded (they would pull)
+    damper_power: float = 0.0
 
 
 def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingState:
@@ -217,6 +222,9 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     M = pin.crba(model, data, q)
     K = np.hstack([M @ red.S, -G])
     rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
+    app = applied(robot, q, red.v, kin) if has_applied(robot) else None
+    if app is not None:  # joint springs, compliant wheels: known at the state (robotdyn.contact.applied_forces)
+        rhs += app.Q
     cond = np.linalg.cond(K)
     if not np.isfinite(cond) or cond > PAINLEVE_CONDITION:
         raise painleve_error(wheels, cond)
@@ -224,7 +232,9 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     k = red.S.shape[1]
     normal = sol[k + position]
     force = -normal[:, None] * coef
-    return SlidingState(sol[:k], red, normal, slip, force, float(np.sum(force * slip)))
+    power = float(np.sum(force * slip)) + (app.friction_power if app is not None else 0.0)
+    return SlidingState(sol[:k], red, normal, slip, force, power,
+                        damper_power=app.damper_power if app is not None else 0.0)
 
 
 def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
@@ -298,6 +308,9 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
     kk = S.shape[1]
     MS = pin.crba(model, data, q) @ S
     rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
+    app = applied(robot, q, red.v, kin) if has_applied(robot) else None
+    if app is not None:  # joint springs, compliant wheels: known at the state (robotdyn.contact.applied_forces)
+        rhs += app.Q
     PV = P @ Vn  # (W, p)
     compat = PV.T @ (kinv[:, None] * C)  # (p, m)
     opened = (N @ Vo).T  # (d - p, m)
@@ -330,8 +343,9 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
         raise painleve_error(wheels, float("inf"))
     normal = loads[where]
     force = -normal[:, None] * coef
-    return SlidingState(sol[:kk], red, normal, slip, force, float(np.sum(force * slip)), lam,
-                        tuple(every[j].name for j in unloaded))
+    power = float(np.sum(force * slip)) + (app.friction_power if app is not None else 0.0)
+    return SlidingState(sol[:kk], red, normal, slip, force, power, lam, tuple(every[j].name for j in unloaded),
+                        damper_power=app.damper_power if app is not None else 0.0)
 
 
 def painleve_error(wheels, cond: float) -> SingularConstraintError:
@@ -436,6 +450,8 @@ def inverse(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> SlidingInvers
     B = input_matrix(robot.motors, kin)
     K = np.hstack([B, G])
     b = pin.rnea(model, data, q, v, a)
+    if has_applied(robot):
+        b -= applied(robot, q, v, kin).Q
     x, _, rank, sv = np.linalg.lstsq(K, b, rcond=None)
     n_tau = B.shape[1]
     lam = x[n_tau:]

@@ -64,6 +64,17 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
                                         # open (robotdyn.contact.compliance, robotdyn.contact.rigid_limit)
     normal_damping = 600.0              # radial damping [N s/m] (default: damping ratio 0.3 of the wheel's share
                                         # of the mass on its default stiffness)
+    contact = "rigid"                   # rigid (normal row a constraint, default) | compliant (a force law of the
+                                        # penetration: the wheel can fly and land; needs friction = coulomb or
+                                        # linear; robotdyn.contact.compliant_contact)
+    contact_law = "linear"              # compliant: linear (k delta + c delta') | hunt_crossley (delta^n (k +
+                                        # lambda delta'): normal_stiffness in N/m^n, normal_damping lambda)
+    contact_exponent = 1.5              # hunt_crossley's n
+    [[springs]]                         # a spring and damper on a joint (suspension, rocker, passive axle)
+    joint = "front_left_suspension"     # the joint (one coordinate: revolute, continuous or prismatic)
+    stiffness = 3.0e4                   # k [N/m or N m/rad]: generalised force -k (q - rest) - c q'
+    damping = 3.0e3                     # c [N s/m or N m s/rad] (default 0)
+    rest = -0.05                        # rest position [m or rad] (default 0)
     [[closures]]
     frame1 = "a"; frame2 = "b"; components = "x y z"   # subset of x y z rx ry rz in frame1's axes
 
@@ -113,12 +124,13 @@ class ConstraintFileError(RobotDynError):
 TOP_KEYS = (
     "name", "title", "urdf", "root", "package_dirs", "massless", "independent", "xacro_args", "labels", "neutral",
     "locked", "terrain", "parameters", "wheels", "closures", "motors", "scenarios", "paper", "packages",
-    "root_height", "twist",
+    "root_height", "twist", "springs",
 )
 TWIST_KEYS = ("frame", "components", "axes", "names")
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro", "minimum")
 WHEEL_KEYS = ("name", "joint", "frame", "radius", "axis", "kind", "roller_angle", "radius_joint", "mu", "friction",
-              "slip_velocity", "stiffness", "slip", "normal_stiffness", "normal_damping")
+              "slip_velocity", "stiffness", "slip", "normal_stiffness", "normal_damping",
+              "contact", "contact_law", "contact_exponent")
 MAX_RADIUS = 1e4
 """Largest wheel radius accepted [m] (larger values only overflow the dynamics)."""
 MAX_FILE_BYTES = 1_000_000
@@ -126,6 +138,7 @@ MAX_FILE_BYTES = 1_000_000
 WHEEL_KINDS = ("standard", "omni", "caster", "support")
 CLOSURE_KEYS = ("name", "frame1", "frame2", "components")
 MOTOR_KEYS = ("name", "joint", "reaction")
+SPRING_KEYS = ("name", "joint", "stiffness", "damping", "rest")
 SCENARIO_KEYS = ("name", "description", "t_end", "torque", "q0", "nu0")
 TERRAINS: dict[str, type[Terrain]] = {
     "flat": FlatTerrain, "ramp": RampTerrain, "bump": BumpTerrain, "sine": SineTerrain,
@@ -560,6 +573,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
     wheels = _wheels(cx, {p.name: p.default for p in params})
     closures = _closures(cx)
     motors = _motors(cx)
+    springs = _springs(cx)
     independent = _independent(cx)
     neutral = _neutral(cx)
     terrain = _terrain(cx)
@@ -586,6 +600,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         packages=cx.named,
         root_height=root_height,
         operational=operational,
+        springs=springs,
     )
     return ConstraintFile(path, spec, _scenarios(cx, motors, operational))
 
@@ -820,14 +835,18 @@ def _wheel(cx: _Context, where: str, w, pvalues: dict) -> tuple[Wheel, str | Non
     if not isinstance(friction, str):
         r.fail(where, f"friction = {friction!r}; expected one of rolling, {', '.join(LAWS)}")
     numbers = {key: r.number(where, w[key], key) for key in ("mu", "slip_velocity", "stiffness", "normal_stiffness",
-                                                             "normal_damping") if key in w}
+                                                             "normal_damping", "contact_exponent") if key in w}
+    numbers.update({key: w[key] for key in ("contact", "contact_law") if key in w})
     slip = w.get("slip", "both")
     if slip not in SLIP_DIRECTIONS:
         r.fail(where, f"slip = {slip!r}; expected one of {', '.join(SLIP_DIRECTIONS)}")
     wheel = Wheel(fname, radius, tuple(float(a) for a in axis), kind if kind in ("omni", "support") else "standard",
                   roller, w.get("radius_joint"), w.get("name", fname), friction=friction, slip=slip, **numbers)
     try:  # the friction keys' physics (mu >= 0, a known law with its parameters) in one line
-        _check_friction(wheel)
+        if wheel.contact == "rigid":
+            _check_friction(wheel)
+            if "contact_law" in w or "contact_exponent" in w:
+                raise InputError("contact_law/contact_exponent need contact = 'compliant'")
     except InputError as exc:
         r.fail(where, str(exc))
     return wheel, spin
@@ -876,6 +895,28 @@ def _closures(cx: _Context) -> list[Closure]:
             r.fail(where, f"components {comps} invalid; expected distinct entries of {' '.join(allowed)}")
         closures.append(Closure(f1, f2, tuple(comps), c.get("name")))
     return closures
+
+
+def _springs(cx: _Context) -> list:
+    """``[[springs]]``: a moving joint each (at most one spring per joint), k and c >= 0, a rest position."""
+    from ..reduction.joint_springs import JointSpring
+
+    r = cx.r
+    out: list = []
+    for i, sp in enumerate(r.table_list(cx.data, "springs")):
+        where = f"springs[{i}]" + (f" ({sp['name']})" if isinstance(sp, dict) and "name" in sp else "")
+        r.keys(where, sp, SPRING_KEYS)
+        j = cx.joint(where, sp.get("joint"), "joint")
+        if j in cx.locked:
+            r.fail(where, f"joint {j!r} is locked; a spring needs a moving joint")
+        if any(o.joint == j for o in out):
+            r.fail(where, f"a second spring on joint {j!r}; expected one spring per joint (add the stiffnesses)")
+        numbers = {key: r.number(where, sp[key], key) for key in ("stiffness", "damping", "rest") if key in sp}
+        for key in ("stiffness", "damping"):
+            if numbers.get(key, 0.0) < 0:
+                r.fail(where, f"{key} = {numbers[key]}; expected a number >= 0")
+        out.append(JointSpring(j, name=sp.get("name", j), **numbers))
+    return out
 
 
 def _motors(cx: _Context) -> list[MotorSpec]:

@@ -146,6 +146,9 @@ SCHEMA: dict = _table({
         "slip": {"enum": ["both", "lateral"], "expected": "both or lateral"},
         "normal_stiffness": _number("a normal (radial) stiffness in N/m, > 0 and <= 1e12", None, 1e12, 0.0),
         "normal_damping": _number("a normal (radial) damping in N s/m, >= 0 and <= 1e12", 0.0, 1e12),
+        "contact": {"enum": ["rigid", "compliant"], "expected": "rigid or compliant"},
+        "contact_law": {"enum": ["linear", "hunt_crossley"], "expected": "linear or hunt_crossley"},
+        "contact_exponent": _number("an exponent n >= 1 and <= 10", 1.0, 10.0),
     }, (), "a table: name, joint or frame, radius, ..."), "wheels"),
     "closures": _array_of(_table({
         "name": _string("a closure name"),
@@ -153,6 +156,13 @@ SCHEMA: dict = _table({
         "frame2": _string("a frame name"),
         "components": _strings(f"distinct entries of {' '.join(CLOSURE_COMPONENTS)}", 1),
     }, ("frame1", "frame2")), "closures"),
+    "springs": _array_of(_table({
+        "name": _string("a spring name"),
+        "joint": _string("the joint the spring acts on"),
+        "stiffness": _number("a stiffness in N/m or N m/rad, >= 0 and <= 1e12", 0.0, 1e12),
+        "damping": _number("a damping in N s/m or N m s/rad, >= 0 and <= 1e12", 0.0, 1e12),
+        "rest": _bounded("a rest position in m or rad", MAX_POSITION),
+    }, ("joint",)), "springs"),
     "motors": _array_of(_table({
         "name": _string("a motor name"),
         "joint": _string("the driven joint"),

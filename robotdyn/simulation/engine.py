@@ -30,6 +30,9 @@ from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import lift_off_message, slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
+from ..contact.compliant_contact import compliant_wheels
+from ..contact.applied_forces import applied, has_applied
+from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .progress import Progress
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
@@ -152,6 +155,9 @@ def simulate(
     stiff_slip_warning(robot, t_end - t0)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
     if stick_slip_wheels(robot):  # exact switching: segment by segment
+        if has_applied(robot):
+            raise RobotDynError("stick-slip wheels with joint springs or compliant wheels are not simulated; expected "
+                                "friction = 'coulomb' or 'linear' on the wheels of a robot with springs")
         if t0 or times is not None:
             raise RobotDynError("t0/times: stick-slip wheels are simulated from t = 0 on n_out samples only")
         from .stick_slip import simulate as simulate_stick_slip
@@ -164,7 +170,8 @@ def simulate(
         return _applied(simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
                                           stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times),
                         robot, torque)
-    method = method or "DOP853"
+    compliant = compliant_wheels(robot)
+    method = method or (STIFF_METHOD if compliant else "DOP853")
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
     report = Progress(t_end, progress, time_limit)
@@ -172,6 +179,8 @@ def simulate(
     from scipy.integrate import solve_ivp
 
     slipping = slipping_wheels(robot)
+    forced = has_applied(robot)  # joint springs, compliant wheels (robotdyn.contact.applied_forces)
+    works = bool(slipping) or forced  # y[n + k:] = (friction work, damper work)
     fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path
     k = robot.mobility
 
@@ -190,7 +199,7 @@ def simulate(
             finite(t, y)
             st = forward_sliding(robot, q, nu, tau)
             report(t)
-            return np.concatenate([position_rate(st.reduced, stabilisation), st.nudot, [st.power]])
+            return np.concatenate([position_rate(st.reduced, stabilisation), st.nudot, [st.power, st.damper_power]])
         if fast is not None:
             try:  # the whole right-hand side in one compiled call (robotdyn.fast.compiled)
                 out = fast.rhs(q, nu, tau, stabilisation)
@@ -200,6 +209,11 @@ def simulate(
                 pass
         finite(t, y)
         red = robot.reduced(q, nu)
+        if forced:
+            app = applied(robot, q, red.v)
+            nudot = solve(red.M, red.B @ tau - red.h + red.S.T @ app.Q)
+            report(t)
+            return np.concatenate([position_rate(red, stabilisation), nudot, [app.friction_power, app.damper_power]])
         nudot = solve(red.M, red.B @ tau - red.h)  # numpy.linalg.solve's LAPACK call, without its overhead
         report(t)
         return np.concatenate([position_rate(red, stabilisation), nudot])
@@ -213,9 +227,12 @@ def simulate(
 
         lift_off.terminal, lift_off.direction = True, -1.0
         events = [lift_off]
+    flights = flight_events(robot, compliant, n)  # compliant wheels: lift-off and touch-down, recorded
+    if flights:
+        events = (events or []) + [e for e, _, _ in flights]
     t_eval = np.linspace(t0, t_end, n_out) if times is None else times
     start = time.perf_counter()
-    y0 = np.concatenate([q0, nu0, [0.0] if slipping else []])
+    y0 = np.concatenate([q0, nu0, [0.0, 0.0] if works else []])
     interrupted = None
     rhs = _timed(rhs)
     if events is None:
@@ -228,7 +245,7 @@ def simulate(
         raise RobotDynError(f"integration failed at t = {sol.t[-1]:.4g} s: {sol.message}"
                             + failure_note(robot, sol.y[:n, -1], stabilisation))
     stats_event = None
-    if slipping and sol.status == 1:  # a slipping wheel's load reached zero: the contact model ends there
+    if slipping and sol.status == 1 and len(sol.t_events[0]):  # a slipping wheel's load reached zero: the contact model ends there
         t_ev, y_ev = sol.t_events[0][0], sol.y_events[0][0]
         stats_event = lift_off_message(robot, t_ev, y_ev[:n], y_ev[n:n + k], zero_tau if torque is None else
                                        np.asarray(torque(t_ev, y_ev[:n], y_ev[n:n + k]), float))
@@ -255,8 +272,14 @@ def simulate(
         stats["t_event"] = float(sol.t_events[0][0])
     if offsets:
         stats["offsets"] = offsets
-    return Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
-                      robot.units, sol.y[n + k][: len(times)] if slipping else None, robot, torque)
+    if flights:
+        stats["flight"] = flight_phases(flights, sol.t_events[len(events) - len(flights):], times[-1])
+        stats["airborne"] = airborne(robot, compliant, q0)
+    traj = Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
+                      robot.units, sol.y[n + k][: len(times)] if (slipping or compliant) else None, robot, torque)
+    if forced:
+        traj.damper_work = sol.y[n + k + 1][: len(times)]
+    return traj
 
 
 MAX_STEPS = 1e8

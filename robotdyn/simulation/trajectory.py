@@ -26,6 +26,9 @@ class Trajectory:
         units: Unit of each column by name (m, rad, m/s, rad/s).
         friction_work: Work done by the slipping wheels' friction forces since t = 0 (N,) [J] (<= 0; ``None``
             without slipping wheels): energy balance E(t) - E(0) = motor work + friction_work.
+        damper_work: Work done by joint dampers and compliant contacts' damping since t = 0 (N,) [J] (<= 0;
+            ``None`` without them): E(t) - E(0) = motor work + friction_work + damper_work, with E counting the
+            springs' and contacts' elastic energy.
         robot, torque: The robot simulated and the torque law applied (``None``: unactuated), as
             :func:`~robotdyn.simulation.engine.simulate` received them: what a post-pass (wheel loads,
             :func:`robotdyn.contact.traction.traction`) must use, also where a scenario built its own controller
@@ -44,6 +47,7 @@ class Trajectory:
     friction_work: np.ndarray | None = None
     robot: object | None = field(default=None, repr=False, compare=False)
     torque: object | None = field(default=None, repr=False, compare=False)
+    damper_work: np.ndarray | None = None
 
     def __repr__(self) -> str:
         return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"

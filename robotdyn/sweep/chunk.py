@@ -194,7 +194,7 @@ def simulate_run(ctx: RunContext, run: RunInput):
 def energy_drift(traj, torque) -> float | None:
     """Largest :math:`|E(t) - E(t_0)|` [J] over the output samples from the first one after which the motor
     torques are zero at every sample (the whole run without torques), with the friction work of slipping wheels
-    added back; ``None`` when the torques never stop or are built by the scenario itself.
+    and the work of dampers added back; ``None`` when the torques never stop or are built by the scenario itself.
 
     Args:
         traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
@@ -216,6 +216,9 @@ def energy_drift(traj, torque) -> float | None:
     if start >= len(traj.t) - 1:
         return None
     e = traj.energy[start:] - (traj.friction_work[start:] if traj.friction_work is not None else 0.0)
+    damper = getattr(traj, "damper_work", None)  # joint dampers and compliant contacts' damping
+    if damper is not None:
+        e = e - damper[start:]
     return float(np.max(np.abs(e - e[0])))
 
 

@@ -1,0 +1,288 @@
+"""Wheels that fly and land: a normal force law of penetration instead of a normal constraint.
+
+A :class:`CompliantWheel` contributes no constraint rows. At every state its contact geometry (the rolling wheel's:
+contact point p, contact frame E = (t1, t2, n), :mod:`robotdyn.constraints.rolling_contact`) gives
+
+- the penetration :math:`\\delta = -\\phi` [m] (:math:`\\phi` the signed distance of the wheel's lowest rim point
+  above the terrain, along its normal) and its rate :math:`\\dot\\delta = -n^T A_w v` [m/s] (the normal velocity
+  of the wheel's material point at p; at the lowest rim point it equals :math:`-\\dot\\phi`);
+- the normal force :math:`f_n = N(\\delta, \\dot\\delta) \\ge 0` of its :class:`NormalLaw` (zero while
+  :math:`\\delta \\le 0`: the wheel flies; never pulling);
+- the tangential force of its friction law :math:`F_t = -f_n c(s)` (:mod:`robotdyn.contact.friction`) from the slip
+  velocity :math:`s = (t_1, t_2)^T A_w v`, on the wheel's own tangential directions (both for a standard wheel,
+  the rollers' driving direction for an omni wheel, none for a support);
+
+and applies :math:`Q = A^T (F_{t1}, F_{t2}, f_n)` with :math:`A = E^T A_w` (3, nv) the rolling rows: the contact
+force on the wheel's material point at p. Energy: the law's elastic part stores :math:`U(\\delta)`, the rest of
+the normal force does the work :math:`-\\int (f_n - f_e(\\delta))\\,\\dot\\delta\\,dt \\le 0` (the damper's),
+friction :math:`\\int F_t \\cdot s\\,dt \\le 0`.
+
+Laws (``shared/notes/indeterminate-loads-and-compliance.md``):
+
+- :class:`LinearContact`: :math:`f_n = \\max(0, k\\delta + c\\dot\\delta)` for :math:`\\delta > 0`.
+- :class:`HuntCrossley`: :math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` (Hunt & Crossley 1975, in the
+  form of Marhefka & Orin 1999: :math:`\\lambda = \\tfrac32 \\alpha k`), whose force is continuous at touch-down.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..constraints.constraint import ConstraintRows, KinematicState
+from ..constraints.rolling_contact import RollingWheel
+from ..errors import InputError
+
+HUNT_CROSSLEY_EXPONENT = 1.5
+"""Default exponent n of the Hunt-Crossley law (Hertz's for a sphere or a crowned tyre on a plane)."""
+HUNT_CROSSLEY_ALPHA = 0.2
+"""Default :math:`\\alpha` [s/m] of the Hunt-Crossley law's damping :math:`\\lambda = 1.5\\alpha k` (Marhefka & Orin
+1999 list 0.08 to 0.32 s/m for common materials)."""
+CONTACT_LAWS = ("linear", "hunt_crossley")
+"""The normal force laws by the name used in TOML files and the API."""
+
+
+class NormalLaw:
+    """A normal force law of penetration :math:`\\delta` [m] and its rate :math:`\\dot\\delta` [m/s]."""
+
+    name = "law"
+
+    def force(self, delta: float, rate: float) -> float:
+        """:math:`f_n \\ge 0` [N] (zero for :math:`\\delta \\le 0`)."""
+        raise NotImplementedError
+
+    def elastic(self, delta: float) -> float:
+        """The elastic part :math:`f_e(\\delta)` [N] (zero for :math:`\\delta \\le 0`)."""
+        raise NotImplementedError
+
+    def potential(self, delta: float) -> float:
+        """Stored energy :math:`U(\\delta) = \\int_0^\\delta f_e` [J]."""
+        raise NotImplementedError
+
+
+class LinearContact(NormalLaw):
+    """:math:`f_n = \\max(0, k\\delta + c\\dot\\delta)` for :math:`\\delta > 0`, else 0.
+
+    Args:
+        stiffness: k [N/m] (> 0).
+        damping: c [N s/m] (>= 0).
+    """
+
+    name = "linear"
+
+    def __init__(self, stiffness: float, damping: float = 0.0) -> None:
+        self.stiffness = _number(stiffness, "normal_stiffness", "N/m", positive=True)
+        self.damping = _number(damping, "normal_damping", "N s/m")
+
+    def force(self, delta: float, rate: float) -> float:
+        return max(0.0, self.stiffness * delta + self.damping * rate) if delta > 0.0 else 0.0
+
+    def elastic(self, delta: float) -> float:
+        return self.stiffness * delta if delta > 0.0 else 0.0
+
+    def potential(self, delta: float) -> float:
+        return 0.5 * self.stiffness * delta * delta if delta > 0.0 else 0.0
+
+    def __repr__(self) -> str:
+        return f"LinearContact(k={self.stiffness:g} N/m, c={self.damping:g} N s/m)"
+
+
+class HuntCrossley(NormalLaw):
+    """:math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` for :math:`\\delta > 0`, else 0.
+
+    Args:
+        stiffness: k [N/m^n] (> 0).
+        damping: :math:`\\lambda` [N s/m^(n+1)] (>= 0).
+        exponent: n (>= 1).
+    """
+
+    name = "hunt_crossley"
+
+    def __init__(self, stiffness: float, damping: float = 0.0, exponent: float = HUNT_CROSSLEY_EXPONENT) -> None:
+        self.stiffness = _number(stiffness, "normal_stiffness", "N/m^n", positive=True)
+        self.damping = _number(damping, "normal_damping", "N s/m^(n+1)")
+        self.exponent = _number(exponent, "contact_exponent", "")
+        if self.exponent < 1.0:
+            raise InputError(f"contact_exponent = {exponent}; expected an exponent n >= 1")
+
+    def force(self, delta: float, rate: float) -> float:
+        return max(0.0, delta ** self.exponent * (self.stiffness + self.damping * rate)) if delta > 0.0 else 0.0
+
+    def elastic(self, delta: float) -> float:
+        return self.stiffness * delta ** self.exponent if delta > 0.0 else 0.0
+
+    def potential(self, delta: float) -> float:
+        n = self.exponent
+        return self.stiffness * delta ** (n + 1.0) / (n + 1.0) if delta > 0.0 else 0.0
+
+    def __repr__(self) -> str:
+        return f"HuntCrossley(k={self.stiffness:g}, lambda={self.damping:g}, n={self.exponent:g})"
+
+
+def make_normal_law(name: str, stiffness: float, damping: float | None, exponent: float | None = None,
+                    wheel: str = "wheel") -> NormalLaw:
+    """A normal law from its name and numbers, with one-line errors naming the wheel.
+
+    Args:
+        name: ``linear`` or ``hunt_crossley``.
+        stiffness: k [N/m, or N/m^n for hunt_crossley].
+        damping: c [N s/m] (linear) or :math:`\\lambda` [N s/m^(n+1)] (hunt_crossley); ``None``: 0 (linear),
+            :math:`1.5\\,\\alpha k` with :data:`HUNT_CROSSLEY_ALPHA` (hunt_crossley).
+        exponent: n of hunt_crossley (default :data:`HUNT_CROSSLEY_EXPONENT`).
+    """
+    try:
+        if name == "linear":
+            if exponent is not None:
+                raise InputError("contact_exponent belongs to contact_law = 'hunt_crossley'")
+            return LinearContact(stiffness, 0.0 if damping is None else damping)
+        if name == "hunt_crossley":
+            n = HUNT_CROSSLEY_EXPONENT if exponent is None else exponent
+            lam = 1.5 * HUNT_CROSSLEY_ALPHA * float(stiffness) if damping is None else damping
+            return HuntCrossley(stiffness, lam, n)
+    except InputError as exc:
+        raise InputError(f"wheel {wheel!r}: {exc}") from None
+    raise InputError(f"wheel {wheel!r}: contact_law = {name!r}; expected one of {', '.join(CONTACT_LAWS)}")
+
+
+class CompliantWheel(RollingWheel):
+    """A wheel whose normal contact is a force law (it can leave the ground and land) and whose tangential force
+    follows a friction law (see the module).
+
+    Args:
+        description, frame, radius: As :class:`~robotdyn.constraints.rolling_contact.RollingWheel`.
+        normal: Its :class:`NormalLaw`.
+        law: Its :class:`~robotdyn.contact.friction.FrictionLaw` (``None``: frictionless, e.g. a support).
+        directions: The tangential directions the law acts on, as rows of coefficients of (t1, t2): (2, 2)
+            identity for a standard wheel, the rollers' driving direction (1, 2) for an omni wheel, (0, 2) for a
+            frictionless support.
+        kind: ``standard``, ``omni`` or ``support`` (reports).
+        **kwargs: axis, terrain, radius_joint, name (as RollingWheel).
+    """
+
+    compliant = True
+
+    def __init__(self, description, frame: str, radius: float, normal: NormalLaw, law=None,
+                 directions=np.eye(2), kind: str = "standard", **kwargs) -> None:
+        super().__init__(description, frame, radius, **kwargs)
+        self.normal_law = normal
+        self.law = law
+        self.tangent_directions = np.atleast_2d(np.asarray(directions, float)).reshape(-1, 2)
+        self.kind = kind
+
+    def __repr__(self) -> str:
+        return (f"CompliantWheel(frame={self.frame!r}, radius={self.radius}, normal={self.normal_law!r}, "
+                f"law={self.law!r}, terrain={self.terrain!r})")
+
+    # no constraint rows: the normal direction is a force law, the tangential ones a friction law
+    def _labels(self) -> list[str]:
+        return []
+
+    def jacobian(self, kin: KinematicState) -> ConstraintRows:
+        return ConstraintRows(np.zeros((0, self.nv)), None, np.zeros(0), np.zeros(0, bool), [])
+
+    def rows(self, kin: KinematicState) -> ConstraintRows:
+        return ConstraintRows(np.zeros((0, self.nv)), np.zeros((0, self.nv)), np.zeros(0), np.zeros(0, bool), [])
+
+    def drift(self, kin: KinematicState) -> np.ndarray:
+        return np.zeros(0)
+
+    def penetration(self, kin: KinematicState) -> float:
+        """:math:`\\delta = -\\phi` [m] at the configuration of ``kin`` (> 0: in contact)."""
+        return -float(self._geometry(kin)[7])
+
+    def state(self, kin: KinematicState) -> dict:
+        """The contact at the state of ``kin``: ``delta``, ``rate`` [m/s], ``normal`` f_n [N], ``slip`` s (2,)
+        [m/s], ``force`` (3,) in the contact frame (t1, t2, n) [N], ``E`` (3, 3), ``point`` p, ``Q`` (nv,) the
+        generalised force, ``friction_power`` :math:`F_t\\cdot s` [W] (<= 0), ``damper_power``
+        :math:`-(f_n - f_e)\\dot\\delta` [W] (<= 0)."""
+        Aw, geo = self._world_jacobian(kin)
+        E = geo[9]
+        A = E.T @ Aw
+        u = A @ kin.v
+        delta, rate = -float(geo[7]), -float(u[2])
+        fn = self.normal_law.force(delta, rate)
+        slip = u[:2]
+        ft = np.zeros(2)
+        if fn > 0.0 and self.law is not None and self.tangent_directions.shape[0]:
+            D = self.tangent_directions
+            along = D.T @ (D @ slip)  # the slip along the law's directions
+            ft = -fn * (D.T @ (D @ self.law.coefficient(along)))
+        force = np.array([ft[0], ft[1], fn])
+        damper = -(fn - self.normal_law.elastic(delta)) * rate if delta > 0.0 else 0.0
+        return dict(delta=delta, rate=rate, normal=fn, slip=slip, force=force, E=E, point=geo[5], Q=A.T @ force,
+                    friction_power=float(ft @ slip), damper_power=float(damper))
+
+
+def compliant_wheels(robot) -> list[CompliantWheel]:
+    """The robot's compliant wheels (empty: every wheel's normal contact is a constraint)."""
+    return [c for c in robot.constraints if isinstance(c, CompliantWheel)]
+
+
+def _number(value, what: str, unit: str, positive: bool = False) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not math.isfinite(x) or x < 0 or (positive and x == 0):
+        raise InputError(f"{what} = {value!r}; expected a finite number {'> 0' if positive else '>= 0'}"
+                         + (f" [{unit}]" if unit else ""))
+    return x
+
+
+__all__ = ["NormalLaw", "LinearContact", "HuntCrossley", "CompliantWheel", "make_normal_law", "compliant_wheels", "compliant_wheel",
+           "CONTACT_LAWS"]
+
+
+def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> CompliantWheel:
+    """A :class:`CompliantWheel` from a spec's :class:`~robotdyn.robot.Wheel` with ``contact = "compliant"``.
+
+    The normal law's numbers: the wheel's ``normal_stiffness`` and ``normal_damping``, or the default rule of
+    :mod:`robotdyn.contact.compliance` (1 mm static deflection under an equal share of the weight; for
+    hunt_crossley the same deflection: :math:`k = (m g / n) / \\delta_0^{\\,n}`, damping
+    :math:`1.5\\,\\alpha k`). The friction law (``friction`` = coulomb or linear, with its mu, slip_velocity,
+    stiffness) acts on the wheel's tangential directions by kind; a support wheel is frictionless.
+
+    Raises:
+        InputError: contact not rigid/compliant, a compliant wheel without a friction law (rolling while in
+            contact is not modelled for compliant wheels), stick_slip or slip = 'lateral' on one, bad numbers.
+    """
+    from .compliance import STATIC_DEFLECTION, normal_compliance, weight
+    from .friction import make_law
+
+    name = w.name or w.frame
+    if w.contact != "compliant":
+        raise InputError(f"wheel {name!r}: contact = {w.contact!r}; expected 'rigid' or 'compliant'")
+    if w.kind not in ("standard", "omni", "support"):
+        raise InputError(f"wheel {name!r}: kind {w.kind!r}; expected 'standard', 'omni' or 'support'")
+    law = None
+    if w.kind == "support":
+        if w.friction not in ("rolling", None):
+            raise InputError(f"wheel {name!r}: friction law {w.friction!r} on a support wheel (frictionless)")
+        directions = np.zeros((0, 2))
+    else:
+        if w.friction in ("rolling", None):
+            raise InputError(f"wheel {name!r}: contact = 'compliant' needs a friction law for its tangential "
+                             "force (friction = 'coulomb' or 'linear'); rolling without slipping while in contact "
+                             "is not modelled for compliant wheels")
+        if w.friction == "stick_slip" or w.slip != "both":
+            raise InputError(f"wheel {name!r}: contact = 'compliant' takes friction = 'coulomb' or 'linear' with "
+                             "slip = 'both'")
+        law = make_law(w.friction, w.mu, w.slip_velocity, w.stiffness, wheel=name)
+        directions = np.eye(2) if w.kind == "standard" else \
+            np.array([[math.cos(roller_angle), math.sin(roller_angle)]])
+    if w.normal_stiffness is not None:
+        k = w.normal_stiffness
+    else:  # the rule of robotdyn.contact.compliance: 1 mm under an equal share of the weight
+        share = weight(robot) / max(len(robot.spec.wheels), 1)
+        n = 1.0 if w.contact_law == "linear" else (HUNT_CROSSLEY_EXPONENT if w.contact_exponent is None
+                                                   else float(w.contact_exponent))
+        k = share / STATIC_DEFLECTION ** n
+    damping = w.normal_damping
+    if damping is None and w.contact_law == "linear":
+        names = [x.name or x.frame for x in robot.spec.wheels]
+        rule = normal_compliance(robot)
+        i = names.index(name) if name in names else 0
+        damping = float(rule.damping[i])  # c = 2 * 0.3 * sqrt(k m / n) with this wheel's k
+    normal = make_normal_law(w.contact_law, k, damping, w.contact_exponent, wheel=name)
+    return CompliantWheel(robot.description, w.frame, radius, normal, law, directions, w.kind, **kwargs)

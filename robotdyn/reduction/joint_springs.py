@@ -1,0 +1,123 @@
+"""Springs and dampers on joints: suspensions, rockers, passive axles.
+
+A :class:`JointSpring` on a one-degree-of-freedom joint (revolute, continuous, prismatic) with coordinate
+:math:`q_j` (natural units: m or rad) and velocity :math:`\\dot q_j` applies the generalised force
+
+.. math:: Q_j = -k\\,(q_j - q_{j,0}) - c\\,\\dot q_j
+
+on that coordinate (zero on every other), i.e. an equal and opposite force or torque on the joint's two bodies.
+It enters the reduced equations through :math:`S^T` like any applied force (D'Alembert:
+:math:`M_r\\dot\\nu + C_r\\nu + g_r = B_r\\tau + S^T Q`). Energy: the spring stores
+:math:`\\tfrac12 k (q_j - q_{j,0})^2` (counted in :meth:`robotdyn.robot.Robot.energy`), the damper does the work
+:math:`-\\int c\\,\\dot q_j^2\\,dt \\le 0` (``Trajectory.damper_work``).
+
+Units: k in N/m (prismatic) or N m/rad (revolute), c in N s/m or N m s/rad, the rest position :math:`q_{j,0}` in
+m or rad.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+
+
+@dataclass
+class JointSpring:
+    """A spring and damper on a joint's coordinate (declared in a :class:`~robotdyn.robot.RobotSpec` or a
+    constraint file's ``[[springs]]``).
+
+    Attributes:
+        joint: The joint's name (URDF name or its coordinate label).
+        stiffness: k [N/m or N m/rad] (>= 0).
+        damping: c [N s/m or N m s/rad] (>= 0).
+        rest: Rest position q0 [m or rad] (the coordinate where the spring force is zero).
+        name: Name in messages (default: the joint's).
+    """
+
+    joint: str
+    stiffness: float = 0.0
+    damping: float = 0.0
+    rest: float = 0.0
+    name: str | None = None
+
+
+class SpringForce:
+    """A built :class:`JointSpring`: its velocity index in the model and its checked numbers.
+
+    Args:
+        spec: The declaration.
+        index: Index of the joint's coordinate in q and v (natural coordinates: nq == nv).
+        unit: ``m`` or ``rad`` (for messages and reports).
+
+    Raises:
+        InputError: a stiffness or damping that is not a finite number >= 0, or a non-finite rest position.
+    """
+
+    def __init__(self, spec: JointSpring, index: int, unit: str = "rad") -> None:
+        self.name = spec.name or spec.joint
+        self.joint = spec.joint
+        self.index = int(index)
+        self.unit = unit
+        per = "N/m" if unit == "m" else "N m/rad"
+        for what, value, u in (("stiffness", spec.stiffness, per), ("damping", spec.damping, per + " s")):
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise InputError(f"spring {self.name!r}: {what} = {value!r}; expected a finite number >= 0 [{u}]")
+        if not (isinstance(spec.rest, (int, float)) and math.isfinite(spec.rest)):
+            raise InputError(f"spring {self.name!r}: rest = {spec.rest!r}; expected a finite position [{unit}]")
+        self.stiffness = float(spec.stiffness)
+        self.damping = float(spec.damping)
+        self.rest = float(spec.rest)
+
+    def force(self, q: np.ndarray, v: np.ndarray) -> float:
+        """:math:`-k(q_j - q_{j,0}) - c\\dot q_j` [N or N m]."""
+        return -self.stiffness * (q[self.index] - self.rest) - self.damping * v[self.index]
+
+    def potential(self, q: np.ndarray) -> float:
+        """Stored energy :math:`\\tfrac12 k (q_j - q_{j,0})^2` [J]."""
+        d = q[self.index] - self.rest
+        return 0.5 * self.stiffness * d * d
+
+    def damper_power(self, v: np.ndarray) -> float:
+        """Power of the damper on the robot :math:`-c\\dot q_j^2` [W] (<= 0)."""
+        return -self.damping * v[self.index] ** 2
+
+    def __repr__(self) -> str:
+        return (f"SpringForce({self.name!r}, k={self.stiffness:g}, c={self.damping:g}, rest={self.rest:g} "
+                f"{self.unit})")
+
+
+def build_springs(robot, springs) -> list[SpringForce]:
+    """The robot's :class:`SpringForce` list from its spec's :class:`JointSpring` declarations.
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` under construction (description and coordinates set).
+        springs: The declarations.
+
+    Raises:
+        InputError: an unknown joint, a joint with more than one coordinate, two springs on one joint, or bad
+            numbers (one line each).
+    """
+    out: list[SpringForce] = []
+    names = robot.description.joint_names
+    for s in springs:
+        if s.joint in names:
+            i = names.index(s.joint)
+        elif s.joint in robot.coordinates:
+            i = robot.coordinates.index(s.joint)
+        else:
+            raise InputError(f"spring {s.name or s.joint!r}: unknown joint {s.joint!r}; expected one of "
+                             f"{', '.join(robot.coordinates)}")
+        unit = robot.units.get(robot.coordinates[i], "rad")
+        spring = SpringForce(s, i, "m" if unit == "m" else "rad")
+        if any(o.index == i for o in out):
+            raise InputError(f"spring {spring.name!r}: a second spring on joint {s.joint!r}; expected one spring "
+                             "per joint (add the stiffnesses)")
+        out.append(spring)
+    return out
+
+
+__all__ = ["JointSpring", "SpringForce", "build_springs"]

@@ -133,6 +133,17 @@ class Wheel:
         stiffness: Linear law's slip stiffness [s/m] (``None``: the law's default).
         slip: With a friction law: ``both`` tangential directions follow it, or ``lateral`` (rolls along its
             rolling direction, only the lateral force follows the law).
+        normal_stiffness: Normal (radial) stiffness k [N/m] (> 0; N/m^n for ``contact_law = "hunt_crossley"``);
+            ``None``: the default rule of :mod:`robotdyn.contact.compliance` (1 mm static deflection under an
+            equal share of the weight).
+        normal_damping: Normal (radial) damping c [N s/m] (>= 0; :math:`\\lambda` [N s/m^(n+1)] for
+            hunt_crossley); ``None``: the default rule (damping ratio 0.3 for linear, :math:`1.5\\alpha k` for
+            hunt_crossley).
+        contact: ``rigid`` (default: the normal row is a constraint) or ``compliant`` (a force law of the
+            penetration: the wheel can fly and land; needs friction ``coulomb`` or ``linear`` with slip ``both``,
+            except on a support; :mod:`robotdyn.contact.compliant_contact`).
+        contact_law: A compliant wheel's normal law: ``linear`` (default) or ``hunt_crossley``.
+        contact_exponent: hunt_crossley's exponent n (>= 1; ``None``: 1.5).
     """
 
     frame: str
@@ -219,6 +230,8 @@ class RobotSpec:
         root_height: Height [m] of the plane in which a planar root moves its link (the root link's height above
             the ground, z = 0), or of the reference of a floating root's z; ``None``: found from the wheels for a
             planar root (:meth:`Robot.root_height_from_wheels`; the default of constraint files), 0 otherwise.
+        springs: :class:`~robotdyn.reduction.joint_springs.JointSpring` declarations: a spring and damper on a
+            joint's coordinate each (at most one per joint; default none).
     """
 
     name: str

@@ -6,8 +6,9 @@ constraint file's wheel keys of the same names). Where they are not given, the d
 - stiffness: :math:`k = m g / (n\\,\\delta_0)`, the robot's weight shared equally by its n wheels deflecting each
   wheel by :data:`STATIC_DEFLECTION` (1 mm, a solid rubber or small pneumatic tyre of a mobile robot). The rule
   uses the robot's total mass and the number of wheels only, never the loads themselves (on a statically
-  indeterminate chassis the loads are what the stiffnesses are asked to decide, so a rule from them is circular:
-  ``shared/notes/indeterminate-loads-and-compliance.md``). All defaulted wheels of a robot get the same k.
+  indeterminate chassis the loads are what the stiffnesses are asked to decide, so a rule from them is circular;
+  the concepts page ``docs/concepts.md``, "Determined and undetermined forces"). All defaulted wheels of a robot
+  get the same k.
 - damping: :math:`c = 2\\zeta\\sqrt{k\\,m/n}` with :data:`DAMPING_RATIO` :math:`\\zeta = 0.3`: the wheel's share
   m/n of the mass on the wheel's stiffness k (given or default) is damped at that ratio.
 
@@ -54,7 +55,15 @@ class NormalCompliance:
 
 
 def weight(robot) -> float:
-    """The robot's weight m g [N] for the default rule (1 N for a robot without mass or gravity)."""
+    """The robot's weight m g [N] for the default rule (1 N for a robot without mass or gravity).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`: its model's total mass m [kg] and the norm of its gravity g
+            [m/s^2].
+
+    Returns:
+        m g [N] if finite and > 0, else 1.0.
+    """
     mass = float(pin.computeTotalMass(robot.model))
     g = float(np.linalg.norm(robot.model.gravity.linear))
     w = mass * g

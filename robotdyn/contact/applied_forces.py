@@ -37,7 +37,11 @@ class Applied:
 
 
 def has_applied(robot) -> bool:
-    """Whether the robot has joint springs or compliant wheels."""
+    """Whether the robot has joint springs or compliant wheels.
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` (its ``springs`` and constraints).
+    """
     from .compliant_contact import compliant_wheels
 
     return bool(getattr(robot, "springs", None)) or bool(compliant_wheels(robot))
@@ -48,8 +52,12 @@ def applied(robot, q: np.ndarray, v: np.ndarray, kin: KinematicState | None = No
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot`.
-        q: Natural coordinates (n,); v: full velocities (n,).
-        kin: The kinematics at (q, v) if already computed (its caches are shared).
+        q: Natural coordinates (n,) [m, rad], in the robot's coordinate order.
+        v: Full velocities (n,) [m/s, rad/s], same order (natural coordinates: nq == nv).
+        kin: The kinematics at (q, v) if already computed (its caches are shared; recomputed if its v differs).
+
+    Returns:
+        The :class:`Applied`: the generalised force Q (nv,) and the powers of friction and dampers.
     """
     from .compliant_contact import compliant_wheels
 
@@ -73,7 +81,16 @@ def applied(robot, q: np.ndarray, v: np.ndarray, kin: KinematicState | None = No
 
 
 def stored_energy(robot, q: np.ndarray) -> float:
-    """Elastic energy of the joint springs and compliant contacts at q [J]."""
+    """Elastic energy of the joint springs and compliant contacts at q [J].
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], in the robot's coordinate order.
+
+    Returns:
+        :math:`\\sum \\tfrac12 k (q_j - q_{j,0})^2` of the springs plus each compliant wheel's :math:`U(\\delta)`
+        [J] (zero for wheels in the air).
+    """
     from .compliant_contact import compliant_wheels
 
     q = np.asarray(q, float)
@@ -87,7 +104,18 @@ def stored_energy(robot, q: np.ndarray) -> float:
 
 def reduced_applied(robot, red, q: np.ndarray) -> tuple[np.ndarray, Applied | None]:
     """:math:`S^T Q` (k,) at the reduced model ``red``'s state and the :class:`Applied` (``None`` and zeros without
-    springs or compliant wheels)."""
+    springs or compliant wheels).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot`.
+        red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at the state (its ``S`` (n, k) and
+            full velocities ``v`` (n,) are used).
+        q: Natural coordinates (n,) [m, rad] of that state.
+
+    Returns:
+        ``(S^T Q, applied)``: the reduced generalised force (k,), conjugate to the independent velocities (in
+        their order), and the :class:`Applied` (``None`` without springs or compliant wheels).
+    """
     if not has_applied(robot):
         return np.zeros(red.S.shape[1]), None
     app = applied(robot, q, red.v)

@@ -17,7 +17,7 @@ force on the wheel's material point at p. Energy: the law's elastic part stores 
 the normal force does the work :math:`-\\int (f_n - f_e(\\delta))\\,\\dot\\delta\\,dt \\le 0` (the damper's),
 friction :math:`\\int F_t \\cdot s\\,dt \\le 0`.
 
-Laws (``shared/notes/indeterminate-loads-and-compliance.md``):
+Laws (:math:`\\delta` the penetration [m], :math:`\\dot\\delta` its rate [m/s]):
 
 - :class:`LinearContact`: :math:`f_n = \\max(0, k\\delta + c\\dot\\delta)` for :math:`\\delta > 0`.
 - :class:`HuntCrossley`: :math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` (Hunt & Crossley 1975, in the
@@ -49,15 +49,28 @@ class NormalLaw:
     name = "law"
 
     def force(self, delta: float, rate: float) -> float:
-        """:math:`f_n \\ge 0` [N] (zero for :math:`\\delta \\le 0`)."""
+        """:math:`f_n \\ge 0` [N] (zero for :math:`\\delta \\le 0`).
+
+        Args:
+            delta: Penetration :math:`\\delta` [m] (> 0: in contact).
+            rate: Its rate :math:`\\dot\\delta` [m/s] (> 0: pressing in).
+        """
         raise NotImplementedError
 
     def elastic(self, delta: float) -> float:
-        """The elastic part :math:`f_e(\\delta)` [N] (zero for :math:`\\delta \\le 0`)."""
+        """The elastic part :math:`f_e(\\delta)` [N] (zero for :math:`\\delta \\le 0`).
+
+        Args:
+            delta: Penetration :math:`\\delta` [m].
+        """
         raise NotImplementedError
 
     def potential(self, delta: float) -> float:
-        """Stored energy :math:`U(\\delta) = \\int_0^\\delta f_e` [J]."""
+        """Stored energy :math:`U(\\delta) = \\int_0^\\delta f_e` [J] (zero for :math:`\\delta \\le 0`).
+
+        Args:
+            delta: Penetration :math:`\\delta` [m].
+        """
         raise NotImplementedError
 
 
@@ -129,7 +142,15 @@ def make_normal_law(name: str, stiffness: float, damping: float | None, exponent
         stiffness: k [N/m, or N/m^n for hunt_crossley].
         damping: c [N s/m] (linear) or :math:`\\lambda` [N s/m^(n+1)] (hunt_crossley); ``None``: 0 (linear),
             :math:`1.5\\,\\alpha k` with :data:`HUNT_CROSSLEY_ALPHA` (hunt_crossley).
-        exponent: n of hunt_crossley (default :data:`HUNT_CROSSLEY_EXPONENT`).
+        exponent: n of hunt_crossley (>= 1; ``None``: :data:`HUNT_CROSSLEY_EXPONENT`); must be ``None`` for linear.
+        wheel: The wheel's name, for the error messages.
+
+    Returns:
+        A :class:`LinearContact` or a :class:`HuntCrossley`.
+
+    Raises:
+        InputError: an unknown law name, an exponent given to the linear law, or a stiffness that is not a finite
+            number > 0, a damping not >= 0, an exponent < 1 (one line naming the wheel).
     """
     try:
         if name == "linear":
@@ -188,14 +209,22 @@ class CompliantWheel(RollingWheel):
         return np.zeros(0)
 
     def penetration(self, kin: KinematicState) -> float:
-        """:math:`\\delta = -\\phi` [m] at the configuration of ``kin`` (> 0: in contact)."""
+        """:math:`\\delta = -\\phi` [m] at the configuration of ``kin`` (> 0: in contact).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` (its q is used).
+        """
         return -float(self._geometry(kin)[7])
 
     def state(self, kin: KinematicState) -> dict:
         """The contact at the state of ``kin``: ``delta``, ``rate`` [m/s], ``normal`` f_n [N], ``slip`` s (2,)
         [m/s], ``force`` (3,) in the contact frame (t1, t2, n) [N], ``E`` (3, 3), ``point`` p, ``Q`` (nv,) the
         generalised force, ``friction_power`` :math:`F_t\\cdot s` [W] (<= 0), ``damper_power``
-        :math:`-(f_n - f_e)\\dot\\delta` [W] (<= 0)."""
+        :math:`-(f_n - f_e)\\dot\\delta` [W] (<= 0).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (v: full velocities (nv,)).
+        """
         Aw, geo = self._world_jacobian(kin)
         E = geo[9]
         A = E.T @ Aw
@@ -215,7 +244,11 @@ class CompliantWheel(RollingWheel):
 
 
 def compliant_wheels(robot) -> list[CompliantWheel]:
-    """The robot's compliant wheels (empty: every wheel's normal contact is a constraint)."""
+    """The robot's compliant wheels (empty: every wheel's normal contact is a constraint).
+
+    Args:
+        robot: A :class:`~robotdyn.robot.Robot` (its ``constraints``, in their order).
+    """
     return [c for c in robot.constraints if isinstance(c, CompliantWheel)]
 
 
@@ -242,6 +275,20 @@ def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> C
     hunt_crossley the same deflection: :math:`k = (m g / n) / \\delta_0^{\\,n}`, damping
     :math:`1.5\\,\\alpha k`). The friction law (``friction`` = coulomb or linear, with its mu, slip_velocity,
     stiffness) acts on the wheel's tangential directions by kind; a support wheel is frictionless.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` under construction (description, mass, gravity and spec wheels
+            set: the default rule uses its weight and number of wheels).
+        w: The :class:`~robotdyn.robot.Wheel` declaration.
+        radius: The wheel's radius [m] (parameters resolved).
+        roller_angle: Omni wheels: the rollers' angle [rad] from the rolling direction (see
+            :class:`~robotdyn.robot.Wheel`); the friction law acts along (cos, sin) of it in (t1, t2). Unused for
+            other kinds.
+        **kwargs: axis, terrain, radius_joint, name: passed to :class:`CompliantWheel` (as
+            :class:`~robotdyn.constraints.rolling_contact.RollingWheel`).
+
+    Returns:
+        The :class:`CompliantWheel`.
 
     Raises:
         InputError: contact not rigid/compliant, a compliant wheel without a friction law (rolling while in

@@ -70,6 +70,7 @@ class WheelForce:
         point: (3,) the contact point in world coordinates [m].
         compliance: (3,) components rigid-body dynamics leave open and the rigid limit of the wheels' normal
             compliance fixes (:mod:`robotdyn.contact.rigid_limit`).
+        frame: (3, 3) the contact frame in world axes, columns (t1, t2, n) (``None``: not given).
     """
 
     name: str

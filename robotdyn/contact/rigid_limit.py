@@ -4,8 +4,8 @@ With the constraint rows :math:`A` (m rows, rank r < m) the multipliers of :math
 are :math:`\\lambda = \\lambda_0 + N z` for any z (N: the null space of :math:`A^T`, m x d): a rigid chassis on
 four wheels is statically indeterminate. Each wheel i has a normal (radial) stiffness :math:`k_i`
 (:mod:`robotdyn.contact.compliance`); the loads a stiff elastic chassis actually carries are the compatible ones,
-which minimise the complementary energy (Menabrea, Castigliano; ``shared/notes/indeterminate-loads-and-
-compliance.md``)
+which minimise the complementary energy (Menabrea, Castigliano: of all statically admissible loads, the
+compatible ones make the complementary energy stationary, a minimum for linear springs)
 
 .. math:: \\min_z \\sum_i \\frac{n_i(z)^2}{2 k_i} \\quad\\text{subject to}\\quad n_i(z) \\ge 0,
 

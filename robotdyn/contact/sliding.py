@@ -164,6 +164,9 @@ class SlidingState:
             compliant wheels' included.
         damper_power: Power of joint dampers and compliant contacts' damping [W] (<= 0;
             :mod:`robotdyn.contact.applied_forces`).
+        lam: (m,) every constraint row's multiplier [N, N m], in the order of ``reduced.jacobian_rows.labels``,
+            where the open loads are split by the rigid limit of the wheels' normal compliance; ``None`` otherwise.
+        unloaded: Names of the wheels the rigid limit leaves unloaded (they would pull); empty otherwise.
     """
 
     nudot: np.ndarray

@@ -431,7 +431,11 @@ class CompiledModel:
 
     def rigid_limit(self, on: bool = True) -> None:
         """Whether :meth:`forces` splits the open loads by the rigid limit of compliance (default) or returns the
-        basic solution (zero on redundant rows)."""
+        basic solution (zero on redundant rows).
+
+        Args:
+            on: ``True``: the rigid limit (:mod:`robotdyn.contact.rigid_limit`); ``False``: the basic solution.
+        """
         self.ev.set_rigid_limit(bool(on))
 
     def forces_at(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau: np.ndarray) -> tuple:

@@ -94,6 +94,15 @@ KEYS: dict[str, tuple[str, str, str]] = {
                                   "weight over its n wheels at 1 mm static deflection", "normal_stiffness = 2.0e5"),
     "wheels[].normal_damping": ("normal (radial) damping c [N s/m]", "2 * 0.3 * sqrt(k m / n): damping ratio 0.3 on "
                                 "the wheel's share of the mass", "normal_damping = 400.0"),
+    "wheels[].contact": ("rigid (the normal row is a constraint) | compliant (a force law of the penetration "
+                         "[m]: the wheel can fly and land; needs friction = coulomb or linear with slip = both, "
+                         "except a support, which is frictionless)", "rigid", 'contact = "compliant"'),
+    "wheels[].contact_law": ("a compliant wheel's normal force law: linear, f = k d + c d' [N] (k in N/m, c in "
+                             "N s/m) | hunt_crossley, f = d^n (k + lambda d') [N] (normal_stiffness k in N/m^n, "
+                             "normal_damping lambda in N s/m^(n+1)); only with contact = compliant", "linear",
+                             'contact_law = "hunt_crossley"'),
+    "wheels[].contact_exponent": ("hunt_crossley's exponent n (dimensionless); only with contact_law = "
+                                  "hunt_crossley", "1.5", "contact_exponent = 1.5"),
     "wheels[].slip": ("with a friction law: both directions, or lateral only (rolls along its rolling direction)",
                       "both", 'slip = "lateral"'),
     "closures": ("loop closures: two frames held together", "[]",
@@ -103,6 +112,17 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "closures[].frame2": ("the second frame", "required", 'frame2 = "link_b_end"'),
     "closures[].components": ("the closed components, a subset of x y z rx ry rz in frame1's axes", '"x y z"',
                               'components = "x z"'),
+    "springs": ("springs and dampers on joints: generalised force -k (q - rest) - c q' on the joint's "
+                "coordinate", "[]", '[[springs]]\njoint = "front_left_suspension"\nstiffness = 3.0e4'),
+    "springs[].name": ("the spring's name (messages, reports)", "the joint name", 'name = "front_left"'),
+    "springs[].joint": ("the moving (not locked) joint it acts on, one coordinate: revolute, continuous or "
+                        "prismatic; at most one spring per joint", "required", 'joint = "front_left_suspension"'),
+    "springs[].stiffness": ("stiffness k: N/m on a prismatic joint, N m/rad on a revolute one", "0",
+                            "stiffness = 3.0e4"),
+    "springs[].damping": ("damping c: N s/m on a prismatic joint, N m s/rad on a revolute one", "0",
+                          "damping = 3.0e3"),
+    "springs[].rest": ("rest position: the coordinate [m or rad] where the spring force is zero", "0",
+                       "rest = -0.05"),
     "motors": ("the actuated joints, in the order of the torques", "[]",
                '[[motors]]\nname = "tau_L"\njoint = "left_wheel_joint"'),
     "motors[].name": ("the motor's name (torque tables, CSV)", "the joint name", 'name = "tau_L"'),

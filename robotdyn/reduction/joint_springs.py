@@ -73,16 +73,29 @@ class SpringForce:
         self.rest = float(spec.rest)
 
     def force(self, q: np.ndarray, v: np.ndarray) -> float:
-        """:math:`-k(q_j - q_{j,0}) - c\\dot q_j` [N or N m]."""
+        """:math:`-k(q_j - q_{j,0}) - c\\dot q_j` [N or N m]: the generalised force on the joint's coordinate j.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] (entry :attr:`index` is used).
+            v: Full velocities (n,) [m/s, rad/s] (entry :attr:`index` is used).
+        """
         return -self.stiffness * (q[self.index] - self.rest) - self.damping * v[self.index]
 
     def potential(self, q: np.ndarray) -> float:
-        """Stored energy :math:`\\tfrac12 k (q_j - q_{j,0})^2` [J]."""
+        """Stored energy :math:`\\tfrac12 k (q_j - q_{j,0})^2` [J].
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] (entry :attr:`index` is used).
+        """
         d = q[self.index] - self.rest
         return 0.5 * self.stiffness * d * d
 
     def damper_power(self, v: np.ndarray) -> float:
-        """Power of the damper on the robot :math:`-c\\dot q_j^2` [W] (<= 0)."""
+        """Power of the damper on the robot :math:`-c\\dot q_j^2` [W] (<= 0).
+
+        Args:
+            v: Full velocities (n,) [m/s, rad/s] (entry :attr:`index` is used).
+        """
         return -self.damping * v[self.index] ** 2
 
     def __repr__(self) -> str:

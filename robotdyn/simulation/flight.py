@@ -54,21 +54,38 @@ def flight_events(robot, wheels, n: int) -> list[tuple]:
 
 def flight_phases(events: list[tuple], times: list, t_end: float) -> list[dict]:
     """``[{"t": s, "wheel": name, "event": "lift-off" | "touch-down"}, ...]`` in time order from the event
-    functions of :func:`flight_events` and the times solve_ivp found for each (``sol.t_events``)."""
+    functions of :func:`flight_events` and the times solve_ivp found for each (``sol.t_events``).
+
+    Args:
+        events: The ``(function, wheel name, kind)`` list of :func:`flight_events`.
+        times: For each event, in the same order, the times [s] it was found at (``sol.t_events``).
+        t_end: End time [s]: later events are dropped.
+    """
     out = [{"t": float(t), "wheel": name, "event": kind}
            for (_, name, kind), ts in zip(events, times) for t in ts if t <= t_end]
     return sorted(out, key=lambda e: e["t"])
 
 
 def airborne(robot, wheels, q: np.ndarray) -> list[str]:
-    """The names of ``wheels`` not touching the ground at q (penetration <= 0)."""
+    """The names of ``wheels`` not touching the ground at q (penetration <= 0).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        wheels: Its :class:`~robotdyn.contact.compliant_contact.CompliantWheel` list to check.
+        q: Natural coordinates (n,) [m, rad], in the robot's coordinate order.
+    """
     kin = KinematicState(robot.model, robot.data, np.asarray(q, float), np.zeros(robot.model.nv))
     return [w.name for w in wheels if w.penetration(kin) <= 0.0]
 
 
 def flight_summary(phases: list[dict], start: list[str] = ()) -> list[str]:
-    """One line per wheel with its lift-off and touch-down times [s] (``start``: the wheels in the air at the
-    start; empty without events)."""
+    """One line per wheel with its lift-off and touch-down times [s] (empty without events or wheels in the air
+    at the start).
+
+    Args:
+        phases: The time-ordered events of :func:`flight_phases`.
+        start: Names of the wheels in the air at the start (:func:`airborne` at q0; default none).
+    """
     wheels: dict[str, list[str]] = {name: ["in the air at the start"] for name in start}
     for e in phases:
         wheels.setdefault(e["wheel"], []).append(f"{e['event']} {e['t']:.6g} s")

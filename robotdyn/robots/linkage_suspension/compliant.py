@@ -62,6 +62,8 @@ def bump_run(robot: Robot, t_end: float = 1.5, rigid: Robot | None = None, speed
         t_end: Duration [s].
         rigid: The rigid rover whose posture starts the run (built here if None); a compliant rover starts at it,
             lowered by its wheels' static deflection (the weight shared by six wheels on their stiffness).
+        speed: The wheel speed [rad/s] the motors hold, also the initial independent wheel speeds (default: the
+            section 3 peak ``PEAK_SPEED``).
         **options: Passed to :func:`robotdyn.simulation.engine.simulate` (rtol, method, ...).
 
     Returns:

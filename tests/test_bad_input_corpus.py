@@ -642,7 +642,8 @@ dd_case("i24-links-3000", "links", urdf_text(extra="".join(
 # ----------------------------------------------------------- generated: every flag of every subcommand (item 7)
 GENERATED_ROBOT = {"impulse": "omni_caster", "ik": "adaptable_wheel", "list": None, "linkage-posture": None}
 """The robot each command's generated cases use (default quasimoro; None: the command takes none)."""
-GENERATED_BASE = {**REQUIRED, "ik": [], "sweep": ["--out", "{d}/s", "--workers", "0", "--quiet", "--no-plot"]}
+GENERATED_BASE = {**REQUIRED, "ik": [], "sweep": ["--out", "{d}/s", "--workers", "0", "--quiet", "--no-plot"],
+                  "optimise": ["--t-end", "3", "--nodes", "5", "--end", "x=0.1"]}
 """What each command needs besides the flag under test (so that a case fails for that flag only)."""
 FLAG_CASES: dict = {
     # flag: (the bad arguments, texts the one line may name: any one of them), for every command taking the flag
@@ -697,6 +698,12 @@ FLAG_CASES: dict = {
     "--states": (["--states", "nosuchstate"], ("nosuchstate",)),
     "--lqr-q": (["--lqr-q", "abc"], ("lqr",)),
     "--lqr-r": (["--lqr-r", "abc"], ("lqr",)),
+    "--nodes": (["--nodes", "1"], ("nodes",)),
+    "--q0": (["--q0", "abc"], ("--q0",)),
+    "--end": (["--end", "nosuch=1"], ("nosuch",)),
+    "--bound": (["--bound", "theta3=1:0"], ("--bound",)),
+    "--tau-max": (["--tau-max", "-1"], ("--tau-max",)),
+    "--derivatives": (["--derivatives", "bogus"], ("--derivatives",)),
 }
 FLAG_CASE_OVERRIDES: dict = {  # (command, flag): a different bad use where the generic one does not fit
     ("sweep", "--t-end"): (["--t-end", "nan"], ("t_end",)),
@@ -797,6 +804,7 @@ _SCHEMA_BASES = {  # a valid table to corrupt, for the tables that the skid-stee
     "closures": {"frame1": "front_axle", "frame2": "chassis"},
     "terrain": {"kind": "ramp"},
     "twist": {"frame": "chassis"},
+    "springs": {"joint": "front_left_spin", "stiffness": 1.0},
 }
 
 

@@ -145,6 +145,7 @@ def main() -> None:
     side_by_side_bench()
     startup_bench()
     compiled_engine_bench()
+    controller_bench()
     compiled_forces_bench()
     traction_bench()
     simulate_many_bench()
@@ -249,6 +250,38 @@ def compiled_engine_bench() -> None:
               f"{np.max(np.abs(traj.q - ref.q)):>17.2e} {np.max(np.abs(traj.nu - ref.nu)):>19.2e} {drift:>13.2e}")
 
 
+def controller_bench() -> None:
+    """The built-in controller scenarios (robotdyn.simulation.feedback: feedback laws as data) on the compiled loop
+    against the same law on the scipy loop, at each scenario's tolerances: cost per simulated second (whole
+    simulate() calls, best of 3; scipy best of 1, after a warm-up), speed-up and the final states' difference.
+    Controllers still given as Python callables run on scipy only and are listed as such."""
+    rows = [("linkage_suspension", "straight_line", None), ("linkage_suspension", "pivot_steering", None),
+            ("linkage_suspension", "bump", None), ("omni_caster", "circle", 20.0)]
+    print("\ncontroller scenarios, compiled loop vs scipy loop (the same law), whole simulate() call:")
+    print(f"{'robot / scenario':<36} {'sim [s]':>8} {'scipy ms/s':>11} {'compiled ms/s':>14} {'speed-up':>9} "
+          f"{'max|dy(t_end)|':>15}")
+    for name, sc_name, t_end in rows:
+        robot = robotdyn.load(name)
+        sc = module(name).SCENARIOS[sc_name]
+        t_end = sc.t_end if t_end is None else t_end
+        sc.run(robot, t_end=0.1, progress=False)  # warm: imports, the compiled model, the projection
+        walls = {}
+        for engine, repeat in (("scipy", 1), ("auto", 3)):
+            best = np.inf
+            for _ in range(repeat):
+                start = time.perf_counter()
+                traj = sc.run(robot, t_end=t_end, progress=False, engine=engine)
+                best = min(best, time.perf_counter() - start)
+            walls[engine] = (best, traj)
+        (ws, ref), (wc, fast) = walls["scipy"], walls["auto"]
+        assert fast.stats["engine"].startswith("compiled"), fast.stats["engine"]
+        dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
+        print(f"{name + ' / ' + sc_name:<36} {t_end:>8.1f} {1e3 * ws / t_end:>11.2f} {1e3 * wc / t_end:>14.3f} "
+              f"{ws / wc:>8.1f}x {dev:>15.2e}")
+    print("  still Python callables (scipy only): mmr12_eod orientation/straight/sinusoid/manipulation/lifting "
+          "(task-space linearising control), omni_caster ellipse (tangent heading: u'' not polynomial in t)")
+
+
 def compiled_forces_bench() -> None:
     """Constraint forces in the compiled evaluation (CompiledModel.forces: forward dynamics, lambda on the
     projection's rows by the LU factors of A_d, per-wheel contact-frame forces) against the compiled evaluation
@@ -326,4 +359,7 @@ def simulate_many_bench(runs: int = 10_000) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["controllers"]:  # only this section: python bench/bench.py controllers
+        controller_bench()
+    else:
+        main()

@@ -31,6 +31,7 @@ from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import lift_off_message, slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
 from .progress import Progress
+from .feedback import FeedbackLaw
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
 
@@ -146,6 +147,8 @@ def simulate(
     nu0 = robot.check_nu(nu0)
     if isinstance(torque, TorqueProfile):
         as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
+    if isinstance(torque, FeedbackLaw):
+        torque = torque.bound(robot)  # one line if it does not fit the robot; its model is the robot simulated
     if not t0:  # a continuation starts where the earlier run ended (its drift is reported, not refused)
         robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
@@ -219,7 +222,7 @@ def simulate(
     interrupted = None
     rhs = _timed(rhs)
     if events is None:
-        breaks = torque.breakpoints() if isinstance(torque, TorqueProfile) else ()
+        breaks = torque.breakpoints() if isinstance(torque, (TorqueProfile, FeedbackLaw)) else ()
         sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks, t0)
     else:
         sol = solve_ivp(rhs, (t0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)

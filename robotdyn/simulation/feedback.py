@@ -101,7 +101,7 @@ class FeedbackLaw:
                                 ("K_nu", None if self.Knu is None else self.Knu.shape, (m, k)),
                                 ("reference accelerations", self.acceleration and self.acceleration.motors, k)):
             if got is not None and got != want:
-                raise InputError(f"feedback law: {what} of size {got}; the robot {robot.name!r} expects {want} "
+                raise InputError(f"feedback law: {what} of size {got}; the robot {robot.spec.name!r} expects {want} "
                                  f"({m} motors, {n} coordinates, {k} independent velocities)")
 
     def bound(self, robot) -> FeedbackLaw:

@@ -9,7 +9,7 @@ motors [N m or N] times a scalar function of time:
 - :class:`Sine`: :math:`\\tau = c \\sin(\\omega t + \\varphi)` inside a window :math:`t_0 \\le t \\le t_1`, zero
   outside (e.g. Staicu's Quasimoro pulse, eq 19: :math:`0.1 \\sin(\\pi t)` for :math:`t \\le 1` s);
 - :class:`Table`: piecewise-linear interpolation of values at increasing times, held constant outside them;
-- :class:`Polynomial`: :math:`\tau = c_0 + c_1 t + \dots + c_d t^d` inside a window, zero outside (Horner's
+- :class:`Polynomial`: :math:`\\tau = c_0 + c_1 t + \\dots + c_d t^d` inside a window, zero outside (Horner's
   scheme on both sides);
 - sums of these (``a + b``, or :class:`Sum`).
 
@@ -254,7 +254,7 @@ class Table(TorqueProfile):
 
 
 class Polynomial(TorqueProfile):
-    """:math:`\tau = c_0 + c_1 t + \dots + c_d t^d` for ``start <= t <= stop`` [s], zero outside (e.g. a quintic
+    """:math:`\\tau = c_0 + c_1 t + \\dots + c_d t^d` for ``start <= t <= stop`` [s], zero outside (e.g. a quintic
     rest-to-rest reference and its derivatives).
 
     Args:

@@ -278,6 +278,29 @@ def controller_bench() -> None:
         dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
         print(f"{name + ' / ' + sc_name:<36} {t_end:>8.1f} {1e3 * ws / t_end:>11.2f} {1e3 * wc / t_end:>14.3f} "
               f"{ws / wc:>8.1f}x {dev:>15.2e}")
+    robot = robotdyn.load("quasimoro")  # the LQR of examples/quasimoro_lqr.py as data (lqr_law), 10 s
+    from robotdyn.reduction.linearization import linearize, lqr
+    from robotdyn.simulation.engine import simulate
+    from robotdyn.simulation.feedback import lqr_law
+
+    q0 = robot.neutral()
+    model = linearize(robot, q0, np.zeros(3), np.zeros(2)).restrict(["theta3", "theta1_dot", "theta2_dot",
+                                                                      "theta3_dot"])
+    law = lqr_law(model, lqr(model, np.eye(4), np.eye(2))[0])
+    start_q = q0.copy()
+    start_q[robot.coordinate_index("theta3")] += 0.1
+    walls = {}
+    for engine, repeat in (("scipy", 1), ("auto", 3)):
+        best = np.inf
+        for _ in range(repeat):
+            start = time.perf_counter()
+            traj = simulate(robot, 10.0, start_q, np.zeros(3), law, n_out=101, progress=False, engine=engine)
+            best = min(best, time.perf_counter() - start)
+        walls[engine] = (best, traj)
+    (ws, ref), (wc, fast) = walls["scipy"], walls["auto"]
+    dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
+    print(f"{'quasimoro / LQR (lqr_law)':<36} {10.0:>8.1f} {1e3 * ws / 10:>11.2f} {1e3 * wc / 10:>14.3f} "
+          f"{ws / wc:>8.1f}x {dev:>15.2e}")
     print("  still Python callables (scipy only): mmr12_eod orientation/straight/sinusoid/manipulation/lifting "
           "(task-space linearising control), omni_caster ellipse (tangent heading: u'' not polynomial in t)")
 

@@ -177,3 +177,14 @@ def test_engine_choice_for_laws_and_one_line_errors():
         FeedbackLaw(nu_ref=Constant([0.0, 0.0, 0.0]))
     with pytest.raises(InputError, match="needs a robot"):
         FeedbackLaw(acceleration=Constant([0.0, 0.0, 0.0]))(0.0, robot.neutral(), np.zeros(3))
+
+
+def test_windows_meeting_one_double_apart_make_one_breakpoint():
+    """The linkage reference's windows meet one double apart: the law has one breakpoint per kink (0.2, 1.2, 3.2,
+    4.2 s), so that no integrator is asked for a one-ulp step there (dopri5 failed at t = 1.2 s before)."""
+    lk = module("linkage_suspension")
+    law = lk.SCENARIOS["straight_line"].torque
+    assert law.breakpoints().tolist() == list(lk.PROFILE[:4])
+    robot = robotdyn.load("linkage_suspension")
+    traj = lk.SCENARIOS["straight_line"].run(robot, t_end=1.5, n_out=4, progress=False, method="dopri5")
+    assert traj.stats["engine"] == "compiled (dopri5)" and traj.t[-1] == 1.5

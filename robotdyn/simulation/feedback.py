@@ -163,7 +163,11 @@ class FeedbackLaw:
         for p in (self.feedforward, self.q_ref, self.nu_ref, self.acceleration):
             if p is not None:
                 points.update(map(float, p.breakpoints()))
-        return np.array(sorted(points), float)
+        out = []
+        for b in sorted(points):  # one breakpoint for windows that meet a few doubles apart (no 1-ulp steps)
+            if not out or b - out[-1] > 16 * np.finfo(float).eps * max(1.0, abs(b)):
+                out.append(b)
+        return np.array(out, float)
 
     def native(self, robot):
         """The C++ twin (``robotdyn._compiled.Controller``, ``robotdyn/_controller.hpp``) for ``robot``.

@@ -419,7 +419,8 @@ class Evaluator {
     if (alpha != 0.0) pull_back(alpha, out);
     if (controller_) {  // a feedback law (robotdyn/_controller.hpp): the torques at this state, not the profile's
       control_tau_.resize(Br_.cols());
-      controller_->eval(control_t_, q, nu, Mr_, hr_, Br_, control_tau_);
+      controller_->eval(control_t_, q, nu, Mr_, hr_, Br_, S_, w_, v_, [this](int f) { return frame_kinematics(f); },
+                        control_tau_);
       force_.noalias() = Br_ * control_tau_;
     } else {
       force_.noalias() = Br_ * tau;
@@ -557,7 +558,22 @@ class Evaluator {
     dynamics(nu);
     robotdyn::Controller law = c;
     VectorXd out(Br_.cols());
-    law.eval(t, q, nu, Mr_, hr_, Br_, out);
+    law.eval(t, q, nu, Mr_, hr_, Br_, S_, w_, v_, [this](int f) { return frame_kinematics(f); }, out);
+    return out;
+  }
+
+  // Frame f (add_frame's index) at the evaluated state, for a linearising law's point tasks: its placement, its
+  // LOCAL_WORLD_ALIGNED Jacobian and its classical acceleration at zero joint acceleration (dynamics' RNEA pass).
+  robotdyn::FrameKinematics frame_kinematics(int f) {
+    if (f < 0 || f >= static_cast<int>(frames_.size())) throw std::invalid_argument("no such frame");
+    const auto fid = static_cast<pin::FrameIndex>(frames_[f]);
+    robotdyn::FrameKinematics out;
+    out.R = data_.oMf[fid].rotation();
+    out.p = data_.oMf[fid].translation();
+    out.J = &Jf_[f];
+    const pin::Motion acc = pin::getFrameClassicalAcceleration(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
+    out.a = acc.linear();
+    out.alpha = acc.angular();
     return out;
   }
 
@@ -1529,7 +1545,31 @@ PYBIND11_MODULE(_compiled, m) {
                     const MatrixXd&, const robotdyn::TorqueProfile*, const robotdyn::TorqueProfile*>(),
            py::arg("motors"), py::arg("n"), py::arg("k"), py::arg("feedforward").none(true), py::arg("Kq"),
            py::arg("q_ref").none(true), py::arg("Knu"), py::arg("nu_ref").none(true),
-           py::arg("acceleration").none(true));
+           py::arg("acceleration").none(true))
+      .def("set_linearising",
+           [](robotdyn::Controller& c, double kp, double kd, double damping, const std::vector<int>& controlled,
+              const py::list& tasks, const py::list& secondary) {
+             auto read = [](const py::list& items) {
+               std::vector<robotdyn::Task> out;
+               for (const py::handle& item : items) {
+                 const py::tuple tp = item.cast<py::tuple>();
+                 robotdyn::Task task;
+                 task.kind = tp[0].cast<int>();
+                 task.frame = tp[1].cast<int>();
+                 task.offset = tp[2].cast<Vector3d>();
+                 task.select = tp[3].cast<std::vector<int>>();
+                 task.y = std::make_shared<robotdyn::TorqueProfile>(tp[4].cast<const robotdyn::TorqueProfile&>());
+                 task.yd = std::make_shared<robotdyn::TorqueProfile>(tp[5].cast<const robotdyn::TorqueProfile&>());
+                 task.ydd = std::make_shared<robotdyn::TorqueProfile>(tp[6].cast<const robotdyn::TorqueProfile&>());
+                 for (const auto& p : {task.y, task.yd, task.ydd})
+                   if (p->motors() != task.dim()) throw std::invalid_argument("a task's reference has the wrong width");
+                 out.push_back(std::move(task));
+               }
+               return out;
+             };
+             c.set_linearising(robotdyn::Linearising(kp, kd, damping, controlled, read(tasks), read(secondary)));
+           },
+           "add the input-output linearising law (robotdyn.simulation.control.LinearisingController)");
   py::class_<robotdyn::TorqueProfile>(m, "TorqueProfile",
                                       "motor torques as data (robotdyn.torque_profile): sum of constant, sine, table terms")
       .def(py::init<int, const std::vector<int>&, const std::vector<MatrixXd>&, const std::vector<std::vector<double>>&>())

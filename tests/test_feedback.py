@@ -189,3 +189,54 @@ def test_windows_meeting_one_double_apart_make_one_breakpoint():
     robot = robotdyn.load("linkage_suspension")
     traj = lk.SCENARIOS["straight_line"].run(robot, t_end=1.5, n_out=4, progress=False, method="dopri5")
     assert traj.stats["engine"] == "compiled (dopri5)" and traj.t[-1] == 1.5
+
+
+# ------------------------------------------------------------------ the linearising controller on the compiled loop
+@pytest.mark.parametrize("name", ["orientation", "straight", "sinusoid"])
+def test_table4_references_as_data_are_the_closed_forms(name):
+    """MMR12-EOD's Table 4 references (sines and polynomials) equal the printed closed forms to 1e-13."""
+    ref = module("mmr12_eod").table4_reference(name)
+    L, w = module("mmr12_eod").LOOK_AHEAD, 0.5
+    for t in np.linspace(0.0, 200.0, 41):
+        if name == "orientation":
+            want = (L * np.array([np.cos(w * t), np.sin(w * t)]), L * w * np.array([-np.sin(w * t), np.cos(w * t)]),
+                    -L * w**2 * np.array([np.cos(w * t), np.sin(w * t)]))
+        elif name == "straight":
+            want = (np.array([30.0, t]), np.array([0.0, 1.0]), np.zeros(2))
+        else:
+            want = (np.array([40 * np.cos(0.25 * t) + 2.5 * t, 30 * np.sin(0.25 * t)]),
+                    np.array([-10 * np.sin(0.25 * t) + 2.5, 7.5 * np.cos(0.25 * t)]),
+                    np.array([-2.5 * np.cos(0.25 * t), -1.875 * np.sin(0.25 * t)]))
+        for got, exp in zip(ref(t), want):
+            assert np.allclose(got, exp, rtol=0, atol=1e-13 * max(1.0, t))
+
+
+def test_cpp_linearising_controller_equals_python_at_states_along_a_run():
+    """The C++ Linearising law (point task with an offset, coordinate hold task, null-space damping, computed
+    torque) gives LinearisingController.command's torques to 1e-12 (relative) at states along the sinusoid run,
+    with random velocities."""
+    mm = module("mmr12_eod")
+    robot = robotdyn.load("mmr12_eod")
+    sc = mm.SCENARIOS["sinusoid"]
+    run_robot, ctrl = sc.prepare(robot)
+    traj = sc.run(robot, t_end=2.0, n_out=5, progress=False)
+    fast = compiled_model(run_robot)
+    native = ctrl.native_controller(run_robot, fast)
+    rng = np.random.default_rng(5)
+    for t, q in zip(traj.t, traj.q):
+        nu = 0.3 * rng.normal(size=run_robot.mobility)
+        want = ctrl.command(t, q, nu)[1]
+        got = np.asarray(fast.ev.control_torque(native, t, q, nu))
+        assert np.abs(got - want).max() <= 1e-12 * max(1.0, np.abs(want).max())
+
+
+@pytest.mark.parametrize("name", ["orientation", "sinusoid"])
+def test_mmr12_platform_scenarios_run_compiled_and_end_where_scipy_ends(name):
+    """Table 4 tasks over 20 s at the scenario's tolerances (rtol 1e-8, atol 1e-10): compiled under auto, and the
+    final states within 1e-5 of the scipy run's (the tracking error is what the paper plots)."""
+    robot = robotdyn.load("mmr12_eod")
+    sc = module("mmr12_eod").SCENARIOS[name]
+    fast = sc.run(robot, t_end=20.0, n_out=21, progress=False)
+    ref = sc.run(robot, t_end=20.0, n_out=21, progress=False, engine="scipy")
+    assert fast.stats["engine"].startswith("compiled") and ref.stats["engine"].startswith("scipy")
+    assert np.abs(fast.q[-1] - ref.q[-1]).max() <= 1e-5 and np.abs(fast.nu[-1] - ref.nu[-1]).max() <= 1e-5

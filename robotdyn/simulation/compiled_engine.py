@@ -105,7 +105,7 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     breaks = sorted(b for b in points if t0 < b < t_end)
     n = robot.nq
     rechoose = rechooser(robot, fast)
-    fast.ev.set_controller(None if controller is None else controller.native(robot))
+    fast.ev.set_controller(None if controller is None else controller.native_controller(robot, fast))
     try:
         out = fast.ev.simulate(q0, nu0, float(t0), float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
                                native, breaks, method, progress, rechoose)
@@ -135,6 +135,18 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     return {"t": out["t"], "y": out["y"], "energy": out["energy"], "residual": out["residual"],
             "nfev": int(out["nfev"]), "steps": int(out["steps"]), "interrupted": interrupted,
             "event": (t_stop, np.asarray(out["y_stop"])) if out["event"] else None}
+
+
+def as_data(torque):
+    """``torque`` if it is a closed loop given as data (a :class:`~robotdyn.simulation.feedback.FeedbackLaw`, or a
+    controller whose ``compiled_form()`` says so, e.g. a
+    :class:`~robotdyn.simulation.control.LinearisingController` on profile references), else None.
+
+    Args:
+        torque: The torque law.
+    """
+    form = getattr(torque, "compiled_form", None)
+    return torque if callable(form) and callable(getattr(torque, "native_controller", None)) and form() else None
 
 
 def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
@@ -173,9 +185,9 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
                                                    "use_compiled(False))")
     elif fast.slip_refusal is not None:
         reason = fast.slip_refusal
-    elif isinstance(torque, FeedbackLaw) and slipping_wheels(robot):
+    elif as_data(torque) is not None and slipping_wheels(robot):
         reason = "feedback laws on robots with slipping wheels are simulated on the Python path"
-    elif torque is not None and not isinstance(torque, (TorqueProfile, FeedbackLaw)):
+    elif torque is not None and not isinstance(torque, TorqueProfile) and as_data(torque) is None:
         reason = ("the torques are a Python function; give a robotdyn.simulation.torque_profile.TorqueProfile (constant, sine, "
                   "table, polynomial) or a robotdyn.simulation.feedback.FeedbackLaw to run them compiled")
     if reason is not None and engine == "compiled":
@@ -209,7 +221,7 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
         times: Output times [s] (increasing, t0 to t_end; default ``None``: ``n_out`` evenly spaced).
     """
 
-    law = torque.bound(robot) if isinstance(torque, FeedbackLaw) else None
+    law = torque.bound(robot) if isinstance(torque, FeedbackLaw) else as_data(torque)
     profile = Constant(np.zeros(len(robot.motors))) if law is not None else as_profile(torque, len(robot.motors))
     tau0 = law(t0, q0, nu0) if law is not None else profile(t0)
     robot.forward_dynamics(q0, nu0, tau0)  # regular where the run starts (raises the Python path's error)

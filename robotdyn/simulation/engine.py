@@ -22,7 +22,7 @@ import numpy as np
 
 from ..fast.compiled import Fallback
 from ..fast.dispatch import compiled_model
-from .compiled_engine import METHODS, at_time, choose_engine, simulate_compiled
+from .compiled_engine import METHODS, as_data, at_time, choose_engine, simulate_compiled
 from ..errors import ConstraintError, NonFiniteError, RobotDynError
 from ..reduction.projection import solve
 from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
@@ -222,7 +222,8 @@ def simulate(
     interrupted = None
     rhs = _timed(rhs)
     if events is None:
-        breaks = torque.breakpoints() if isinstance(torque, (TorqueProfile, FeedbackLaw)) else ()
+        data = isinstance(torque, (TorqueProfile, FeedbackLaw)) or as_data(torque) is not None
+        breaks = torque.breakpoints() if data else ()
         sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks, t0)
     else:
         sol = solve_ivp(rhs, (t0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)

@@ -33,6 +33,19 @@ from ..errors import InputError
 from .torque_profile import TorqueProfile
 
 
+def native_profile(p: TorqueProfile):
+    """The C++ object of a profile (``robotdyn._compiled.TorqueProfile``), as
+    :func:`robotdyn.simulation.compiled_engine.native_profile`.
+
+    Args:
+        p: The :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (any width).
+    """
+    from .._compiled import TorqueProfile as Native
+
+    kinds, coefs, pars = p.encode()
+    return Native(p.motors, kinds, [np.atleast_2d(c) for c in coefs], [q.tolist() for q in pars])
+
+
 def _gain(K, what: str) -> np.ndarray | None:
     if K is None:
         return None
@@ -176,18 +189,26 @@ class FeedbackLaw:
             robot: The :class:`~robotdyn.robot.Robot` (its dimensions; checked).
         """
         self.check(robot)
-        from .._compiled import Controller, TorqueProfile as Native
+        from .._compiled import Controller
 
-        def nat(p):  # as robotdyn.simulation.compiled_engine.native_profile
-            if p is None:
-                return None
-            kinds, coefs, pars = p.encode()
-            return Native(p.motors, kinds, [np.atleast_2d(c) for c in coefs], [q.tolist() for q in pars])
-
+        nat = lambda p: None if p is None else native_profile(p)  # noqa: E731
         empty = np.zeros((0, 0))
         return Controller(len(robot.motors), robot.nq, robot.mobility, nat(self.feedforward),
                           empty if self.Kq is None else self.Kq, nat(self.q_ref),
                           empty if self.Knu is None else self.Knu, nat(self.nu_ref), nat(self.acceleration))
+
+    def native_controller(self, robot, fast=None):
+        """:meth:`native` (the compiled engine's entry point for every law given as data).
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot`.
+            fast: Its compiled model (unused).
+        """
+        return self.native(robot)
+
+    def compiled_form(self) -> bool:
+        """Always True: every feedback law runs on the compiled engine."""
+        return True
 
     def __repr__(self) -> str:
         parts = [name for name, v in (("feedforward", self.feedforward), ("Kq", self.Kq), ("Knu", self.Knu),

@@ -22,7 +22,6 @@ sec 2.11 e and the climbing posture's contact forces on a ramp (:func:`climbing_
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
 
 import numpy as np
 
@@ -147,33 +146,39 @@ def _quintic(t: float, T: float, a, b) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return a + (b - a) * p, (b - a) * dp, (b - a) * ddp
 
 
-def table4_reference(name: str, omega: float = 0.5) -> Callable:
-    """Table 4's platform references as t -> (p_d, p_d', p_d'') of the controlled point [m]:
-    ``orientation`` (turning about the centre x = y = 0: P on a circle of radius LOOK_AHEAD at omega rad/s),
-    ``straight`` (x = 30, y = t), ``sinusoid`` (x = 40 cos 0.25t + 2.5t, y = 30 sin 0.25t).
+def table4_reference(name: str, omega: float = 0.5):
+    """Table 4's platform references as t -> (p_d, p_d', p_d'') of the controlled point [m], given as data
+    (:class:`~robotdyn.simulation.control.ProfileReference`: sines and polynomials of t, so that the controller
+    runs on the compiled engine): ``orientation`` (turning about the centre x = y = 0: P on a circle of radius
+    LOOK_AHEAD at omega rad/s), ``straight`` (x = 30, y = t), ``sinusoid`` (x = 40 cos 0.25t + 2.5t,
+    y = 30 sin 0.25t).
 
     Args:
         name: ``orientation``, ``straight`` or ``sinusoid``.
         omega: Turning rate of the orientation task [rad/s].
     """
-    L = LOOK_AHEAD
+    from ...simulation.control import ProfileReference
+    from ...simulation.torque_profile import Constant, Polynomial, Sine
+
+    L, c = LOOK_AHEAD, np.pi / 2  # cos(x) = sin(x + pi/2)
+    x, y = np.array([1.0, 0.0]), np.array([0.0, 1.0])
     if name == "orientation":
-        return lambda t: (L * np.array([np.cos(omega * t), np.sin(omega * t)]),
-                          L * omega * np.array([-np.sin(omega * t), np.cos(omega * t)]),
-                          -L * omega**2 * np.array([np.cos(omega * t), np.sin(omega * t)]))
+        return ProfileReference(Sine(L * x, omega, c) + Sine(L * y, omega),
+                                Sine(-L * omega * x, omega) + Sine(L * omega * y, omega, c),
+                                Sine(-L * omega**2 * x, omega, c) + Sine(-L * omega**2 * y, omega))
     if name == "straight":
-        return lambda t: (np.array([30.0, t]), np.array([0.0, 1.0]), np.zeros(2))
+        return ProfileReference(Polynomial([[30.0, 0.0], [0.0, 1.0]]), Constant([0.0, 1.0]), Constant([0.0, 0.0]))
     if name == "sinusoid":
-        return lambda t: (np.array([40 * np.cos(0.25 * t) + 2.5 * t, 30 * np.sin(0.25 * t)]),
-                          np.array([-10 * np.sin(0.25 * t) + 2.5, 7.5 * np.cos(0.25 * t)]),
-                          np.array([-2.5 * np.cos(0.25 * t), -1.875 * np.sin(0.25 * t)]))
+        return ProfileReference(Sine(40 * x, 0.25, c) + Sine(30 * y, 0.25) + Polynomial([[0.0, 0.0], [2.5, 0.0]]),
+                                Sine(-10 * x, 0.25) + Sine(7.5 * y, 0.25, c) + Constant([2.5, 0.0]),
+                                Sine(-2.5 * x, 0.25, c) + Sine(-1.875 * y, 0.25))
     raise InputError(f"unknown Table 4 trajectory {name!r}; expected orientation, straight or sinusoid")
 
 
 def _hold_task(robot: Robot, labels, q0):
-    from ...simulation.control import CoordinateTask, hold
+    from ...simulation.control import CoordinateTask, hold_data
 
-    return CoordinateTask(list(labels), hold([q0[robot.coordinate_index(c)] for c in labels]))
+    return CoordinateTask(list(labels), hold_data([q0[robot.coordinate_index(c)] for c in labels]))
 
 
 def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):

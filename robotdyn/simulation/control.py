@@ -54,7 +54,9 @@ class ProfileReference:
     ``robotdyn/_controller.hpp``, ``Linearising``).
 
     Attributes:
-        value: y_d(t) [m or rad]. rate: y_d'(t) [per s]. acceleration: y_d''(t) [per s^2].
+        value: y_d(t) [m or rad].
+        rate: y_d'(t) [per s].
+        acceleration: y_d''(t) [per s^2].
     """
 
     value: object

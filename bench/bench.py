@@ -257,7 +257,7 @@ def controller_bench() -> None:
     Controllers still given as Python callables run on scipy only and are listed as such."""
     rows = [("linkage_suspension", "straight_line", None), ("linkage_suspension", "pivot_steering", None),
             ("linkage_suspension", "bump", None), ("omni_caster", "circle", 20.0), ("mmr12_eod", "orientation", 50.0),
-            ("mmr12_eod", "sinusoid", 50.0)]
+            ("mmr12_eod", "sinusoid", 50.0), ("mmr12_eod", "manipulation", None), ("mmr12_eod", "lifting", None)]
     print("\ncontroller scenarios, compiled loop vs scipy loop (the same law), whole simulate() call:")
     print(f"{'robot / scenario':<36} {'sim [s]':>8} {'scipy ms/s':>11} {'compiled ms/s':>14} {'speed-up':>9} "
           f"{'max|dy(t_end)|':>15} {'evals scipy/compiled':>21}")
@@ -314,8 +314,8 @@ def controller_bench() -> None:
           "are bound by the evaluation, not by Python; compiled Adams steps onto each of the scenario's 400 samples "
           "per second (3,700 evaluations where DOP853 interpolates with 1,650); with 11 samples it needs half "
           "DOP853's")
-    print("  still Python callables (scipy only): mmr12_eod manipulation and lifting (quintic references not yet "
-          "given as data), omni_caster ellipse (tangent heading: u'' not polynomial in t)")
+    print("  still a Python callable (scipy only): omni_caster ellipse (tangent heading: u'' is not a polynomial or "
+          "sine of t)")
 
 
 def compiled_forces_bench() -> None:

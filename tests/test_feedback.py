@@ -240,3 +240,36 @@ def test_mmr12_platform_scenarios_run_compiled_and_end_where_scipy_ends(name):
     ref = sc.run(robot, t_end=20.0, n_out=21, progress=False, engine="scipy")
     assert fast.stats["engine"].startswith("compiled") and ref.stats["engine"].startswith("scipy")
     assert np.abs(fast.q[-1] - ref.q[-1]).max() <= 1e-5 and np.abs(fast.nu[-1] - ref.nu[-1]).max() <= 1e-5
+
+
+def test_quintic_reference_as_data_is_the_quintic():
+    """MMR12-EOD's rest-to-rest quintic as data equals _quintic (value, rate, acceleration) to 1e-13, before, inside
+    and after the motion."""
+    from robotdyn.robots.mmr12_eod.model import _quintic as quintic
+
+    mm = module("mmr12_eod")
+    a, b, T = np.array([0.3, -1.0]), np.array([2.0, 0.5]), 5.0
+    ref = mm.quintic_reference(T, a, b)
+    for t in [*np.linspace(0.0, 7.0, 57), T]:
+        for got, exp in zip(ref(t), quintic(t, T, a, b)):
+            assert np.allclose(got, exp, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("name, t_end", [("manipulation", 12.0), ("lifting", 6.0)])
+def test_mmr12_quintic_scenarios_run_compiled_and_end_where_scipy_ends(name, t_end):
+    """The manipulation (secondary posture task) and lifting (underactuated: x, y, psi free) scenarios run compiled,
+    their C++ torques equal the Python controller's to 1e-12 along the run, and the final states are within 1e-5 of
+    the scipy run's."""
+    robot = robotdyn.load("mmr12_eod")
+    sc = module("mmr12_eod").SCENARIOS[name]
+    fast = sc.run(robot, t_end=t_end, n_out=7, progress=False)
+    ref = sc.run(robot, t_end=t_end, n_out=7, progress=False, engine="scipy")
+    assert fast.stats["engine"].startswith("compiled") and ref.stats["engine"].startswith("scipy")
+    assert np.abs(fast.q[-1] - ref.q[-1]).max() <= 1e-5 and np.abs(fast.nu[-1] - ref.nu[-1]).max() <= 1e-5
+    run_robot, ctrl = fast.stats["robot"], fast.stats["controller"]
+    comp = compiled_model(run_robot)
+    native = ctrl.native_controller(run_robot, comp)
+    for t, q, nu in zip(fast.t, fast.q, fast.nu):
+        want = ctrl.command(t, q, nu)[1]
+        got = np.asarray(comp.ev.control_torque(native, t, q, nu))
+        assert np.abs(got - want).max() <= 1e-12 * max(1.0, np.abs(want).max())

@@ -146,6 +146,27 @@ def _quintic(t: float, T: float, a, b) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return a + (b - a) * p, (b - a) * dp, (b - a) * ddp
 
 
+def quintic_reference(T: float, a, b):
+    """:func:`_quintic` as data (:class:`~robotdyn.simulation.control.ProfileReference`): the rest-to-rest quintic
+    a + (b - a)(10 s^3 - 15 s^4 + 6 s^5), s = t / T, as polynomials of t on [0, T] (rate and acceleration too),
+    then b held (a window starting one double after T).
+
+    Args:
+        T: Duration [s].
+        a, b: Start and end values (same shape).
+    """
+    from ...simulation.control import ProfileReference
+    from ...simulation.torque_profile import Polynomial, Sine
+
+    a, b = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
+    d, z = b - a, np.zeros_like(a)
+    after = float(np.nextafter(T, np.inf))
+    value = Polynomial([a, z, z, 10 * d / T**3, -15 * d / T**4, 6 * d / T**5], 0.0, T) + Sine(b, 0.0, np.pi / 2, after)
+    rate = Polynomial([z, z, 30 * d / T**3, -60 * d / T**4, 30 * d / T**5], 0.0, T)
+    acceleration = Polynomial([z, 60 * d / T**3, -180 * d / T**4, 120 * d / T**5], 0.0, T)
+    return ProfileReference(value, rate, acceleration)
+
+
 def table4_reference(name: str, omega: float = 0.5):
     """Table 4's platform references as t -> (p_d, p_d', p_d'') of the controlled point [m], given as data
     (:class:`~robotdyn.simulation.control.ProfileReference`: sines and polynomials of t, so that the controller
@@ -259,8 +280,8 @@ def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float
         raise InputError(f"manipulation target {MANIPULATION_TARGET.tolist()} not reachable (IK error {goal.error:.3g} m)")
     arm = list(MANIPULATOR[:3])
     idx = [robot.coordinate_index(c) for c in arm]
-    ref = lambda t: _quintic(t, T, start, MANIPULATION_TARGET)  # noqa: E731
-    posture = lambda t: _quintic(t, T, q0[idx], goal.q[idx])  # noqa: E731
+    ref = quintic_reference(T, start, MANIPULATION_TARGET)
+    posture = quintic_reference(T, q0[idx], goal.q[idx])
     held = [*(f"theta_C{i}" for i in _ARMS), "theta4", *LOAD]
     return LinearisingController(robot, [PointTask("E", ref), _hold_task(robot, held, q0)],
                                  secondary=[CoordinateTask(arm, posture)], **GAINS)
@@ -347,7 +368,7 @@ def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
 
     q0 = lifting_initial(robot)[0]
     th0 = contact_angle(robot.params)
-    tasks = [CoordinateTask(["theta_C1"], lambda t: _quintic(t, T, th0, end)),
+    tasks = [CoordinateTask(["theta_C1"], quintic_reference(T, th0, end)),
              _hold_task(robot, [*MANIPULATOR, *LOAD, "theta_R", "theta_L"], q0)]
     return LinearisingController(robot, tasks, controlled=["theta_R", "theta_L", "theta_C1", *MANIPULATOR, *LOAD],
                                  **GAINS)

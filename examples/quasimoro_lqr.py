@@ -22,8 +22,9 @@ import argparse
 import numpy as np
 
 import robotdyn
-from robotdyn.reduction.linearization import linearize, lqr, lqr_torque
+from robotdyn.reduction.linearization import linearize, lqr
 from robotdyn.simulation.engine import simulate
+from robotdyn.simulation.feedback import lqr_law
 
 STATES = ["theta3", "theta1_dot", "theta2_dot", "theta3_dot"]
 Q_WEIGHTS = [10.0, 1.0, 1.0, 1.0]  # body angle [1/rad^2], wheel and body rates [s^2/rad^2]
@@ -45,7 +46,7 @@ def main(argv: list[str] | None = None) -> dict:
     print("closed-loop eigenvalues [1/s]:", np.round(closed, 4))
     print("LQR gain K (rows m1, m2; columns " + ", ".join(STATES) + "):\n", np.round(K, 4))
 
-    torque = lqr_torque(model, K)
+    torque = lqr_law(model, K)  # lqr_torque's law as data: the run is compiled
     start = q0.copy()
     start[robot.coordinate_index("theta3")] += 0.2
     traj = simulate(robot, args.t_end, start, np.zeros(robot.mobility), torque, n_out=501, rtol=1e-8, atol=1e-10,

@@ -27,6 +27,7 @@
 
 #include "_integrator.hpp"
 #include "_torque_profile.hpp"
+#include "_controller.hpp"
 
 #include <pybind11/pybind11.h>
 #include <pybind11/eigen.h>
@@ -416,7 +417,14 @@ class Evaluator {
     if (out.size() != nv_ + k) throw std::invalid_argument("state has the wrong length");
     out.head(nv_) = v_;
     if (alpha != 0.0) pull_back(alpha, out);
-    force_.noalias() = Br_ * tau;
+    if (controller_) {  // a feedback law (robotdyn/_controller.hpp): the torques at this state, not the profile's
+      control_tau_.resize(Br_.cols());
+      controller_->eval(control_t_, q, nu, Mr_, hr_, Br_, S_, w_, v_, [this](int f) { return frame_kinematics(f); },
+                        control_tau_);
+      force_.noalias() = Br_ * control_tau_;
+    } else {
+      force_.noalias() = Br_ * tau;
+    }
     force_ -= hr_;
     llt_.compute(Mr_);
     llt_.solveInPlace(force_);
@@ -530,6 +538,45 @@ class Evaluator {
     return py::make_tuple(out, slip_normal_, RowMat(slip_s_), force);
   }
 
+  // ------------------------------------------------------------------------------------------ feedback laws
+  // A feedback law (robotdyn/_controller.hpp) replacing the torque profile in rhs_into (simulate), or none.
+  void set_controller(const robotdyn::Controller* c) {
+    if (c == nullptr) {
+      controller_.reset();
+      return;
+    }
+    if (c->motors() != static_cast<int>(motors_.size()) || c->n() != nv_ || c->k() != mobility())
+      throw std::invalid_argument("the feedback law is for another robot (motors, coordinates or velocities)");
+    if (!slips_.empty()) throw std::invalid_argument("feedback laws do not run with slipping wheels");
+    controller_ = *c;
+  }
+
+  // The law's torques at (t, q, nu) (robotdyn/simulation/feedback.py's reference checks them).
+  VectorXd control_torque(const robotdyn::Controller& c, double t, const Eigen::Ref<const VectorXd>& q,
+                          const Eigen::Ref<const VectorXd>& nu) {
+    configure(q);
+    dynamics(nu);
+    robotdyn::Controller law = c;
+    VectorXd out(Br_.cols());
+    law.eval(t, q, nu, Mr_, hr_, Br_, S_, w_, v_, [this](int f) { return frame_kinematics(f); }, out);
+    return out;
+  }
+
+  // Frame f (add_frame's index) at the evaluated state, for a linearising law's point tasks: its placement, its
+  // LOCAL_WORLD_ALIGNED Jacobian and its classical acceleration at zero joint acceleration (dynamics' RNEA pass).
+  robotdyn::FrameKinematics frame_kinematics(int f) {
+    if (f < 0 || f >= static_cast<int>(frames_.size())) throw std::invalid_argument("no such frame");
+    const auto fid = static_cast<pin::FrameIndex>(frames_[f]);
+    robotdyn::FrameKinematics out;
+    out.R = data_.oMf[fid].rotation();
+    out.p = data_.oMf[fid].translation();
+    out.J = &Jf_[f];
+    const pin::Motion acc = pin::getFrameClassicalAcceleration(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
+    out.a = acc.linear();
+    out.alpha = acc.angular();
+    return out;
+  }
+
   // ------------------------------------------------------------------------------------------ simulation
   // Where the row choice stops working (Fallback), `rechoose(q, nu)` (Python, with the GIL) returns the Python
   // path's new (rows, independent, dependent), or raises the Python path's error: as the scipy path, which
@@ -560,6 +607,7 @@ class Evaluator {
              const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
     const int k = mobility();
     last_t_ = t;  // where an escaping Fallback happened (the Python side names the time)
+    control_t_ = t;  // the time of a feedback law's references (rhs_into)
     tau_.resize(profile.motors());
     profile.eval(t, tau_);
     dy.resize(y.size());
@@ -1549,6 +1597,9 @@ class Evaluator {
   RowMat wl_, ww_, wf_, wp_;
   const double* fbuffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   long fgeneration_ = 0;
+  std::optional<robotdyn::Controller> controller_;  // set_controller
+  double control_t_ = 0.0;
+  VectorXd control_tau_;
   VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_, est_v_, est_s_, est_old_;
   MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
@@ -1594,6 +1645,37 @@ class Evaluator {
 PYBIND11_MODULE(_compiled, m) {
   m.doc() = "robotdyn's compiled reduced-model evaluator (see robotdyn.compiled)";
   py::register_exception<Fallback>(m, "Fallback", PyExc_RuntimeError);
+  py::class_<robotdyn::Controller>(m, "Controller",
+                                    "a feedback law as data (robotdyn.simulation.feedback.FeedbackLaw)")
+      .def(py::init<int, int, int, const robotdyn::TorqueProfile*, const MatrixXd&, const robotdyn::TorqueProfile*,
+                    const MatrixXd&, const robotdyn::TorqueProfile*, const robotdyn::TorqueProfile*>(),
+           py::arg("motors"), py::arg("n"), py::arg("k"), py::arg("feedforward").none(true), py::arg("Kq"),
+           py::arg("q_ref").none(true), py::arg("Knu"), py::arg("nu_ref").none(true),
+           py::arg("acceleration").none(true))
+      .def("set_linearising",
+           [](robotdyn::Controller& c, double kp, double kd, double damping, const std::vector<int>& controlled,
+              const py::list& tasks, const py::list& secondary) {
+             auto read = [](const py::list& items) {
+               std::vector<robotdyn::Task> out;
+               for (const py::handle& item : items) {
+                 const py::tuple tp = item.cast<py::tuple>();
+                 robotdyn::Task task;
+                 task.kind = tp[0].cast<int>();
+                 task.frame = tp[1].cast<int>();
+                 task.offset = tp[2].cast<Vector3d>();
+                 task.select = tp[3].cast<std::vector<int>>();
+                 task.y = std::make_shared<robotdyn::TorqueProfile>(tp[4].cast<const robotdyn::TorqueProfile&>());
+                 task.yd = std::make_shared<robotdyn::TorqueProfile>(tp[5].cast<const robotdyn::TorqueProfile&>());
+                 task.ydd = std::make_shared<robotdyn::TorqueProfile>(tp[6].cast<const robotdyn::TorqueProfile&>());
+                 for (const auto& p : {task.y, task.yd, task.ydd})
+                   if (p->motors() != task.dim()) throw std::invalid_argument("a task's reference has the wrong width");
+                 out.push_back(std::move(task));
+               }
+               return out;
+             };
+             c.set_linearising(robotdyn::Linearising(kp, kd, damping, controlled, read(tasks), read(secondary)));
+           },
+           "add the input-output linearising law (robotdyn.simulation.control.LinearisingController)");
   py::class_<robotdyn::TorqueProfile>(m, "TorqueProfile",
                                       "motor torques as data (robotdyn.torque_profile): sum of constant, sine, table terms")
       .def(py::init<int, const std::vector<int>&, const std::vector<MatrixXd>&, const std::vector<std::vector<double>>&>())
@@ -1635,6 +1717,9 @@ PYBIND11_MODULE(_compiled, m) {
       .def_property_readonly("v", &Evaluator::v, py::return_value_policy::reference_internal)
       .def("rhs", &Evaluator::rhs)
       .def("simulate", &Evaluator::simulate)
+      .def("set_controller", &Evaluator::set_controller, py::arg("controller").none(true),
+           "a feedback law replacing the torque profile in simulate (None: none)")
+      .def("control_torque", &Evaluator::control_torque)
       .def("simulate_many", &Evaluator::simulate_many)
       .def("forces", &Evaluator::forces)
       .def("set_normal_stiffness", &Evaluator::set_normal_stiffness)

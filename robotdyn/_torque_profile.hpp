@@ -4,6 +4,7 @@
 //   0 constant      tau += c
 //   1 sine          tau += c sin(omega t + phase)    for start <= t <= stop
 //   2 table         tau += piecewise-linear interpolation of values at times (held outside them)
+//   3 polynomial    tau += c_0 + t (c_1 + t (c_2 + ...))   for start <= t <= stop (Horner, rows of coef)
 // with the same floating-point operations in the same order as TorqueProfile.__call__ (libm's sin on both sides),
 // so that the compiled and the scipy paths see the same torques bit for bit.
 #pragma once
@@ -39,7 +40,8 @@ class TorqueProfile {
       if (term.kind == 1 && term.par.size() != 4) throw std::invalid_argument("sine term: 4 parameters expected");
       if (term.kind == 2 && (term.par.empty() || static_cast<Eigen::Index>(term.par.size()) != term.coef.rows()))
         throw std::invalid_argument("table term: one time per row of values expected");
-      if (term.kind < 0 || term.kind > 2) throw std::invalid_argument("unknown torque term");
+      if (term.kind == 3 && term.par.size() != 2) throw std::invalid_argument("polynomial term: 2 parameters expected");
+      if (term.kind < 0 || term.kind > 3) throw std::invalid_argument("unknown torque term");
       terms_.push_back(std::move(term));
     }
   }
@@ -56,6 +58,15 @@ class TorqueProfile {
         if (term.par[2] <= t && t <= term.par[3]) {
           const double s = std::sin(term.par[0] * t + term.par[1]);
           for (int j = 0; j < motors_; ++j) out[j] += term.coef(0, j) * s;
+        }
+      } else if (term.kind == 3) {
+        if (term.par[0] <= t && t <= term.par[1]) {
+          const Eigen::Index last = term.coef.rows() - 1;
+          for (int j = 0; j < motors_; ++j) {
+            double p = term.coef(last, j);
+            for (Eigen::Index i = last - 1; i >= 0; --i) p = term.coef(i, j) + t * p;
+            out[j] += p;
+          }
         }
       } else {
         const std::vector<double>& ts = term.par;

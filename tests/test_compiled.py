@@ -771,7 +771,7 @@ def test_simulate_linkage_equals_python(linkage, monkeypatch):
         return out
 
     monkeypatch.setattr(compiled.CompiledModel, "rhs", rhs)
-    got = scenario.run(linkage, t_end=0.5, progress=False)
+    got = scenario.run(linkage, t_end=0.5, progress=False, engine="scipy")  # the compiled rhs in the scipy loop
     assert len(calls) >= 0.9 * got.stats["nfev"] > 50  # all but the first evaluations (which choose the rows)
     monkeypatch.undo()
     with use_compiled(False):

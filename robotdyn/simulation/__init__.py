@@ -2,7 +2,10 @@
 
 Owns ``engine`` (:func:`simulate`, the scipy engine), ``trajectory`` (:class:`Trajectory`, what every engine
 returns), ``progress`` (a run's reporter), ``compiled_engine`` (the C++ integrators), ``stick_slip`` (exact
-switching), ``streaming`` (long runs written to a CSV file in segments), ``torque_profile``, ``scenario``, ``control``, ``many_runs``, ``batch``, ``model_variants`` and ``flight`` (compliant wheels' lift-off and touch-down events). Imports every earlier stage (up to robotdyn.robot). ``robotdyn.simulation.simulate`` and
+switching), ``streaming`` (long runs written to a CSV file in segments), ``torque_profile``, ``feedback`` (feedback
+laws as data, run compiled), ``scenario``, ``control``, ``many_runs``, ``batch``, ``model_variants`` and ``flight``
+(compliant wheels' lift-off and touch-down events). Imports every earlier stage (up to robotdyn.robot).
+``robotdyn.simulation.simulate`` and
 ``robotdyn.simulation.Trajectory`` still work (re-exported lazily from ``engine`` and ``trajectory``).
 
 Import rule (tests/test_layout.py enforces it): the stages are, in order, foundation (robotdyn.errors, robotdyn.inputs,

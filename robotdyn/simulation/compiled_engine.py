@@ -43,7 +43,8 @@ from ..errors import NonFiniteError, RobotDynError
 from ..reduction.pull_back import failure_note
 from ..contact.sliding import slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
-from .torque_profile import TorqueProfile, as_profile
+from .feedback import FeedbackLaw
+from .torque_profile import Constant, TorqueProfile, as_profile
 from .trajectory import Trajectory
 
 
@@ -68,7 +69,8 @@ def native_profile(profile: TorqueProfile):
 
 
 def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: TorqueProfile, t_eval: np.ndarray,
-        rtol: float, atol: float, stabilisation: float, method: str, progress=None, t0: float = 0.0) -> dict:
+        rtol: float, atol: float, stabilisation: float, method: str, progress=None, t0: float = 0.0,
+        controller: FeedbackLaw | None = None) -> dict:
     """Integrate on the compiled model ``fast`` of ``robot``.
 
     Args:
@@ -83,6 +85,8 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
         method: One of :data:`METHODS`.
         progress: ``progress(t)`` called about every 50 ms (None: not called).
         t0: Start time [s] (the profile is evaluated at absolute times).
+        controller: A :class:`~robotdyn.simulation.feedback.FeedbackLaw` evaluated in C++ instead of ``profile``
+            (``robotdyn/_controller.hpp``; default ``None``: the profile's torques).
 
     Returns:
         ``t`` (N,), ``y`` (N, n + k), ``energy`` (N,) [J], ``residual`` (N,), ``nfev``, ``steps`` and
@@ -95,14 +99,20 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     if method not in METHODS:
         raise RobotDynError(f"unknown compiled integrator {method!r}; expected one of {', '.join(METHODS)}")
     native = native_profile(profile)
-    breaks = [float(b) for b in profile.breakpoints() if t0 < b < t_end]
+    points = set(map(float, profile.breakpoints()))
+    if controller is not None:
+        points.update(map(float, controller.breakpoints()))
+    breaks = sorted(b for b in points if t0 < b < t_end)
     n = robot.nq
     rechoose = rechooser(robot, fast)
+    fast.ev.set_controller(None if controller is None else controller.native_controller(robot, fast))
     try:
         out = fast.ev.simulate(q0, nu0, float(t0), float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
                                native, breaks, method, progress, rechoose)
     except Fallback as exc:  # the Python path's row choice did not serve the compiled model either
         raise stuck(robot, rechoose.last, float(fast.ev.last_t), str(exc)) from None
+    finally:
+        fast.ev.set_controller(None)
     status, t_stop = out["status"], float(out["t_stop"])
     if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's errors
         from ..contact.sliding import painleve_error, redundant_load_error
@@ -125,6 +135,18 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     return {"t": out["t"], "y": out["y"], "energy": out["energy"], "residual": out["residual"],
             "nfev": int(out["nfev"]), "steps": int(out["steps"]), "interrupted": interrupted,
             "event": (t_stop, np.asarray(out["y_stop"])) if out["event"] else None}
+
+
+def as_data(torque):
+    """``torque`` if it is a closed loop given as data (a :class:`~robotdyn.simulation.feedback.FeedbackLaw`, or a
+    controller whose ``compiled_form()`` says so, e.g. a
+    :class:`~robotdyn.simulation.control.LinearisingController` on profile references), else None.
+
+    Args:
+        torque: The torque law.
+    """
+    form = getattr(torque, "compiled_form", None)
+    return torque if callable(form) and callable(getattr(torque, "native_controller", None)) and form() else None
 
 
 def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
@@ -163,9 +185,11 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
                                                    "use_compiled(False))")
     elif fast.slip_refusal is not None:
         reason = fast.slip_refusal
-    elif torque is not None and not isinstance(torque, TorqueProfile):
+    elif as_data(torque) is not None and slipping_wheels(robot):
+        reason = "feedback laws on robots with slipping wheels are simulated on the Python path"
+    elif torque is not None and not isinstance(torque, TorqueProfile) and as_data(torque) is None:
         reason = ("the torques are a Python function; give a robotdyn.simulation.torque_profile.TorqueProfile (constant, sine, "
-                  "table) to run them compiled")
+                  "table, polynomial) or a robotdyn.simulation.feedback.FeedbackLaw to run them compiled")
     if reason is not None and engine == "compiled":
         raise RobotDynError(f"engine = 'compiled' cannot run this simulation: {reason}")
     return reason is None
@@ -183,7 +207,8 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
         t_end: Final time [s].
         q0: Initial coordinates (n,) [m, rad].
         nu0: Initial independent velocities (k,).
-        torque: ``None`` or a :class:`~robotdyn.simulation.torque_profile.TorqueProfile`.
+        torque: ``None``, a :class:`~robotdyn.simulation.torque_profile.TorqueProfile` or a
+            :class:`~robotdyn.simulation.feedback.FeedbackLaw`.
         n_out: Number of evenly spaced output samples (unless ``times``).
         rtol: Relative error tolerance.
         atol: Absolute error tolerance per component.
@@ -196,13 +221,15 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
         times: Output times [s] (increasing, t0 to t_end; default ``None``: ``n_out`` evenly spaced).
     """
 
-    profile = as_profile(torque, len(robot.motors))
-    robot.forward_dynamics(q0, nu0, profile(t0))  # regular where the run starts (raises the Python path's error)
+    law = torque.bound(robot) if isinstance(torque, FeedbackLaw) else as_data(torque)
+    profile = Constant(np.zeros(len(robot.motors))) if law is not None else as_profile(torque, len(robot.motors))
+    tau0 = law(t0, q0, nu0) if law is not None else profile(t0)
+    robot.forward_dynamics(q0, nu0, tau0)  # regular where the run starts (raises the Python path's error)
     fast = compiled_model(robot)
     start = time.perf_counter()
     t_eval = np.linspace(t0, t_end, n_out) if times is None else times
     out = run(robot, fast, t_end, q0, nu0, profile, t_eval, rtol, atol, stabilisation, method,
-              progress if progress.needed else None, t0)
+              progress if progress.needed else None, t0, law)
     wall = time.perf_counter() - start
     n = robot.nq
     stats = {"nfev": out["nfev"], "steps": out["steps"], "wall": wall, "method": method, "rtol": rtol,

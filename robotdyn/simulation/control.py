@@ -46,6 +46,43 @@ def hold(values) -> Reference:
     return lambda t: (y, z, z)
 
 
+@dataclass
+class ProfileReference:
+    """A reference as data: value, rate and acceleration as
+    :class:`~robotdyn.simulation.torque_profile.TorqueProfile` terms of the task's dimension. Callable as a
+    :data:`Reference`; with it a :class:`LinearisingController` runs on the compiled engine (the C++ twin in
+    ``robotdyn/_controller.hpp``, ``Linearising``).
+
+    Attributes:
+        value: y_d(t) [m or rad].
+        rate: y_d'(t) [per s].
+        acceleration: y_d''(t) [per s^2].
+    """
+
+    value: object
+    rate: object
+    acceleration: object
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.value(t), self.rate(t), self.acceleration(t)
+
+    def breakpoints(self) -> set[float]:
+        """Times [s] where a profile is not smooth."""
+        return {float(b) for p in (self.value, self.rate, self.acceleration) for b in p.breakpoints()}
+
+
+def hold_data(values) -> ProfileReference:
+    """A constant reference as data (:func:`hold`'s values, zero rate and acceleration).
+
+    Args:
+        values: The constant value(s) y_d.
+    """
+    from .torque_profile import Constant
+
+    y = np.atleast_1d(np.asarray(values, dtype=float))
+    return ProfileReference(Constant(y), Constant(np.zeros_like(y)), Constant(np.zeros_like(y)))
+
+
 class Task:
     """An output y(q) with its Jacobian rows J (on the full velocity v) and drift :math:`\\dot J v`."""
 
@@ -222,6 +259,56 @@ class LinearisingController:
     def __call__(self, t: float, q: np.ndarray, nu: np.ndarray) -> np.ndarray:
         return self.command(t, q, nu)[1]
 
+    def compiled_form(self) -> bool:
+        """Whether the compiled engine can run this controller: every task a :class:`PointTask` or
+        :class:`CoordinateTask` whose reference is a :class:`ProfileReference`."""
+        return all(isinstance(task, (PointTask, CoordinateTask)) and isinstance(task.reference, ProfileReference)
+                   for task in [*self.tasks, *self.secondary])
+
+    def breakpoints(self) -> np.ndarray:
+        """Sorted times [s] where a reference is not smooth (both engines restart there)."""
+        points = set()
+        for task in [*self.tasks, *self.secondary]:
+            if isinstance(task.reference, ProfileReference):
+                points |= task.reference.breakpoints()
+        return np.array(sorted(points), float)
+
+    def native_controller(self, robot, fast):
+        """The C++ twin (``robotdyn._compiled.Controller`` with its ``Linearising`` law) on ``fast``, the compiled
+        model of ``robot`` (point tasks' frames are added to it once).
+
+        Args:
+            robot: The :class:`~robotdyn.robot.Robot` simulated (this controller's robot).
+            fast: Its :class:`~robotdyn.fast.compiled.CompiledModel`.
+        """
+        from .._compiled import Controller
+        from .feedback import native_profile
+
+        frames = fast.__dict__.setdefault("_task_frames", {})
+
+        def encode(task):
+            ref = task.reference
+            profiles = (native_profile(ref.value), native_profile(ref.rate), native_profile(ref.acceleration))
+            if isinstance(task, CoordinateTask):
+                return (1, -1, np.zeros(3), [int(robot.coordinate_index(c)) for c in task.labels], *profiles)
+            fid = robot.description.frame_id(task.frame)
+            if fid not in frames:
+                if fid in fast.frame_ids:
+                    frames[fid] = fast.frame_ids.index(fid)
+                else:
+                    f = robot.model.frames[fid]
+                    M = f.placement
+                    frames[fid] = fast.ev.add_frame(int(f.parentJoint), np.hstack([M.rotation, M.translation[:, None]]))
+                    fast.frame_ids.append(fid)
+            return (0, frames[fid], np.asarray(task.offset, float), [int(a) for a in task.axes], *profiles)
+
+        m, empty = len(robot.motors), np.zeros((0, 0))
+        out = Controller(m, robot.nq, robot.mobility, None, empty, None, empty, None, None)
+        out.set_linearising(float(self.kp), float(self.kd), float(self.damping),
+                            [] if self._ctrl is None else [int(i) for i in self._ctrl],
+                            [encode(t) for t in self.tasks], [encode(t) for t in self.secondary])
+        return out
+
 
 def tracking_errors(controller: LinearisingController, traj: Trajectory, task: int = 0,
                     after: float = 0.0) -> dict[str, float]:
@@ -295,5 +382,5 @@ class ControlledScenario(Scenario):
         return traj
 
 
-__all__ = ["LinearisingController", "PointTask", "CoordinateTask", "Task", "hold", "computed_torque",
+__all__ = ["LinearisingController", "PointTask", "CoordinateTask", "Task", "hold", "hold_data", "ProfileReference", "computed_torque",
            "tracking_errors", "ControlledScenario"]

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..fast.compiled import Fallback
 from ..fast.dispatch import compiled_model
-from .compiled_engine import METHODS, at_time, choose_engine, simulate_compiled
+from .compiled_engine import METHODS, as_data, at_time, choose_engine, simulate_compiled
 from ..errors import ConstraintError, NonFiniteError, RobotDynError
 from ..reduction.projection import solve
 from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
@@ -34,6 +34,7 @@ from ..contact.compliant_contact import compliant_wheels
 from ..contact.applied_forces import applied, has_applied
 from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .progress import Progress
+from .feedback import FeedbackLaw
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
 
@@ -149,6 +150,8 @@ def simulate(
     nu0 = robot.check_nu(nu0)
     if isinstance(torque, TorqueProfile):
         as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
+    if isinstance(torque, FeedbackLaw):
+        torque = torque.bound(robot)  # one line if it does not fit the robot; its model is the robot simulated
     if not t0:  # a continuation starts where the earlier run ended (its drift is reported, not refused)
         robot.check_constraints(q0)
     offsets = start_offsets(robot, q0, stabilisation)
@@ -236,7 +239,8 @@ def simulate(
     interrupted = None
     rhs = _timed(rhs)
     if events is None:
-        breaks = torque.breakpoints() if isinstance(torque, TorqueProfile) else ()
+        data = isinstance(torque, (TorqueProfile, FeedbackLaw)) or as_data(torque) is not None
+        breaks = torque.breakpoints() if data else ()
         sol, interrupted = _integrate(rhs, t_end, y0, method, t_eval, rtol, atol, breaks, t0)
     else:
         sol = solve_ivp(rhs, (t0, t_end), y0, method=method, t_eval=t_eval, rtol=rtol, atol=atol, events=events)

@@ -9,6 +9,8 @@ motors [N m or N] times a scalar function of time:
 - :class:`Sine`: :math:`\\tau = c \\sin(\\omega t + \\varphi)` inside a window :math:`t_0 \\le t \\le t_1`, zero
   outside (e.g. Staicu's Quasimoro pulse, eq 19: :math:`0.1 \\sin(\\pi t)` for :math:`t \\le 1` s);
 - :class:`Table`: piecewise-linear interpolation of values at increasing times, held constant outside them;
+- :class:`Polynomial`: :math:`\\tau = c_0 + c_1 t + \\dots + c_d t^d` inside a window, zero outside (Horner's
+  scheme on both sides);
 - sums of these (``a + b``, or :class:`Sum`).
 
 A profile is callable with the scipy path's signature ``profile(t, q, nu)`` (q and nu are ignored), and
@@ -27,7 +29,7 @@ import numpy as np
 
 from ..errors import InputError
 
-CONSTANT, SINE, TABLE = 0, 1, 2
+CONSTANT, SINE, TABLE, POLYNOMIAL = 0, 1, 2, 3
 """Term kinds in :meth:`TorqueProfile.encode` (the C++ side's codes)."""
 
 
@@ -68,6 +70,9 @@ class TorqueProfile:
             elif kind == SINE:
                 if par[2] <= t <= par[3]:
                     out = out + coef * math.sin(par[0] * t + par[1])
+            elif kind == POLYNOMIAL:
+                if par[0] <= t <= par[1]:
+                    out = out + _horner(coef, t)
             else:  # coef: (points, motors) values, par: the times
                 out = out + _interpolate(par, coef, t)
         return out
@@ -90,6 +95,9 @@ class TorqueProfile:
             elif kind == SINE:
                 inside = (par[2] <= t) & (t <= par[3])
                 out = out + np.where(inside[:, None], coef * np.sin(par[0] * t + par[1])[:, None], 0.0)
+            elif kind == POLYNOMIAL:
+                inside = (par[0] <= t) & (t <= par[1])
+                out = out + np.where(inside[:, None], _horner(coef, t[:, None]), 0.0)
             else:
                 i = np.clip(np.searchsorted(par, t, side="right") - 1, 0, len(par) - 2)
                 s = (t - par[i]) / (par[i + 1] - par[i])
@@ -104,6 +112,8 @@ class TorqueProfile:
         for kind, _, par in self._all():
             if kind == SINE:
                 points += [x for x in par[2:4] if math.isfinite(x)]
+            elif kind == POLYNOMIAL:
+                points += [x for x in par[0:2] if math.isfinite(x)]
             elif kind == TABLE:
                 points += list(par)
         return np.array(sorted(set(map(float, points))), float)  # np.unique would import numpy.ma (~20 ms) on first use
@@ -139,6 +149,14 @@ class TorqueProfile:
                                         for (ka, ca, pa), (kb, cb, pb) in zip(a, b))
 
     __hash__ = None
+
+
+def _horner(coef: np.ndarray, t):
+    """c_0 + t (c_1 + t (c_2 + ...)) per motor (coef: (degree + 1, motors)), the C++ side's order of operations."""
+    p = coef[-1]
+    for i in range(coef.shape[0] - 2, -1, -1):
+        p = coef[i] + t * p
+    return p
 
 
 def _interpolate(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
@@ -235,6 +253,43 @@ class Table(TorqueProfile):
         return f"Table({self.times.size} points, {self.times[0]:g} .. {self.times[-1]:g} s)"
 
 
+class Polynomial(TorqueProfile):
+    """:math:`\\tau = c_0 + c_1 t + \\dots + c_d t^d` for ``start <= t <= stop`` [s], zero outside (e.g. a quintic
+    rest-to-rest reference and its derivatives).
+
+    Args:
+        coefficients: (degree + 1, motors), lowest power first [N m / s^i or N / s^i].
+        start, stop: The window [s] (default: always on).
+
+    Raises:
+        InputError: Not a finite (degree + 1, motors) array, or an empty window.
+
+    Example:
+        >>> from robotdyn.simulation.torque_profile import Polynomial
+        >>> Polynomial([[1.0], [0.0], [2.0]], 0.0, 1.0).at([0.5, 2.0]).tolist()  # 1 + 2 t^2 on [0, 1]
+        [[1.5], [0.0]]
+    """
+
+    def __init__(self, coefficients, start: float = -math.inf, stop: float = math.inf) -> None:
+        self.coefficients = np.asarray(coefficients, dtype=float)
+        if self.coefficients.ndim == 1:
+            self.coefficients = self.coefficients[:, None]
+        if (self.coefficients.ndim != 2 or self.coefficients.size == 0
+                or not np.all(np.isfinite(self.coefficients))):
+            raise InputError(f"polynomial torque: coefficients of shape {self.coefficients.shape}; expected finite "
+                             "(degree + 1, motors)")
+        self.start, self.stop = float(start), float(stop)
+        if math.isnan(self.start) or math.isnan(self.stop) or self.start > self.stop:
+            raise InputError(f"polynomial torque window [{start!r}, {stop!r}] s; expected start <= stop")
+
+    def _terms(self):
+        return [(POLYNOMIAL, self.coefficients, np.array([self.start, self.stop]))]
+
+    def __repr__(self) -> str:
+        return (f"Polynomial(degree {self.coefficients.shape[0] - 1}, {self.coefficients.shape[1]} values, "
+                f"window=[{self.start:g}, {self.stop:g}] s)")
+
+
 class Sum(TorqueProfile):
     """The sum of profiles (all with the same number of motors).
 
@@ -307,4 +362,4 @@ def as_profile(torque, motors: int) -> TorqueProfile | None:
     return None
 
 
-__all__ = ["TorqueProfile", "Constant", "Sine", "Table", "Sum", "Scaled", "as_profile"]
+__all__ = ["TorqueProfile", "Constant", "Sine", "Table", "Polynomial", "Sum", "Scaled", "as_profile"]

@@ -240,17 +240,39 @@ class TerrainScenario(Scenario):
         return q0, nu0
 
 
+def speed_reference(signs=(1.0,), peak: float = PEAK_SPEED):
+    """The section 3 wheel-speed profile :func:`wheel_speed` as data: a
+    :class:`~robotdyn.simulation.torque_profile.TorqueProfile` of one value per sign (``signs[i] * omega(t)``
+    [rad/s]). Each half-cosine ramp is a windowed constant plus a windowed sine, the hold a windowed constant (a sine
+    of zero frequency at phase pi/2); the windows meet without overlapping (each starts one double after the
+    previous one ends).
+
+    Args:
+        signs: The factors of the profile (e.g. +1 and -1 for pivot steering).
+        peak: Peak wheel speed [rad/s].
+    """
+    from ...simulation.torque_profile import Sine
+
+    t0, t1, t2, t3, _ = PROFILE
+    w1, w2 = np.pi / (t1 - t0), np.pi / (t3 - t2)
+    after = lambda t: float(np.nextafter(t, np.inf))  # noqa: E731
+    half, full = 0.5 * peak * np.asarray(signs, float), peak * np.asarray(signs, float)
+    return (Sine(half, 0.0, np.pi / 2, t0, t1) + Sine(half, w1, -w1 * t0 - np.pi / 2, t0, t1)
+            + Sine(full, 0.0, np.pi / 2, after(t1), t2)
+            + Sine(half, 0.0, np.pi / 2, after(t2), t3) + Sine(half, w2, -w2 * t2 + np.pi / 2, after(t2), t3))
+
+
 def _tracking(signs: tuple[float, float], profile: bool = True):
     """Torques of the six wheel motors tracking the section 3 wheel-speed profile (right side signs[0], left
-    signs[1]) with gain SPEED_GAIN; nu = (phi2', phi5') are the right and left middle wheel speeds."""
+    signs[1]) with gain SPEED_GAIN: tau_right = SPEED_GAIN (signs[0] omega(t) - phi2'), tau_left likewise with
+    phi5' (nu = (phi2', phi5'), the right and left middle wheel speeds), as a
+    :class:`~robotdyn.simulation.feedback.FeedbackLaw` (it runs compiled)."""
+    from ...simulation.feedback import FeedbackLaw
+    from ...simulation.torque_profile import Constant
 
-    def tau(t, q, nu):
-        ref = wheel_speed(t)[0] if profile else PEAK_SPEED
-        right = SPEED_GAIN * (signs[0] * ref - nu[0])
-        left = SPEED_GAIN * (signs[1] * ref - nu[1])
-        return np.array([right, right, right, left, left, left])
-
-    return tau
+    ref = speed_reference(signs) if profile else Constant(PEAK_SPEED * np.asarray(signs, float))
+    Knu = SPEED_GAIN * np.array([[1.0, 0.0]] * 3 + [[0.0, 1.0]] * 3)
+    return FeedbackLaw(Knu=Knu, nu_ref=ref)
 
 
 SCENARIOS = {

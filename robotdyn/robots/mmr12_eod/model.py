@@ -22,7 +22,6 @@ sec 2.11 e and the climbing posture's contact forces on a ramp (:func:`climbing_
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
 
 import numpy as np
 
@@ -150,33 +149,60 @@ def _quintic(t: float, T: float, a, b) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return a + (b - a) * p, (b - a) * dp, (b - a) * ddp
 
 
-def table4_reference(name: str, omega: float = 0.5) -> Callable:
-    """Table 4's platform references as t -> (p_d, p_d', p_d'') of the controlled point [m]:
-    ``orientation`` (turning about the centre x = y = 0: P on a circle of radius LOOK_AHEAD at omega rad/s),
-    ``straight`` (x = 30, y = t), ``sinusoid`` (x = 40 cos 0.25t + 2.5t, y = 30 sin 0.25t).
+def quintic_reference(T: float, a, b):
+    """:func:`_quintic` as data (:class:`~robotdyn.simulation.control.ProfileReference`): the rest-to-rest quintic
+    a + (b - a)(10 s^3 - 15 s^4 + 6 s^5), s = t / T, as polynomials of t on [0, T] (rate and acceleration too),
+    then b held (a window starting one double after T).
+
+    Args:
+        T: Duration [s].
+        a, b: Start and end values (same shape).
+    """
+    from ...simulation.control import ProfileReference
+    from ...simulation.torque_profile import Polynomial, Sine
+
+    a, b = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
+    d, z = b - a, np.zeros_like(a)
+    after = float(np.nextafter(T, np.inf))
+    value = Polynomial([a, z, z, 10 * d / T**3, -15 * d / T**4, 6 * d / T**5], 0.0, T) + Sine(b, 0.0, np.pi / 2, after)
+    rate = Polynomial([z, z, 30 * d / T**3, -60 * d / T**4, 30 * d / T**5], 0.0, T)
+    acceleration = Polynomial([z, 60 * d / T**3, -180 * d / T**4, 120 * d / T**5], 0.0, T)
+    return ProfileReference(value, rate, acceleration)
+
+
+def table4_reference(name: str, omega: float = 0.5):
+    """Table 4's platform references as t -> (p_d, p_d', p_d'') of the controlled point [m], given as data
+    (:class:`~robotdyn.simulation.control.ProfileReference`: sines and polynomials of t, so that the controller
+    runs on the compiled engine): ``orientation`` (turning about the centre x = y = 0: P on a circle of radius
+    LOOK_AHEAD at omega rad/s), ``straight`` (x = 30, y = t), ``sinusoid`` (x = 40 cos 0.25t + 2.5t,
+    y = 30 sin 0.25t).
 
     Args:
         name: ``orientation``, ``straight`` or ``sinusoid``.
         omega: Turning rate of the orientation task [rad/s].
     """
-    L = LOOK_AHEAD
+    from ...simulation.control import ProfileReference
+    from ...simulation.torque_profile import Constant, Polynomial, Sine
+
+    L, c = LOOK_AHEAD, np.pi / 2  # cos(x) = sin(x + pi/2)
+    x, y = np.array([1.0, 0.0]), np.array([0.0, 1.0])
     if name == "orientation":
-        return lambda t: (L * np.array([np.cos(omega * t), np.sin(omega * t)]),
-                          L * omega * np.array([-np.sin(omega * t), np.cos(omega * t)]),
-                          -L * omega**2 * np.array([np.cos(omega * t), np.sin(omega * t)]))
+        return ProfileReference(Sine(L * x, omega, c) + Sine(L * y, omega),
+                                Sine(-L * omega * x, omega) + Sine(L * omega * y, omega, c),
+                                Sine(-L * omega**2 * x, omega, c) + Sine(-L * omega**2 * y, omega))
     if name == "straight":
-        return lambda t: (np.array([30.0, t]), np.array([0.0, 1.0]), np.zeros(2))
+        return ProfileReference(Polynomial([[30.0, 0.0], [0.0, 1.0]]), Constant([0.0, 1.0]), Constant([0.0, 0.0]))
     if name == "sinusoid":
-        return lambda t: (np.array([40 * np.cos(0.25 * t) + 2.5 * t, 30 * np.sin(0.25 * t)]),
-                          np.array([-10 * np.sin(0.25 * t) + 2.5, 7.5 * np.cos(0.25 * t)]),
-                          np.array([-2.5 * np.cos(0.25 * t), -1.875 * np.sin(0.25 * t)]))
+        return ProfileReference(Sine(40 * x, 0.25, c) + Sine(30 * y, 0.25) + Polynomial([[0.0, 0.0], [2.5, 0.0]]),
+                                Sine(-10 * x, 0.25) + Sine(7.5 * y, 0.25, c) + Constant([2.5, 0.0]),
+                                Sine(-2.5 * x, 0.25, c) + Sine(-1.875 * y, 0.25))
     raise InputError(f"unknown Table 4 trajectory {name!r}; expected orientation, straight or sinusoid")
 
 
 def _hold_task(robot: Robot, labels, q0):
-    from ...simulation.control import CoordinateTask, hold
+    from ...simulation.control import CoordinateTask, hold_data
 
-    return CoordinateTask(list(labels), hold([q0[robot.coordinate_index(c)] for c in labels]))
+    return CoordinateTask(list(labels), hold_data([q0[robot.coordinate_index(c)] for c in labels]))
 
 
 def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
@@ -257,8 +283,8 @@ def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float
         raise InputError(f"manipulation target {MANIPULATION_TARGET.tolist()} not reachable (IK error {goal.error:.3g} m)")
     arm = list(MANIPULATOR[:3])
     idx = [robot.coordinate_index(c) for c in arm]
-    ref = lambda t: _quintic(t, T, start, MANIPULATION_TARGET)  # noqa: E731
-    posture = lambda t: _quintic(t, T, q0[idx], goal.q[idx])  # noqa: E731
+    ref = quintic_reference(T, start, MANIPULATION_TARGET)
+    posture = quintic_reference(T, q0[idx], goal.q[idx])
     held = [*(f"theta_C{i}" for i in _ARMS), "theta4", *LOAD]
     return LinearisingController(robot, [PointTask("E", ref), _hold_task(robot, held, q0)],
                                  secondary=[CoordinateTask(arm, posture)], **GAINS)
@@ -345,7 +371,7 @@ def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
 
     q0 = lifting_initial(robot)[0]
     th0 = contact_angle(robot.params)
-    tasks = [CoordinateTask(["theta_C1"], lambda t: _quintic(t, T, th0, end)),
+    tasks = [CoordinateTask(["theta_C1"], quintic_reference(T, th0, end)),
              _hold_task(robot, [*MANIPULATOR, *LOAD, "theta_R", "theta_L"], q0)]
     return LinearisingController(robot, tasks, controlled=["theta_R", "theta_L", "theta_C1", *MANIPULATOR, *LOAD],
                                  **GAINS)

@@ -363,6 +363,9 @@ class PathScenario(Scenario):
         Returns:
             tau(t, q, nu) [N m], one per motor.
         """
+        if self.kind == "circle":  # u'' = (0, R, 1) beta''(t), a cubic in t on [0, T]: computed torque as data
+            return circle_law(robot)
+
         def torque(t, q, nu):
             red = robot.reduced(q, nu)
             T_u = red.M @ path_state(self.kind, t)["nudot"] + red.h
@@ -371,13 +374,34 @@ class PathScenario(Scenario):
 
     def run(self, robot, t_end: float | None = None, n_out: int | None = None, **kwargs):
         from ...simulation import simulate
+        from ...simulation.feedback import FeedbackLaw
 
         t_end, n_out = self.span(t_end, n_out, streamed=kwargs.get("sink") is not None)
         q0, nu0 = self.initial_state(robot)
-        kwargs.setdefault("method", "LSODA")
+        law = self.torque_law(robot)
+        if not isinstance(law, FeedbackLaw) or kwargs.get("engine") == "scipy":
+            kwargs.setdefault("method", "LSODA")  # the scipy engine's stiff-capable default for these paths
         kwargs.setdefault("rtol", 1e-9)
         kwargs.setdefault("atol", 1e-9)
-        return simulate(robot, t_end, q0, nu0, self.torque_law(robot), n_out=n_out, **kwargs)
+        return simulate(robot, t_end, q0, nu0, law, n_out=n_out, **kwargs)
+
+
+def circle_law(robot: Robot, params: dict | None = None):
+    """The circle's feed-forward torques tau = B_r^+ (I_uu* u''(t) + u'^T P_uuu* u') (eq 47, minimum-norm) as a
+    :class:`~robotdyn.simulation.feedback.FeedbackLaw` (it runs compiled): u''(t) = (0, R, 1) beta''(t) with
+    beta'' = total (60 s - 180 s^2 + 120 s^3) / T^2, s = t / T (eq 61), a cubic polynomial in t on [0, T].
+
+    Args:
+        robot: The omni caster :class:`~robotdyn.robot.Robot`.
+        params: Overrides of :data:`CIRCLE` (R [m], T [s]) (default ``None``).
+    """
+    from ...simulation.feedback import FeedbackLaw
+    from ...simulation.torque_profile import Polynomial
+
+    c = {**CIRCLE, **(params or {})}
+    R, T, total = c["R"], c["T"], 2 * np.pi
+    powers = total * np.array([0.0, 60.0 / T**3, -180.0 / T**4, 120.0 / T**5])
+    return FeedbackLaw(acceleration=Polynomial(np.outer(powers, [0.0, R, 1.0]), 0.0, T), robot=robot)
 
 
 SCENARIOS = {

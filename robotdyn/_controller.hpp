@@ -1,0 +1,246 @@
+// Feedback laws as data, evaluated without Python: the C++ side of robotdyn/simulation/feedback.py (FeedbackLaw,
+// whose __call__ is the Python reference of eval below, term by term).
+//
+//   tau = f(t) + K_q (q_d(t) - q) + K_nu (nu_d(t) - nu) + B_r^+ (M_r a(t) + h_r)
+//
+// f (motors), q_d (n), nu_d (k) and a (k) are profiles of time (robotdyn::TorqueProfile, any width); K_q
+// (motors, n) and K_nu (motors, k) constant gains; B_r^+ the minimum-norm least-squares inverse (numpy.linalg.lstsq)
+// of the reduced input matrix, with M_r and h_r the reduced mass matrix and the reduced nonlinear forces the
+// evaluator has just computed at (q, nu). Each term is optional. Covers PD tracking of coordinates and velocities,
+// LQR (tau0 - K (x - x0)) and computed-torque (inverse dynamics) feed-forward of a reference acceleration.
+//
+// Plus, optionally, the input-output linearising law of robotdyn/simulation/control.py (LinearisingController.
+// command, its Python reference, step by step): tasks on coordinates and on points of frames, references as
+// profiles (value, rate, acceleration), u = (JS)^+ (y_d'' + K_d (y_d' - y') + K_p (y_d - y) - J w - Jdot v), a
+// secondary task in the null space, damping of the rest, and the computed torque on the reduced model
+// (computed_torque: [B_r, -M_r[:, free]] solved in least squares).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <stdexcept>
+
+#include "_torque_profile.hpp"
+
+namespace robotdyn {
+
+// One output of the linearising law: a point of a frame (kind 0; `frame` the evaluator's frame index, `offset` in
+// the frame's axes, `select` the world axes) or coordinates (kind 1; `select` their indices in q). Its reference:
+// value, rate and acceleration profiles, each of the task's dimension.
+struct Task {
+  int kind = 1;
+  int frame = -1;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  std::vector<int> select;
+  std::shared_ptr<TorqueProfile> y, yd, ydd;
+  int dim() const { return static_cast<int>(select.size()); }
+};
+
+// The kinematics of a frame at the evaluated state: placement, LOCAL_WORLD_ALIGNED Jacobian (6, n), and the
+// classical acceleration of its origin and its angular acceleration at zero joint acceleration (world axes).
+struct FrameKinematics {
+  Eigen::Matrix3d R;
+  Eigen::Vector3d p, a, alpha;
+  const Eigen::Matrix<double, 6, Eigen::Dynamic>* J = nullptr;
+};
+
+// numpy.linalg.pinv(A, rcond): singular values below rcond * the largest dropped.
+inline Eigen::MatrixXd pinv(const Eigen::MatrixXd& A, double rcond) {
+  if (A.size() == 0) return Eigen::MatrixXd::Zero(A.cols(), A.rows());
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& s = svd.singularValues();
+  const double cut = rcond * (s.size() ? s[0] : 0.0);
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(s.size());
+  for (Eigen::Index i = 0; i < s.size(); ++i)
+    if (s[i] > cut) inv[i] = 1.0 / s[i];
+  return svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose();
+}
+
+class Linearising {
+ public:
+  Linearising() = default;
+  Linearising(double kp, double kd, double damping, const std::vector<int>& controlled, std::vector<Task> tasks,
+              std::vector<Task> secondary)
+      : kp_(kp), kd_(kd), damping_(damping), controlled_(controlled), tasks_(std::move(tasks)),
+        secondary_(std::move(secondary)) {}
+
+  // The motor torques (out) at (t, q, nu) from the reduced model (M, h, B, S, w, v) and frame(f) -> kinematics.
+  template <class Frames>
+  void eval(double t, const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& nu,
+            const Eigen::MatrixXd& M, const Eigen::VectorXd& h, const Eigen::MatrixXd& B, const Eigen::MatrixXd& S,
+            const Eigen::VectorXd& w, const Eigen::VectorXd& v, Frames&& frame, Eigen::Ref<Eigen::VectorXd> out) {
+    const Eigen::Index k = M.rows();
+    Eigen::MatrixXd A;
+    Eigen::VectorXd b;
+    rows(tasks_, t, q, S, w, v, frame, A, b);
+    const Eigen::MatrixXd P = pinv(A, 1e-10);
+    Eigen::VectorXd u = P * b;
+    Eigen::MatrixXd N = Eigen::MatrixXd::Identity(k, k) - P * A;
+    if (!secondary_.empty()) {
+      Eigen::MatrixXd A2;
+      Eigen::VectorXd b2;
+      rows(secondary_, t, q, S, w, v, frame, A2, b2);
+      const Eigen::MatrixXd A2N = A2 * N;
+      const Eigen::MatrixXd P2 = pinv(A2N, 1e-8);
+      const Eigen::VectorXd r2 = b2 - A2 * u;
+      u = u + P2 * r2;
+      const Eigen::MatrixXd N2 = Eigen::MatrixXd::Identity(k, k) - P2 * A2N;
+      N = (N * N2).eval();
+    }
+    if (damping_ != 0.0) {
+      const Eigen::VectorXd d = damping_ * nu;
+      u -= N * d;
+    }
+    // computed_torque: M nudot + h = B tau with nudot[controlled] = u[controlled], the free ones unknown
+    const Eigen::Index m = B.cols();
+    std::vector<int> ctrl = controlled_, free;
+    if (ctrl.empty())
+      for (int i = 0; i < k; ++i) ctrl.push_back(i);
+    std::vector<char> is_ctrl(k, 0);
+    for (int c : ctrl) is_ctrl[c] = 1;
+    for (int i = 0; i < k; ++i)
+      if (!is_ctrl[i]) free.push_back(i);
+    Eigen::MatrixXd lhs(k, m + free.size());
+    lhs.leftCols(m) = B;
+    for (size_t j = 0; j < free.size(); ++j) lhs.col(m + j) = -M.col(free[j]);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(k);
+    for (int c : ctrl) rhs += M.col(c) * u[c];
+    rhs += h;
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(lhs);
+    out += cod.solve(rhs).head(m);
+  }
+
+ private:
+  template <class Frames>
+  void rows(const std::vector<Task>& tasks, double t, const Eigen::Ref<const Eigen::VectorXd>& q,
+            const Eigen::MatrixXd& S, const Eigen::VectorXd& w, const Eigen::VectorXd& v, Frames& frame,
+            Eigen::MatrixXd& A, Eigen::VectorXd& b) {
+    int total = 0;
+    for (const Task& task : tasks) total += task.dim();
+    const Eigen::Index n = S.rows();
+    A.resize(total, S.cols());
+    b.resize(total);
+    int row = 0;
+    for (const Task& task : tasks) {
+      const int d = task.dim();
+      Eigen::VectorXd y(d), drift(d), yr(d), ydr(d), yddr(d);
+      Eigen::MatrixXd J(d, n);
+      if (task.kind == 0) {
+        const FrameKinematics f = frame(task.frame);
+        const Eigen::Vector3d r = f.R * task.offset;
+        const Eigen::Vector3d omega = f.J->bottomRows<3>() * v;
+        Eigen::Matrix3d sk;
+        sk << 0.0, -r[2], r[1], r[2], 0.0, -r[0], -r[1], r[0], 0.0;
+        const Eigen::MatrixXd Jp = f.J->topRows<3>() - sk * f.J->bottomRows<3>();
+        const Eigen::Vector3d dr = f.a + f.alpha.cross(r) + omega.cross(omega.cross(r));
+        const Eigen::Vector3d pos = f.p + r;
+        for (int i = 0; i < d; ++i) {
+          y[i] = pos[task.select[i]];
+          J.row(i) = Jp.row(task.select[i]);
+          drift[i] = dr[task.select[i]];
+        }
+      } else {
+        J.setZero();
+        for (int i = 0; i < d; ++i) {
+          y[i] = q[task.select[i]];
+          J(i, task.select[i]) = 1.0;
+        }
+        drift.setZero();
+      }
+      task.y->eval(t, yr);
+      task.yd->eval(t, ydr);
+      task.ydd->eval(t, yddr);
+      const Eigen::VectorXd ydot = J * v;
+      A.middleRows(row, d) = J * S;
+      b.segment(row, d) = yddr + kd_ * (ydr - ydot) + kp_ * (yr - y) - J * w - drift;
+      row += d;
+    }
+  }
+
+  double kp_ = 0.0, kd_ = 0.0, damping_ = 0.0;
+  std::vector<int> controlled_;
+  std::vector<Task> tasks_, secondary_;
+};
+
+class Controller {
+ public:
+  Controller() = default;
+  // Null profiles / empty gain matrices: the term is absent.
+  Controller(int motors, int n, int k, const TorqueProfile* feedforward, const Eigen::MatrixXd& Kq,
+             const TorqueProfile* q_ref, const Eigen::MatrixXd& Knu, const TorqueProfile* nu_ref,
+             const TorqueProfile* acceleration)
+      : motors_(motors), n_(n), k_(k), Kq_(Kq), Knu_(Knu) {
+    auto keep = [](const TorqueProfile* p, int width, const char* what) -> std::shared_ptr<TorqueProfile> {
+      if (p == nullptr) return nullptr;
+      if (p->motors() != width)
+        throw std::invalid_argument(std::string("feedback law: ") + what + " has the wrong width");
+      return std::make_shared<TorqueProfile>(*p);
+    };
+    ff_ = keep(feedforward, motors, "the feed-forward torque");
+    qd_ = keep(q_ref, n, "the coordinate reference");
+    nud_ = keep(nu_ref, k, "the velocity reference");
+    acc_ = keep(acceleration, k, "the reference acceleration");
+    if (Kq_.size() && (Kq_.rows() != motors || Kq_.cols() != n))
+      throw std::invalid_argument("feedback law: K_q must be (motors, n)");
+    if (Knu_.size() && (Knu_.rows() != motors || Knu_.cols() != k))
+      throw std::invalid_argument("feedback law: K_nu must be (motors, k)");
+    if (qd_ && !Kq_.size()) throw std::invalid_argument("feedback law: a coordinate reference without K_q");
+    if (nud_ && !Knu_.size()) throw std::invalid_argument("feedback law: a velocity reference without K_nu");
+    qbuf_.resize(n);
+    nubuf_.resize(k);
+  }
+
+  // Adds the linearising law's torques to every evaluation.
+  void set_linearising(const Linearising& law) { lin_ = std::make_shared<Linearising>(law); }
+  bool needs_frames() const { return static_cast<bool>(lin_); }
+
+  int motors() const { return motors_; }
+  int n() const { return n_; }
+  int k() const { return k_; }
+  bool needs_dynamics() const { return static_cast<bool>(acc_); }
+
+  // tau at (t, q, nu), with the reduced model (M_r, h_r, B_r, S, w, v) and the frames' kinematics at that state,
+  // into out (motors).
+  template <class Frames>
+  void eval(double t, const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& nu,
+            const Eigen::MatrixXd& M, const Eigen::VectorXd& h, const Eigen::MatrixXd& B, const Eigen::MatrixXd& S,
+            const Eigen::VectorXd& w, const Eigen::VectorXd& v, Frames&& frame, Eigen::Ref<Eigen::VectorXd> out) {
+    out.setZero();
+    if (ff_) ff_->eval(t, out);
+    if (Kq_.size()) {
+      if (qd_) qd_->eval(t, qbuf_);
+      else qbuf_.setZero();
+      qbuf_ -= q;
+      out.noalias() += Kq_ * qbuf_;
+    }
+    if (Knu_.size()) {
+      if (nud_) nud_->eval(t, nubuf_);
+      else nubuf_.setZero();
+      nubuf_ -= nu;
+      out.noalias() += Knu_ * nubuf_;
+    }
+    if (acc_) {
+      acc_->eval(t, nubuf_);
+      force_.noalias() = M * nubuf_;
+      force_ += h;
+      cod_.compute(B);
+      out.noalias() += cod_.solve(force_);
+    }
+    if (lin_) lin_->eval(t, q, nu, M, h, B, S, w, v, frame, out);
+  }
+
+ private:
+  int motors_ = 0, n_ = 0, k_ = 0;
+  std::shared_ptr<TorqueProfile> ff_, qd_, nud_, acc_;
+  std::shared_ptr<Linearising> lin_;  // shared by copies (its evaluation keeps no state)
+  Eigen::MatrixXd Kq_, Knu_;
+  Eigen::VectorXd qbuf_, nubuf_, force_;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
+};
+
+}  // namespace robotdyn

@@ -84,6 +84,10 @@ def solve_contact_forces(
         objective: ``"friction"`` (minimise squared friction forces) or ``"norm"`` (squared forces).
         tol: Feasibility tolerance on the unilateral and cone constraints [N].
 
+    Returns:
+        A :class:`ContactForces`: forces (P, 3) [N] in the world frame, normal and tangential magnitudes (P,) [N],
+        friction ratio, wrench residual and the method used.
+
     Raises:
         InputError: Bad shapes, mu <= 0, unknown objective.
         ConstraintError: No forces satisfy equilibrium, unilateral contact and the cones (the robot would tip or

@@ -57,7 +57,11 @@ SELF_CHECK_TOL = 1e-9
 
 
 def available() -> bool:
-    """Whether the compiled extension was built (it needs a C++ compiler at install time)."""
+    """Whether the compiled extension was built (it needs a C++ compiler at install time).
+
+    Returns:
+        ``True`` if ``robotdyn._compiled`` was imported.
+    """
     return _compiled is not None
 
 
@@ -92,6 +96,9 @@ def why_not(robot) -> str | None:
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        A one-line reason, or ``None``.
     """
     if _compiled is None:
         return "the compiled extension robotdyn._compiled was not built"
@@ -324,6 +331,9 @@ class CompiledModel:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
 
+        Returns:
+            The 11-tuple described above (arrays in the reduced coordinates' order; residual and condition as floats).
+
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
         """
@@ -339,6 +349,9 @@ class CompiledModel:
         Args:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+
+        Returns:
+            The 7-tuple ``(M_r, h, g_r, B_r, S, w, v)`` of read-only array views.
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
@@ -362,6 +375,9 @@ class CompiledModel:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
             independent: Indices of the independent velocities in v (default ``None``: the chosen ones).
+
+        Returns:
+            The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics`, or ``None``.
         """
         self._mine()
         hint = self._hint
@@ -390,6 +406,9 @@ class CompiledModel:
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
             stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
 
+        Returns:
+            The state derivative :math:`(\\dot q, \\dot\\nu)` as one array (nq + k,).
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
@@ -413,6 +432,9 @@ class CompiledModel:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+
+        Returns:
+            The tuple of read-only views described above.
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`; also where the compatible loads would pull on a wheel
@@ -449,6 +471,9 @@ class CompiledModel:
             a: Full accelerations (n,) [m/s^2, rad/s^2].
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
 
+        Returns:
+            The tuple described above (forces in N, N m).
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
@@ -464,6 +489,9 @@ class CompiledModel:
         Args:
             Q: Coordinates (N, n) [m, rad].
             NU: Independent velocities (N, k).
+
+        Returns:
+            The tuple described above, stacked over the N states, and the list of indices that failed.
         """
         self._mine()
         N, n = Q.shape

@@ -85,8 +85,8 @@ def solve_contact_forces(
         tol: Feasibility tolerance on the unilateral and cone constraints [N].
 
     Returns:
-        A :class:`ContactForces`: forces (P, 3) [N] in the world frame, normal and tangential magnitudes (P,) [N],
-        friction ratio, wrench residual and the method used.
+        A :class:`ContactForces`: forces (k, 3) [N] in the world frame, normal components and friction magnitudes
+        (k,) [N], friction use (k,), the equilibrium residual [N, N m] and the method used.
 
     Raises:
         InputError: Bad shapes, mu <= 0, unknown objective.

@@ -126,7 +126,8 @@ class Traction:
         """CSV columns by name: ``<wheel>.normal`` [N] and ``<wheel>.mu_required`` for each determined wheel.
 
         Returns:
-            An ordered dict of column name to a (N,) float array.
+            A dict of column name to a (N,) float array, wheels in wheel order, then ``mu_required_min`` (the smallest
+            friction coefficient of :meth:`ConstraintForces.minimum_mu`) where that applies.
         """
         out = {}
         for j, name in enumerate(self.wheels):

@@ -92,7 +92,7 @@ def sample_loads(forces) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]
         forces: One sample's :class:`~robotdyn.contact.contact_forces.ConstraintForces`.
 
     Returns:
-        ``(names, normal, tangential, known)``: wheel names (W,), normal loads (W,) [N], tangential loads (W, 2) [N] and
+        ``(names, normal, tangential, known)``: wheel names (W,), normal loads (W,) [N], tangential load magnitudes (W,) [N] and
         the boolean mask (W, 3) of the determined components.
     """
     wheels = forces.wheels

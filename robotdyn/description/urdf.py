@@ -607,7 +607,8 @@ def build_description(
             reference of the z coordinate (floating root); see :meth:`Description.set_root_height`.
 
     Returns:
-        The :class:`Description` (Pinocchio model, data and geometry, with the names and reports of the expansion).
+        The :class:`Description`: the Pinocchio model, its visual geometry, the URDF text, root kind, joint names and
+        limits.
     """
     from .ros_packages import PackageIndex
     from .visual_geometry import build_visual

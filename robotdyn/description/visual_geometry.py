@@ -256,8 +256,8 @@ def inertia_box(mass: float, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarra
         inertia: Central inertia tensor (3, 3) [kg m^2].
 
     Returns:
-        ``(sides, axes)``: sides (3,) [m] and axes (3, 3) (columns, in the link frame), or ``None`` where the inertia is
-        not usable.
+        ``(sides, axes)``: sides (3,) [m] and axes (3, 3) (columns, in the frame of ``inertia``), or ``None`` for a
+        massless or non-physical inertia.
     """
     if not (np.isfinite(mass) and mass > 0) or not np.all(np.isfinite(inertia)):
         return None

@@ -332,7 +332,9 @@ class CompiledModel:
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
 
         Returns:
-            The 11-tuple described above (arrays in the reduced coordinates' order; residual and condition as floats).
+            ``(M_r (k, k), h (k,), g_r (k,), B_r (k, motors), S (n, k), w (n,), v (n,), A (m, n), residual, condition,
+            inverse)`` as described above; ``condition`` and ``inverse`` are ``None`` except for operational
+            velocities.
 
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
@@ -434,7 +436,9 @@ class CompiledModel:
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
 
         Returns:
-            The tuple of read-only views described above.
+            ``(nudot (k,), lambda (m,), e (n,), wheel forces (nw, 3) [N] in (t1, t2, n), wheel forces (nw, 3) [N] in
+            world axes, contact frames (nw, 9), contact points (nw, 3) [m])``: read-only views, overwritten by the next
+            call.
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`; also where the compatible loads would pull on a wheel
@@ -472,7 +476,8 @@ class CompiledModel:
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
 
         Returns:
-            The tuple described above (forces in N, N m).
+            ``(lambda (m,), e (n,), (wheel forces, world forces, frames, points), A (m, n))``: copies, the inner tuple
+            as in :meth:`forces` (forces in N, points in m).
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
@@ -491,7 +496,8 @@ class CompiledModel:
             NU: Independent velocities (N, k).
 
         Returns:
-            The tuple described above, stacked over the N states, and the list of indices that failed.
+            ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n), B_r (N, k, motors), failed)``, ``failed``
+            the list of state indices left for the Python path.
         """
         self._mine()
         N, n = Q.shape

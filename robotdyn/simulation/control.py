@@ -244,7 +244,7 @@ def tracking_errors(controller: LinearisingController, traj: Trajectory, task: i
         after: Ignore samples before this time [s] (the transient).
 
     Returns:
-        A dict with keys ``mean``, ``rms``, ``max`` (floats, unit of y) and the remaining summary keys of the task.
+        A dict with keys ``mean``, ``rms``, ``max`` and ``final`` (the last sample's error), floats in the unit of y.
     """
     errs = []
     for t, q, nu in zip(traj.t, traj.q, traj.nu):

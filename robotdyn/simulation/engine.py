@@ -103,8 +103,8 @@ def simulate(
             :func:`robotdyn.simulation.streaming.stream`: the integrator restarts at each segment boundary).
 
     Returns:
-        The :class:`~robotdyn.simulation.trajectory.Trajectory` (t [s], q, nu, energy [J], residual), or the stream's
-        result when ``sink`` is given.
+        The :class:`~robotdyn.simulation.trajectory.Trajectory` (t [s], q, nu, energy [J], residual), or the
+        :class:`~robotdyn.simulation.streaming.StreamResult` when ``sink`` is given.
 
     Example:
         >>> import robotdyn

@@ -96,7 +96,7 @@ def flight_summary(phases: list[dict], start: list[str] = ()) -> list[str]:
         start: Names of the wheels in the air at the start (:func:`airborne` at q0; default none).
 
     Returns:
-        The lines, one per wheel that left the ground.
+        The lines, one per wheel with an event or in the air at the start.
     """
     wheels: dict[str, list[str]] = {name: ["in the air at the start"] for name in start}
     for e in phases:

@@ -277,7 +277,7 @@ class TrajectoryProblem:
             z: Decision vector, as for :meth:`defects`.
 
         Returns:
-            The values (nnz,) in the order of the structure's (row, column) pairs.
+            The values (nnz,), in the order given above (that of the problem's sparsity pattern).
         """
         key = z.tobytes()
         if self._jac_cache[0] == key:  # IPOPT asks again at the same point (e.g. after a function evaluation)

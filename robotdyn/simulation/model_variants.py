@@ -68,7 +68,7 @@ def structure(robot) -> tuple:
         robot: A :class:`~robotdyn.robot.Robot` with a compiled model.
 
     Returns:
-        A hashable tuple ``(joints, frames, rows, motors, terrains, velocity names)``.
+        The tuple ``(joints, frames, rows, motors, terrains, velocity names)`` (equal for robots that can share a compiled model).
     """
     fast = _fast(robot)
     model = robot.model

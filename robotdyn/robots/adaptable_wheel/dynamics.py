@@ -168,7 +168,9 @@ class MissionModel:
             t: Time [s] in the run's interval.
 
         Returns:
-            A dict of the quantities at t, keyed as the fields of :class:`DynamicsRun` (SI units).
+            A dict of the quantities at t: ``q``, ``v``, ``a``, ``x`` (the IK solution), ``tau`` (motor torques [N m]),
+            ``forces``, ``normal``, ``ratio``, ``residual``, ``lateral_slip``, ``motor_power``, ``contact_power``,
+            ``energy``, ``tau_static`` and ``tau_eq35`` (SI units; meanings as in :class:`DynamicsRun`).
         """
         rolling, pr = self.rolling, self.p
         cmd, x, q, v, a = self.state(t)

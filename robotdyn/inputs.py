@@ -90,7 +90,7 @@ def parse_assignments(items: Iterable[str], what: str = "--param") -> dict[str, 
         what: The option's name, for messages.
 
     Returns:
-        A dict of NAME to VALUE (strings), in the given order.
+        A dict of NAME to VALUE (both stripped strings), in the given order; a repeated NAME keeps its last VALUE.
 
     Raises:
         InputError: An item without ``=``.

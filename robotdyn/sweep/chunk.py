@@ -179,7 +179,8 @@ def scaled_torque(torque, scale: float):
         scale: The run's torque scale (dimensionless).
 
     Returns:
-        The scaled torque law (``torque`` itself where no scaling applies).
+        ``torque`` itself when it is ``None`` or ``scale`` is 1; else a scaled profile for a profile, or a callable
+        ``tau(t, q, nu)`` returning the scaled torques.
     """
     if torque is None or scale == 1.0:
         return torque

@@ -197,8 +197,8 @@ class ConstraintForces:
         the ground (a wheel the rigid limit unloads included).
 
         Returns:
-            The smallest friction coefficient (dimensionless, >= 0); ``float("inf")`` where a wheel is not pressed on the
-            ground, ``None`` where a normal load has no value.
+            The smallest friction coefficient (dimensionless, >= 0); ``float("inf")`` where a wheel is not pressed on
+            the ground, ``None`` where a normal load has no value.
         """
         if not self.wheels or not all(w.known[2] for w in self.wheels):
             return None

@@ -92,8 +92,8 @@ def sample_loads(forces) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]
         forces: One sample's :class:`~robotdyn.contact.contact_forces.ConstraintForces`.
 
     Returns:
-        ``(names, normal, tangential, known)``: wheel names (W,), normal loads (W,) [N], tangential load magnitudes (W,) [N] and
-        the boolean mask (W, 3) of the determined components.
+        ``(names, normal, tangential, known)``: wheel names (W,), normal loads (W,) [N], tangential load magnitudes
+        (W,) [N] and the boolean mask (W, 3) of the determined components.
     """
     wheels = forces.wheels
     return ([w.name for w in wheels], np.array([w.normal for w in wheels], float),

@@ -59,8 +59,8 @@ class Task:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
 
         Returns:
-            ``(y, J, Jdot_v)``: the output (d,), its Jacobian (d, nv) and the drift :math:`\\dot J v` (d,), in the task's
-            units (m or rad).
+            ``(y, J, Jdot_v)``: the output (d,), its Jacobian (d, nv) and the drift :math:`\\dot J v` (d,), in the
+            task's units (m or rad).
         """
         raise NotImplementedError
 

@@ -68,7 +68,8 @@ def structure(robot) -> tuple:
         robot: A :class:`~robotdyn.robot.Robot` with a compiled model.
 
     Returns:
-        The tuple ``(joints, frames, rows, motors, terrains, velocity names)`` (equal for robots that can share a compiled model).
+        The tuple ``(joints, frames, rows, motors, terrains, velocity names)`` (equal for robots that can share a
+        compiled model).
     """
     fast = _fast(robot)
     model = robot.model

@@ -179,7 +179,10 @@ def _returns_a_value(func) -> bool:
         tree = ast.parse(textwrap.dedent(inspect.getsource(func)))
     except (OSError, TypeError, SyntaxError):
         return False
-    node = tree.body[0]
+    node = next((n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))),
+                None)
+    if node is None or isinstance(node, ast.Lambda):  # a lambda returns its expression
+        return node is not None
     stack = list(node.body)
     while stack:
         n = stack.pop()
@@ -273,6 +276,7 @@ def test_the_check_finds_an_undocumented_return():
     def procedure(a) -> None:
         """Something."""
 
-    flagged = [f.__name__ for f in (annotated, unannotated, nothing, documented, generator, procedure)
+    lam = lambda a: a  # noqa: E731 (a public name bound to a lambda returns its expression)
+    flagged = [f.__name__ for f in (annotated, unannotated, nothing, documented, generator, procedure, lam)
                if needs_returns(f) and not has_section(f.__doc__)]
-    assert flagged == ["annotated", "unannotated"]
+    assert flagged == ["annotated", "unannotated", "<lambda>"]

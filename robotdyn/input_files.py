@@ -26,6 +26,9 @@ def resolved(path, what: str) -> Path:
         path: A file or directory path (str or Path).
         what: What the path is, for the message (e.g. ``"--package"``, ``"package_dirs"``).
 
+    Returns:
+        The absolute, resolved path.
+
     Raises:
         InputError: The path's symbolic links form a loop (or another link error of the file system).
     """
@@ -43,6 +46,9 @@ def regular_file(path, what: str, max_bytes: int) -> os.stat_result:
         path: The file.
         what: What the file is, for the message (e.g. ``"sweep file"``).
         max_bytes: Largest size accepted [bytes].
+
+    Returns:
+        The ``os.stat_result`` of the file.
 
     Raises:
         InputError: Missing, unreadable, a directory, a FIFO, a device or a socket, or larger than ``max_bytes``.

@@ -52,6 +52,9 @@ def as_vector(values, n: int, what: str, names: Sequence[str] | None = None,
         limit: Largest magnitude accepted (None: any finite number), e.g. :data:`MAX_VELOCITY`.
         unit: Unit of the entries, for the message.
 
+    Returns:
+        A float array of shape (n,).
+
     Raises:
         InputError: Wrong length, non-numeric, non-finite or too large entries.
     """
@@ -85,6 +88,9 @@ def parse_assignments(items: Iterable[str], what: str = "--param") -> dict[str, 
     Args:
         items: ``NAME=VALUE`` strings (``None``: none).
         what: The option's name, for messages.
+
+    Returns:
+        A dict of NAME to VALUE (both stripped strings), in the given order; a repeated NAME keeps its last VALUE.
 
     Raises:
         InputError: An item without ``=``.

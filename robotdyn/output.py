@@ -34,6 +34,9 @@ def check_target(path, what: str = "output file", suffixes: tuple[str, ...] | No
         what: What it is, for messages.
         suffixes: Allowed extensions (e.g. ``(".png", ".pdf")``; default ``None``: any).
 
+    Returns:
+        The validated path (a :class:`~pathlib.Path`).
+
     Raises:
         OutputError: The path is a directory, its directory is missing or not writable, or its extension is not
             allowed.
@@ -83,6 +86,9 @@ def atomic_output(path, what: str = "output file") -> Iterator[Path]:
     Args:
         path: The output file.
         what: What it is, for messages.
+
+    Yields:
+        The temporary :class:`~pathlib.Path` to write to.
     """
     target = check_target(path, what)
     try:

@@ -479,7 +479,11 @@ class Robot:
         raise InputError(f"unknown coordinate {label!r}; expected one of {', '.join(self.coordinates)}")
 
     def neutral(self) -> np.ndarray:
-        """A valid configuration: the spec's ``neutral`` values, zero elsewhere."""
+        """A valid configuration: the spec's ``neutral`` values, zero elsewhere.
+
+        Returns:
+            The configuration q (nq,), in coordinate order.
+        """
         q = np.zeros(self.nq)
         for label, value in self.spec.neutral.items():
             q[self.coordinate_index(label)] = self._value(value)
@@ -955,7 +959,11 @@ class Robot:
         admissible ones :func:`~robotdyn.constraints.base_mobility.reachable_motion` finds), e.g. a skid-steer base
         whose non-steering wheels roll without slipping, or where that holds only at the neutral configuration
         (steerable wheels parallel there); and joint-origin angles that look like a rounded multiple of pi/2
-        (:mod:`robotdyn.description.rounded_angles`)."""
+        (:mod:`robotdyn.description.rounded_angles`).
+
+        Returns:
+            ``(mobility, notes)``: n - rank A (an int) and the notes (one string each; empty if none).
+        """
         A = self.rows_at(self.neutral()).A
         rank = int(np.linalg.matrix_rank(A)) if A.size else 0
         notes = []
@@ -1030,7 +1038,11 @@ class Robot:
         return best
 
     def info(self) -> dict:
-        """Coordinates, independent velocities, parameters (value, unit) and actuators, as plain data."""
+        """Coordinates, independent velocities, parameters (value, unit) and actuators, as plain data.
+
+        Returns:
+            A JSON-ready dict of plain Python values.
+        """
         mobility, notes = self.mobility_check()
         report = self.description.visual_report
         heights = self.wheel_heights() if self.spec.root != "fixed" else {}

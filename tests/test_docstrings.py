@@ -158,3 +158,125 @@ def test_docstring_examples(dotted, tmp_path, monkeypatch):
     for t in examples:
         runner.run(t)
     assert runner.failures == 0, f"{runner.failures} failing example(s) in {dotted} (run pytest -rA for the diff)"
+
+
+RETURN_SECTIONS = ("Returns", "Return", "Yields", "Yield")
+
+
+def has_section(doc: str | None, sections=RETURN_SECTIONS) -> bool:
+    """Whether a Google-style docstring has one of the given sections (a header line at the left margin)."""
+    if not doc:
+        return False
+    return any(line.endswith(":") and line[:-1] in sections
+               for line in inspect.cleandoc(doc).splitlines())
+
+
+def _returns_a_value(func) -> bool:
+    """Whether the function's own body (not a nested function's) has a ``return <value>`` (or is a generator)."""
+    import ast
+    import textwrap
+    try:
+        tree = ast.parse(textwrap.dedent(inspect.getsource(func)))
+    except (OSError, TypeError, SyntaxError):
+        return False
+    node = next((n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))),
+                None)
+    if node is None or isinstance(node, ast.Lambda):  # a lambda returns its expression
+        return node is not None
+    stack = list(node.body)
+    while stack:
+        n = stack.pop()
+        if isinstance(n, ast.Return) and n.value is not None and not (
+                isinstance(n.value, ast.Constant) and n.value.value is None):
+            return True
+        if isinstance(n, (ast.Yield, ast.YieldFrom)):
+            return True
+        if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            continue
+        stack.extend(ast.iter_child_nodes(n))
+    return False
+
+
+def needs_returns(func) -> bool:
+    """A function needs ``Returns:``/``Yields:`` if annotated other than None, or unannotated and returning a value."""
+    try:
+        ann = inspect.signature(func).return_annotation
+    except (TypeError, ValueError):
+        return False
+    if ann is inspect.Signature.empty:
+        return _returns_a_value(func)
+    return ann not in (None, "None", "NoReturn", "typing.NoReturn")
+
+
+def missing_returns() -> list[str]:
+    missing = []
+    for mod in public_modules():
+        for name, obj in vars(mod).items():
+            if name.startswith("_") or getattr(obj, "__module__", None) != mod.__name__:
+                continue
+            where = f"{mod.__name__}.{name}"
+            if inspect.isfunction(obj):
+                if needs_returns(obj) and not has_section(obj.__doc__):
+                    missing.append(where)
+            elif inspect.isclass(obj) and not issubclass(obj, BaseException):
+                fields = getattr(obj, "__dataclass_fields__", {})
+                for mname, member in obj.__dict__.items():
+                    if mname.startswith("_") or mname in fields:  # dunders, dataclass-generated methods, fields
+                        continue
+                    func = member.__func__ if isinstance(member, (staticmethod, classmethod)) else member
+                    if inspect.isfunction(func) and needs_returns(func) and not has_section(
+                            inspect.getdoc(getattr(obj, mname))):  # properties are exempt: not functions
+                        missing.append(f"{where}.{mname}")
+    return missing
+
+
+def test_every_public_function_documents_what_it_returns():
+    missing = missing_returns()
+    assert not missing, f"{len(missing)} public functions without a Returns:/Yields: section:\n" + "\n".join(missing)
+
+
+def test_the_check_finds_an_undocumented_return():
+    def annotated(a) -> int:
+        """Something.
+
+        Args:
+            a: First.
+        """
+        return a
+
+    def unannotated(a):
+        """Something."""
+        def inner():
+            return 1
+        return a + inner()
+
+    def nothing(a):
+        """Something."""
+        def inner():
+            return 1
+        inner()
+        return
+
+    def documented(a) -> tuple[int, int]:
+        """Something.
+
+        Returns:
+            ``(a, a)``.
+        """
+        return a, a
+
+    def generator(a):
+        """Something.
+
+        Yields:
+            ``a`` once.
+        """
+        yield a
+
+    def procedure(a) -> None:
+        """Something."""
+
+    lam = lambda a: a  # noqa: E731 (a public name bound to a lambda returns its expression)
+    flagged = [f.__name__ for f in (annotated, unannotated, nothing, documented, generator, procedure, lam)
+               if needs_returns(f) and not has_section(f.__doc__)]
+    assert flagged == ["annotated", "unannotated", "<lambda>"]

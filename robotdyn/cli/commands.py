@@ -597,6 +597,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
     Args:
         only: One of :data:`BUILT_IN` (default ``None``: every command).
+
+    Returns:
+        The :class:`argparse.ArgumentParser` of every built-in command, or of ``only`` alone.
     """
     if only is not None and only not in BUILT_IN:
         raise ValueError(f"only = {only!r}; expected one of {', '.join(BUILT_IN)}")

@@ -73,6 +73,10 @@ def spec_from_args(args):
 
     Args:
         args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The :class:`~robotdyn.sweep.spec.SweepSpec` of the ``--spec`` file (or the default spec) with the command line's
+        flags merged on top.
     """
     from ..inputs import parse_assignments
     from ..sweep.spec import SweepSpec, from_toml, parse_axis

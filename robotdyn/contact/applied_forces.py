@@ -41,6 +41,9 @@ def has_applied(robot) -> bool:
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` (its ``springs`` and constraints).
+
+    Returns:
+        ``True`` if the robot has at least one joint spring or compliant wheel.
     """
     from .compliant_contact import compliant_wheels
 

@@ -54,6 +54,9 @@ class NormalLaw:
         Args:
             delta: Penetration :math:`\\delta` [m] (> 0: in contact).
             rate: Its rate :math:`\\dot\\delta` [m/s] (> 0: pressing in).
+
+        Returns:
+            The normal force :math:`f_n \\ge 0` [N] (0.0 out of contact).
         """
         raise NotImplementedError
 
@@ -62,6 +65,9 @@ class NormalLaw:
 
         Args:
             delta: Penetration :math:`\\delta` [m].
+
+        Returns:
+            The elastic force :math:`f_e(\\delta)` [N] (0.0 out of contact).
         """
         raise NotImplementedError
 
@@ -70,6 +76,9 @@ class NormalLaw:
 
         Args:
             delta: Penetration :math:`\\delta` [m].
+
+        Returns:
+            The stored energy :math:`U(\\delta)` [J] (0.0 out of contact).
         """
         raise NotImplementedError
 
@@ -213,6 +222,9 @@ class CompliantWheel(RollingWheel):
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` (its q is used).
+
+        Returns:
+            The penetration :math:`\\delta` [m] (> 0 in contact, <= 0 in the air).
         """
         return -float(self._geometry(kin)[7])
 
@@ -224,6 +236,10 @@ class CompliantWheel(RollingWheel):
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (v: full velocities (nv,)).
+
+        Returns:
+            A dict with the keys listed above (floats [m, m/s, N, W] and NumPy arrays; contact-frame quantities in (t1,
+            t2, n), ``point`` in the world frame, ``Q`` in the model's velocity order).
         """
         Aw, geo = self._world_jacobian(kin)
         E = geo[9]
@@ -248,6 +264,9 @@ def compliant_wheels(robot) -> list[CompliantWheel]:
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` (its ``constraints``, in their order).
+
+    Returns:
+        The :class:`CompliantWheel` constraints of ``robot``, in constraint order (empty if none).
     """
     return [c for c in robot.constraints if isinstance(c, CompliantWheel)]
 

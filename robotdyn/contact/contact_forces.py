@@ -194,7 +194,12 @@ class ConstraintForces:
         The normal loads are those of the rigid limit of compliance where rigid-body dynamics leave them open, and
         z then runs over what stays open (:attr:`open`). Equal to the largest per-wheel required mu when every
         friction force has a value; ``None`` when a normal load has none; ``inf`` when a wheel is not pressed on
-        the ground (a wheel the rigid limit unloads included)."""
+        the ground (a wheel the rigid limit unloads included).
+
+        Returns:
+            The smallest friction coefficient (dimensionless, >= 0); ``float("inf")`` where a wheel is not pressed on
+            the ground, ``None`` where a normal load has no value.
+        """
         if not self.wheels or not all(w.known[2] for w in self.wheels):
             return None
         fn = np.array([w.normal for w in self.wheels])
@@ -224,7 +229,11 @@ class ConstraintForces:
         raise InputError(f"unknown wheel {name!r}; expected one of {', '.join(w.name for w in self.wheels)}")
 
     def as_dict(self) -> dict:
-        """Plain data (for JSON): rows, wheels, closures and what is undetermined."""
+        """Plain data (for JSON): rows, wheels, closures and what is undetermined.
+
+        Returns:
+            A JSON-ready dict of plain Python values (forces in N, moments in N m).
+        """
         return {
             "rows": {lab: float(x) for lab, x in zip(self.labels, self.lam)},
             "determined": {lab: bool(d) for lab, d in zip(self.labels, self.determined)},
@@ -258,7 +267,11 @@ class ConstraintForces:
         }
 
     def table(self) -> str:
-        """A readable text table of the wheel and closure forces."""
+        """A readable text table of the wheel and closure forces.
+
+        Returns:
+            The table as one string (lines joined with newlines; forces in N).
+        """
         lines = []
         if self.wheels:
             lines.append("contact forces (ground on wheel, contact frame) [N]:")
@@ -422,6 +435,9 @@ def apply_rigid_limit(robot, out: ConstraintForces, lam: np.ndarray | None = Non
         lam: (m,) multipliers already split (with slipping wheels: :func:`robotdyn.contact.rigid_limit.coupled`,
             whose friction depends on them); ``None``: split here.
         unloaded: With ``lam``, the wheels it leaves unloaded.
+
+    Returns:
+        ``out`` itself, with its open loads fixed by the rigid limit (unchanged where there is nothing to fix).
     """
     if out.null_space.shape[1] == 0 or not out.wheels or all(w.determined[2] for w in out.wheels) or out._inert:
         return out

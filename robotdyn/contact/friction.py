@@ -53,7 +53,11 @@ class FrictionLaw:
 
     def encode(self) -> tuple[int, float, float] | None:
         """The law as data for the compiled engine (``robotdyn/_compiled.cpp``, ``Slip``): ``(code, p0, p1)``, or
-        ``None`` where its formula is not compiled (the robot then runs on the Python path)."""
+        ``None`` where its formula is not compiled (the robot then runs on the Python path).
+
+        Returns:
+            ``(code, p0, p1)`` (an int and two floats in the law's own units), or ``None``.
+        """
         return None
 
 
@@ -81,7 +85,11 @@ class RegularisedCoulomb(FrictionLaw):
         return self.mu * s / math.sqrt(float(s @ s) + self.slip_velocity**2)
 
     def encode(self) -> tuple[int, float, float] | None:
-        """``(0, mu, slip_velocity)`` (:meth:`FrictionLaw.encode`; a subclass with its own formula: ``None``)."""
+        """``(0, mu, slip_velocity)`` (:meth:`FrictionLaw.encode`; a subclass with its own formula: ``None``).
+
+        Returns:
+            ``(0, mu, slip_velocity)`` (mu dimensionless, slip_velocity [m/s]), or ``None``.
+        """
         return (0, self.mu, self.slip_velocity) if type(self).coefficient is RegularisedCoulomb.coefficient else None
 
     def __repr__(self) -> str:
@@ -114,7 +122,11 @@ class LinearTyre(FrictionLaw):
         return self.mu * s / speed
 
     def encode(self) -> tuple[int, float, float] | None:
-        """``(1, stiffness, mu)`` (:meth:`FrictionLaw.encode`; a subclass with its own formula: ``None``)."""
+        """``(1, stiffness, mu)`` (:meth:`FrictionLaw.encode`; a subclass with its own formula: ``None``).
+
+        Returns:
+            ``(1, stiffness, mu)`` (stiffness [s/m], mu dimensionless), or ``None``.
+        """
         return (1, self.stiffness, self.mu) if type(self).coefficient is LinearTyre.coefficient else None
 
     def __repr__(self) -> str:
@@ -161,6 +173,9 @@ def make_law(name: str, mu: float | None = None, slip_velocity: float | None = N
         mu: Friction coefficient (>= 0; default ``None``: not given).
         slip_velocity: The coulomb law's regularisation velocity [m/s] (> 0; default ``None``: 1e-3).
         stiffness: The linear law's slip stiffness [s/m] (> 0; default ``None``).
+
+    Returns:
+        The :class:`FrictionLaw` instance (:class:`ExactCoulomb`, :class:`RegularisedCoulomb` or :class:`LinearTyre`).
     """
     try:
         if name == "stick_slip":

@@ -87,6 +87,10 @@ def impact(M, n, nu, e: float) -> Impulse:
         nu: Velocity just before impact (k,); it must approach the surface (n^T nu < 0).
         e: Coefficient of restitution, 0 (plastic) to 1 (elastic).
 
+    Returns:
+        An :class:`Impulse`: magnitude [N s], direction, velocity jump, velocities after, normal velocities before and
+        after, effective mass [kg].
+
     Raises:
         InputError: Bad shapes, non-finite values, e outside [0, 1], or a velocity that does not approach.
     """

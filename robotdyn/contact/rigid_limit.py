@@ -70,6 +70,9 @@ def normal_map(rows: list[np.ndarray], directions: list[np.ndarray], m: int) -> 
         rows: Per wheel the indices of its rows among the m rows.
         directions: Per wheel D (rows, 3): row i acts along D[i] of (t1, t2, n).
         m: Number of rows.
+
+    Returns:
+        The matrix C (W, m), one row per wheel in wheel order, one column per multiplier in row order.
     """
     C = np.zeros((len(rows), m))
     for w, (idx, D) in enumerate(zip(rows, directions)):

@@ -94,6 +94,9 @@ class SlippingWheel(SupportWheel):
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            ``(Jt, s)``: the tangential rows (2, nv) and the slip velocity (2,) [m/s] in (t1, t2) of the contact frame.
         """
         return tangential(self, kin)
 
@@ -101,7 +104,12 @@ class SlippingWheel(SupportWheel):
         """What the compiled evaluator needs for this wheel's friction: its law as data
         (:meth:`~robotdyn.contact.friction.FrictionLaw.encode`) and the mask of its free directions (t1, t2); or,
         as a string, why its friction stays on the Python path (a subclass with its own formulas, a law without
-        compiled formula)."""
+        compiled formula).
+
+        Returns:
+            ``(code, free)``: the law's :meth:`~robotdyn.contact.friction.FrictionLaw.encode` tuple and the
+            free-direction mask (2,) (1.0 where free); or a one-line string saying why not.
+        """
         if type(self).friction_coefficient is not SlippingWheel.friction_coefficient or \
                 type(self).slip is not SlippingWheel.slip:
             return f"wheel {self.name!r} ({type(self).__name__}) is simulated on the Python path"
@@ -119,6 +127,9 @@ def tangential(wheel, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
     Args:
         wheel: A rolling-contact wheel (:class:`~robotdyn.constraints.rolling_contact.RollingWheel` or a subclass).
         kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+    Returns:
+        ``(Jt, s)``: the tangential rows (2, nv) and the slip velocity ``Jt @ kin.v`` (2,) [m/s], rows (t1, t2).
     """
     Aw, geo = wheel._world_jacobian(kin)
     Jt = geo[9][:, :2].T @ Aw
@@ -358,6 +369,9 @@ def painleve_error(wheels, cond: float) -> SingularConstraintError:
     Args:
         wheels: The slipping wheels.
         cond: Condition number of the coupled system.
+
+    Returns:
+        The :class:`~robotdyn.errors.SingularConstraintError` to raise (not raised here).
     """
     return SingularConstraintError(
         f"the friction of slipping wheels {', '.join(w.name for w in wheels)} makes the contact problem "
@@ -370,6 +384,9 @@ def redundant_load_error(wheel) -> ConstraintError:
 
     Args:
         wheel: The slipping wheel.
+
+    Returns:
+        The :class:`~robotdyn.errors.ConstraintError` to raise (not raised here).
     """
     return ConstraintError(f"slipping wheel {wheel.name!r}: its normal row is redundant here, so its load "
                            "(and its friction) is not determined by rigid-body dynamics")
@@ -385,6 +402,9 @@ def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.nda
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
         nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
         tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+
+    Returns:
+        The one-line message (time in s, load in N).
     """
     wheels = sliding_now(robot)
     st = forward(robot, q, nu, tau)
@@ -433,6 +453,10 @@ def inverse(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> SlidingInvers
     Args:
         robot: A :class:`~robotdyn.robot.Robot` (its sliding wheels as :func:`sliding_now` lists them).
         q, v, a: Natural coordinates, full velocities (consistent with the constraints) and full accelerations.
+
+    Returns:
+        A :class:`SlidingInverse`: motor torques, multipliers by row label, normal loads [N], slip and the friction
+        forces.
     """
     q, v, a = (np.asarray(x, float) for x in (q, v, a))
     wheels = sliding_now(robot)

@@ -84,6 +84,10 @@ def solve_contact_forces(
         objective: ``"friction"`` (minimise squared friction forces) or ``"norm"`` (squared forces).
         tol: Feasibility tolerance on the unilateral and cone constraints [N].
 
+    Returns:
+        A :class:`ContactForces`: forces (k, 3) [N] in the world frame, normal components and friction magnitudes
+        (k,) [N], friction use (k,), the equilibrium residual [N, N m] and the method used.
+
     Raises:
         InputError: Bad shapes, mu <= 0, unknown objective.
         ConstraintError: No forces satisfy equilibrium, unilateral contact and the cones (the robot would tip or

@@ -102,7 +102,11 @@ class Traction:
 
     def broken(self) -> np.ndarray:
         """(N, W) where the no-slip assumption is broken: load <= 0, or required friction above mu (every wheel
-        where no admissible split of the open forces stays within mu)."""
+        where no admissible split of the open forces stays within mu).
+
+        Returns:
+            A boolean array (N, W), samples by wheels in wheel order, ``True`` where the assumption is broken.
+        """
         out = self.normal <= 0
         rolling = np.array([w not in self.sliding for w in self.wheels], bool)
         known = np.isfinite(self.mu) & self.friction_determined & rolling
@@ -119,7 +123,12 @@ class Traction:
         return np.asarray(self.minimum_mu, float) > np.max(self.mu)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """CSV columns by name: ``<wheel>.normal`` [N] and ``<wheel>.mu_required`` for each determined wheel."""
+        """CSV columns by name: ``<wheel>.normal`` [N] and ``<wheel>.mu_required`` for each determined wheel.
+
+        Returns:
+            A dict of column name to a (N,) float array, wheels in wheel order, then ``mu_required_min`` (the smallest
+            friction coefficient of :meth:`ConstraintForces.minimum_mu`) where that applies.
+        """
         out = {}
         for j, name in enumerate(self.wheels):
             out[f"{name}.normal"] = self.normal[:, j]
@@ -130,7 +139,11 @@ class Traction:
         return out
 
     def summary(self) -> str:
-        """One line: the extremes per wheel set and the first event (or that the no-slip assumption holds)."""
+        """One line: the extremes per wheel set and the first event (or that the no-slip assumption holds).
+
+        Returns:
+            The one-line summary.
+        """
         parts = []
         if self.wheels:
             rolling = np.array([w not in self.sliding for w in self.wheels], bool)

@@ -90,6 +90,10 @@ def sample_loads(forces) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]
 
     Args:
         forces: One sample's :class:`~robotdyn.contact.contact_forces.ConstraintForces`.
+
+    Returns:
+        ``(names, normal, tangential, known)``: wheel names (W,), normal loads (W,) [N], tangential load magnitudes
+        (W,) [N] and the boolean mask (W, 3) of the determined components.
     """
     wheels = forces.wheels
     return ([w.name for w in wheels], np.array([w.normal for w in wheels], float),
@@ -109,6 +113,9 @@ def torques(torque, t: np.ndarray, Q: np.ndarray, NU: np.ndarray, motors: int) -
         Q: Coordinates (N, n) [m, rad].
         NU: Independent velocities (N, k).
         motors: The robot's number of motors.
+
+    Returns:
+        The torques (N, motors) as an array, or a list of N per-sample torque vectors for a torque function.
     """
     if torque is None:
         return np.zeros((len(t), motors))

@@ -34,7 +34,11 @@ run and must not fill the disk)."""
 
 
 def cache_dir() -> Path | None:
-    """robotdyn's cache directory: ``$ROBOTDYN_CACHE`` or ``~/.cache/robotdyn`` (None when ``off``)."""
+    """robotdyn's cache directory: ``$ROBOTDYN_CACHE`` or ``~/.cache/robotdyn`` (None when ``off``).
+
+    Returns:
+        The cache directory (not necessarily existing), or ``None`` when caching is off.
+    """
     root = os.environ.get("ROBOTDYN_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "robotdyn")
     return None if root == "off" else Path(root)
 
@@ -45,6 +49,9 @@ def package_stamp(name: str) -> str:
 
     Args:
         name: The package's import name.
+
+    Returns:
+        The stamp string (``<name>-missing`` if the package is not installed).
     """
     from importlib.util import find_spec
 
@@ -78,6 +85,9 @@ def lookup(path: Path, mappings: dict[str, str], index) -> str | None:
         path: The description file expanded.
         mappings: The xacro arguments (name -> value text) of the expansion.
         index: The :class:`~robotdyn.description.ros_packages.PackageIndex` that answered ``$(find)``.
+
+    Returns:
+        The cached URDF text, or ``None``.
     """
     entry = _entry(path, mappings, index)
     if entry is None:

@@ -67,6 +67,12 @@ class ImplausibleInertia:
     along: str = ""
 
     def text(self) -> str:
+        """The finding in words, as the load warning prints it.
+
+        Returns:
+            One line: the link, its mass [kg] and inertia [kg m^2], the radius of gyration [m] against its extent [m]
+            and, where known, its share of the effective mass.
+        """
         what = "its geometry" if self.extent_from == "geometry" else "the size rule (no geometry)"
         out = (f"{self.link} ({self.mass:.4g} kg, I = {self.inertia:.4g} kg m^2): radius of gyration "
                f"{self.gyration:.3g} m, {self.gyration / self.extent:.3g} times its extent {self.extent:.3g} m "

@@ -79,6 +79,9 @@ def frame_names(robot) -> list[str]:
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The body frame names, in the Pinocchio model's frame order.
     """
     return [f.name for f in robot.model.frames if f.type == pin.FrameType.BODY]
 
@@ -163,6 +166,10 @@ def position_ik(
         tol: Position tolerance [m] for ``success``.
         regularisation: Weight of the minimum-change residuals.
         extra: Extra residuals as a function of the full q.
+
+    Returns:
+        An :class:`IKResult`: the configuration q (nq,), the residual norm [m], whether it is below ``tol``, and the
+        number of function evaluations.
     """
     target = np.asarray(target, dtype=float)
     if target.shape != (3,) or not np.all(np.isfinite(target)):
@@ -211,6 +218,9 @@ def pose_text(T: np.ndarray, title: str) -> str:
     Args:
         T: A 4x4 pose.
         title: The first line.
+
+    Returns:
+        ``title`` followed by the four rows of the matrix, one per line.
     """
     return title + "\n" + "\n".join("  " + " ".join(f"{x: .10g}".rjust(18) for x in row) for row in T)
 

@@ -74,6 +74,9 @@ def package_name(directory: Path) -> str | None:
 
     Args:
         directory: A directory that may hold a ``package.xml``.
+
+    Returns:
+        The package name, or ``None``.
     """
     manifest = directory / "package.xml"
     try:
@@ -181,6 +184,9 @@ class PackageIndex:
             dirs: Directories searched for packages (crawled for ``package.xml``).
             environment: Also search ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH`` and pip-installed robot data.
 
+        Returns:
+            The new :class:`PackageIndex`.
+
         Raises:
             DescriptionError: An explicit package directory that does not exist.
         """
@@ -210,6 +216,9 @@ class PackageIndex:
 
         Args:
             name: The package's name.
+
+        Returns:
+            The package's resolved directory, or ``None`` if it is not found.
         """
         path = self._lookup(name)
         if path is not None:
@@ -240,6 +249,10 @@ class PackageIndex:
 
         Args:
             uri: A ``package://NAME/rest`` URI.
+
+        Returns:
+            ``(path, missing)``: the resolved file path and ``None``, or ``None`` and the name of the package that was
+            not found.
         """
         rest = uri[len("package://"):]
         name, _, tail = rest.partition("/")
@@ -249,7 +262,11 @@ class PackageIndex:
         return (root / tail).resolve(), None
 
     def roots(self) -> list[Path]:
-        """The directories a description may read files from: every package found and the explicit ones."""
+        """The directories a description may read files from: every package found and the explicit ones.
+
+        Returns:
+            The directories, sorted and without duplicates.
+        """
         return sorted({*self.used.values(), *self.explicit.values()})
 
 
@@ -258,6 +275,9 @@ def missing_name(path: str) -> str | None:
 
     Args:
         path: A path produced by ``$(find NAME)``.
+
+    Returns:
+        The package name, or ``None``.
     """
     match = re.match(re.escape(MISSING_ROOT) + r"/([^/]+)", str(path))
     return match.group(1) if match else None
@@ -274,6 +294,9 @@ def xacro_find(index: PackageIndex):
 
     Args:
         index: The :class:`PackageIndex` that answers ``$(find NAME)``.
+
+    Yields:
+        The list that collects the names of packages xacro asked for and did not find (filled while active).
     """
     import xacro.substitution_args as sa
 
@@ -315,6 +338,9 @@ def required_packages(path: Path, index: PackageIndex, limit: int = 200) -> set[
         path: The Xacro file scanned.
         index: The :class:`PackageIndex` resolving the includes that can be followed.
         limit: Largest number of files scanned.
+
+    Returns:
+        The names of those packages that ``index`` cannot find (empty: all are found).
     """
     seen: set[Path] = set()
     names: set[str] = set()

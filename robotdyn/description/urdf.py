@@ -73,6 +73,9 @@ def xacro_value(name: str, value, properties=()) -> str:
         name: The argument's name (for the message).
         value: A number, bool or string.
         properties: Names of the ``xacro:property`` s of the description (a word naming one would be its value).
+
+    Returns:
+        The value as xacro text (``true``/``false``, a number's repr, or a plain or quoted string).
     """
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -526,6 +529,9 @@ def drop_inertials(urdf: str, links) -> str:
     Args:
         urdf: The URDF XML text.
         links: Names of the links made massless.
+
+    Returns:
+        The URDF text without those links' inertials (``urdf`` unchanged if there are none).
     """
     links = list(links or [])
     if not links:
@@ -552,6 +558,9 @@ def lock_joints(model: pin.Model, visual: pin.GeometryModel, locked: dict[str, f
         model: The Pinocchio model.
         visual: Its visual geometry model.
         locked: Joint name -> value [m or rad] at which it is held.
+
+    Returns:
+        The reduced ``(model, visual)`` pair of ``pin.buildReducedModel``.
     """
     ids, q_ref = [], np.zeros(model.nq)
     for name, value in locked.items():
@@ -596,6 +605,10 @@ def build_description(
             :mod:`robotdyn.description.visual_geometry`).
         root_height: Height [m] of the root link's plane above the world's z = 0 (planar root), or of the
             reference of the z coordinate (floating root); see :meth:`Description.set_root_height`.
+
+    Returns:
+        The :class:`Description`: the Pinocchio model, its visual geometry, the URDF text, root kind, joint names and
+        limits.
     """
     from .ros_packages import PackageIndex
     from .visual_geometry import build_visual

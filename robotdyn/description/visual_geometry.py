@@ -99,6 +99,9 @@ def description_tree(source: Path | None) -> Path | None:
 
     Args:
         source: The description file (``None``: none).
+
+    Returns:
+        The tree's root directory, or ``None`` without a source file.
     """
     if source is None:
         return None
@@ -251,6 +254,10 @@ def inertia_box(mass: float, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarra
     Args:
         mass: Mass [kg].
         inertia: Central inertia tensor (3, 3) [kg m^2].
+
+    Returns:
+        ``(sides, axes)``: sides (3,) [m] and axes (3, 3) (columns, in the frame of ``inertia``), or ``None`` for a
+        massless or non-physical inertia.
     """
     if not (np.isfinite(mass) and mass > 0) or not np.all(np.isfinite(inertia)):
         return None
@@ -300,6 +307,9 @@ def build_visual(model: pin.Model, urdf: str, index: PackageIndex, source: Path 
         index: The :class:`~robotdyn.description.ros_packages.PackageIndex` resolving ``package://`` meshes.
         source: The description file, whose tree meshes may be read from (default ``None``).
         allowed: More directories meshes may be read from.
+
+    Returns:
+        ``(geometry, report)``: the ``pin.GeometryModel`` and the :class:`VisualReport` of what was replaced and why.
     """
     text, report = prepare_visuals(urdf, index, source, allowed)
     loader = _mesh_loader()

@@ -57,7 +57,11 @@ SELF_CHECK_TOL = 1e-9
 
 
 def available() -> bool:
-    """Whether the compiled extension was built (it needs a C++ compiler at install time)."""
+    """Whether the compiled extension was built (it needs a C++ compiler at install time).
+
+    Returns:
+        ``True`` if ``robotdyn._compiled`` was imported.
+    """
     return _compiled is not None
 
 
@@ -92,6 +96,9 @@ def why_not(robot) -> str | None:
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        A one-line reason, or ``None``.
     """
     if _compiled is None:
         return "the compiled extension robotdyn._compiled was not built"
@@ -324,6 +331,11 @@ class CompiledModel:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
 
+        Returns:
+            ``(M_r (k, k), h (k,), g_r (k,), B_r (k, motors), S (n, k), w (n,), v (n,), A (m, n), residual, condition,
+            inverse)`` as described above; ``condition`` and ``inverse`` are ``None`` except for operational
+            velocities.
+
         Raises:
             robotdyn._compiled.Fallback: The current row choice does not work here (use the Python path).
         """
@@ -339,6 +351,9 @@ class CompiledModel:
         Args:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+
+        Returns:
+            The 7-tuple ``(M_r, h, g_r, B_r, S, w, v)`` of read-only array views.
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
@@ -362,6 +377,9 @@ class CompiledModel:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
             independent: Indices of the independent velocities in v (default ``None``: the chosen ones).
+
+        Returns:
+            The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics`, or ``None``.
         """
         self._mine()
         hint = self._hint
@@ -390,6 +408,9 @@ class CompiledModel:
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
             stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
 
+        Returns:
+            The state derivative :math:`(\\dot q, \\dot\\nu)` as one array (nq + k,).
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
@@ -413,6 +434,11 @@ class CompiledModel:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
+
+        Returns:
+            ``(nudot (k,), lambda (m,), e (n,), wheel forces (nw, 3) [N] in (t1, t2, n), wheel forces (nw, 3) [N] in
+            world axes, contact frames (nw, 9), contact points (nw, 3) [m])``: read-only views, overwritten by the next
+            call.
 
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`; also where the compatible loads would pull on a wheel
@@ -449,6 +475,10 @@ class CompiledModel:
             a: Full accelerations (n,) [m/s^2, rad/s^2].
             tau: Motor torques [N m] (forces [N] on prismatic joints), one per motor in the robot's motor order.
 
+        Returns:
+            ``(lambda (m,), e (n,), (wheel forces, world forces, frames, points), A (m, n))``: copies, the inner tuple
+            as in :meth:`forces` (forces in N, points in m).
+
         Raises:
             robotdyn._compiled.Fallback: As :meth:`evaluate`.
         """
@@ -464,6 +494,10 @@ class CompiledModel:
         Args:
             Q: Coordinates (N, n) [m, rad].
             NU: Independent velocities (N, k).
+
+        Returns:
+            ``(M_r (N, k, k), h (N, k), g_r (N, k), S (N, n, k), w (N, n), B_r (N, k, motors), failed)``, ``failed``
+            the list of state indices left for the Python path.
         """
         self._mine()
         N, n = Q.shape

@@ -29,7 +29,11 @@ _ENABLED: ContextVar[bool] = ContextVar("robotdyn_compiled", default=_DEFAULT)
 
 
 def enabled() -> bool:
-    """Whether the fast path is used where a robot allows it (built, and not turned off in this thread's context)."""
+    """Whether the fast path is used where a robot allows it (built, and not turned off in this thread's context).
+
+    Returns:
+        ``True`` if the compiled path is built and enabled here.
+    """
     return _ENABLED.get() and available()
 
 
@@ -40,6 +44,9 @@ def use_compiled(flag: bool):
 
     Args:
         flag: True: the compiled path where it serves; False: always the Python path.
+
+    Yields:
+        Nothing (``None``); the setting is restored on exit.
     """
     token = _ENABLED.set(bool(flag))
     try:
@@ -56,6 +63,9 @@ def compiled_model(robot) -> CompiledModel | None:
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The :class:`~robotdyn.fast.compiled.CompiledModel`, or ``None`` where the robot cannot use the compiled path.
     """
     if not enabled():
         return None
@@ -93,6 +103,9 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
         nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
         coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
         independent: Indices of the independent velocities in v (default ``None``: the robot's).
+
+    Returns:
+        The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu).
     """
     op = getattr(robot, "operational", None)
     fast = None if coriolis else compiled_model(robot)

@@ -69,10 +69,19 @@ class Comparison:
         return row
 
     def as_dicts(self) -> list[dict]:
+        """The rows as plain data (for JSON).
+
+        Returns:
+            One dict per row, in row order: the row's fields plus ``deviation`` and ``verdict``.
+        """
         return [dict(asdict(r), deviation=r.deviation, verdict=r.verdict) for r in self.rows]
 
     def table(self) -> str:
-        """A fixed-width text table."""
+        """A fixed-width text table.
+
+        Returns:
+            The table as one string (lines joined with newlines).
+        """
         w = max([len(r.quantity) for r in self.rows] + [8])
         lines = [self.title, f"{'quantity':<{w}}  {'paper':>13}  {'model':>13}  {'|diff|':>9}  verdict"]
         for r in self.rows:

@@ -200,6 +200,9 @@ def _walk(schema: dict, prefix: str = "", required=()):
 def rows() -> list[KeyRow]:
     """Every key of the schema, in the schema's order.
 
+    Returns:
+        One :class:`KeyRow` per key.
+
     Raises:
         KeyError: the schema and :data:`KEYS` disagree (a key missing on either side), naming the keys.
     """
@@ -214,7 +217,11 @@ def rows() -> list[KeyRow]:
 
 def markdown_table() -> str:
     """The reference as one Markdown table: key and type, what it is and what it accepts (units, ranges), default,
-    example."""
+    example.
+
+    Returns:
+        The Markdown table as one string (header, separator, one line per key).
+    """
 
     def cell(text: str) -> str:
         return text.replace("|", "\\|").replace("\n", "<br>")

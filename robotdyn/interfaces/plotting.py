@@ -83,6 +83,9 @@ def pose_columns(robot, traj) -> tuple[str, str, str] | None:
     Args:
         robot: The :class:`~robotdyn.robot.Robot` simulated.
         traj: Its :class:`~robotdyn.simulation.trajectory.Trajectory`.
+
+    Returns:
+        The three column names ``(x, y, heading)``, or ``None`` where ``traj`` has no such root.
     """
     joints = robot.description.joint_names
     heading = "psi" if robot.spec.root == "planar" else "yaw" if robot.spec.root == "floating" else None
@@ -133,6 +136,9 @@ def finish(fig, path=None, title: str = ""):
         fig: The matplotlib figure.
         path: The image file (default ``None``: not saved, the figure stays open).
         title: The figure's title (default: none).
+
+    Returns:
+        The matplotlib figure ``fig`` (closed if it was saved).
     """
     if title:
         fig.suptitle(title)

@@ -64,6 +64,9 @@ def pack_scene(commands: list[bytes]) -> bytes:
 
     Args:
         commands: The scene's msgpack commands, in order.
+
+    Returns:
+        The zlib-compressed bytes of the compact form.
     """
     import umsgpack
 
@@ -107,6 +110,9 @@ def unpack_scene(packed: bytes) -> list[bytes]:
 
     Args:
         packed: The output of :func:`pack_scene`.
+
+    Returns:
+        The msgpack commands, one ``bytes`` each.
     """
     buf = zlib.decompress(packed)
     (n,), o = struct.unpack_from("<I", buf, 0), 4
@@ -132,6 +138,9 @@ def page_commands(page: str) -> list[bytes]:
 
     Args:
         page: A page's HTML text (:meth:`~robotdyn.interfaces.viewer.Viewer.static_html`).
+
+    Returns:
+        The msgpack commands, one ``bytes`` each.
     """
     start = page.index('var robotdyn_scene = "') + len('var robotdyn_scene = "')
     return unpack_scene(base64.b64decode(page[start:page.index('"', start)]))

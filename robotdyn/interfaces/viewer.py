@@ -456,6 +456,9 @@ class Viewer:
         Args:
             t: Sample times (N,) [s], increasing.
             fps: Keyframe rate [1/s].
+
+        Returns:
+            The key times (K,) [s], increasing.
         """
         n = int(np.floor((t[-1] - t[0]) * fps + 1e-9))
         times = t[0] + np.arange(n + 1) / fps
@@ -464,7 +467,11 @@ class Viewer:
         return times
 
     def static_html(self) -> str:
-        """The scene as a standalone HTML page (meshcat's JavaScript inlined; opens offline)."""
+        """The scene as a standalone HTML page (meshcat's JavaScript inlined; opens offline).
+
+        Returns:
+            The HTML page as one string.
+        """
         return static_page(self._window.commands(), f"robotdyn: {self.robot.spec.name}")
 
     def save(self, path: str | Path) -> Path:
@@ -472,6 +479,9 @@ class Viewer:
 
         Args:
             path: The HTML file (written atomically).
+
+        Returns:
+            ``path`` as a :class:`~pathlib.Path`.
         """
         path = Path(path)
         try:
@@ -543,7 +553,11 @@ CHROMIUM_FLAGS = (
 
 
 def find_chromium() -> str | None:
-    """Path of a Chromium/Chrome executable (``$ROBOTDYN_CHROMIUM`` first), or None."""
+    """Path of a Chromium/Chrome executable (``$ROBOTDYN_CHROMIUM`` first), or None.
+
+    Returns:
+        The executable's path, or ``None`` if none is found.
+    """
     import os
     import shutil
 

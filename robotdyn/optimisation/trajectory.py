@@ -97,7 +97,11 @@ class TrajectorySolution:
 
     def profile(self):
         """The optimal torques as a :class:`~robotdyn.simulation.torque_profile.Table` (linear between nodes,
-        what the collocation assumed), for :func:`robotdyn.simulation.engine.simulate`."""
+        what the collocation assumed), for :func:`robotdyn.simulation.engine.simulate`.
+
+        Returns:
+            The :class:`~robotdyn.simulation.torque_profile.Table` of the node times [s] and torques [N m or N].
+        """
         from ..simulation.torque_profile import Table
 
         return Table(self.t, self.tau)
@@ -235,6 +239,9 @@ class TrajectoryProblem:
         Args:
             z: Decision vector (N (nx + m),): the states :math:`x_j = (q_j, \\nu_j)` node after node, then the
                 torques :math:`\\tau_j` node after node [SI units].
+
+        Returns:
+            The defects ((N-1) nx,), node-major, in the state's (q, nu) order.
         """
         key = z.tobytes()
         if self._defect_cache[0] == key:
@@ -268,6 +275,9 @@ class TrajectoryProblem:
 
         Args:
             z: Decision vector, as for :meth:`defects`.
+
+        Returns:
+            The values (nnz,), in the order given above (that of the problem's sparsity pattern).
         """
         key = z.tobytes()
         if self._jac_cache[0] == key:  # IPOPT asks again at the same point (e.g. after a function evaluation)

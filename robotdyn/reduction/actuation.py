@@ -49,6 +49,9 @@ class Motor:
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            The column (nv,), in the model's velocity order.
         """
         col = np.zeros(kin.model.nv)
         if self.rid is None:
@@ -68,6 +71,9 @@ def input_matrix(motors: list[Motor], kin: KinematicState) -> np.ndarray:
     Args:
         motors: The :class:`Motor` objects, in the robot's motor order.
         kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+    Returns:
+        B (nv, n_motors): one column per motor, in motor order.
     """
     B = np.zeros((kin.model.nv, len(motors)))
     for j, m in enumerate(motors):

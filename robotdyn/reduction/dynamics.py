@@ -18,6 +18,9 @@ def mass_matrix(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
         model: The Pinocchio model (natural coordinates: nq == nv).
         data: Its Pinocchio data (overwritten).
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+
+    Returns:
+        M (nv, nv), a copy, in the model's velocity order.
     """
     return pin.crba(model, data, q).copy()
 
@@ -30,6 +33,9 @@ def coriolis_matrix(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarr
         data: Its Pinocchio data (overwritten).
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
         v: Full velocities (n,) [m/s, rad/s].
+
+    Returns:
+        C (nv, nv), a copy.
     """
     return pin.computeCoriolisMatrix(model, data, q, v).copy()
 
@@ -41,6 +47,9 @@ def gravity(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
         model: The Pinocchio model (natural coordinates: nq == nv).
         data: Its Pinocchio data (overwritten).
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+
+    Returns:
+        g (nv,) [N or N m], a copy.
     """
     return pin.computeGeneralizedGravity(model, data, q).copy()
 
@@ -54,6 +63,9 @@ def inverse_dynamics(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndar
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
         v: Full velocities (n,) [m/s, rad/s].
         a: Full accelerations (n,) [m/s^2, rad/s^2].
+
+    Returns:
+        :math:`\\tau` (nv,) [N or N m], a copy.
     """
     return pin.rnea(model, data, q, v, a).copy()
 
@@ -66,6 +78,9 @@ def energy(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> tu
         data: Its Pinocchio data (overwritten).
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
         v: Full velocities (n,) [m/s, rad/s].
+
+    Returns:
+        ``(kinetic, potential)`` [J], two floats.
     """
     kinetic = pin.computeKineticEnergy(model, data, q, v)
     potential = pin.computePotentialEnergy(model, data, q)

@@ -78,6 +78,9 @@ class SpringForce:
         Args:
             q: Natural coordinates (n,) [m, rad] (entry :attr:`index` is used).
             v: Full velocities (n,) [m/s, rad/s] (entry :attr:`index` is used).
+
+        Returns:
+            The generalised force [N or N m].
         """
         return -self.stiffness * (q[self.index] - self.rest) - self.damping * v[self.index]
 
@@ -86,6 +89,9 @@ class SpringForce:
 
         Args:
             q: Natural coordinates (n,) [m, rad] (entry :attr:`index` is used).
+
+        Returns:
+            The stored energy [J].
         """
         d = q[self.index] - self.rest
         return 0.5 * self.stiffness * d * d
@@ -95,6 +101,9 @@ class SpringForce:
 
         Args:
             v: Full velocities (n,) [m/s, rad/s] (entry :attr:`index` is used).
+
+        Returns:
+            The damper's power [W] (<= 0).
         """
         return -self.damping * v[self.index] ** 2
 
@@ -109,6 +118,9 @@ def build_springs(robot, springs) -> list[SpringForce]:
     Args:
         robot: A :class:`~robotdyn.robot.Robot` under construction (description and coordinates set).
         springs: The declarations.
+
+    Returns:
+        One :class:`SpringForce` per declaration, in declaration order (empty without springs).
 
     Raises:
         InputError: an unknown joint, a joint with more than one coordinate, two springs on one joint, or bad

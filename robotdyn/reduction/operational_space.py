@@ -78,6 +78,9 @@ class FrameTwist:
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            ``(J_o, Jdot_o)``, each (k, n).
         """
         J = self.jacobian(kin)
         if not np.any(kin.v):  # at rest the time variation is zero (and kin may not have computed it)
@@ -90,6 +93,9 @@ class FrameTwist:
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            :math:`J_o` (k, n), a copy.
         """
         return pin.getFrameJacobian(kin.model, kin.data, self.fid, self.reference)[self.select].copy()
 
@@ -119,6 +125,9 @@ class OperationalProjection:
         Args:
             drift: The constraints' drift terms dA/dt v (all rows).
             Jdot_v: dJ_o/dt v (k,), the outputs' drift.
+
+        Returns:
+            w (n,), in the model's velocity order.
         """
         return -self._inv @ np.concatenate([drift[self.rows], Jdot_v])
 
@@ -128,6 +137,9 @@ class OperationalProjection:
         Args:
             Adot: dA/dt (all rows x n) along the motion.
             Jdot: dJ_o/dt (k, n) along the motion.
+
+        Returns:
+            :math:`\\dot S` (n, k).
         """
         return -self._inv @ np.vstack([Adot[self.rows] @ self.S, Jdot @ self.S])
 
@@ -139,6 +151,9 @@ def project_operational(A: np.ndarray, J: np.ndarray, names: list[str] | None = 
         A: Constraint Jacobian (m, n) (all rows; the independent ones are chosen here).
         J: Output Jacobian J_o (k, n): nu = J_o v.
         names: Names of the k outputs, for messages (default ``None``: nu0, nu1, ...).
+
+    Returns:
+        The :class:`OperationalProjection` (S, rows used, condition number).
 
     Raises:
         SingularConstraintError: k differs from the mobility n - rank(A), or K is singular / ill-conditioned
@@ -170,6 +185,9 @@ def operational_projection(robot, twist: FrameTwist, q: np.ndarray) -> Operation
         robot: The :class:`~robotdyn.robot.Robot`.
         twist: The :class:`FrameTwist` whose components are the independent velocities.
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+
+    Returns:
+        The :class:`OperationalProjection` at q.
     """
     kin = KinematicState(robot.model, robot.data, np.asarray(q, float), np.zeros(robot.model.nv))
     J = twist.jacobian(kin)
@@ -192,6 +210,9 @@ def reduce_operational(robot, twist: FrameTwist, q: np.ndarray, nu: np.ndarray,
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
         nu: The twist components (k,) [m/s, rad/s], in the twist's axes and order.
         coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
+
+    Returns:
+        The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu) in operational velocities.
     """
     model, data = robot.model, robot.data
     q = np.asarray(q, float)
@@ -231,6 +252,9 @@ class OperationalVelocities:
 
         Args:
             description: The robot's :class:`~robotdyn.description.urdf.Description`.
+
+        Returns:
+            The :class:`OperationalModel`.
         """
         return OperationalModel(FrameTwist(description, self.frame, self.components, self.axes, self.names))
 
@@ -255,6 +279,9 @@ class OperationalModel:
         Args:
             robot: The :class:`~robotdyn.robot.Robot`.
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
+
+        Returns:
+            The :class:`OperationalProjection` at q.
         """
         return operational_projection(robot, self.twist, q)
 
@@ -276,6 +303,9 @@ class OperationalModel:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: The twist components (k,) [m/s, rad/s].
             coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
+
+        Returns:
+            The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu).
         """
         self.check(nu)
         return reduce_operational(robot, self.twist, q, np.asarray(nu, float), coriolis)

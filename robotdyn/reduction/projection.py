@@ -105,6 +105,9 @@ def solve(A: np.ndarray, B: np.ndarray) -> np.ndarray:
         A: A small square matrix (m, m).
         B: The right-hand side (m,) or (m, p).
 
+    Returns:
+        :math:`X = A^{-1}B`, shaped like B.
+
     Raises:
         numpy.linalg.LinAlgError: A is exactly singular.
     """
@@ -120,6 +123,9 @@ def inverse_and_condition(A: np.ndarray) -> tuple[np.ndarray | None, float]:
 
     Args:
         A: A small square matrix.
+
+    Returns:
+        ``(inverse, condition)``: :math:`A^{-1}` or ``None``, and the condition number (``inf`` if singular).
     """
     try:
         inv = solve(A, np.eye(len(A)))
@@ -134,6 +140,9 @@ def independent_rows(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
     Args:
         A: The constraint Jacobian (m, n).
         tol: Relative rank tolerance: a pivot counts when above ``tol`` times the largest (at least 1).
+
+    Returns:
+        The row indices, sorted (int array, possibly empty).
     """
     if A.shape[0] == 0:
         return np.zeros(0, dtype=int)
@@ -151,6 +160,9 @@ def auto_independent(A: np.ndarray, tol: float = RANK_TOL) -> np.ndarray:
     Args:
         A: The constraint Jacobian (m, n).
         tol: Relative rank tolerance (:func:`independent_rows`).
+
+    Returns:
+        The independent velocity indices (k,), sorted (int array).
     """
     n = A.shape[1]
     rows = independent_rows(A, tol)
@@ -191,6 +203,9 @@ class Projection:
 
         Args:
             Adot: dA/dt of all rows (m, n) along the motion.
+
+        Returns:
+            :math:`\\dot S` (n, k).
         """
         out = np.zeros_like(self.S)
         if self.rows.size:
@@ -202,6 +217,9 @@ class Projection:
 
         Args:
             drift: dA/dt v of all rows (m,) [m/s^2 or rad/s^2].
+
+        Returns:
+            w (n,), in the model's velocity order.
         """
         w = np.zeros(self.S.shape[0])
         if self.rows.size:
@@ -259,6 +277,9 @@ def project(
         names: Velocity names, used in error messages.
         hint: A projection at a nearby state: its choice of independent rows is reused when it still spans the
             row space (checked: :math:`\\|A S\\|` must vanish), which skips the rank-revealing QR.
+
+    Returns:
+        The :class:`Projection`.
 
     Raises:
         SingularConstraintError: The number of independent velocities does not match the mobility, or the

@@ -63,6 +63,9 @@ def position_rate(red, stabilisation: float) -> np.ndarray:
     Args:
         red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu).
         stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+
+    Returns:
+        :math:`\\dot q` (n,) [m/s or rad/s].
     """
     qdot = red.v
     rows = red.jacobian_rows
@@ -81,6 +84,9 @@ def offsets(A_h: np.ndarray, phi: np.ndarray, labels) -> dict[str, float]:
         A_h: Holonomic constraint rows (m, n).
         phi: Their residuals (m,).
         labels: Their names (m,).
+
+    Returns:
+        A dict of row label to residual [m or rad] (only those above the tolerance; empty if none).
     """
     if A_h.size == 0 or not phi.any():
         return {}
@@ -94,6 +100,9 @@ def describe_offsets(found: dict[str, float]) -> str:
 
     Args:
         found: Residual [m or rad] by row label (:func:`offsets`).
+
+    Returns:
+        The one-line description.
     """
     parts = ", ".join(f"{lab} {x:.3g}" for lab, x in found.items())
     return (f"holonomic residuals that no coordinate of this model can change, kept as constant offsets (not "
@@ -114,6 +123,9 @@ def check_start(A_h: np.ndarray, phi: np.ndarray, labels, stabilisation: float) 
         phi: Their residuals (h,) [m or rad].
         labels: Their labels.
         stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+
+    Returns:
+        The offsets at q0 by row label [m or rad] (empty if none).
 
     Raises:
         ConstraintError: With ``stabilisation`` on, removing the correctable residual would move a coordinate by
@@ -140,6 +152,10 @@ def weakest(A_h: np.ndarray, labels) -> tuple[float, str]:
     Args:
         A_h: The holonomic rows of A (h, n).
         labels: Their labels.
+
+    Returns:
+        ``(value, rows)``: the relative singular value (``inf`` without holonomic rows), and the heaviest rows' labels
+        joined by commas.
     """
     if A_h.size == 0:
         return float("inf"), ""
@@ -161,6 +177,9 @@ def start_offsets(robot, q0: np.ndarray, stabilisation: float, rows=None) -> dic
         q0: The initial configuration (n,) [m, rad].
         stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
         rows: ``robot.rows_at(q0)``, when the caller has them (default ``None``: computed).
+
+    Returns:
+        The offsets by row label [m or rad] (empty if none).
     """
     rows = robot.rows_at(q0) if rows is None else rows
     hol = rows.holonomic
@@ -179,6 +198,9 @@ def failure_note(robot, q: np.ndarray, stabilisation: float) -> str:
         robot: The :class:`~robotdyn.robot.Robot`.
         q: The configuration where the integration failed (n,) [m, rad].
         stabilisation: Gain alpha [1/s] of the pull-back of the holonomic residuals (0: none).
+
+    Returns:
+        The note (starting with a space), or ``""`` where it does not apply.
     """
     if not stabilisation or not np.all(np.isfinite(q)):
         return ""

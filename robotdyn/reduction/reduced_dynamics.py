@@ -90,6 +90,9 @@ class ConstraintSet:
 
         Args:
             constraints: The robot's current constraint objects.
+
+        Returns:
+            ``True`` if the set is up to date.
         """
         return len(constraints) == len(self.constraints) and all(
             a is b for a, b in zip(constraints, self.constraints))
@@ -99,6 +102,9 @@ class ConstraintSet:
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            The stacked :class:`~robotdyn.constraints.constraint.ConstraintRows` (m, nv).
         """
         parts = [c.jacobian(kin) for c in self.constraints]
         return ConstraintRows.stack(parts, self.nv) if len(parts) != 1 else parts[0]
@@ -108,6 +114,9 @@ class ConstraintSet:
 
         Args:
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            The drift (m,), in row order.
         """
         with np.errstate(over="ignore", invalid="ignore"):  # beyond double precision: refused by checked, in one line
             parts = [c.drift(kin) for c in self.constraints]
@@ -121,6 +130,9 @@ def constraint_set(robot) -> ConstraintSet:
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The :class:`ConstraintSet`.
     """
     cset = getattr(robot, "_constraint_set", None)
     if cset is None or not cset.current(robot.constraints):
@@ -148,6 +160,9 @@ def velocity(robot, q: np.ndarray, nu: np.ndarray) -> tuple[np.ndarray, Constrai
         robot: The :class:`~robotdyn.robot.Robot`.
         q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
         nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+
+    Returns:
+        ``(v, rows)``: the full velocities (nv,) and the :class:`~robotdyn.constraints.constraint.ConstraintRows` at q.
     """
     if getattr(robot, "operational", None) is not None:
         red = robot.reduced(q, nu)
@@ -172,6 +187,9 @@ def assemble(robot, q: np.ndarray, proj, rows0: ConstraintRows, v: np.ndarray, w
         B: The full input matrix (n, motors).
         coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
         sdot: ``sdot(Adot)`` -> dS/dt (n, k), called only with ``coriolis``.
+
+    Returns:
+        The :class:`ReducedDynamics`.
     """
     model, data = robot.model, robot.data
     S = proj.S
@@ -201,6 +219,9 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
         nu: Independent velocities (k,).
         coriolis: Also build the matrix :math:`C_r` (costs a Coriolis matrix and :math:`\\dot S`).
         independent: Override of the independent velocity indices.
+
+    Returns:
+        The :class:`ReducedDynamics` at (q, nu).
     """
     ind = robot.independent_indices if independent is None else independent
     kin0, rows0, proj = _project_at(robot, q, ind)
@@ -218,6 +239,9 @@ def solve_mass(M: np.ndarray, b: np.ndarray) -> np.ndarray:
     Args:
         M: A reduced mass matrix (k, k), symmetric positive definite.
         b: The right-hand side (k,) or (k, p).
+
+    Returns:
+        :math:`M^{-1} b`, shaped like b.
     """
     try:
         L = np.linalg.cholesky(M)
@@ -239,6 +263,9 @@ def reference(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, inde
         nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
         coriolis: Also compute the matrix C_r (k, k) and dS/dt (default: only the bias h = C_r nu + g_r).
         independent: Indices of the independent velocities in v (default ``None``: the robot's).
+
+    Returns:
+        The :class:`ReducedDynamics` at (q, nu).
     """
     op = getattr(robot, "operational", None)
     if op is not None:
@@ -253,6 +280,9 @@ def checked(out: ReducedDynamics, q, nu) -> ReducedDynamics:
         out: The reduced model to check.
         q: Its configuration (for the message).
         nu: Its independent velocities (for the message).
+
+    Returns:
+        ``out`` unchanged.
 
     Raises:
         NonFiniteError: They are not (a state beyond what double precision holds).

@@ -17,7 +17,11 @@ from ..errors import UnknownRobotError
 
 
 def names() -> list[str]:
-    """Registered robot names, sorted."""
+    """Registered robot names, sorted.
+
+    Returns:
+        The names, sorted.
+    """
     return sorted(m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_"))
 
 
@@ -26,6 +30,9 @@ def module(name: str) -> ModuleType:
 
     Args:
         name: The robot's registry name (:func:`names`).
+
+    Returns:
+        The robot's module.
 
     Raises:
         UnknownRobotError: naming the known robots.

@@ -107,6 +107,9 @@ def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
             process evaluates some 3e5 states/s, so starting workers pays off only for batches of about 1e5
             states and more (``make bench``; 2 workers: 54k states/s for 2000 states, 376k/s for 200,000).
 
+    Returns:
+        A :class:`Batch` of the reduced model at the N states (arrays stacked along a first axis of length N).
+
     Raises:
         RobotDynError: Wrong shapes or non-finite entries.
         SingularConstraintError: At a singular state (its index is named).

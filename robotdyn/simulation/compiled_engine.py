@@ -60,6 +60,9 @@ def native_profile(profile: TorqueProfile):
 
     Args:
         profile: The :class:`~robotdyn.simulation.torque_profile.TorqueProfile`.
+
+    Returns:
+        The ``robotdyn._compiled.TorqueProfile`` holding the same terms.
     """
     from .._compiled import TorqueProfile as Native
 
@@ -219,6 +222,9 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
             (:func:`robotdyn.reduction.pull_back.start_offsets`).
         t0: Start time [s].
         times: Output times [s] (increasing, t0 to t_end; default ``None``: ``n_out`` evenly spaced).
+
+    Returns:
+        The :class:`~robotdyn.simulation.trajectory.Trajectory` of the run.
     """
 
     law = torque.bound(robot) if isinstance(torque, FeedbackLaw) else as_data(torque)
@@ -322,6 +328,9 @@ def rechooser(robot, fast=None):
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
         fast: The robot's compiled model, told to use the new choice (default ``None``).
+
+    Returns:
+        The callback, a function of (q, nu) returning ``(rows, independent, dependent)`` as lists of int.
     """
     from ..fast.dispatch import use_compiled
 

@@ -94,6 +94,10 @@ class Task:
         Args:
             robot: The :class:`~robotdyn.robot.Robot`.
             kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            ``(y, J, Jdot_v)``: the output (d,), its Jacobian (d, nv) and the drift :math:`\\dot J v` (d,), in the
+            task's units (m or rad).
         """
         raise NotImplementedError
 
@@ -210,6 +214,9 @@ class LinearisingController:
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
             t: Time [s] at which the references are evaluated.
+
+        Returns:
+            ``(y, y', y_d, y_d')``, each (d,), the tasks stacked in order.
         """
         red = self.robot.reduced(q, nu)
         kin = KinematicState(self.robot.model, self.robot.data, q, red.v)
@@ -227,6 +234,9 @@ class LinearisingController:
             t: Time [s].
             q: Natural coordinates (n,) [m, rad], ordered as the robot's coordinates.
             nu: Independent velocities (k,) [m/s, rad/s], ordered as the robot's velocity names.
+
+        Returns:
+            ``(u, tau)``: the new input (k,) and the motor torques (n_motors,) [N m or N].
         """
         red = self.robot.reduced(q, nu)
         kin = KinematicState(self.robot.model, self.robot.data, q, red.v)
@@ -319,6 +329,9 @@ def tracking_errors(controller: LinearisingController, traj: Trajectory, task: i
         traj: The :class:`~robotdyn.simulation.trajectory.Trajectory` it produced.
         task: Index of the task in the controller's tasks.
         after: Ignore samples before this time [s] (the transient).
+
+    Returns:
+        A dict with keys ``mean``, ``rms``, ``max`` and ``final`` (the last sample's error), floats in the unit of y.
     """
     errs = []
     for t, q, nu in zip(traj.t, traj.q, traj.nu):
@@ -363,6 +376,9 @@ class ControlledScenario(Scenario):
 
         Args:
             robot: The :class:`~robotdyn.robot.Robot`.
+
+        Returns:
+            ``(robot, controller)``: the robot used and its :class:`LinearisingController`.
         """
         if self.adapt_robot is not None:
             robot = self.adapt_robot(robot)

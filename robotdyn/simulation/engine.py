@@ -103,6 +103,10 @@ def simulate(
             :class:`robotdyn.simulation.streaming.StreamResult` instead of a Trajectory (see
             :func:`robotdyn.simulation.streaming.stream`: the integrator restarts at each segment boundary).
 
+    Returns:
+        The :class:`~robotdyn.simulation.trajectory.Trajectory` (t [s], q, nu, energy [J], residual), or the
+        :class:`~robotdyn.simulation.streaming.StreamResult` when ``sink`` is given.
+
     Example:
         >>> import robotdyn
         >>> from robotdyn.simulation.engine import simulate

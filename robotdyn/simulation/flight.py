@@ -31,6 +31,9 @@ def flight_events(robot, wheels, n: int) -> list[tuple]:
         robot: The :class:`~robotdyn.robot.Robot`.
         wheels: Its :class:`~robotdyn.contact.compliant_contact.CompliantWheel` list.
         n: Number of coordinates (the state's first n entries are q).
+
+    Returns:
+        One ``(function, wheel name, kind)`` tuple per wheel and kind.
     """
     out = []
     last: dict = {}  # the penetrations of every wheel at the last configuration asked for (one kinematics pass)
@@ -60,6 +63,9 @@ def flight_phases(events: list[tuple], times: list, t_end: float) -> list[dict]:
         events: The ``(function, wheel name, kind)`` list of :func:`flight_events`.
         times: For each event, in the same order, the times [s] it was found at (``sol.t_events``).
         t_end: End time [s]: later events are dropped.
+
+    Returns:
+        The event dicts, sorted by time.
     """
     out = [{"t": float(t), "wheel": name, "event": kind}
            for (_, name, kind), ts in zip(events, times) for t in ts if t <= t_end]
@@ -73,6 +79,9 @@ def airborne(robot, wheels, q: np.ndarray) -> list[str]:
         robot: The :class:`~robotdyn.robot.Robot`.
         wheels: Its :class:`~robotdyn.contact.compliant_contact.CompliantWheel` list to check.
         q: Natural coordinates (n,) [m, rad], in the robot's coordinate order.
+
+    Returns:
+        The wheel names, in the order of ``wheels``.
     """
     kin = KinematicState(robot.model, robot.data, np.asarray(q, float), np.zeros(robot.model.nv))
     return [w.name for w in wheels if w.penetration(kin) <= 0.0]
@@ -85,6 +94,9 @@ def flight_summary(phases: list[dict], start: list[str] = ()) -> list[str]:
     Args:
         phases: The time-ordered events of :func:`flight_phases`.
         start: Names of the wheels in the air at the start (:func:`airborne` at q0; default none).
+
+    Returns:
+        The lines, one per wheel with an event or in the air at the start.
     """
     wheels: dict[str, list[str]] = {name: ["in the air at the start"] for name in start}
     for e in phases:

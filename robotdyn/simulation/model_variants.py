@@ -66,6 +66,10 @@ def structure(robot) -> tuple:
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` with a compiled model.
+
+    Returns:
+        The tuple ``(joints, frames, rows, motors, terrains, velocity names)`` (equal for robots that can share a
+        compiled model).
     """
     fast = _fast(robot)
     model = robot.model
@@ -83,6 +87,9 @@ def variant(robot, vector: np.ndarray):
     Args:
         robot: A :class:`~robotdyn.robot.Robot` with a compiled model.
         vector: A model vector of its layout (:func:`model_vector`).
+
+    Returns:
+        The new :class:`~robotdyn.robot.Robot` (``robot`` is not changed).
     """
     fast = _fast(robot)
     vector = np.asarray(vector, float)
@@ -141,6 +148,9 @@ def to_dynamic(V: np.ndarray, slots: np.ndarray) -> np.ndarray:
     Args:
         V: Model vectors (N, L), inertia blocks as (m, c, I_C).
         slots: Start index of each inertia block in a model vector.
+
+    Returns:
+        The converted model vectors (N, L).
     """
     V = np.array(V, float)
     for s in slots:
@@ -158,6 +168,9 @@ def from_dynamic(V: np.ndarray, slots: np.ndarray) -> np.ndarray:
     Args:
         V: Model vectors (N, L), inertia blocks as (m, mc, I_O).
         slots: Start index of each inertia block in a model vector.
+
+    Returns:
+        The model vectors (N, L) in the model vector's own form.
     """
     V = np.array(V, float)
     for s in slots:
@@ -178,6 +191,9 @@ def physical(V: np.ndarray, robot) -> list[str]:
     Args:
         V: Model vectors (N, L) (or one (L,)).
         robot: The :class:`~robotdyn.robot.Robot` they are variants of (its joint names for the messages).
+
+    Returns:
+        One string per model vector, in order (``''``: physical).
     """
     V = np.atleast_2d(V)
     out = [""] * len(V)
@@ -327,6 +343,9 @@ class ParameterModel:
 
         Args:
             values: Parameter values (N, len(names)) in the parameters' units (or one row).
+
+        Returns:
+            The model vectors (N, L).
 
         Raises:
             InputError: A value outside the box (the fit is verified only inside it).

@@ -107,7 +107,11 @@ class TorqueProfile:
         return out
 
     def breakpoints(self) -> np.ndarray:
-        """Sorted times [s] where the profile or its derivative jumps (window edges, table knots)."""
+        """Sorted times [s] where the profile or its derivative jumps (window edges, table knots).
+
+        Returns:
+            The times (P,) [s], sorted, without duplicates.
+        """
         points = []
         for kind, _, par in self._all():
             if kind == SINE:
@@ -120,7 +124,11 @@ class TorqueProfile:
 
     def encode(self) -> tuple[list[int], list[np.ndarray], list[np.ndarray]]:
         """The terms as the C++ side reads them: kinds, coefficient arrays ((motors,) or (points, motors)) and
-        parameter arrays (sine: omega [rad/s], phase [rad], window start and end [s]; table: the times [s])."""
+        parameter arrays (sine: omega [rad/s], phase [rad], window start and end [s]; table: the times [s]).
+
+        Returns:
+            ``(kinds, coefficients, parameters)``: three lists with one entry per term.
+        """
         terms = self._all()
         return ([k for k, _, _ in terms], [np.ascontiguousarray(c, float) for _, c, _ in terms],
                 [np.ascontiguousarray(p, float) for _, _, p in terms])

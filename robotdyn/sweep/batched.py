@@ -66,6 +66,9 @@ def base_robot(ctx: RunContext, terrain: str | None):
     Args:
         ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
         terrain: The terrain label of the runs (``None``: the robot's own terrain).
+
+    Returns:
+        The :class:`~robotdyn.robot.Robot`.
     """
     key = (repr(sorted(ctx.source.items())), repr(sorted(ctx.fixed.items())), terrain,
            repr(ctx.terrains.get(terrain)))
@@ -93,6 +96,9 @@ def fit_builds(m: int, degree: int = 3) -> int:
     Args:
         m: Number of varied parameters.
         degree: Total degree of the fitted polynomial.
+
+    Returns:
+        The number of robots built (an upper bound).
     """
     return 1 + m + math.comb(m + degree, degree) + 6
 
@@ -105,6 +111,9 @@ def model_vectors(ctx: RunContext, runs: list[RunInput], mode: str = "auto") -> 
         ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
         runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
         mode: ``auto``, ``always`` or ``never`` (:data:`MODES`).
+
+    Returns:
+        A :class:`Batching`: the model vector of every batched run by run id, and why the others are not batched.
     """
     if mode not in MODES:
         raise RobotDynError(f"batch = {mode!r}; expected one of {', '.join(MODES)}")
@@ -203,6 +212,9 @@ def run_batched(ctx: RunContext, runs: list[RunInput], vectors: list[np.ndarray]
         ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
         runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
         vectors: The model vector (L,) of each run, in the same order.
+
+    Returns:
+        One ``(row, trajectory columns or None)`` pair per run, in the order of ``runs``.
     """
     mod = load_source(ctx.source)
     out: list = [None] * len(runs)

@@ -76,6 +76,9 @@ def load_source(source: dict):
 
     Args:
         source: The :attr:`RunContext.source`.
+
+    Returns:
+        The robot module, or the :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`.
     """
     key = tuple(sorted((k, tuple(sorted(v.items())) if isinstance(v, dict) else v) for k, v in source.items()))
     return _load(key)
@@ -88,6 +91,9 @@ def build_terrain(mod, definition: tuple):
         mod: The robot's module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``; a robot module or a
             :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`).
         definition: ``("named", name)`` or ``("kind", kind, {arg: value})``.
+
+    Returns:
+        The terrain object.
     """
     if definition[0] == "named":
         return mod.TERRAINS[definition[1]]()
@@ -102,6 +108,9 @@ def overrides_run(scenario) -> bool:
 
     Args:
         scenario: The :class:`~robotdyn.simulation.scenario.Scenario`.
+
+    Returns:
+        ``True`` if the scenario's class overrides :meth:`~robotdyn.simulation.scenario.Scenario.run`.
     """
     return type(scenario).run is not Scenario.run
 
@@ -112,6 +121,10 @@ def prepare(ctx: RunContext, run: RunInput):
     Args:
         ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
         run: The :class:`~robotdyn.sweep.spec.RunInput`.
+
+    Returns:
+        ``(robot, scenario, t_end, n_out)``: the :class:`~robotdyn.robot.Robot`, the scenario copy, the duration [s] and
+        the number of output samples.
     """
     mod = load_source(ctx.source)
     params = {**ctx.fixed, **{k: v for k, v in run.params if k != "torque_scale"}}
@@ -130,6 +143,9 @@ def scenario_of(ctx: RunContext, mod, run: RunInput):
         mod: The robot's module-like object (``SPEC``, ``SCENARIOS``, optionally ``TERRAINS``; a robot module or a
             :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`).
         run: The :class:`~robotdyn.sweep.spec.RunInput`.
+
+    Returns:
+        The scenario copy.
     """
     scenario = copy.copy(mod.SCENARIOS[run.scenario])
     if run.terrain is not None and dataclasses.is_dataclass(scenario) and hasattr(scenario, "terrain"):
@@ -145,6 +161,9 @@ def build_robot(mod, params: dict, terrain):
             :class:`~robotdyn.interfaces.constraint_file.ConstraintFile`).
         params: Parameter values by name.
         terrain: A :class:`~robotdyn.constraints.terrain.Terrain` (``None``: the robot's own).
+
+    Returns:
+        The :class:`~robotdyn.robot.Robot`.
     """
     from ..interfaces.constraint_file import ConstraintFile
     from ..robot import Robot
@@ -158,6 +177,10 @@ def scaled_torque(torque, scale: float):
     Args:
         torque: The scenario's torques (``None``, a profile, or a callable ``tau(t, q, nu)``).
         scale: The run's torque scale (dimensionless).
+
+    Returns:
+        ``torque`` itself when it is ``None`` or ``scale`` is 1; else a scaled profile for a profile, or a callable
+        ``tau(t, q, nu)`` returning the scaled torques.
     """
     if torque is None or scale == 1.0:
         return torque
@@ -177,6 +200,10 @@ def simulate_run(ctx: RunContext, run: RunInput):
     Args:
         ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
         run: The :class:`~robotdyn.sweep.spec.RunInput`.
+
+    Returns:
+        ``(robot, trajectory, law)``: the :class:`~robotdyn.robot.Robot`, the
+        :class:`~robotdyn.simulation.trajectory.Trajectory` and the torque law as above.
     """
     from ..simulation.engine import simulate
 
@@ -199,6 +226,9 @@ def energy_drift(traj, torque) -> float | None:
     Args:
         traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
         torque: Its torque law (``None``: none; :data:`SCENARIO_LAW`: built by the scenario).
+
+    Returns:
+        The drift [J], or ``None`` where it is not defined.
     """
     if torque is SCENARIO_LAW:
         return None
@@ -232,6 +262,9 @@ def summary(mod, robot, traj, torque, columns) -> dict:
         traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
         torque: Its torque law (as :func:`energy_drift`).
         columns: Columns whose maximum and minimum are kept.
+
+    Returns:
+        The summary row: a dict of output column name to value.
     """
     names = traj.coordinates + traj.velocity_names
     data = np.column_stack([traj.q, traj.nu])
@@ -256,6 +289,9 @@ def trajectory_columns(traj) -> dict:
 
     Args:
         traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
+
+    Returns:
+        A dict of column name to a (N,) array.
     """
     return {"t": traj.t, **{c: traj.q[:, i] for i, c in enumerate(traj.coordinates)},
             **{c: traj.nu[:, i] for i, c in enumerate(traj.velocity_names)},
@@ -268,6 +304,9 @@ def error_message(exc: Exception) -> str:
 
     Args:
         exc: The exception that ended the run.
+
+    Returns:
+        The message (at most 1000 characters).
     """
     message = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
     if not isinstance(exc, RobotDynError):
@@ -286,6 +325,9 @@ def finished_row(ctx: RunContext, run: RunInput, robot, traj, torque) -> tuple[d
         robot: The :class:`~robotdyn.robot.Robot`.
         traj: The run's :class:`~robotdyn.simulation.trajectory.Trajectory`.
         torque: Its torque law (as :func:`energy_drift`).
+
+    Returns:
+        ``(row, columns)``: the summary row dict, and the trajectory columns or ``None``.
     """
     try:
         row = {"run_id": run.run_id, "status": "ok", "error": None,
@@ -323,6 +365,9 @@ def run_chunk(ctx: RunContext, runs: list[RunInput], vectors: dict | None = None
         ctx: The sweep's :class:`~robotdyn.sweep.chunk.RunContext`.
         runs: The runs (:class:`~robotdyn.sweep.spec.RunInput`), in order.
         vectors: Model vectors by run id (default ``None``: every run built afresh).
+
+    Returns:
+        One ``(row, trajectory columns or None)`` pair per run, in run order.
     """
     from ..fast.dispatch import use_compiled
 

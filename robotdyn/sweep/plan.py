@@ -58,6 +58,9 @@ class Plan:
 
         Args:
             run: The :class:`~robotdyn.sweep.spec.RunInput`.
+
+        Returns:
+            A dict of input column name to value.
         """
         return {"run_id": run.run_id, "run_index": run.index, "robot": self.robot, "scenario": run.scenario,
                 "terrain": run.terrain, "torque_scale": run.torque_scale, "t_end": self.spans[run.scenario][0],

@@ -11,6 +11,9 @@ def default_column(plan) -> str:
 
     Args:
         plan: The sweep's :class:`~robotdyn.sweep.plan.Plan`.
+
+    Returns:
+        The column name.
     """
     if plan.spec.plot_column:
         return plan.spec.plot_column
@@ -28,6 +31,9 @@ def plot_summary(table, plan, path, column: str | None = None) -> Path:
         plan: The sweep's :class:`~robotdyn.sweep.plan.Plan`.
         path: The image file written (atomically).
         column: The plotted column (default ``None``: :func:`default_column`).
+
+    Returns:
+        The image's path.
     """
     import matplotlib
 

@@ -84,7 +84,11 @@ class SweepResult:
                 + (", interrupted" if self.interrupted else "") + ")")
 
     def frame(self):
-        """The results as a pandas DataFrame."""
+        """The results as a pandas DataFrame.
+
+        Returns:
+            The ``pandas.DataFrame`` of the result table, one row per run.
+        """
         return self.table.to_pandas()
 
 
@@ -143,7 +147,11 @@ WORKERS_PER_CPU = 4
 
 
 def max_local_workers() -> int:
-    """The largest number of worker processes of a local cluster: :data:`WORKERS_PER_CPU` per CPU here."""
+    """The largest number of worker processes of a local cluster: :data:`WORKERS_PER_CPU` per CPU here.
+
+    Returns:
+        The number of workers (>= 1).
+    """
     import os
 
     return WORKERS_PER_CPU * (os.cpu_count() or 1)

@@ -92,7 +92,11 @@ class Axis:
         return not self.values
 
     def grid(self) -> list:
-        """The axis's points on a grid."""
+        """The axis's points on a grid.
+
+        Returns:
+            The points (floats or the given values), in order.
+        """
         if not self.ranged:
             return list(self.values)
         if self.n is None:
@@ -105,6 +109,9 @@ class Axis:
 
         Args:
             u: Uniform samples in [0, 1).
+
+        Returns:
+            The values, shaped like ``u``, in the parameter's unit.
         """
         if self.log:
             return np.exp(np.log(self.low) + u * (np.log(self.high) - np.log(self.low)))
@@ -168,6 +175,9 @@ class SweepSpec:
 
         Args:
             **changes: Fields to replace (empty values are ignored; ``axes`` replace the axes of the same name).
+
+        Returns:
+            The new :class:`SweepSpec`.
         """
         changes = {k: v for k, v in changes.items() if v not in (None, [], {}, ())}
         axes = changes.pop("axes", [])
@@ -177,7 +187,11 @@ class SweepSpec:
         return out
 
     def to_dict(self) -> dict:
-        """Plain data (for the sweep's ``sweep.json``)."""
+        """Plain data (for the sweep's ``sweep.json``).
+
+        Returns:
+            A JSON-ready dict of the spec's fields.
+        """
         return asdict(self)
 
 
@@ -361,6 +375,9 @@ def resolve_axis(axis: Axis, parameter) -> Axis:
     Args:
         axis: The :class:`Axis` as parsed.
         parameter: The robot's :class:`~robotdyn.robot.Parameter` (``None`` for the torque scale).
+
+    Returns:
+        The checked :class:`Axis`, values converted to the parameter's unit.
     """
     where = f"parameters.{axis.name}"
     unit = "-" if parameter is None else parameter.unit
@@ -393,6 +410,9 @@ def points(spec: SweepSpec, axes: list[Axis]) -> list[dict]:
     Args:
         spec: The :class:`SweepSpec` (its ``sample``, ``n`` and ``seed``).
         axes: The resolved axes.
+
+    Returns:
+        One dict of parameter name to value per point.
     """
     if spec.sample not in SAMPLERS:
         raise SweepSpecError(f"sample = {spec.sample!r}; expected one of {', '.join(SAMPLERS)}")

@@ -40,6 +40,9 @@ def schema(fields: list[tuple[str, str, str]], metadata: dict | None = None):
     Args:
         fields: (column, type, unit) triples.
         metadata: Schema-level metadata (default ``None``).
+
+    Returns:
+        The ``pyarrow.Schema``.
     """
     import pyarrow as pa
 
@@ -53,6 +56,9 @@ def prepare(out) -> Path:
 
     Args:
         out: The sweep directory.
+
+    Returns:
+        The sweep directory.
     """
     out = Path(out)
     try:
@@ -176,6 +182,9 @@ def write_chunk(out: Path, rows: list[dict], trajectories: list[dict | None], sc
         rows: The chunk's result rows.
         trajectories: Each row's trajectory columns (``None``: not kept).
         schema: The results' pyarrow schema (:func:`schema`).
+
+    Returns:
+        The row file's path.
     """
     import pyarrow as pa
 
@@ -225,6 +234,9 @@ def finished(out: Path) -> dict[str, str]:
 
     Args:
         out: The sweep directory.
+
+    Returns:
+        A dict of run id to status.
     """
     import pyarrow.parquet as pq
 
@@ -247,6 +259,9 @@ def consolidate(out: Path, order: dict[str, int], schema):
         out: The sweep directory.
         order: Run index by run id (the runs of this sweep).
         schema: The results' pyarrow schema (:func:`schema`).
+
+    Returns:
+        The consolidated ``pyarrow.Table``, in run order.
     """
     import pyarrow as pa
     import pyarrow.compute as pc
@@ -306,6 +321,9 @@ def load_trajectory(out, run_id: str):
     Args:
         out: A sweep directory run with ``--trajectories``.
         run_id: The run's id (``run_id`` column).
+
+    Returns:
+        The ``pandas.DataFrame`` of the run's trajectory, one row per sample.
     """
     import pyarrow.parquet as pq
 

@@ -39,6 +39,9 @@ def euler_zyx(R: np.ndarray) -> tuple[float, float, float]:
 
     Args:
         R: A rotation matrix (3, 3).
+
+    Returns:
+        ``(yaw, pitch, roll)`` [rad], three floats.
     """
     return float(np.arctan2(R[1, 0], R[0, 0])) + 0.0, float(np.arcsin(-np.clip(R[2, 0], -1, 1))) + 0.0, float(
         np.arctan2(R[2, 1], R[2, 2]))
@@ -197,6 +200,9 @@ def cmd_ik(args) -> int:
 
     Args:
         args: The parsed command line (``argparse.Namespace``).
+
+    Returns:
+        The exit status 0 (the results are printed).
     """
     import json
 

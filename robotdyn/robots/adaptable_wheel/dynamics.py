@@ -49,6 +49,9 @@ def body_coordinates(run: IKRun, t: float, terrain: Terrain) -> np.ndarray:
         run: An :class:`~robotdyn.robots.adaptable_wheel.missions.IKRun`.
         t: Time [s] in the run's interval.
         terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
+
+    Returns:
+        The array (6,): position (x, y, z) [m] in the world frame, then (yaw, pitch, roll) [rad].
     """
     R, d = body_pose(_commands_at(run, t), terrain)
     return np.concatenate([d, euler_zyx(R)])
@@ -130,6 +133,9 @@ class MissionModel:
         Args:
             t: Time [s] in the run's interval.
             guess: Initial IK guess (6,) [rad] (default ``None``: the nearest step's solution).
+
+        Returns:
+            ``(commands, x)``: the :class:`Commands` at t and the IK solution vector of :func:`solve_ik`.
         """
         cmd = _commands_at(self.run, t)
         if guess is None:
@@ -142,6 +148,10 @@ class MissionModel:
 
         Args:
             t: Time [s] in the run's interval.
+
+        Returns:
+            ``(commands, x, q, v, a)``: the :class:`Commands`, the IK solution, the configuration (nq,), velocities
+            (nv,) and accelerations (nv,) [SI].
         """
         from ...reduction.reduced_dynamics import reduce
 
@@ -156,6 +166,11 @@ class MissionModel:
 
         Args:
             t: Time [s] in the run's interval.
+
+        Returns:
+            A dict of the quantities at t: ``q``, ``v``, ``a``, ``x`` (the IK solution), ``tau`` (motor torques [N m]),
+            ``forces``, ``normal``, ``ratio``, ``residual``, ``lateral_slip``, ``motor_power``, ``contact_power``,
+            ``energy``, ``tau_static`` and ``tau_eq35`` (SI units; meanings as in :class:`DynamicsRun`).
         """
         rolling, pr = self.rolling, self.p
         cmd, x, q, v, a = self.state(t)
@@ -200,6 +215,9 @@ def mission_dynamics(run: IKRun, params: dict | None = None, every: int = 1) -> 
         run: An :class:`IKRun`.
         params: Parameter overrides (e.g. ``m_wheel``, ``I_adjust``).
         every: Use every n-th step of the run.
+
+    Returns:
+        The :class:`DynamicsRun` of the mission.
     """
     mm = MissionModel(run, params)
     idx = np.arange(0, len(run.t), every)
@@ -264,6 +282,9 @@ def mission_friction(run: IKRun, lateral: str = "coulomb", params: dict | None =
         lateral: ``coulomb`` or ``linear`` (the ``lateral`` parameter of :data:`SPEC`).
         params: Parameter overrides (e.g. ``mu``).
         every: Use every n-th step of the run.
+
+    Returns:
+        The :class:`FrictionRun` of the mission.
     """
     from ...contact.sliding import inverse
 

@@ -49,6 +49,9 @@ def radius_law_d(q: float, w: float) -> float:
     Args:
         q: Adjustment angle q [rad] (0 to pi).
         w: The pattern width w [m].
+
+    Returns:
+        :math:`dR_{ch}/dq` [m/rad].
     """
     return -0.5 * w * np.sin(0.5 * q) * _COS30
 
@@ -59,6 +62,9 @@ def radius_law_dd(q: float, w: float) -> float:
     Args:
         q: Adjustment angle q [rad] (0 to pi).
         w: The pattern width w [m].
+
+    Returns:
+        :math:`d^2R_{ch}/dq^2` [m/rad^2].
     """
     return -0.25 * w * np.cos(0.5 * q) * _COS30
 
@@ -84,6 +90,9 @@ def q_range_radius(p: dict) -> tuple[float, float]:
     Args:
         p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: w, Lx, Ly, L_reading, R_ru [m], m
             [kg], g [m/s^2], mu).
+
+    Returns:
+        ``(smallest, largest)`` R_T [m].
     """
     return p["R_ru"], p["R_ru"] + p["w"] * _COS30
 
@@ -115,6 +124,9 @@ def paper_normal(terrain: Terrain, x: float, y: float) -> np.ndarray:
         terrain: The surface (a :class:`~robotdyn.constraints.terrain.Terrain`).
         x: World x [m].
         y: World y [m].
+
+    Returns:
+        N (3,), not normalised.
     """
     fx, fy = terrain.gradient(x, y)
     return np.array([-fx, -fy, 1.0])
@@ -318,6 +330,9 @@ def paper_torque_eq35(q, p: dict):
         q: Adjustment angle(s) q_i [rad].
         p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: w, Lx, Ly, L_reading, R_ru [m], m
             [kg], g [m/s^2], mu).
+
+    Returns:
+        The torque t_i [N m], shaped like ``q`` (a NumPy array or scalar).
     """
     return -0.5 * p["m"] * p["g"] * p["w"] * np.sin(0.5 * np.asarray(q)) * _COS30 / 3.0
 

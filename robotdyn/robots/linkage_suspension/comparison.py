@@ -46,6 +46,9 @@ def model_R_A(robot: Robot, q: np.ndarray, axle: str = "axle3") -> np.ndarray:
         robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
         q: Natural coordinates (n,) [m, rad].
         axle: The axle frame's name (``axle1`` ... ``axle6``).
+
+    Returns:
+        The homogeneous transform (4, 4) [m] of A_i in R.
     """
     _fk(robot, q)
     fid = robot.model.getFrameId
@@ -91,6 +94,9 @@ def random_dimensions(rng) -> dict[str, float]:
 
     Args:
         rng: A ``numpy.random.Generator``.
+
+    Returns:
+        A dict of Table 1 length name to value [m].
     """
     return {"a1": rng.uniform(-0.1, 0.1), "d1": rng.uniform(0.02, 0.2), "a5": rng.uniform(0.1, 0.3),
             "d5": rng.uniform(0.15, 0.3), "a6": rng.uniform(0.08, 0.2), "a7": rng.uniform(0.08, 0.2)}
@@ -267,6 +273,9 @@ def section3_comparison(cmp: Comparison, robot: Robot) -> dict[str, dict]:
     Args:
         cmp: The :class:`~robotdyn.interfaces.comparison.Comparison` the rows are added to.
         robot: The linkage-suspension :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        ``{"straight": ..., "pivot": ...}``: the comparison results of the two manoeuvres.
     """
     from ...constraints.posture import set_terrain
 

@@ -30,6 +30,9 @@ def compliant_spec(stiffness: float | None = None, damping: float | None = None)
     Args:
         stiffness: Each wheel's normal stiffness [N/m] (None: the default rule, 1 mm under an equal share).
         damping: Each wheel's normal damping [N s/m] (None: the default rule).
+
+    Returns:
+        The new :class:`~robotdyn.robot.RobotSpec` (``SPEC`` is not changed).
     """
     wheels = [replace(w, contact="compliant", friction="linear", stiffness=TYRE_STIFFNESS, mu=TYRE_MU,
                       normal_stiffness=stiffness, normal_damping=damping) for w in SPEC.wheels]

@@ -117,6 +117,9 @@ def wheel_speed(t: float, peak: float = PEAK_SPEED) -> tuple[float, float]:
     Args:
         t: Time [s].
         peak: Peak wheel speed [rad/s].
+
+    Returns:
+        ``(omega, omega_dot)``: [rad/s] and [rad/s^2].
     """
     t0, t1, t2, t3, _ = PROFILE
     if t <= t0 or t >= t3:
@@ -136,6 +139,9 @@ def profile_distance(peak_speed: float) -> float:
 
     Args:
         peak_speed: The point's peak speed [m/s].
+
+    Returns:
+        The distance [m].
     """
     t0, t1, t2, t3, _ = PROFILE
     return peak_speed * ((t1 - t0) / 2 + (t2 - t1) + (t3 - t2) / 2)
@@ -189,6 +195,9 @@ def centroid_circle_radius(run: dict[str, np.ndarray]) -> float:
 
     Args:
         run: A :func:`kinematic_run` result.
+
+    Returns:
+        The radius [m].
     """
     return float(np.mean(np.ptp(run["com"][:, :2], axis=0)) / 2)
 

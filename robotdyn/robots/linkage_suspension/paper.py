@@ -43,6 +43,9 @@ def table1_R_A3(p: dict, theta1: float, beta1: float) -> np.ndarray:
         p: Table 1 lengths as a plain dict [m]: a1, d1, a5, d5, a6, a7.
         theta1: The rocker angle theta1 [rad] (Table 1).
         beta1: The bogie angle beta1 [rad] (Table 1).
+
+    Returns:
+        The homogeneous transform (4, 4) [m] of A3 in R.
     """
     return dh(np.pi / 2, p["a1"], -p["d1"], 0.0) @ dh(0.0, p["a5"], p["d5"], 1.5 * np.pi - theta1) @ dh(
         -np.pi / 2, -p["a7"], 0.0, beta1)
@@ -86,6 +89,9 @@ def paper_eq4(p: dict, theta1: float, beta1: float, rho: float, delta: float) ->
         beta1: The bogie angle beta1 [rad] (Table 1).
         rho: The roller angle rho [rad].
         delta: The contact angle delta [rad].
+
+    Returns:
+        A dict of entry name to value [m or dimensionless], as printed.
     """
     a1, d1, a5, d5, a7 = (p[k] for k in ("a1", "d1", "a5", "d5", "a7"))
     f = beta1 - theta1
@@ -115,6 +121,9 @@ def eq4_readings(p: dict, theta1: float, beta1: float, rho: float, delta: float)
         beta1: The bogie angle beta1 [rad] (Table 1).
         rho: The roller angle rho [rad].
         delta: The contact angle delta [rad].
+
+    Returns:
+        A dict of entry name to ``(reading, value)``: the named correction and the corrected value.
     """
     a5, a7, d1 = p["a5"], p["a7"], p["d1"]
     f = beta1 - theta1
@@ -139,6 +148,9 @@ def paper_eq10_lhs(p: dict, theta1: float, beta1: float, v0: np.ndarray, w0: np.
         beta1: The bogie angle beta1 [rad] (Table 1).
         theta1_dot: Rocker rate [rad/s].
         beta1_dot: Bogie rate [rad/s].
+
+    Returns:
+        The velocity (3,) [m/s] in R axes.
     """
     a1, d1, a5, d5, a7 = (p[k] for k in ("a1", "d1", "a5", "d5", "a7"))
     f = beta1 - theta1
@@ -161,6 +173,9 @@ def corrected_eq10_joint_terms(p: dict, theta1: float, beta1: float) -> tuple[np
         p: Table 1 lengths as a plain dict [m]: a1, d1, a5, d5, a6, a7.
         theta1: The rocker angle theta1 [rad] (Table 1).
         beta1: The bogie angle beta1 [rad] (Table 1).
+
+    Returns:
+        The two columns (3,) each, in R axes, of theta1' and beta1' [m per rad].
     """
     a5, a7 = p["a5"], p["a7"]
     f = beta1 - theta1

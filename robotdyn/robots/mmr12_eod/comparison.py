@@ -49,6 +49,9 @@ def printed_states(p: dict) -> dict[str, tuple[dict, dict, str, str]]:
 
     Args:
         p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
+
+    Returns:
+        A dict of printed equation key to ``(overrides, values, frame, reading)``.
     """
     h = np.pi / 2
     lift = paper_delta_lambda(p, h)  # eq 26 at theta_C1 = pi/2, r = 0.08: 0.37
@@ -76,6 +79,9 @@ def model_printed(robot: Robot, key: str) -> np.ndarray:
     Args:
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
         key: The printed equation's key (:func:`printed_states`).
+
+    Returns:
+        The model's homogeneous transform (4, 4) [m] of that frame.
     """
     from ...description.kinematics import frame_pose
 
@@ -106,6 +112,9 @@ def ik_cases(robot: Robot, n: int = 5, seed: int = 0) -> list[dict]:
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
         n: Number of targets.
         seed: Seed of the targets and arm values.
+
+    Returns:
+        One dict per target with keys ``target``, ``arm``, ``phi``, ``platform`` and ``free``.
     """
     from ...description.kinematics import position_ik
 

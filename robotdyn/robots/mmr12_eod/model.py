@@ -180,6 +180,9 @@ def table4_reference(name: str, omega: float = 0.5):
     Args:
         name: ``orientation``, ``straight`` or ``sinusoid``.
         omega: Turning rate of the orientation task [rad/s].
+
+    Returns:
+        A function of t [s] returning ``(p_d, p_d', p_d'')``, each (2,) [m, m/s, m/s^2] in the world x, y.
     """
     from ...simulation.control import ProfileReference
     from ...simulation.torque_profile import Constant, Polynomial, Sine
@@ -212,6 +215,9 @@ def platform_controller(robot: Robot, name: str, q0: np.ndarray | None = None):
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
         name: The Table 4 trajectory (:func:`table4_reference`).
         q0: The configuration whose joint values are held (default ``None``: the neutral one).
+
+    Returns:
+        The :class:`~robotdyn.simulation.control.LinearisingController`.
     """
     from ...simulation.control import LinearisingController, PointTask
 
@@ -229,6 +235,9 @@ def platform_initial(robot: Robot, name: str) -> tuple[np.ndarray, np.ndarray]:
     Args:
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
         name: The Table 4 trajectory (:func:`table4_reference`).
+
+    Returns:
+        ``(q0, nu0)``: the configuration (nq,) and the independent velocities (k,).
     """
     pd, vd, _ = table4_reference(name)(0.0)
     speed = float(np.linalg.norm(vd))
@@ -253,6 +262,9 @@ def manipulation_goal(robot: Robot, q0: np.ndarray | None = None):
     Args:
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
         q0: The starting configuration (default ``None``: :func:`manipulation_initial`).
+
+    Returns:
+        The :class:`~robotdyn.description.kinematics.IKResult` of the solve.
     """
     from ...description.kinematics import position_ik
 
@@ -272,6 +284,9 @@ def manipulation_controller(robot: Robot, q0: np.ndarray | None = None, T: float
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
         q0: The starting configuration (default ``None``: :func:`manipulation_initial`).
         T: Duration of the quintic [s].
+
+    Returns:
+        The :class:`~robotdyn.simulation.control.LinearisingController`.
     """
     from ...simulation.control import CoordinateTask, LinearisingController, PointTask
     from ...description.kinematics import frame_pose
@@ -295,6 +310,9 @@ def manipulation_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
 
     Args:
         robot: The MMR12-EOD :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        ``(q0, nu0)``: the configuration (nq,) and zero independent velocities (k,).
     """
     return state(robot, psi=np.pi / 4), np.zeros(robot.mobility)
 
@@ -353,6 +371,9 @@ def lifting_initial(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
 
     Args:
         robot: The lifting robot (:func:`lift_robot`).
+
+    Returns:
+        ``(q0, nu0)``: the configuration (nq,) and zero independent velocities (k,).
     """
     th = contact_angle(robot.params)
     return state(robot, lambda_C=0.0, **{f"theta_C{i}": th for i in _ARMS}), np.zeros(robot.mobility)
@@ -366,6 +387,9 @@ def lifting_controller(robot: Robot, T: float = 5.0, end: float = LIFT_END):
         robot: The lifting robot (:func:`lift_robot`).
         T: Duration of the quintic [s].
         end: Final arm angle [rad].
+
+    Returns:
+        The :class:`~robotdyn.simulation.control.LinearisingController`.
     """
     from ...simulation.control import CoordinateTask, LinearisingController
 
@@ -470,6 +494,9 @@ def climbing_forces(slope: float, robot: Robot | None = None):
     Args:
         slope: Ramp angle [rad] (abs(slope) < pi/2).
         robot: The robot whose parameters are kept (default ``None``: the defaults).
+
+    Returns:
+        The :class:`~robotdyn.contact.contact_forces.ConstraintForces` (forces in N).
     """
     climber = climbing_robot(slope, robot)
     zero = np.zeros(climber.mobility)

@@ -43,6 +43,9 @@ def paper_delta_lambda(p: dict, theta_C1: float, r: float | None = None) -> floa
         p: The parameters as a plain dict (Table 2 names of :data:`.model.SPEC`; lengths [m], angles [rad]).
         theta_C1: Arm angle theta_C1 [rad].
         r: Tip wheel radius [m] (default ``None``: ``p['r']``).
+
+    Returns:
+        Delta lambda_C [m] (>= 0).
     """
     r = p["r"] if r is None else r
     value = p["l_cs1"] * np.sin(theta_C1) - p["lambda_C0"] + r

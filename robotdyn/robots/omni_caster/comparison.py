@@ -48,6 +48,10 @@ def offset_link_correction(p: dict, phi, nu) -> np.ndarray:
             m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
         phi: Steering angles (phi1, phi2, phi3) [rad].
         nu: The platform twist u' = (v_cx, v_cy, omega) [m/s, m/s, rad/s] in platform axes.
+
+    Returns:
+        The missing velocity-product forces (3,) on the platform twist, summed over the chains: F_x, F_y [N] and
+        M_z [N m] in platform axes.
     """
     out = np.zeros(3)
     m2, pp, r = p["m_link"], p["p"], p["r"]
@@ -67,6 +71,10 @@ def model_chain_jacobians(robot: Robot, q: np.ndarray) -> dict[int, np.ndarray]:
     Args:
         robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
         q: Natural coordinates (n,) [m, rad].
+
+    Returns:
+        A dict of chain i (1, 2, 3) to its (3, 3) matrix: rows (eta_i', theta_i', phi_i'), columns (v_cx, v_cy,
+        omega).
     """
     from ...constraints.constraint import KinematicState
 

@@ -74,7 +74,11 @@ NO_WHEELS = {"m_wheel": 0.0, "I_wheel_axle": 0.0, "I_wheel_diam": 0.0, "m_link":
 
 
 def noc_spec() -> RobotSpec:
-    """The same robot with the paper's NOC minimal coordinates (theta1', theta2', phi3'), eq (A9)."""
+    """The same robot with the paper's NOC minimal coordinates (theta1', theta2', phi3'), eq (A9).
+
+    Returns:
+        The new :class:`~robotdyn.robot.RobotSpec` (``SPEC`` is not changed).
+    """
     return dataclasses.replace(SPEC, operational=None, independent=list(NOC_INDEPENDENT))
 
 
@@ -149,6 +153,9 @@ def beta_profile(t, T: float, total: float = 2 * np.pi) -> tuple[np.ndarray, np.
         t: Time(s) [s].
         T: Duration of the motion [s].
         total: Total angle [rad].
+
+    Returns:
+        ``(beta, beta', beta'')`` at the times given [rad, rad/s, rad/s^2], each shaped like t.
     """
     s = np.clip(np.asarray(t, float) / T, 0.0, 1.0)
     inside = (np.asarray(t, float) >= 0) & (np.asarray(t, float) <= T)
@@ -293,6 +300,9 @@ def operational_forces(robot: Robot, pl: dict) -> np.ndarray:
     Args:
         robot: The omni caster :class:`~robotdyn.robot.Robot` (operational velocities: the platform twist).
         pl: A :func:`plan`.
+
+    Returns:
+        The forces (n, 3): F_x, F_y [N], M_z [N m] per sample.
     """
     out = np.zeros((len(pl["t"]), 3))
     for k in range(len(pl["t"])):

@@ -79,6 +79,9 @@ def paper_chain_inertia(p: dict) -> np.ndarray:
     Args:
         p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
             m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+
+    Returns:
+        The diagonal matrix (3, 3), (eta, theta, phi) order [kg m^2].
     """
     m1, m2, r = p["m_wheel"], p["m_link"], p["r"]
     return np.diag([m2 * p["p"] ** 2 + p["I_wheel_diam"] + p["I_link_z"], 1.5 * m1 * r**2 + m2 * r**2, 0.0])
@@ -90,6 +93,9 @@ def paper_platform_inertia(p: dict) -> np.ndarray:
     Args:
         p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
             m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
+
+    Returns:
+        The diagonal matrix (3, 3) [kg, kg, kg m^2].
     """
     return np.diag([p["m_pl"], p["m_pl"], 0.5 * p["m_pl"] * p["b"] ** 2])
 
@@ -179,6 +185,9 @@ def paper_noc_jacobians(p: dict, phi) -> tuple[np.ndarray, np.ndarray]:
         p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
             m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
         phi: Steering angles (phi1, phi2, phi3) [rad].
+
+    Returns:
+        ``(J_p, J_a)``: (6, 6) and (6, 3).
     """
     g = {i: paper_forward(p, i, phi[i - 1]) for i in _CHAINS}
     z = np.zeros(3)
@@ -198,6 +207,9 @@ def paper_noc_map(p: dict, phi) -> np.ndarray:
         p: The parameters as a plain dict, by the names of Tables 1-2 (:data:`.model.SPEC`: d, r, a, l, b, p [m];
             m_wheel, m_link, m_pl [kg]; inertias [kg m^2]).
         phi: Steering angles (phi1, phi2, phi3) [rad].
+
+    Returns:
+        K (3, 3).
     """
     return np.vstack([paper_inverse(p, 1, phi[0])[1], paper_inverse(p, 2, phi[1])[1], paper_inverse(p, 3, phi[2])[2]])
 

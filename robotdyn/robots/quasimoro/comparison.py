@@ -27,6 +27,10 @@ def model_equations(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, dict[tuple
     Args:
         robot: The Quasimoro :class:`~robotdyn.robot.Robot`.
         q: Natural coordinates (x, y, psi, theta1, theta2, theta3) [m, rad].
+
+    Returns:
+        ``(M_r, coefficients, g_r)``: the reduced mass matrix (k, k), a dict of velocity pair (i, j) to its coefficient
+        column (k,), and the reduced gravity (k,).
     """
     red = robot.reduced(q, np.zeros(3))
     quad = quadratic_coefficients(lambda nu: robot.reduced(q, nu).h, 3)

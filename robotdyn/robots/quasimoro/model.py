@@ -110,6 +110,9 @@ def drift(robot: Robot, traj) -> float:
     Args:
         robot: The Quasimoro :class:`~robotdyn.robot.Robot` (its rho).
         traj: Its :class:`~robotdyn.simulation.trajectory.Trajectory`.
+
+    Returns:
+        The largest violation [rad].
     """
     rho = robot.params["rho"]
     return float(np.max(np.abs(traj.column("psi") - rho * (traj.column("theta2") - traj.column("theta1")))))

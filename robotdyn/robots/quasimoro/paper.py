@@ -21,6 +21,9 @@ def paper_coefficients(p: dict, theta3: float) -> dict[str, float]:
     Args:
         p: Parameters m, M, J1, J2, r, d, rho.
         theta3: Body inclination [rad].
+
+    Returns:
+        A dict of coefficient name (``A11`` to ``A19``) to value, as printed.
     """
     m, M, J1, J2, r, d, rho = (p[k] for k in ("m", "M", "J1", "J2", "r", "d", "rho"))
     s, c = np.sin(theta3), np.cos(theta3)

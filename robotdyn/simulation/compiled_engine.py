@@ -147,6 +147,9 @@ def as_data(torque):
 
     Args:
         torque: The torque law.
+
+    Returns:
+        ``torque`` itself where the compiled loop can run it, else ``None``.
     """
     form = getattr(torque, "compiled_form", None)
     return torque if callable(form) and callable(getattr(torque, "native_controller", None)) and form() else None

@@ -67,7 +67,11 @@ class ProfileReference:
         return self.value(t), self.rate(t), self.acceleration(t)
 
     def breakpoints(self) -> set[float]:
-        """Times [s] where a profile is not smooth."""
+        """Times [s] where a profile is not smooth.
+
+        Returns:
+            The set of breakpoint times [s] of the value, rate and acceleration profiles.
+        """
         return {float(b) for p in (self.value, self.rate, self.acceleration) for b in p.breakpoints()}
 
 
@@ -76,6 +80,9 @@ def hold_data(values) -> ProfileReference:
 
     Args:
         values: The constant value(s) y_d.
+
+    Returns:
+        The :class:`ProfileReference` holding ``values`` (width ``len(values)``) with zero rate and acceleration.
     """
     from .torque_profile import Constant
 
@@ -271,12 +278,20 @@ class LinearisingController:
 
     def compiled_form(self) -> bool:
         """Whether the compiled engine can run this controller: every task a :class:`PointTask` or
-        :class:`CoordinateTask` whose reference is a :class:`ProfileReference`."""
+        :class:`CoordinateTask` whose reference is a :class:`ProfileReference`.
+
+        Returns:
+            True where the compiled engine can run it.
+        """
         return all(isinstance(task, (PointTask, CoordinateTask)) and isinstance(task.reference, ProfileReference)
                    for task in [*self.tasks, *self.secondary])
 
     def breakpoints(self) -> np.ndarray:
-        """Sorted times [s] where a reference is not smooth (both engines restart there)."""
+        """Sorted times [s] where a reference is not smooth (both engines restart there).
+
+        Returns:
+            The breakpoint times (b,) [s], ascending.
+        """
         points = set()
         for task in [*self.tasks, *self.secondary]:
             if isinstance(task.reference, ProfileReference):
@@ -290,6 +305,9 @@ class LinearisingController:
         Args:
             robot: The :class:`~robotdyn.robot.Robot` simulated (this controller's robot).
             fast: Its :class:`~robotdyn.fast.compiled.CompiledModel`.
+
+        Returns:
+            The ``robotdyn._compiled.Controller`` the compiled loop evaluates.
         """
         from .._compiled import Controller
         from .feedback import native_profile

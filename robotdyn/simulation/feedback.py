@@ -39,6 +39,9 @@ def native_profile(p: TorqueProfile):
 
     Args:
         p: The :class:`~robotdyn.simulation.torque_profile.TorqueProfile` (any width).
+
+    Returns:
+        The ``robotdyn._compiled.TorqueProfile`` with the same terms.
     """
     from .._compiled import TorqueProfile as Native
 
@@ -122,6 +125,9 @@ class FeedbackLaw:
 
         Args:
             robot: The :class:`~robotdyn.robot.Robot`.
+
+        Returns:
+            This law if its robot is ``robot``, else a shallow copy bound to ``robot``.
         """
         self.check(robot)
         if self.robot is robot:
@@ -171,7 +177,11 @@ class FeedbackLaw:
         return self.torque(t, q, nu, red.M, red.h, red.B)
 
     def breakpoints(self) -> np.ndarray:
-        """Sorted times [s] where a profile of the law is not smooth (both engines restart there)."""
+        """Sorted times [s] where a profile of the law is not smooth (both engines restart there).
+
+        Returns:
+            The breakpoint times (b,) [s], ascending, those a few doubles apart merged into one.
+        """
         points = set()
         for p in (self.feedforward, self.q_ref, self.nu_ref, self.acceleration):
             if p is not None:
@@ -187,6 +197,9 @@ class FeedbackLaw:
 
         Args:
             robot: The :class:`~robotdyn.robot.Robot` (its dimensions; checked).
+
+        Returns:
+            The ``robotdyn._compiled.Controller`` of this law.
         """
         self.check(robot)
         from .._compiled import Controller
@@ -203,11 +216,18 @@ class FeedbackLaw:
         Args:
             robot: The :class:`~robotdyn.robot.Robot`.
             fast: Its compiled model (unused).
+
+        Returns:
+            The ``robotdyn._compiled.Controller`` of this law (:meth:`native`).
         """
         return self.native(robot)
 
     def compiled_form(self) -> bool:
-        """Always True: every feedback law runs on the compiled engine."""
+        """Whether the compiled engine can run this law.
+
+        Returns:
+            Always True: every feedback law runs on the compiled engine.
+        """
         return True
 
     def __repr__(self) -> str:
@@ -225,6 +245,9 @@ def lqr_law(model, K) -> FeedbackLaw:
     Args:
         model: The :class:`~robotdyn.reduction.linearization.LinearModel` (states, operating point and torques).
         K: The gain (n_motors, n_x) (e.g. from :func:`robotdyn.reduction.linearization.lqr`).
+
+    Returns:
+        The :class:`FeedbackLaw` (motor torques [N m or N] from the state).
 
     Raises:
         InputError: A gain of another shape.

@@ -259,6 +259,10 @@ def speed_reference(signs=(1.0,), peak: float = PEAK_SPEED):
     Args:
         signs: The factors of the profile (e.g. +1 and -1 for pivot steering).
         peak: Peak wheel speed [rad/s].
+
+    Returns:
+        The :class:`~robotdyn.simulation.torque_profile.TorqueProfile` of width ``len(signs)``: the wheel speeds
+        [rad/s] against time [s].
     """
     from ...simulation.torque_profile import Sine
 

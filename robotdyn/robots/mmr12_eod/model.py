@@ -157,6 +157,10 @@ def quintic_reference(T: float, a, b):
     Args:
         T: Duration [s].
         a, b: Start and end values (same shape).
+
+    Returns:
+        The :class:`~robotdyn.simulation.control.ProfileReference` (value, rate, acceleration), each of the width of
+        ``a``, in the units of ``a`` per s^0, s^1, s^2.
     """
     from ...simulation.control import ProfileReference
     from ...simulation.torque_profile import Polynomial, Sine

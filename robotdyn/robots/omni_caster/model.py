@@ -404,6 +404,9 @@ def circle_law(robot: Robot, params: dict | None = None):
     Args:
         robot: The omni caster :class:`~robotdyn.robot.Robot`.
         params: Overrides of :data:`CIRCLE` (R [m], T [s]) (default ``None``).
+
+    Returns:
+        The :class:`~robotdyn.simulation.feedback.FeedbackLaw` (motor torques [N m] against time and state).
     """
     from ...simulation.feedback import FeedbackLaw
     from ...simulation.torque_profile import Polynomial

@@ -5,13 +5,12 @@ path, in bounded time, never read (a FIFO would block), never a traceback."""
 from __future__ import annotations
 
 import os
-import signal
 import time
 from pathlib import Path
 
 import pytest
 
-from robotdyn.cli.commands import main
+import cli_run
 from robotdyn.description.ros_packages import PackageIndex, crawl, package_name
 from robotdyn.errors import InputError
 from robotdyn.input_files import read_text, regular_file, resolved
@@ -23,27 +22,9 @@ SECONDS = 15
 """A case still running after this long is a hang (each takes well under a second)."""
 
 
-class _Hang(BaseException):
-    pass
-
-
-def _alarm(signum, frame):
-    raise _Hang
-
-
 def run_cli(argv, capsys) -> tuple[int, str, float]:
-    """``main(argv)`` under an alarm: (exit status, stderr, seconds)."""
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(SECONDS)
-    start = time.perf_counter()
-    try:
-        rc = main([str(a) for a in argv])
-    except _Hang:
-        pytest.fail(f"{argv}: still running after {SECONDS} s")
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
-    return rc, capsys.readouterr().err, time.perf_counter() - start
+    """``main(argv)`` under an alarm of :data:`SECONDS`: (exit status, stderr, seconds)."""
+    return cli_run.run_cli(argv, capsys, SECONDS)
 
 
 def one_line(rc: int, err: str, *needles: str) -> None:
@@ -67,16 +48,9 @@ def test_fifo_named_package_xml_is_not_read(tmp_path):
     (tmp_path / "a_pipe").mkdir()
     os.mkfifo(tmp_path / "a_pipe" / "package.xml")
     package(tmp_path / "b_real", "real_pkg")
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(SECONDS)
-    try:
+    with cli_run.deadline(SECONDS, "reading a FIFO named package.xml"):
         assert package_name(tmp_path / "a_pipe") is None
         assert crawl(tmp_path) == {"real_pkg": tmp_path / "b_real"}
-    except _Hang:
-        pytest.fail("reading a FIFO named package.xml blocked")
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 def test_directory_of_symlinks_to_itself_is_crawled_once(tmp_path):

@@ -9,7 +9,6 @@ The test servers listen on 127.0.0.1 only, on a free port, and stop by themselve
 from __future__ import annotations
 
 import os
-import signal
 import socket
 import threading
 import time
@@ -17,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+import cli_run
 from robotdyn.cli.commands import main
 from robotdyn.sweep import runner
 
@@ -24,33 +24,15 @@ SECONDS = 20
 SW = ["sweep", "quasimoro", "--vary", "M=4,5", "--t-end", "0.2", "--workers", "0", "--quiet", "--no-plot"]
 
 
-class _Hang(BaseException):
-    pass
-
-
-def _alarm(signum, frame):
-    raise _Hang
-
-
 def refused(argv, capsys, *needles) -> float:
     """``main(argv)`` ends with exit status 2 and one line holding every needle; returns its wall time [s]."""
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(SECONDS)
-    start = time.perf_counter()
-    try:
-        rc = main([str(a) for a in argv])
-    except _Hang:
-        pytest.fail(f"{argv}: still running after {SECONDS} s")
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
-    err = capsys.readouterr().err
+    rc, err, wall = cli_run.run_cli(argv, capsys, SECONDS)
     lines = [line for line in err.splitlines() if not line.startswith("robotdyn: warning: ")]
     assert rc == 2, err
     assert len(lines) == 1 and lines[0].startswith("robotdyn: error: "), err
     for needle in needles:
         assert needle in lines[0], (needle, lines[0])
-    return time.perf_counter() - start
+    return wall
 
 
 # ------------------------------------------------------------------------------------------------ schedulers

@@ -391,12 +391,8 @@ def closure_velocity_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
         The derivative (rows x n) of the closed components' rows (in frame1's axes, in the order of the
         closure's ``components``).
     """
-    kin0 = fpass.kin0
-    M1, J1 = kin0.pose(closure.f1)
-    M2, J2 = kin0.pose(closure.f2)
+    M1, J1, M2, J2, V1, dV1, V2, dV2 = _closure_frames(closure, fpass)
     R1T = M1.rotation.T
-    V1, dV1 = fpass.velocity(closure.f1)
-    V2, dV2 = fpass.velocity(closure.f2)
     d = M2.translation - M1.translation
     dd = J2[:3] - J1[:3]
     yt = V2[:3] - V1[:3] + np.cross(d, V1[3:])
@@ -405,6 +401,16 @@ def closure_velocity_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
     dyr = dV2[3:] - dV1[3:]
     out = np.vstack([R1T @ (skew(yt) @ J1[3:] + dyt), R1T @ (skew(yr) @ J1[3:] + dyr)])
     return out[closure._sel]
+
+
+def _closure_frames(closure: LoopClosure, fpass: FramePass) -> tuple:
+    """The closure's two frames at the pass: their placements and Jacobians, velocities and velocity derivatives
+    ``(M1, J1, M2, J2, V1, dV1, V2, dV2)`` (as :meth:`FramePass.velocity` gives them)."""
+    M1, J1 = fpass.kin0.pose(closure.f1)
+    M2, J2 = fpass.kin0.pose(closure.f2)
+    V1, dV1 = fpass.velocity(closure.f1)
+    V2, dV2 = fpass.velocity(closure.f2)
+    return M1, J1, M2, J2, V1, dV1, V2, dV2
 
 
 def closure_drift_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
@@ -420,12 +426,8 @@ def closure_drift_dq(closure: LoopClosure, fpass: FramePass) -> np.ndarray:
         The derivative (rows x n) of the closed components' drift rows (in frame1's axes, in the order of the
         closure's ``components``).
     """
-    kin0 = fpass.kin0
-    M1, J1 = kin0.pose(closure.f1)
-    M2, J2 = kin0.pose(closure.f2)
+    M1, J1, M2, J2, V1, dV1, V2, dV2 = _closure_frames(closure, fpass)
     R1T = M1.rotation.T
-    V1, dV1 = fpass.velocity(closure.f1)
-    V2, dV2 = fpass.velocity(closure.f2)
     a1, da1, _ = fpass.acceleration(closure.f1)
     a2, da2, _ = fpass.acceleration(closure.f2)
     d = M2.translation - M1.translation

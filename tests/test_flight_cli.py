@@ -103,3 +103,17 @@ def test_dump_applies_the_springs():
     total = sum(w["normal"] for w in data["forces"]["wheels"].values())
     import pinocchio as pin
     assert total == pytest.approx(pin.computeTotalMass(robot.model) * 9.81, rel=1e-12)
+
+
+def test_dump_inverse_names_the_springs():
+    """dump --a on the sprung car at rest: the generalised forces are M a + C v + g less the springs' forces, and
+    the label says so (it printed "M a + C v + g" while taking the springs off); at rest on its preloaded springs
+    they vanish (no torque needed to hold it), as the forward dynamics' zero accelerations say."""
+    out = run("dump", "--constraints", str(EXAMPLES / "sprung_car.toml"), "--v", "0", "0", "0", "0", "--a", "0", "0",
+              "0", "0")
+    assert out.returncode == 0, out.stderr
+    assert "tau (generalised forces M a + C v + g - Q_springs/contacts):" in out.stdout
+    out = run("dump", "--constraints", str(EXAMPLES / "sprung_car.toml"), "--v", "0", "0", "0", "0", "--a", "0", "0",
+              "0", "0", "--json")
+    data = json.loads(out.stdout)
+    assert np.max(np.abs(data["tau"])) < 1e-6  # the chassis' weight, ~1e4 N, is carried by the springs

@@ -80,3 +80,15 @@ def test_drive_wheels_first_and_supports_only_in_the_load_panel():
     ax_n, ax_mu = fig.axes[:2]
     assert [line.get_label() for line in ax_n.lines[:3]] == ["left", "right", "caster (support, frictionless)"]
     assert [line.get_label() for line in ax_mu.lines if len(line.get_xdata())] == ["left", "right"]
+
+
+def test_shading_names_what_it_marks():
+    """A wheel in the air (load 0, e.g. a compliant wheel in flight) is shaded and the legend says what the shading
+    is (it said "no-slip broken", which is wrong for wheels under a friction law); samples with load shade nothing."""
+    tr = _traction(["front", "rear"], [True, True], None)
+    tr.normal[2:4, 0] = 0.0
+    fig = plot_traction(tr)
+    ax_n = fig.axes[0]
+    labels = [c.get_label() for c in ax_n.collections]
+    assert labels == ["a wheel unloaded or beyond its mu"]
+    np.testing.assert_array_equal(tr.broken().any(axis=1), [False, False, True, True, False])

@@ -43,6 +43,7 @@ def test_time_limit_stops_a_stiff_run_with_a_marked_partial_file(stiff, tmp_path
     reached = float(err[1].split("samples up to t = ")[1].split(" s")[0])
     lines = csv.read_text().splitlines()
     assert lines[-1].startswith("# partial: ") and "samples up to t = " in lines[-1]
+    assert lines[-1].startswith("# partial: time limit of 1 s reached")  # streamed too (it said "interrupted")
     data = np.loadtxt(lines[1:-1], delimiter=",", ndmin=2)
     assert data[-1, 0] == pytest.approx(reached, abs=1e-12) and reached < 2.0
     assert not (tmp_path / "run.csv.partial").exists()

@@ -228,7 +228,10 @@ def cmd_dump(args) -> int:
             inv = inverse_sliding(robot, q, red.v, red.S @ nudot + red.w)
             tau, resid = inv.tau, inv.residual
         out.update(tau=Q, motor_torques=dict(zip(motors, tau)), motor_residual=resid)
-        text += [_vector_text("tau (generalised forces M a + C v + g)", names, Q),
+        from ..contact.applied_forces import has_applied
+
+        applied = " - Q_springs/contacts" if has_applied(robot) else ""  # what inverse_dynamics takes off
+        text += [_vector_text(f"tau (generalised forces M a + C v + g{applied})", names, Q),
                  _vector_text(f"motor torques (least squares, residual {resid:.3g})", motors, tau) if motors else
                  f"motor torques: none (the robot has no motors; residual {resid:.3g})"]
     elif args.tau is not None or args.tau_set:
@@ -449,7 +452,7 @@ def _simulate_streamed(args, robot, sc, extra: dict, limit) -> int:
 
     limit.start()
     res = sc.run(robot, t_end=args.t_end, progress=not args.quiet,
-                 sink=CsvSink(args.csv, columns if has_wheels else None, SEGMENT), **extra)
+                 sink=CsvSink(args.csv, columns if has_wheels else None, SEGMENT, limit.reason), **extra)
     limit.stop()
     partial = limit.reason(res.stats.get("partial"))
     final = dict(zip(res.coordinates + res.velocity_names, np.concatenate([res.q, res.nu])))

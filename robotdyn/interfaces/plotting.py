@@ -184,8 +184,8 @@ def wheel_order(robot, wheels: Sequence[str]) -> tuple[list[str], set[str]]:
 
 def plot_traction(tr, path=None, title: str = "", robot=None):
     """Plot a :class:`~robotdyn.contact.traction.Traction`: normal loads (top) and required friction (bottom)
-    per wheel against time, shaded where the no-slip assumption is broken (load <= 0, or required friction above
-    the wheel's mu, drawn dashed).
+    per wheel against time, shaded where a wheel is unloaded (load <= 0: lifting off, or in the air for a compliant
+    wheel) or a rolling wheel needs more friction than its mu (drawn dashed): where the no-slip assumption breaks.
 
     Drive wheels come first. Every wheel that can slip has its required friction ``|f_t|/f_n`` drawn where it is
     determined; where rigid-body dynamics split a force between wheels only as a sum (e.g. two wheels on one
@@ -230,7 +230,7 @@ def plot_traction(tr, path=None, title: str = "", robot=None):
     for ax in (ax_n, ax_mu):
         if broken.any():
             ax.fill_between(tr.t, 0, 1, where=broken, transform=ax.get_xaxis_transform(), color="C3", alpha=0.15,
-                            label="no-slip broken" if ax is ax_n else None)
+                            label="a wheel unloaded or beyond its mu" if ax is ax_n else None)
         ax.grid(alpha=0.3)
     ax_n.axhline(0.0, color="k", lw=0.8)
     ax_mu.set_ylim(bottom=0.0)

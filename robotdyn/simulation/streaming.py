@@ -49,11 +49,15 @@ class CsvSink:
         columns: Extra columns of a segment by name, ``columns(trajectory) -> {name: (N,) array}`` (``None``: none).
             The names of the first segment make the header; a later segment's missing names are written as nan.
         segment: Output samples per segment (>= 2): bounds the memory of the run.
+        stopped_by: Rewrites a partial run's note before it is written to the file, ``stopped_by(note) -> note``
+            (e.g. the CLI's :meth:`robotdyn.cli.time_limit.Limit.reason`, which says that the time limit, not an
+            interruption, stopped the run); ``None``: the note as it is.
     """
 
     path: str | Path
     columns: Callable | None = None
     segment: int = SEGMENT
+    stopped_by: Callable | None = None
 
 
 @dataclass
@@ -213,6 +217,8 @@ def stream(robot, t_end: float, q0, nu0, torque, n_out: int, sink: CsvSink, prog
                 written = 0
             reached = f"samples up to t = {t_last:.6g} s" if written else "no samples"
             stats["partial"] = f"{stats['partial'].split(':')[0]}: {reached} of {t_end:g} s"
+            if sink.stopped_by is not None:
+                stats["partial"] = sink.stopped_by(stats["partial"])
             f.write(f"# partial: {stats['partial']}\n".encode())
     return StreamResult(Path(sink.path), written, t_last, list(robot.coordinates), list(robot.velocity_names),
                         np.asarray(q, float), np.asarray(nu, float), energy_start, energy_end, max_residual, stats)

@@ -33,7 +33,7 @@ from .constraints.rolling_contact import OmniWheel, RollingWheel, SupportWheel
 from .contact.sliding import SlippingWheel, sliding_now
 from .contact.sliding import forward as forward_sliding
 from .contact.stick_slip_wheel import StickSlipWheel
-from .contact.applied_forces import reduced_applied, stored_energy
+from .contact.applied_forces import has_applied, reduced_applied, stored_energy
 from .reduction.joint_springs import build_springs
 from .constraints.terrain import FlatTerrain, Terrain
 
@@ -438,11 +438,6 @@ class Robot:
     def nq(self) -> int:
         """Number of natural coordinates (= number of full velocities)."""
         return self.model.nq
-
-    @property
-    def _compliant(self) -> bool:
-        """Whether some wheel's normal contact is a force law (:mod:`robotdyn.contact.compliant_contact`)."""
-        return any(getattr(c, "compliant", False) for c in self.constraints)
 
     @property
     def mobility(self) -> int:
@@ -949,7 +944,7 @@ class Robot:
             Kinetic plus potential energy [J] (gravity's potential zero at z = 0; springs' zero at their rest).
         """
         kinetic, potential = energy(self.model, self.data, np.asarray(q, float), np.asarray(v, float))
-        if getattr(self, "springs", None) or self._compliant:
+        if has_applied(self):
             potential += stored_energy(self, q)
         return kinetic + potential
 

@@ -16,6 +16,20 @@ import robotdyn
 from robotdyn.fast.dispatch import compiled_model
 
 
+def _race(threads) -> None:
+    """Start and join ``threads`` with the interpreter switching between them as often as it can (a switch interval
+    of 1 us), so that unsynchronised shared state shows."""
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    finally:
+        sys.setswitchinterval(interval)
+
+
 @pytest.mark.parametrize("name", ["quasimoro", "linkage_suspension"])
 def test_concurrent_evaluations_equal_sequential(name):
     robot = robotdyn.load(name)
@@ -39,15 +53,7 @@ def test_concurrent_evaluations_equal_sequential(name):
                 errors.append(("reduced", i))
 
     threads = [threading.Thread(target=work, args=(k * 37,)) for k in range(4)]
-    interval = sys.getswitchinterval()
-    sys.setswitchinterval(1e-6)
-    try:
-        for t in threads:
-            t.start()
-        for t in threads:
-            t.join()
-    finally:
-        sys.setswitchinterval(interval)
+    _race(threads)
     assert errors == []
 
 
@@ -134,15 +140,7 @@ def test_many_threads_switching_leave_the_fast_path_on():
                 wrong.append("the fast path was off outside any block")
 
     threads = [threading.Thread(target=off) for _ in range(4)] + [threading.Thread(target=on) for _ in range(2)]
-    interval = sys.getswitchinterval()
-    sys.setswitchinterval(1e-6)
-    try:
-        for t in threads:
-            t.start()
-        for t in threads:
-            t.join()
-    finally:
-        sys.setswitchinterval(interval)
+    _race(threads)
     assert wrong == []
     assert enabled()
     runs = simulate_many(robot, 0.2, q0=np.tile(q, (2, 1)), nu0=[[0.1, 0.0, 0.0], [0.0, 0.1, 0.0]], n_out=3,

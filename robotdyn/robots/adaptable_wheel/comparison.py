@@ -11,6 +11,8 @@ The ``ik`` CLI subcommand shows the paper's IK and statics beside the model's co
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pinocchio as pin
 
@@ -33,6 +35,9 @@ from .paper import (
     solve_ik,
     static_torques,
 )
+
+if TYPE_CHECKING:
+    from ...contact.contact_forces import ConstraintForces
 
 
 def euler_zyx(R: np.ndarray) -> tuple[float, float, float]:
@@ -292,7 +297,8 @@ def register_cli(subparsers, parents) -> None:
 
 
 # ------------------------------------------------------------------------------------------- wheel loads (sec 5)
-def hold_loads(terrain: str = "flat", lateral: str = "rolling", params: dict | None = None):
+def hold_loads(terrain: str = "flat", lateral: str = "rolling",
+               params: dict | None = None) -> tuple[Robot, np.ndarray, np.ndarray, ConstraintForces]:
     """robotdyn's wheel loads with the robot at rest on ``terrain`` (the ``hold`` scenario's pose: the paper's IK at
     the path origin, h_CG = 0.15 m, body level, and its least-squares holding torques).
 

@@ -46,6 +46,8 @@ from ..constraints.loop_closure import LoopClosure
 from ..constraints.rolling_contact import RollingWheel
 from .sliding import forward as forward_sliding
 from .sliding import sliding_now, tangential
+from .compliant_rolling import forward as rolling_forward
+from .compliant_rolling import rolling_wheels
 from .applied_forces import applied, has_applied, reduced_applied
 from . import rigid_limit
 from .compliance import wheel_stiffness
@@ -394,6 +396,14 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         kin_v = KinematicState(robot.model, robot.data, q, red.v)
         for i, wheel in enumerate(sliding_now(robot)):
             friction[wheel.name] = (tangential(wheel, kin_v)[0], st.force[i])
+    elif nudot is None and rolling_wheels(robot):  # compliant wheels rolling while they press: their rows' forces
+        tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
+        rolled = rolling_forward(robot, q, nu, tau, red=red)  # robotdyn.contact.compliant_rolling
+        nudot = rolled.nudot
+        kin_v = KinematicState(robot.model, robot.data, q, red.v)
+        for wheel in rolling_wheels(robot):
+            if wheel.name in rolled.tangential:
+                friction[wheel.name] = (tangential(wheel, kin_v)[0], rolled.tangential[wheel.name])
     elif nudot is None:
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         from ..reduction.reduced_dynamics import solve_mass
@@ -519,9 +529,12 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     for c in robot.constraints:
         if getattr(c, "compliant", False):  # its force is its laws' (robotdyn.contact.compliant_contact)
             st = compliant[c.name]
-            out.wheels.append(WheelForce(c.name, "compliant", st["force"], np.ones(3, bool), st["E"] @ st["force"],
+            force = st["force"].copy()
+            if c.name in friction:  # a rolling compliant wheel in contact: its rows' force
+                force[:2] += friction[c.name][1]
+            out.wheels.append(WheelForce(c.name, "compliant", force, np.ones(3, bool), st["E"] @ force,
                                          np.array(st["point"], float)))
-            out._tangential.append(([], np.zeros((0, 3)), st["force"][:2]))
+            out._tangential.append(([], np.zeros((0, 3)), force[:2]))
         elif isinstance(c, RollingWheel):
             fr = friction.get(c.name, (None, None))[1]
             if served is not None:

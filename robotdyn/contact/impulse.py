@@ -172,7 +172,7 @@ def plastic_impact(M, G, nu, rcond: float = 1e-10) -> PlasticImpulse:
     dnu = MinvGT @ Lam
     after = nu + dnu
     left = np.abs(G @ after).max(initial=0.0)
-    if left > 1e-8 * max(np.abs(before).max(initial=0.0), 1e-300):
+    if left > 1e-8 * np.abs(before).max(initial=0.0) + 1e-12:  # [m/s] for rows of point velocities
         raise InputError(f"the rows cannot all be stopped by one impulse (|G nu+| = {left:.3g}); expected "
                          "consistent rows")
     lost = 0.5 * float(-before @ Lam)  # = 1/2 before^T W^+ before >= 0

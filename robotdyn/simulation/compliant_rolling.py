@@ -96,7 +96,7 @@ def simulate_rolling(robot, t_end: float, q0: np.ndarray, nu0: np.ndarray, torqu
     contact = tuple(nm for nm, p in zip(names, indicators(np.concatenate([q_start, nu_start]))) if p > 0.0)
     start_loss = 0.0
     if contact:  # wheels pressing at the start: their slip is stopped there (a touch-down at t0)
-        nu_start, start_loss = _touch(robot, q_start, nu_start, contact, contact, t0, events_log)
+        nu_start, start_loss = _touch(robot, q_start, nu_start, contact, contact, t0, events_log, start=True)
     y = np.concatenate([q_start, nu_start, [0.0, 0.0]])
     t = float(t0)
     ts, ys, losses = [], [], []
@@ -191,14 +191,14 @@ def simulate_rolling(robot, t_end: float, q0: np.ndarray, nu0: np.ndarray, torqu
     return traj
 
 
-def _touch(robot, q, nu, contact, landing, t, log) -> tuple[np.ndarray, float]:
+def _touch(robot, q, nu, contact, landing, t, log, start: bool = False) -> tuple[np.ndarray, float]:
     """ν after the touch-down impact of the wheels ``landing`` (all of ``contact`` keep rolling) and its energy
     loss [J]; appends one touch-down entry per landing wheel to ``log`` (the impact's loss on the first, the slip
-    speed [m/s] it stopped on each)."""
+    speed [m/s] it stopped on each; at the ``start``, only for wheels that were slipping)."""
     kin = KinematicState(robot.model, robot.data, np.asarray(q, float), robot.velocity(q, nu))
     before = {nm: float(np.linalg.norm(rows(robot, kin, (nm,))[0] @ kin.v)) for nm in landing}
     nu_after, imp = touch_down(robot, q, nu, contact)
-    for j, nm in enumerate(landing):
+    for j, nm in enumerate(n for n in landing if not start or before[n] > 1e-9):
         log.append({"t": float(t), "wheel": nm, "event": "touch-down", "slip": before[nm],
                     "loss": imp.energy_lost if j == 0 else 0.0})
     return nu_after, float(imp.energy_lost)

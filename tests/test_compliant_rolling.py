@@ -187,3 +187,25 @@ def test_compiled_engine_refuses_rolling_compliant_wheels_in_one_line():
                                             "roll while in contact .friction = 'rolling'. are simulated on the "
                                             "Python path"):
         simulate(robot, 0.01, q0, nu0, engine="compiled", progress=False)
+
+
+def test_example_base_on_rolling_tyres_from_simulate(capsys):
+    """examples/bump_base_rolling.toml through `robotdyn simulate` (in-process): both front wheels leave the bump's
+    crest together (the base is symmetric) with their rows dropped, the rear ones still rolling; the JSON report
+    carries the flight events and the touch-down losses; energy change = damper work - touch-down losses (no
+    motors, no friction law)."""
+    import json
+
+    from robotdyn.cli.commands import main
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "bump_base_rolling.toml"
+    rc = main(["simulate", "--constraints", str(example), "--scenario", "bump", "--t-end", "0.08", "--quiet",
+               "--json"])
+    out = capsys.readouterr()
+    assert rc == 0, out.err
+    data = json.loads(out.out)
+    lifts = {e["wheel"]: e["t"] for e in data["flight"] if e["event"] == "lift-off"}
+    assert set(lifts) == {"front_left", "front_right"}
+    assert lifts["front_left"] == pytest.approx(lifts["front_right"], abs=1e-9) and 0.06 < lifts["front_left"] < 0.075
+    assert data["friction_work"] == 0.0 and data["damper_work"] < 0 and data["touchdown_loss"] >= 0.0
+    assert "stopped" not in data

@@ -398,7 +398,12 @@ def _simulate(args, limit) -> int:
         fw = 0.0 if traj.friction_work is None else float(traj.friction_work[-1])
         dw = 0.0 if traj.damper_work is None else float(traj.damper_work[-1])
         out["friction_work"], out["damper_work"] = fw, dw
-        text.append(f"work: friction {fw:.10g} J, dampers {dw:.10g} J (energy change = motor work + these)")
+        lost = getattr(traj, "impact_loss", None)  # rolling compliant wheels' touch-downs (simulation.compliant_rolling)
+        if lost is not None:
+            out["touchdown_loss"] = float(lost[-1] - lost[0])
+        text.append(f"work: friction {fw:.10g} J, dampers {dw:.10g} J" + (
+            "" if lost is None else f", touch-down impacts {-(lost[-1] - lost[0]):.10g} J")
+            + " (energy change = motor work + these)")
     if switches is not None:
         out["switches"] = switches
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(

@@ -42,6 +42,9 @@ from ..reduction.reduced_dynamics import velocity
 from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .trajectory import Trajectory
 
+START_SLIP = 1e-6
+"""Slip speed [m/s] above which a wheel pressing at the start is reported as a touch-down at t0 (below it the start
+impact, which still makes its rows exact, only removes rounding: e.g. 2e-7 m/s from a posture given to 1e-3 m)."""
 MAX_SWITCHES = 10_000
 """Largest number of contact switches of one run (beyond it the run stops with an error: chattering contact)."""
 
@@ -123,15 +126,16 @@ def simulate_rolling(robot, t_end: float, q0: np.ndarray, nu0: np.ndarray, torqu
 
             event.terminal, event.direction = True, (-1.0 if nm in active else 1.0)
             switch.append(event)
-        todo = t_eval[t_eval > t] if ts else t_eval[t_eval >= t]
+        todo = t_eval[t_eval > t] if switches else t_eval[t_eval >= t]
         sol = solve_ivp(rhs, (t, t_end), y, method=method, t_eval=todo, rtol=rtol, atol=atol,
                         events=switch + [e for e, _, _ in other_events])
         nfev += int(sol.nfev)
         if not sol.success:
             raise RobotDynError(f"integration failed at t = {sol.t[-1] if len(sol.t) else t:.4g} s: {sol.message}"
                                 + failure_note(robot, sol.y[:n, -1] if len(sol.t) else y[:n], stabilisation))
-        ts.append(sol.t)
-        ys.append(sol.y)
+        if len(sol.t):  # (a segment between two events may hold no output time)
+            ts.append(sol.t)
+            ys.append(np.asarray(sol.y, float).reshape(len(y), -1))
         for j in range(len(other_events)):
             other_times[j].extend(float(x) for x in sol.t_events[len(switch) + j])
         if sol.status != 1:
@@ -183,7 +187,7 @@ def simulate_rolling(robot, t_end: float, q0: np.ndarray, nu0: np.ndarray, torqu
     stats = {"nfev": nfev, "wall": wall, "method": method, "rtol": rtol, "engine": f"scipy ({method})",
              "flight": [e for e in flight if e["t"] <= times[-1]],
              "airborne": airborne(robot, compliant_wheels(robot), q0),
-             "touchdown_loss": float(impact[-1]), "rolling_residual": rolling_residual, "switches": switches}
+             "touchdown_loss": float(impact[-1]), "rolling_residual": rolling_residual, "contact_switches": switches}
     traj = Trajectory(times, q, nu, energy, residual, list(robot.coordinates), list(robot.velocity_names), stats,
                       robot.units, Y[n + k], robot, torque)
     traj.damper_work = Y[n + k + 1]
@@ -194,14 +198,14 @@ def simulate_rolling(robot, t_end: float, q0: np.ndarray, nu0: np.ndarray, torqu
 def _touch(robot, q, nu, contact, landing, t, log, start: bool = False) -> tuple[np.ndarray, float]:
     """ν after the touch-down impact of the wheels ``landing`` (all of ``contact`` keep rolling) and its energy
     loss [J]; appends one touch-down entry per landing wheel to ``log`` (the impact's loss on the first, the slip
-    speed [m/s] it stopped on each; at the ``start``, only for wheels that were slipping)."""
+    speed [m/s] it stopped on each; at the ``start``, only for wheels slipping faster than :data:`START_SLIP`)."""
     kin = KinematicState(robot.model, robot.data, np.asarray(q, float), robot.velocity(q, nu))
     before = {nm: float(np.linalg.norm(rows(robot, kin, (nm,))[0] @ kin.v)) for nm in landing}
     nu_after, imp = touch_down(robot, q, nu, contact)
-    for j, nm in enumerate(n for n in landing if not start or before[n] > 1e-9):
+    for j, nm in enumerate(n for n in landing if not start or before[n] > START_SLIP):
         log.append({"t": float(t), "wheel": nm, "event": "touch-down", "slip": before[nm],
                     "loss": imp.energy_lost if j == 0 else 0.0})
     return nu_after, float(imp.energy_lost)
 
 
-__all__ = ["simulate_rolling", "MAX_SWITCHES"]
+__all__ = ["simulate_rolling", "MAX_SWITCHES", "START_SLIP"]

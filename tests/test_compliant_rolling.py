@@ -209,3 +209,29 @@ def test_example_base_on_rolling_tyres_from_simulate(capsys):
     assert lifts["front_left"] == pytest.approx(lifts["front_right"], abs=1e-9) and 0.06 < lifts["front_left"] < 0.075
     assert data["friction_work"] == 0.0 and data["damper_work"] < 0 and data["touchdown_loss"] >= 0.0
     assert "stopped" not in data
+
+
+def test_forces_of_rolling_tyres_one_story(capsys):
+    """The rolling rows' forces on the four-wheel base (examples/bump_base_rolling.toml), driven: the same numbers
+    from dump --forces as from the API; each wheel's longitudinal force is determined, the lateral split between the
+    two wheels of an axle is not (two redundant side-slip rows: reported open, not an arbitrary split), and the
+    minimum mu over the admissible splits is at least every wheel's longitudinal |F_x| / F_n."""
+    import json
+
+    from robotdyn.cli.commands import main
+    from robotdyn.interfaces.constraint_file import load_robot
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "bump_base_rolling.toml"
+    robot = load_robot(example)
+    q, nu, tau = robot.neutral(), np.array([4, 0, 0, 0, 0, 0, 40, 40, 40, 40.0]), np.array([1.0, 2.0, 3.0, 4.0])
+    forces = robot.contact_forces(q, nu, tau=tau)
+    assert [w.determined.tolist() for w in forces.wheels] == [[True, False, True]] * 4
+    ratios = [abs(w.force[0]) / w.normal for w in forces.wheels]
+    assert forces.minimum_mu() >= max(ratios) - 1e-12
+    rc = main(["dump", "--constraints", str(example), "--v", *map(str, nu), "--tau", *map(str, tau), "--forces",
+               "--json"])
+    data = json.loads(capsys.readouterr().out)
+    assert rc == 0
+    assert np.allclose(data["a"], robot.forward_dynamics(q, nu, tau), rtol=1e-12, atol=1e-12)
+    for w in forces.wheels:
+        assert data["forces"]["wheels"][w.name]["longitudinal"] == pytest.approx(w.force[0], rel=1e-12)

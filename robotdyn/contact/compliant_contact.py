@@ -230,6 +230,14 @@ class CompliantWheel(RollingWheel):
         # the rolling rows D (t1, t2)^T A_w through RollingWheel.jacobian/drift (self's own give no rows)
         self._directions = np.hstack([self.tangent_directions, np.zeros((self.tangent_directions.shape[0], 1))])
 
+    def rolling_labels(self) -> list[str]:
+        """Labels of the rolling rows (``<name>.longitudinal``, ``<name>.lateral`` for a standard wheel,
+        ``<name>.driving`` for an omni wheel; none without rolling)."""
+        if not self.rolling:
+            return []
+        rows = ("longitudinal", "lateral") if self.kind == "standard" else ("driving",)
+        return [f"{self.name}.{r}" for r in rows]
+
     def tangential_rows(self, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
         """The rolling rows :math:`G = D\\,(t_1, t_2)^T A_w` (d, nv) and their drift :math:`\\dot G v` (d,)
         [m/s^2]: the velocity of the wheel's material point at the contact along its tangential directions D

@@ -387,6 +387,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
     forward = nudot is None  # accelerations solved from the mass matrix (its conditioning then matters)
     friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
     st = None
+    jrows = red.jacobian_rows
     if sliding_now(robot):
         if nudot is not None:
             raise InputError("with slipping wheels the forces follow from motor torques: give tau, not nudot")
@@ -396,14 +397,15 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         kin_v = KinematicState(robot.model, robot.data, q, red.v)
         for i, wheel in enumerate(sliding_now(robot)):
             friction[wheel.name] = (tangential(wheel, kin_v)[0], st.force[i])
-    elif nudot is None and rolling_wheels(robot):  # compliant wheels rolling while they press: their rows' forces
+    elif nudot is None and rolling_wheels(robot):  # compliant wheels rolling while they press: their rows join
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         rolled = rolling_forward(robot, q, nu, tau, red=red)  # robotdyn.contact.compliant_rolling
         nudot = rolled.nudot
-        kin_v = KinematicState(robot.model, robot.data, q, red.v)
-        for wheel in rolling_wheels(robot):
-            if wheel.name in rolled.tangential:
-                friction[wheel.name] = (tangential(wheel, kin_v)[0], rolled.tangential[wheel.name])
+        if rolled.contact:  # their multipliers (minimum-norm, with the open part in the null space) are their forces
+            labels = [lab for w in rolling_wheels(robot) if w.name in rolled.contact for lab in w.rolling_labels()]
+            m = len(labels)
+            jrows = ConstraintRows.stack([jrows, ConstraintRows(rolled.rows, None, np.zeros(m), np.zeros(m, bool),
+                                                                labels)], robot.model.nv)
     elif nudot is None:
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         from ..reduction.reduced_dynamics import solve_mass
@@ -416,7 +418,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         else:
             tau = robot.check_tau(tau)
     a = red.S @ nudot + red.w
-    out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
+    out = _forces(robot, q, red.v, a, tau, jrows, friction, nudot)
     if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
         out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
     if st is not None and st.lam is not None:  # the loads of the coupled solve (rigid limit with friction)
@@ -529,12 +531,15 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     for c in robot.constraints:
         if getattr(c, "compliant", False):  # its force is its laws' (robotdyn.contact.compliant_contact)
             st = compliant[c.name]
-            force = st["force"].copy()
-            if c.name in friction:  # a rolling compliant wheel in contact: its rows' force
-                force[:2] += friction[c.name][1]
-            out.wheels.append(WheelForce(c.name, "compliant", force, np.ones(3, bool), st["E"] @ force,
+            force, known = st["force"].copy(), np.ones(3, bool)
+            idx = [index[lab] for lab in c.rolling_labels() if lab in index]  # rolling in contact: its rows
+            if idx:
+                force[:2] = c.tangent_directions.T @ lam[idx]
+                if N.shape[1]:  # an open split (e.g. the side force of two wheels on one axle)
+                    known[:2] = np.linalg.norm(c.tangent_directions.T @ N[idx], axis=1) <= DETERMINED_TOL
+            out.wheels.append(WheelForce(c.name, "compliant", force, known, st["E"] @ force,
                                          np.array(st["point"], float)))
-            out._tangential.append(([], np.zeros((0, 3)), force[:2]))
+            out._tangential.append((idx, c._directions, None) if idx else ([], np.zeros((0, 3)), force[:2]))
         elif isinstance(c, RollingWheel):
             fr = friction.get(c.name, (None, None))[1]
             if served is not None:

@@ -204,12 +204,16 @@ class ConstraintForces:
         """
         if not self.wheels or not all(w.known[2] for w in self.wheels):
             return None
-        fn = np.array([w.normal for w in self.wheels])
+        # a compliant wheel in the air carries nothing and needs no friction (robotdyn.contact.compliant_contact)
+        pairs = [(t, w) for t, w in zip(self._tangential, self.wheels) if not (w.kind == "compliant" and w.normal <= 0)]
+        if not pairs:
+            return 0.0
+        fn = np.array([w.normal for _, w in pairs])
         if np.any(fn <= 0):
             return float("inf")
         space = self.open
         maps = []  # f_t,i(z) = base_i + T_i z
-        for (idx, D, friction), w in zip(self._tangential, self.wheels):
+        for (idx, D, friction), w in pairs:
             if friction is not None:
                 maps.append((np.asarray(friction, float), np.zeros((2, space.shape[1]))))
             else:

@@ -45,6 +45,10 @@ from .trajectory import Trajectory
 START_SLIP = 1e-6
 """Slip speed [m/s] above which a wheel pressing at the start is reported as a touch-down at t0 (below it the start
 impact, which still makes its rows exact, only removes rounding: e.g. 2e-7 m/s from a posture given to 1e-3 m)."""
+SIMULTANEOUS = 1e-10
+"""Contact indicator [m] within which other wheels switch with the wheel whose event fired (wheels that leave or
+land together, e.g. on a symmetric axle, found one event apart only by rounding; dropping the rows of one of them
+alone would change the other's motion at once)."""
 MAX_SWITCHES = 10_000
 """Largest number of contact switches of one run (beyond it the run stops with an error: chattering contact)."""
 
@@ -150,11 +154,11 @@ def simulate_rolling(robot, t_end: float, q0: np.ndarray, nu0: np.ndarray, torqu
         if switches > MAX_SWITCHES:
             raise RobotDynError(f"the rolling compliant wheels' contact switched more than {MAX_SWITCHES} times by "
                                 f"t = {t:.6g} s (chattering contact); expected more normal damping or a shorter run")
-        # the wheel whose event fired switches; any other wheel whose indicator has the other sign already (two
-        # wheels landing together, within the event's tolerance) switches with it
+        # the wheel whose event fired switches; any other wheel whose indicator has reached zero too (within
+        # SIMULTANEOUS: e.g. the two wheels of a symmetric axle) switches with it
         signs = indicators(y)
-        leaving = [nm for j, nm in enumerate(names) if nm in active and (j == i or signs[j] < 0.0)]
-        landing = [nm for j, nm in enumerate(names) if nm not in active and (j == i or signs[j] > 0.0)]
+        leaving = [nm for j, nm in enumerate(names) if nm in active and (j == i or signs[j] <= SIMULTANEOUS)]
+        landing = [nm for j, nm in enumerate(names) if nm not in active and (j == i or signs[j] >= -SIMULTANEOUS)]
         for nm in leaving:
             events_log.append({"t": t, "wheel": nm, "event": "lift-off"})
         contact = tuple(x for x in names if (x in active and x not in leaving) or x in landing)
@@ -208,4 +212,4 @@ def _touch(robot, q, nu, contact, landing, t, log, start: bool = False) -> tuple
     return nu_after, float(imp.energy_lost)
 
 
-__all__ = ["simulate_rolling", "MAX_SWITCHES", "START_SLIP"]
+__all__ = ["simulate_rolling", "MAX_SWITCHES", "START_SLIP", "SIMULTANEOUS"]

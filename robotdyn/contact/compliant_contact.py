@@ -267,7 +267,8 @@ class CompliantWheel(RollingWheel):
 
     def __repr__(self) -> str:
         return (f"CompliantWheel(frame={self.frame!r}, radius={self.radius}, normal={self.normal_law!r}, "
-                f"law={self.law!r}, terrain={self.terrain!r})")
+                + (f"law={self.law!r}, " if not self.rolling else "rolling while in contact, ")
+                + f"terrain={self.terrain!r})")
 
     # no constraint rows: the normal direction is a force law, the tangential ones a friction law
     def _labels(self) -> list[str]:

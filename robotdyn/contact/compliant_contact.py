@@ -231,8 +231,12 @@ class CompliantWheel(RollingWheel):
         self._directions = np.hstack([self.tangent_directions, np.zeros((self.tangent_directions.shape[0], 1))])
 
     def rolling_labels(self) -> list[str]:
-        """Labels of the rolling rows (``<name>.longitudinal``, ``<name>.lateral`` for a standard wheel,
-        ``<name>.driving`` for an omni wheel; none without rolling)."""
+        """Labels of the rolling rows, in the order of :meth:`tangential_rows`.
+
+        Returns:
+            ``<name>.longitudinal``, ``<name>.lateral`` for a standard wheel, ``<name>.driving`` for an omni wheel;
+            an empty list for a wheel that does not roll (a friction law, a support).
+        """
         if not self.rolling:
             return []
         rows = ("longitudinal", "lateral") if self.kind == "standard" else ("driving",)

@@ -94,9 +94,14 @@ def simulate_rolling(robot, t_end: float, q0: np.ndarray, nu0: np.ndarray, torqu
     def tau_at(t, q, nu):
         return zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
 
+    last: dict = {}  # the indicators at the last state asked for (one projection for every wheel's event)
+
     def indicators(y: np.ndarray) -> np.ndarray:
-        q, nu = y[:n], y[n:n + k]
-        return pressing(robot, q, robot.velocity(q, nu))
+        key = np.asarray(y[:n + k], float).tobytes()
+        if last.get("key") != key:
+            q, nu = y[:n], y[n:n + k]
+            last["key"], last["values"] = key, pressing(robot, q, robot.velocity(q, nu))
+        return last["values"]
 
     events_log: list[dict] = []
     q_start, nu_start = np.asarray(q0, float), np.asarray(nu0, float)

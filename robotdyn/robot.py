@@ -751,6 +751,10 @@ class Robot:
         if sliding_now(self):
             return forward_sliding(self, q, nu, tau).nudot
         red = self.reduced(q, nu)
+        if any(getattr(c, "rolling", False) for c in self.constraints):  # robotdyn.contact.compliant_rolling
+            from .contact.compliant_rolling import forward as rolling_forward
+
+            return rolling_forward(self, q, nu, tau, red=red).nudot
         out = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(self, red, q)[0])
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "

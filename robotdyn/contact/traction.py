@@ -238,7 +238,8 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
                    _friction_coefficients(robot, wheels, mu), friction_known, undetermined)
     out.minimum_mu = loads.minimum_mu
     out.method = used
-    by_law = {c.name for c in robot.constraints if getattr(c, "sliding", False) or hasattr(c, "law")}
+    by_law = {c.name for c in robot.constraints if getattr(c, "sliding", False)
+              or (hasattr(c, "law") and not getattr(c, "rolling", False))}  # rolling compliant: no law, no slip
     out.sliding = [w for w in wheels if w in by_law]  # (they slip by design: their friction is their law's)
     if loads.compliance is not None:
         out.compliance = [names[j] for j in keep if loads.compliance[:, j].any()]

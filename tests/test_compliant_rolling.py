@@ -239,3 +239,21 @@ def test_forces_of_rolling_tyres_one_story(capsys):
     assert np.allclose(data["a"], robot.forward_dynamics(q, nu, tau), rtol=1e-12, atol=1e-12)
     for w in forces.wheels:
         assert data["forces"]["wheels"][w.name]["longitudinal"] == pytest.approx(w.force[0], rel=1e-12)
+
+
+@pytest.mark.parametrize("example", ["bump_base_rolling", "bump_base"])
+def test_what_compliant_wheels_do_not_take_is_refused_in_one_line(example):
+    """Inverse dynamics does not take the rolling rows of compliant wheels in contact, and derivatives have no rule
+    for compliant wheels: each says so in one line (the derivatives used to end in a numpy broadcast error)."""
+    from robotdyn.errors import InputError
+    from robotdyn.interfaces.constraint_file import read
+
+    robot = read(Path(__file__).resolve().parents[1] / "examples" / f"{example}.toml").robot()
+    q, nu, tau = robot.neutral(), np.zeros(robot.mobility), np.zeros(len(robot.motors))
+    calls = [lambda: robot.dynamics_derivatives(q, nu, tau)]
+    if example == "bump_base_rolling":  # (at neutral its wheels press on the ground)
+        calls.append(lambda: robot.inverse_dynamics(q, nu, np.zeros(robot.mobility)))
+    for call in calls:
+        with pytest.raises(InputError) as info:
+            call()
+        assert "\n" not in str(info.value) and "compliant" in str(info.value)

@@ -257,3 +257,14 @@ def test_what_compliant_wheels_do_not_take_is_refused_in_one_line(example):
         with pytest.raises(InputError) as info:
             call()
         assert "\n" not in str(info.value) and "compliant" in str(info.value)
+
+
+def test_a_compliant_wheels_load_is_reported_as_its_contact_law():
+    """The normal load of a compliant wheel comes from its force law, not from rigid-body dynamics: its source says
+    so (dump --forces --json printed "rigid")."""
+    from robotdyn.contact.contact_forces import COMPLIANT_SOURCE
+    from robotdyn.interfaces.constraint_file import read
+
+    robot = read(Path(__file__).resolve().parents[1] / "examples" / "bump_base.toml").robot()
+    forces = robot.contact_forces(robot.neutral(), np.zeros(robot.mobility), tau=np.zeros(len(robot.motors)))
+    assert {w["source"] for w in forces.as_dict()["wheels"].values()} == {COMPLIANT_SOURCE}

@@ -59,6 +59,10 @@ DETERMINED_TOL = 1e-8
 """A row (or force component) is determined when its weight in every null-space direction is below this."""
 
 
+COMPLIANT_SOURCE = "compliant contact"
+"""How a compliant wheel's normal load is reported (its force law of penetration and its rate)."""
+
+
 @dataclass
 class WheelForce:
     """The ground's force on one wheel at its contact point.
@@ -92,7 +96,9 @@ class WheelForce:
     @property
     def source(self) -> str:
         """Which model produced the normal load: ``rigid`` (rigid-body dynamics), ``rigid limit of compliance``,
-        or ``open`` (neither determines it)."""
+        ``compliant contact`` (a compliant wheel's force law of penetration), or ``open`` (none determines it)."""
+        if self.kind == "compliant":
+            return COMPLIANT_SOURCE
         if self.determined[2]:
             return "rigid"
         return rigid_limit.MODEL if self.compliance[2] else "open"

@@ -137,3 +137,12 @@ def test_traction_of_a_compliant_robot_names_its_flying_wheels():
     assert flying == {"front_left", "front_right"}
     assert not tr.broken()[air].any()
     assert (tr.normal[air] <= 0).all() and (tr.normal[~air] > 0).all()
+
+
+def test_a_constant_required_mu_is_drawn_inside_the_axes():
+    """A steady manoeuvre's required mu is constant (examples/cornering_car.toml: 0.491 all along); its line must lie
+    inside the friction panel, not on its upper frame (the axes ended at the line's value)."""
+    steady = 0.491 + 1e-12 * np.arange(5)  # (constant to rounding: the axes' autoscale ends at its value)
+    fig = plot_traction(_traction(["a", "b"], [False, False], steady))
+    bottom, top = fig.axes[1].get_ylim()
+    assert bottom == 0.0 and top >= 1.05 * 0.491

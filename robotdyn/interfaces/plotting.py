@@ -239,7 +239,9 @@ def plot_traction(tr, path=None, title: str = "", robot=None):
                             hatch="//", label="a compliant wheel in the air (flight)" if ax is ax_n else None)
         ax.grid(alpha=0.3)
     ax_n.axhline(0.0, color="k", lw=0.8)
-    ax_mu.set_ylim(bottom=0.0)
+    drawn = [y for line in ax_mu.lines for y in np.asarray(line.get_ydata(), float).ravel() if np.isfinite(y)]
+    top = max(ax_mu.get_ylim()[1], 1.1 * max(drawn)) if drawn else None
+    ax_mu.set_ylim(bottom=0.0, top=top)  # (a constant line, e.g. a steady turn's mu, not hidden on the frame)
     ax_n.set_ylabel("normal load [N]")
     ax_mu.set_ylabel("required friction |f_t|/f_n")
     ax_mu.set_xlabel("t [s]")

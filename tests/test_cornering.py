@@ -205,3 +205,25 @@ def test_sprung_car_splits_the_transfer_by_roll_stiffness(k_front, k_rear):
     phi = moment / (2 * (k_front + k_rear) * B**2 - M_C * G * H_C)
     assert q[c.index("roll")] == pytest.approx(phi, rel=0.04)
     assert q[c.index("roll")] > 0.04  # a real roll (to the outside of the left turn: positive about x)
+
+
+def test_dump_prints_the_same_loads(capsys):
+    """`robotdyn dump --forces` on the example, in the steady turn (12 m/s): the four loads of the closed forms (to
+    the 6 digits printed), each reported as the rigid limit of compliance."""
+    from robotdyn.cli.commands import main
+
+    rc = main(["dump", "--constraints", str(EXAMPLES / "cornering_car.toml"), "--q", "0", "0", "0.55",
+               *["0"] * 7, "--v", "12", "--tau", "0", "0", "0", "0", "--forces"])
+    out = capsys.readouterr().out
+    assert rc == 0
+    rows = {line.split()[0]: line.split() for line in out.splitlines() if line.split()[:1] and
+            line.split()[0] in CORNERS}
+    transfer, front = _closed_form(12.0 / 30.0, 30.0)
+    share = 3.0e5 / (3.0e5 + 2.0e5)  # the example's tyre stiffnesses
+    m = M_C + 4 * (M_U + M_W)
+    expected = {"front_left": front / 2 - share * transfer / 2, "front_right": front / 2 + share * transfer / 2,
+                "rear_left": (m * G - front) / 2 - (1 - share) * transfer / 2,
+                "rear_right": (m * G - front) / 2 + (1 - share) * transfer / 2}
+    for name in CORNERS:
+        assert float(rows[name][3]) == pytest.approx(expected[name], rel=1e-6), rows[name]
+        assert "rigid limit of compliance" in " ".join(rows[name])

@@ -380,7 +380,9 @@ def _simulate(args, limit) -> int:
     if tr is not None:
         out["traction"] = {"summary": tr.summary(), "wheels": tr.wheels, "undetermined": list(tr.undetermined),
                            "events": [vars(e) for e in tr.events],
-                           "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)},
+                           "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)
+                                               if tr.friction_determined[j]},  # (as the streamed run: no
+                                                                                # arbitrary split's value)
                            "min_normal_load": {w: float(np.min(tr.normal[:, j])) for j, w in enumerate(tr.wheels)}}
     text = [f"{args.robot} / {sc.name}: {sc.description}",
             f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations, "

@@ -355,11 +355,17 @@ def cone_minimum(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: i
         return min(float(res.fun), ratio(np.zeros(1)))
     from scipy.optimize import minimize
 
-    cons = [{"type": "ineq", "fun": (lambda x, b=b, T=T, f=f: (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2))}
-            for (b, T), f in zip(maps, fn)]
+    def cone(x, b, T, f):  # (t f)^2 - |b + T z|^2 >= 0 for x = (z, t)
+        return (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2)
+
+    def cone_jac(x, b, T, f):  # its gradient in (z, t): the exact one, so SLSQP needs no differences
+        return np.append(-2.0 * (b + T @ x[:-1]) @ T, 2.0 * x[-1] * f * f)
+
+    cons = [{"type": "ineq", "fun": cone, "jac": cone_jac, "args": (b, T, f)} for (b, T), f in zip(maps, fn)]
+    last = np.append(np.zeros(d), 1.0)
     x0 = np.append(np.zeros(d), ratio(np.zeros(d)))
-    res = minimize(lambda x: x[-1], x0, constraints=cons, bounds=[(None, None)] * d + [(0, None)],
-                   method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
+    res = minimize(lambda x: x[-1], x0, jac=lambda x: last, constraints=cons,
+                   bounds=[(None, None)] * d + [(0, None)], method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
     return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
 
 

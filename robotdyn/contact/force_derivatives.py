@@ -108,6 +108,8 @@ class ContactForceDerivatives:
         tangent: (n, p) :math:`\\partial q/\\partial q_P` along the holonomic manifold.
         coordinates, velocities, motors: Names of q, nu and tau.
         source: ``model`` or ``floating twin`` (where the planar model's loads come from).
+        dynamics: The :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` at the state (the
+            accelerations and their derivatives, computed on the way).
     """
 
     wheels: list[str]
@@ -133,6 +135,7 @@ class ContactForceDerivatives:
     velocities: list[str] = field(default_factory=list)
     motors: list[str] = field(default_factory=list)
     source: str = "model"
+    dynamics: object = field(default=None, repr=False)
 
     @property
     def dforce_dq_manifold(self) -> np.ndarray:
@@ -428,7 +431,7 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
     out = ContactForceDerivatives(names, force, dF_q, dF_nu, dF_tau, mu, *dmu, rough, known, list(unloaded),
                                   lay.labels, lay.lam, dlam_dq, dlam_dnu, dlam_dtau, D.positions, D.tangent,
                                   list(robot.coordinates), list(robot.velocity_names),
-                                  [mo.name for mo in robot.motors], "floating twin" if twin else "model")
+                                  [mo.name for mo in robot.motors], "floating twin" if twin else "model", D)
     for name in ("force", "dforce_dq", "dforce_dnu", "dforce_dtau", "dlam_dq", "dlam_dnu", "dlam_dtau"):
         if not np.all(np.isfinite(getattr(out, name))):
             raise NonFiniteError(f"contact force derivatives: {name} is not finite at this state")

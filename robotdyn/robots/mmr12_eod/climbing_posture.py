@@ -9,7 +9,8 @@ motor torques) is not defined with it free.
 The least-friction posture (:func:`climbing_posture_problem`): at rest on the ramp, holding (the robot's motors
 hold it still: :math:`\\dot\\nu = 0`), the manipulator (theta1, lambda2, theta3, theta4), the load slide (lambda6)
 and the rear arms (theta_C4; theta_C3 follows from the tips' contact) chosen with the holding torques to minimise
-the larger required mu of the two drive wheels, each rear tip keeping a load of at least ``min_tip_load``
+the larger required mu of the two drive wheels (the drive wheels' axle held where it is on the ramp: x, y, yaw
+and the wheel angles; the platform's height, pitch and roll and theta_C3 follow), each rear tip keeping a load of at least ``min_tip_load``
 (:class:`robotdyn.optimisation.posture.PostureProblem`). The manipulator moves in the robot's plane of symmetry, so
 the drive wheels' lateral forces (a squeeze rigid-body dynamics leave open) are zero in the best split and in the
 minimum-norm one alike.
@@ -121,7 +122,7 @@ def climbing_posture_problem(slope: float, min_tip_load: float | None = None, de
         min_tip_load = TIP_LOAD_SHARE * weight(climber)
     return PostureProblem(climber, locked_climbing_state(climber, slope), list(POSTURE),
                           friction_wheels=["W_R", "W_L"], min_load={"tip3": min_tip_load, "tip4": min_tip_load},
-                          derivatives=derivatives)
+                          held=("x", "y", "yaw", "theta_R", "theta_L"), derivatives=derivatives)
 
 
 __all__ = ["locked_climbing_robot", "locked_climbing_state", "climbing_posture_problem", "least_mu_bound", "weight",

@@ -37,6 +37,7 @@ UPWARD = {
     ("robots.adaptable_wheel.comparison", "cli.commands"),
     ("robots.linkage_suspension.model", "cli.commands"),
     ("robots.mmr12_eod.model", "cli.fk"),
+    ("robots.mmr12_eod.climbing_posture", "cli.commands"),
     ("robots.omni_caster.model", "cli.commands"),
     # simulate_many(robot="quasimoro"): a robot given by its registered name
     ("simulation.many_runs", ""),

@@ -3,8 +3,9 @@
 The problem (one robot at rest, :math:`\\nu = 0`):
 
 .. math:: \\min_{x,\\,\\tau,\\,s} s \\quad\\text{s.t.}\\quad \\dot\\nu(q(x), 0, \\tau) = 0,\\quad
-          \\|F_{t,i}\\| - s\\,F_{n,i} \\le 0\\ (i \\in \\text{friction wheels}),\\quad F_{n,i} \\ge F_{\\min,i}\\ (\\text{all
-          wheels}),\\quad x_{lo} \\le x \\le x_{hi},\\; \\tau_{lo} \\le \\tau \\le \\tau_{hi},
+          \\|F_{t,i}\\| - s\\,F_{n,i} \\le 0\\ (i \\in \\text{friction wheels}),\\quad
+          F_{n,i} \\ge F_{\\min,i}\\ (\\text{all wheels}),\\quad x_{lo} \\le x \\le x_{hi},\\;
+          \\tau_{lo} \\le \\tau \\le \\tau_{hi},
 
 with x the chosen posture coordinates (each one coordinate, or a group of coordinates moved together), q(x) the
 configuration on the holonomic manifold with every other independent position coordinate held

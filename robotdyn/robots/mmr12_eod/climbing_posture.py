@@ -10,10 +10,10 @@ The least-friction posture (:func:`climbing_posture_problem`): at rest on the ra
 hold it still: :math:`\\dot\\nu = 0`), the manipulator (theta1, lambda2, theta3, theta4), the load slide (lambda6)
 and the rear arms (theta_C4; theta_C3 follows from the tips' contact) chosen with the holding torques to minimise
 the larger required mu of the two drive wheels (the drive wheels' axle held where it is on the ramp: x, y, yaw
-and the wheel angles; the platform's height, pitch and roll and theta_C3 follow), each rear tip keeping a load of at least ``min_tip_load``
-(:class:`robotdyn.optimisation.posture.PostureProblem`). The manipulator moves in the robot's plane of symmetry, so
-the drive wheels' lateral forces (a squeeze rigid-body dynamics leave open) are zero in the best split and in the
-minimum-norm one alike.
+and the wheel angles; the platform's height, pitch and roll and theta_C3 follow), each rear tip keeping a load
+of at least ``min_tip_load`` (:class:`robotdyn.optimisation.posture.PostureProblem`). The manipulator moves in
+the robot's plane of symmetry, so the drive wheels' lateral forces (a squeeze rigid-body dynamics leave open) are
+zero in the best split and in the minimum-norm one alike.
 
 A closed form bounds it: the tips are frictionless, so the drive wheels' traction is the whole weight's component
 along the ramp, :math:`F_R + F_L = mg\\sin\\psi`, while their loads are the normal component less the tips',

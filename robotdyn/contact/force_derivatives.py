@@ -382,8 +382,15 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
                          "wheels, whose forces have no derivatives here; expected rigid and slipping wheels, loop "
                          "closures and joint couplings")
     forces = constraint_forces(robot, q, nu, tau=tau)
-    D = robot.dynamics_derivatives(q, nu, tau)
-    pc = pieces(robot, q, nu)
+    pc = pieces(robot, q, nu)  # shared with the dynamics derivatives (Robot.dynamics_derivatives' choice)
+    if sliding_now(robot):
+        from .sliding_derivatives import sliding_derivatives
+
+        D = sliding_derivatives(robot, q, nu, tau, pc)
+    else:
+        from ..reduction.dynamics_derivatives import dynamics_derivatives
+
+        D = dynamics_derivatives(robot, q, nu, tau, pc)
     S, v = pc.S, pc.v
     a = S @ D.nudot + pc.w
     a_q = pc.Aq(D.nudot) + S @ D.dq  # total da/dq

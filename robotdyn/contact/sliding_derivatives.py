@@ -71,7 +71,7 @@ def law_jacobian(wheel: SlippingWheel, s: np.ndarray, numerical: set[str]) -> np
     return f[:, None] * J * f[None, :]
 
 
-def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
+def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
     """:math:`\\dot\\nu` and its derivatives in q, :math:`\\nu`, :math:`\\tau` for a robot with slipping wheels
     (Python path; the same contents as :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`).
 
@@ -81,6 +81,8 @@ def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
         q: Natural coordinates (n,) [m, rad], in the order of ``robot.coordinates``.
         nu: Independent velocities (k,) in the order of ``robot.velocity_names`` [m/s, rad/s].
         tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+        pc: The derivative :class:`~robotdyn.reduction.dynamics_derivatives.Pieces` at (q, nu) when the caller
+            has them already (default None: computed here).
 
     Returns:
         A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`.
@@ -100,7 +102,7 @@ def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
         if isinstance(wheel.law, ExactCoulomb):
             raise InputError(f"dynamics derivatives: wheel {wheel.name!r} has exact (set-valued) Coulomb friction, "
                              "which has no derivative; expected friction = 'coulomb' (regularised) or 'linear'")
-    pc = pieces(robot, q, nu)
+    pc = pieces(robot, q, nu) if pc is None else pc
     model, tree, n, k = pc.model, pc.tree, pc.n, pc.k
     S, M, v, w, B, kin0 = pc.S, pc.M, pc.v, pc.w, pc.B, pc.kin0
     rows = pc.rows0

@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, NonFiniteError
+from .callbacks import sparse_callback
 
 DERIVATIVES = ("analytic", "finite-difference")
 """How the dynamics' Jacobian is computed (``derivatives`` of :class:`TrajectoryProblem`)."""
@@ -339,61 +340,9 @@ class TrajectoryProblem:
         N, nx, m = self.nodes, self.nx, self.m
         nz, ng = N * (nx + m), (N - 1) * nx
         rows, cols = self._pattern()
-        order = np.lexsort((rows, cols))  # column-major: CasADi's compressed-column storage
-        colind = np.searchsorted(cols[order], np.arange(nz + 1))
-        sparsity = ca.Sparsity(ng, nz, colind.tolist(), rows[order].tolist())
-        problem = self
-
-        class Jac(ca.Callback):
-            def __init__(self, name, opts):
-                ca.Callback.__init__(self)
-                self.construct(name, opts)
-
-            def get_n_in(self):
-                return 2
-
-            def get_n_out(self):
-                return 1
-
-            def get_sparsity_in(self, i):
-                return ca.Sparsity.dense(nz, 1) if i == 0 else ca.Sparsity.dense(ng, 1)
-
-            def get_sparsity_out(self, i):
-                return sparsity
-
-            def eval(self, arg):
-                vals = problem.jacobian_values(np.asarray(arg[0], float).ravel())
-                return [ca.DM(sparsity, vals[order])]
-
-        class Defects(ca.Callback):
-            def __init__(self, name, opts):
-                ca.Callback.__init__(self)
-                self.construct(name, opts)
-
-            def get_n_in(self):
-                return 1
-
-            def get_n_out(self):
-                return 1
-
-            def get_sparsity_in(self, i):
-                return ca.Sparsity.dense(nz, 1)
-
-            def get_sparsity_out(self, i):
-                return ca.Sparsity.dense(ng, 1)
-
-            def eval(self, arg):
-                return [ca.DM(problem.defects(np.asarray(arg[0], float).ravel()))]
-
-            def has_jacobian(self):
-                return True
-
-            def get_jacobian(self, name, inames, onames, opts):
-                problem._callbacks.append(Jac(name, opts))  # CasADi holds no Python reference to it
-                return problem._callbacks[-1]
-
-        self._callbacks = [Defects("defects", {"enable_fd": False})]
-        defects = self._callbacks[0]
+        self._callbacks = []  # CasADi holds no Python reference to them
+        defects = sparse_callback("defects", nz, ng, self.defects, self.jacobian_values, rows, cols,
+                                  self._callbacks)
         z = ca.MX.sym("z", nz)
         h = self.t_end / (N - 1)
         w = np.full(N, h)

@@ -67,7 +67,7 @@ class ContactLimits:
 
         sliding = sliding_now(robot)
         self._coupled = bool(sliding) and ([w.name for w in sliding] == self.wheels
-                                           and all(getattr(w, "slip", "both") == "both" for w in sliding))
+                                           and all(getattr(w, "slip_directions", None) == "both" for w in sliding))
         self._compiled = None
         if not sliding and not self._coupled:
             from ..fast.dispatch import compiled_model
@@ -183,12 +183,8 @@ class ContactLimits:
         return F0, dF
 
     def _analytic(self, q, nu, tau):
-        fn = getattr(self.robot, "contact_force_derivatives", None)
-        if fn is None:
-            raise InputError("analytic derivatives of the contact forces need Robot.contact_force_derivatives, "
-                             "which this robotdyn lacks; use derivatives='finite-difference'")
         self.calls += 1
-        d = fn(q, nu, tau)
+        d = self.robot.contact_force_derivatives(q, nu, tau)
         return _forces_and_jacobian(d, self.wheels, self.n, self.k, self.m)
 
     def jacobian(self, q: np.ndarray, nu: np.ndarray, tau: np.ndarray, s: float = 0.0
@@ -255,8 +251,11 @@ def required_mu(F: np.ndarray) -> np.ndarray:
 
 
 def _forces_and_jacobian(d, wheels: list[str], n: int, k: int, m: int) -> tuple[np.ndarray, np.ndarray]:
-    """Forces (nw, 3) and their Jacobian (nw, 3, n + k + m) from ``Robot.contact_force_derivatives``' result."""
-    raise InputError("Robot.contact_force_derivatives' result is not understood by this version")
+    """Forces (nw, 3) and their Jacobian (nw, 3, n + k + m) from ``Robot.contact_force_derivatives``' result
+    (a :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives`), wheels in the order ``wheels``."""
+    order = [list(d.wheels).index(w) for w in wheels]
+    dF = np.concatenate([d.dforce_dq, d.dforce_dnu, d.dforce_dtau], axis=2)
+    return np.asarray(d.force, float)[order], dF[order]
 
 
 __all__ = ["ContactLimits", "required_mu"]

@@ -30,9 +30,20 @@ scipy's ``trust-constr`` is not a sparse interior-point solver for large NLPs. T
 CasADi ``Callback`` (all defects at once) whose Jacobian is another ``Callback`` with a declared sparsity pattern:
 the analytic derivatives are passed as callbacks; CasADi's automatic differentiation is not used through Pinocchio.
 
-Scope: robots without holonomic constraint rows (their natural coordinates are then all independent, e.g.
-Quasimoro; a robot with loop closures or terrain-following rows is refused in one line: its collocation would need
-the holonomic rows as path constraints, not built here).
+Holonomic rows (wheels on a terrain, loop closures, couplings): every node is kept on the constraint manifold. The
+defects of the dependent position coordinates (those the holonomic rows fix, :attr:`~robotdyn.reduction.
+dynamics_derivatives.DynamicsDerivatives.positions` naming the others) are replaced by the independent holonomic
+residuals :math:`\\phi(q_{j+1}) = 0` at nodes 1..N-1, whose Jacobian is the holonomic rows :math:`A_h`: the same
+number of equations, and the dependent coordinates follow the manifold instead of drifting off it by the
+trapezoid's error. The dynamics' derivatives in q are exact along the manifold's tangent; their part normal to it
+lies in the row space of :math:`A_h` and only changes the holonomic rows' multipliers, not the optimum.
+
+Traction limits (:mod:`robotdyn.optimisation.contact_limits`): with ``min_load`` or ``mu_max`` every node's wheel
+loads :math:`f_n \\ge f_{min}` and friction cones :math:`\\|f_t\\| \\le \\mu_{max} f_n` are path constraints; with
+``cost="peak-mu"`` the cost is the square of the largest required friction coefficient over wheels and nodes (an
+epigraph variable s with :math:`\\|f_t\\|^2 \\le s f_n^2` at every node) plus ``effort_weight`` times the effort.
+Their Jacobian comes from :meth:`robotdyn.robot.Robot.contact_force_derivatives` (``force_derivatives="analytic"``)
+or from central differences of the forces.
 """
 
 from __future__ import annotations
@@ -44,6 +55,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, NonFiniteError
+from .callbacks import sparse_callback
 
 DERIVATIVES = ("analytic", "finite-difference")
 """How the dynamics' Jacobian is computed (``derivatives`` of :class:`TrajectoryProblem`)."""
@@ -138,10 +150,11 @@ class TrajectorySolution:
 
 
 class TrajectoryProblem:
-    """A minimum-effort motion of a robot between two states in a fixed time (see the module docstring).
+    """A minimum-effort (or least-peak-mu) motion of a robot between two states in a fixed time (see the module
+    docstring).
 
     Args:
-        robot: A :class:`~robotdyn.robot.Robot` without holonomic constraint rows.
+        robot: A :class:`~robotdyn.robot.Robot` (holonomic rows are kept at every node).
         t_end: Duration T [s] (> 0).
         nodes: Number of collocation nodes N (>= 3).
         q0: Initial natural coordinates (n,) [m, rad].
@@ -150,22 +163,36 @@ class TrajectoryProblem:
         nu_end: Final independent velocities (k,) (default: at rest); ``None`` entries are free.
         tau_bounds: ``(lower, upper)`` motor torques [N m or N], each a number or one per motor
             (default: unbounded).
-        bounds: Bounds on coordinates or velocities at every node, by name {name: (lower, upper)} [SI units].
+        bounds: Bounds on coordinates or velocities at every node, by name {name: (lower, upper)} [SI units]
+            (the coordinates are always kept within their joint ranges).
         derivatives: ``analytic`` (default) or ``finite-difference`` (central differences of the forward dynamics,
             the comparison).
         guess: Initial guess ``(q (N, n), nu (N, k), tau (N, m))`` (default: the coordinates from ``q0`` towards
             ``q_end`` along a smooth rest-to-rest ramp, the velocities that best follow it through S(q) in least
             squares, no torque; a guess at rest everywhere can make the defects' Jacobian rank-deficient for
             nonholonomic robots).
+        min_load: Least normal load of every wheel at every node [N] (default ``None``: none; 0 where ``mu_max`` or
+            the ``peak-mu`` cost is asked).
+        mu_max: Largest required friction coefficient :math:`\\|f_t\\|/f_n` of every wheel at every node (default
+            ``None``: none).
+        cost: ``effort`` (default, :math:`\\int\\|\\tau\\|^2dt`) or ``peak-mu`` (the squared peak required mu plus
+            ``effort_weight`` times the effort).
+        effort_weight: The effort's weight in the ``peak-mu`` cost [1/(N^2 m^2 s)] (default 1e-3).
+        force_derivatives: ``analytic`` or ``finite-difference``, the contact forces' Jacobian (default: as
+            ``derivatives``).
+        rate_weight: Weight of the torques' rate :math:`\\int\\|\\dot\\tau\\|^2 dt` added to either cost (default 0:
+            none) [cost units per N^2 m^2 / s]: it suppresses the node-to-node oscillation the trapezoidal rule
+            leaves free in directions without inertia of their own (a massless mechanism).
 
     Raises:
-        InputError: A wrong size, name or bound, a robot with holonomic rows, non-finite data.
+        InputError: A wrong size, name or bound, non-finite data.
+        ConstraintError: q0 off the holonomic constraint manifold (by more than :data:`HOLONOMIC_TOL`).
     """
 
     def __init__(self, robot, t_end: float, nodes: int, q0, nu0=None, q_end: dict | None = None,
                  nu_end=None, tau_bounds=None, bounds: dict | None = None, derivatives: str = "analytic",
                  guess=None, min_load: float | None = None, mu_max: float | None = None, cost: str = "effort",
-                 effort_weight: float = 1e-3, force_derivatives: str | None = None) -> None:
+                 effort_weight: float = 1e-3, force_derivatives: str | None = None, rate_weight: float = 0.0) -> None:
         self.robot = robot
         self.t_end = _finite(t_end, "t_end")
         if not self.t_end > 0:
@@ -188,6 +215,9 @@ class TrajectoryProblem:
         self.effort_weight = _finite(effort_weight, "effort_weight")
         if self.effort_weight < 0:
             raise InputError(f"effort_weight = {effort_weight!r}; expected a finite number >= 0")
+        self.rate_weight = _finite(rate_weight, "rate_weight")
+        if self.rate_weight < 0:
+            raise InputError(f"rate_weight = {rate_weight!r}; expected a finite number >= 0")
         force_derivatives = derivatives if force_derivatives is None else force_derivatives
         if force_derivatives not in DERIVATIVES:
             raise InputError(f"force_derivatives = {force_derivatives!r}; expected one of {', '.join(DERIVATIVES)}")
@@ -215,11 +245,16 @@ class TrajectoryProblem:
                 self.x_end[self.n + i] = _finite(value, f"nu_end[{i}]")
         self.tau_lo, self.tau_hi = _pair(tau_bounds, self.m, "tau_bounds")
         self.x_lo, self.x_hi = np.full(nx, -np.inf), np.full(nx, np.inf)
+        self.x_lo[:self.n] = robot.description.lower  # the joint ranges (the dynamics refuse a q beyond them)
+        self.x_hi[:self.n] = robot.description.upper
         for name, pair in (bounds or {}).items():
             if name not in names:
                 raise InputError(f"bounds names {name!r}; expected a coordinate or velocity name of {names}")
             lo, hi = _pair(pair, 1, f"bounds[{name!r}]")
-            self.x_lo[names.index(name)], self.x_hi[names.index(name)] = lo[0], hi[0]
+            i = names.index(name)
+            self.x_lo[i], self.x_hi[i] = max(lo[0], self.x_lo[i]), min(hi[0], self.x_hi[i])
+            if self.x_lo[i] > self.x_hi[i]:
+                raise InputError(f"bounds[{name!r}] = {pair!r} lies outside the joint range of {name}")
         x0 = np.concatenate([self.q0, self.nu0])
         for what, x in (("the initial state", x0), ("the final state", self.x_end)):
             bad = [names[i] for i in range(nx) if np.isfinite(x[i]) and not self.x_lo[i] <= x[i] <= self.x_hi[i]]
@@ -263,7 +298,10 @@ class TrajectoryProblem:
         bounded = [self.names[i] for i in range(self.nx) if np.isfinite(self.x_lo[i]) or np.isfinite(self.x_hi[i])]
         return (f"TrajectoryProblem(robot={self.robot.spec.name!r}, t_end={self.t_end:g} s, nodes={self.nodes}, "
                 f"final={fixed}, bounded={bounded}, tau in [{_fmt(self.tau_lo)}, {_fmt(self.tau_hi)}], "
-                f"derivatives={self.derivatives!r})")
+                f"derivatives={self.derivatives!r}"
+                + ("" if self.limits is None else f", min_load={self.limits.min_load}, mu_max={self.limits.mu_max}")
+                + ("" if self.cost_kind == "effort" else f", cost='peak-mu', effort_weight={self.effort_weight:g}")
+                + ")")
 
     # --- the dynamics at the nodes -------------------------------------------------------------------------------
 
@@ -458,6 +496,15 @@ class TrajectoryProblem:
     # --- the NLP ---------------------------------------------------------------------------------------------------
 
     def _initial(self) -> np.ndarray:
+        z = self._initial_states()
+        if self.cost_kind == "peak-mu":  # s starts at the guess's own peak (squared): a feasible start for its rows
+            X, U = self._split(z)
+            F = np.array([self.limits.forces(X[j, :self.n], X[j, self.n:], U[j]) for j in range(self.nodes)])
+            ratio = (F[..., 0] ** 2 + F[..., 1] ** 2) / np.maximum(F[..., 2], 1e-9 * self.limits.scale) ** 2
+            z[-1] = min(float(np.max(ratio)), 1e6)
+        return z
+
+    def _initial_states(self) -> np.ndarray:
         N = self.nodes
         extra = [np.ones(1)] if self.cost_kind == "peak-mu" else []
         if self.guess is not None:
@@ -498,61 +545,9 @@ class TrajectoryProblem:
         N, nx, m = self.nodes, self.nx, self.m
         nz, ng = self.nz, self.n_constraints
         rows, cols = self._pattern()
-        order = np.lexsort((rows, cols))  # column-major: CasADi's compressed-column storage
-        colind = np.searchsorted(cols[order], np.arange(nz + 1))
-        sparsity = ca.Sparsity(ng, nz, colind.tolist(), rows[order].tolist())
-        problem = self
-
-        class Jac(ca.Callback):
-            def __init__(self, name, opts):
-                ca.Callback.__init__(self)
-                self.construct(name, opts)
-
-            def get_n_in(self):
-                return 2
-
-            def get_n_out(self):
-                return 1
-
-            def get_sparsity_in(self, i):
-                return ca.Sparsity.dense(nz, 1) if i == 0 else ca.Sparsity.dense(ng, 1)
-
-            def get_sparsity_out(self, i):
-                return sparsity
-
-            def eval(self, arg):
-                vals = problem.jacobian_values(np.asarray(arg[0], float).ravel())
-                return [ca.DM(sparsity, vals[order])]
-
-        class Constraints(ca.Callback):
-            def __init__(self, name, opts):
-                ca.Callback.__init__(self)
-                self.construct(name, opts)
-
-            def get_n_in(self):
-                return 1
-
-            def get_n_out(self):
-                return 1
-
-            def get_sparsity_in(self, i):
-                return ca.Sparsity.dense(nz, 1)
-
-            def get_sparsity_out(self, i):
-                return ca.Sparsity.dense(ng, 1)
-
-            def eval(self, arg):
-                return [ca.DM(problem.constraints(np.asarray(arg[0], float).ravel()))]
-
-            def has_jacobian(self):
-                return True
-
-            def get_jacobian(self, name, inames, onames, opts):
-                problem._callbacks.append(Jac(name, opts))  # CasADi holds no Python reference to it
-                return problem._callbacks[-1]
-
-        self._callbacks = [Constraints("constraints", {"enable_fd": False})]
-        constraints = self._callbacks[0]
+        self._callbacks = []  # CasADi holds no Python reference to them
+        constraints = sparse_callback("constraints", nz, ng, self.constraints, self.jacobian_values, rows, cols,
+                                      self._callbacks)
         z = ca.MX.sym("z", nz)
         h = self.t_end / (N - 1)
         w = np.full(N, h)
@@ -561,6 +556,9 @@ class TrajectoryProblem:
         u = z[N * nx:N * (nx + m)]
         effort = ca.dot(weights * u, u)
         cost = effort if self.cost_kind == "effort" else z[nz - 1] + self.effort_weight * effort
+        if self.rate_weight > 0:  # the torques' rate, sum |tau_{j+1} - tau_j|^2 / h (the integral of |dtau/dt|^2)
+            du = u[m:] - u[:-m]
+            cost = cost + self.rate_weight / h * ca.dot(du, du)
         lbx = np.concatenate([np.tile(self.x_lo, N), np.tile(self.tau_lo, N)])
         ubx = np.concatenate([np.tile(self.x_hi, N), np.tile(self.tau_hi, N)])
         if self.cost_kind == "peak-mu":  # s = (peak required mu)^2, within mu_max^2 if given
@@ -639,4 +637,4 @@ def _fmt(a: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:g}" for v in a) + "]"
 
 
-__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES"]
+__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES", "COSTS", "HOLONOMIC_TOL"]

@@ -143,3 +143,44 @@ def test_replay_with_the_exact_model_keeps_the_constraints(tricycle, fixed_fd):
     assert np.max(mu) <= rs.peak_mu(fixed_fd) * 1.05, (np.max(mu), rs.peak_mu(fixed_fd))
     ix = [robot.coordinate_index(c) for c in ("x", "y", "yaw")]
     assert np.max(np.abs(traj.q[-1, ix] - fixed_fd.q[-1, ix])) < 0.05
+
+
+def test_cli_solves_the_apis_problem_with_traction_limits(tricycle, capsys):
+    """One story: ``robotdyn optimise --min-load --cost peak-mu`` (fixed radii through --bound) solves the API's
+    problem: the same cost, loads above the bound, the printed peak mu the nodes' largest."""
+    import json
+
+    from robotdyn.cli import main
+
+    robot, q0, _ = tricycle
+    e = rs.DISTANCE / np.sqrt(2.0)
+    bounds = {"x": (-0.03, e + 0.02), "y": (-0.03, e + 0.02), "yaw": (rs.HEADING - 0.02, rs.HEADING + 0.02)}
+    for tag in rs.WHEELS:
+        v = q0[robot.coordinate_index(f"q_{tag}")]
+        bounds[f"q_{tag}"] = (v, v)
+    end = {"x": e, "y": e, "yaw": rs.HEADING}
+    argv = ["optimise", "adaptable_wheel", "--param", "lateral=slip", "--q0", *[repr(float(v)) for v in q0],
+            "--t-end", "3", "--nodes", "4", "--min-load", "5", "--cost", "peak-mu", "--derivatives",
+            "finite-difference", "--json"]
+    argv += [a for k, v in end.items() for a in ("--end", f"{k}={float(v)!r}")]
+    argv += [a for k, (lo, hi) in bounds.items() for a in ("--bound", f"{k}={float(lo)!r}:{float(hi)!r}")]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        api = TrajectoryProblem(robot, 3.0, 4, q0, q_end=end, bounds=bounds, min_load=5.0, cost="peak-mu",
+                                derivatives="finite-difference").solve()
+    assert out["success"] and abs(out["cost"] - api.cost) <= 1e-9
+    assert np.min(np.array(out["forces"])[..., 2]) >= 5.0 - 1e-7
+    assert abs(np.max(out["required_mu"]) - rs.peak_mu(api)) <= 1e-9
+
+
+@pytest.mark.parametrize("extra, needle", [(["--mu-max", "-0.1"], "--mu-max"), (["--min-load", "nan"], "--min-load"),
+                                           (["--cost", "mu"], "--cost")])
+def test_cli_traction_options_bad_input_one_line_exit_2(extra, needle, capsys):
+    from robotdyn.cli import main
+
+    argv = ["optimise", "quasimoro", "--t-end", "3", "--nodes", "5", "--end", "x=1", *extra]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0], err

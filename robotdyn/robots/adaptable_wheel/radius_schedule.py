@@ -32,8 +32,8 @@ import numpy as np
 from ...errors import InputError
 from ...optimisation.trajectory import TrajectoryProblem
 
-DISTANCE, T_END, NODES, MIN_LOAD, PATH_TOL, EFFORT_WEIGHT, RATE_WEIGHT = 1.0, 3.0, 7, 5.0, 0.02, 1e-5, 1e-4
-"""The example's defaults: 1 m in 3 s on 7 nodes, every wheel loaded with at least 5 N, within 2 cm / 0.02 rad of
+DISTANCE, T_END, NODES, MIN_LOAD, PATH_TOL, EFFORT_WEIGHT, RATE_WEIGHT = 1.0, 3.0, 5, 5.0, 0.02, 1e-5, 1e-4
+"""The example's defaults: 1 m in 3 s on 5 nodes (seconds per solve; 7 or more resolve the motion better), every wheel loaded with at least 5 N, within 2 cm / 0.02 rad of
 the path, the effort weighted 1e-5 beside the squared peak mu (small beside it: about 1e-3 against 7e-3 at the
 fixed-radius optimum; it makes the optimum unique), the torques' rate weighted 1e-4 (it removes the node-to-node
 oscillation of the torques that the massless mechanism leaves free: measured, peak mu 0.0739 with it against 0.0736

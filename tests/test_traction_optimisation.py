@@ -101,11 +101,20 @@ def test_nodes_on_the_manifold_and_within_the_bounds(tricycle, fixed_fd):
         assert np.allclose(s.q[:, i], q0[i], atol=1e-9)
     peak = rs.peak_mu(s)
     assert np.sum(s.required_mu > peak - 1e-6) >= 2  # a min-max: the peak is reached more than once
+    # at the first node (at rest, contact normals parallel to 1e-3 deg) the three wheels share the whole robot's ratio
+    # of tangential to normal ground force: the least peak any share of the total force allows
+    cf = robot.contact_forces(s.q[0], s.nu[0], tau=s.tau[0])
+    total = np.sum([w.world for w in cf.wheels], axis=0)
+    n = np.mean([w.frame[:, 2] for w in cf.wheels], axis=0)
+    n /= np.linalg.norm(n)
+    ratio = np.linalg.norm(total - (total @ n) * n) / (total @ n)
+    assert np.allclose(s.required_mu[0], ratio, rtol=1e-4)
 
 
-def test_schedule_lowers_the_peak_required_mu(tricycle, fixed_fd):
-    """Started from the fixed-radius optimum (a feasible point of it), the schedule's optimum is at most the fixed
-    one's cost, and its peak required mu lower."""
+def test_schedule_costs_at_most_the_fixed_radii(tricycle, fixed_fd):
+    """Started from the fixed-radius optimum (a feasible point of it), the schedule's optimum costs at most the fixed
+    one's; its peak required mu is the fixed one's within the discretisation error (the peak is the whole robot's
+    ratio of tangential to normal ground force, which the radii do not change) and its effort lower."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         p = rs.radius_schedule(nodes=NODES, derivatives="finite-difference", robot=tricycle[0])
@@ -113,7 +122,8 @@ def test_schedule_lowers_the_peak_required_mu(tricycle, fixed_fd):
         s = p.solve()
     assert s.success, s.status
     assert s.cost <= fixed_fd.cost + 1e-9
-    assert rs.peak_mu(s) < rs.peak_mu(fixed_fd)
+    assert abs(rs.peak_mu(s) - rs.peak_mu(fixed_fd)) <= 0.01 * rs.peak_mu(fixed_fd)
+    assert s.effort < 0.9 * fixed_fd.effort
     assert np.min(s.forces[..., 2]) >= rs.MIN_LOAD - 1e-7
 
 

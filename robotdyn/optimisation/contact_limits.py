@@ -84,7 +84,11 @@ class ContactLimits:
         return len(self.wheels) * ((self.min_load is not None) + (self.mu_max is not None) + self.peak)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper bounds of one node's rows (in their scaled units), in the order of :meth:`values`."""
+        """Lower and upper bounds of one node's rows (in their scaled units), in the order of :meth:`values`.
+
+        Returns:
+            ``(lower, upper)``, each (:attr:`rows_per_node`,).
+        """
         nw, lo, hi = len(self.wheels), [], []
         if self.min_load is not None:
             lo.append(np.full(nw, self.min_load / self.scale))

@@ -100,6 +100,7 @@ class TrajectorySolution:
         effort: :math:`\\int_0^T \\lVert\\tau\\rVert^2 dt` by the trapezoid rule [N^2 m^2 s] (equal to ``cost`` for
             the ``effort`` cost).
         force_calls: Contact-force evaluations (rows and finite differences).
+        cost_kind: ``effort`` or ``peak-mu`` (the problem's ``cost``).
     """
 
     t: np.ndarray
@@ -122,6 +123,7 @@ class TrajectorySolution:
     wheels: list[str] = field(default_factory=list)
     effort: float = math.nan
     force_calls: int = 0
+    cost_kind: str = "effort"
 
     @property
     def required_mu(self) -> np.ndarray | None:
@@ -145,7 +147,8 @@ class TrajectorySolution:
         return Table(self.t, self.tau)
 
     def __repr__(self) -> str:
-        return (f"TrajectorySolution({self.status}, cost={self.cost:.6g} N^2 m^2 s, {len(self.t)} nodes, "
+        unit = " N^2 m^2 s" if self.cost_kind == "effort" else f" ({self.cost_kind})"
+        return (f"TrajectorySolution({self.status}, cost={self.cost:.6g}{unit}, {len(self.t)} nodes, "
                 f"{self.iterations} iterations, {self.wall_time:.3g} s, derivatives={self.derivatives})")
 
 
@@ -605,7 +608,7 @@ class TrajectoryProblem:
                                   wall, calls["dynamics"], calls["derivatives"], max_defect, self.derivatives,
                                   list(self.robot.coordinates), list(self.robot.velocity_names),
                                   [mo.name for mo in self.robot.motors], forces=forces, wheels=wheels,
-                                  effort=effort, force_calls=calls.get("forces", 0))
+                                  effort=effort, force_calls=calls.get("forces", 0), cost_kind=self.cost_kind)
 
 
 def _finite(value, what: str) -> float:

@@ -14,9 +14,16 @@ wheel carrying at least ``min_load``.
 The comparison (``fixed=True``): the same problem with each radius held at its initial value (the paper's IK
 configuration at the start), the conventional tricycle the adaptable wheel is meant to improve on.
 :func:`compare` solves the fixed-radius case first and starts the schedule from its optimum (a feasible point of the
-scheduled problem), so that the schedule's optimum is at most the fixed one's: the problem is not convex, and from
-other starts IPOPT finds worse local optima (measured: 0.098 from the minimum-effort motion, against 0.081 with
-fixed radii, 9 nodes).
+scheduled problem), so that the schedule's optimal cost is at most the fixed one's: the problem is not convex, and
+from other starts IPOPT finds worse local optima (measured: peak mu 0.098 from the minimum-effort motion against
+0.081 with fixed radii, 9 nodes, effort weight 1e-2).
+
+Result (measured, 5 and 7 nodes): the schedule does not lower the peak required mu beyond the discretisation error
+(0.07896 against 0.07901 with fixed radii at 5 nodes, 0.07395 against 0.07385 at 7), and lowers the effort
+(130 to 106 and 120 N^2 m^2 s). Where the peak is reached all three wheels need the same mu, equal to the whole
+robot's ratio of tangential to normal ground force (0.07901 at the start node, contact normals parallel within
+0.001 deg): a ratio of the total force that accelerates the robot up the slope, which the share among the wheels,
+what the radii change, cannot lower.
 
 Model: ``lateral = slip`` (each wheel rolls along its rolling direction; sideways it slides without friction), the
 paper's own kinematic assumption for its missions (``docs/errata/adaptable_wheel.md``): with wheels that roll

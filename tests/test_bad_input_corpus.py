@@ -704,6 +704,9 @@ FLAG_CASES: dict = {
     "--bound": (["--bound", "theta3=1:0"], ("--bound",)),
     "--tau-max": (["--tau-max", "-1"], ("--tau-max",)),
     "--derivatives": (["--derivatives", "bogus"], ("--derivatives",)),
+    "--min-load": (["--min-load", "-1"], ("--min-load",)),
+    "--mu-max": (["--mu-max", "nan"], ("--mu-max",)),
+    "--cost": (["--cost", "bogus"], ("--cost",)),
 }
 FLAG_CASE_OVERRIDES: dict = {  # (command, flag): a different bad use where the generic one does not fit
     ("sweep", "--t-end"): (["--t-end", "nan"], ("t_end",)),

@@ -243,3 +243,15 @@ def test_repr_names_the_shapes_and_mu():
     assert "2 wheels" in text and "required mu" in text and "floating twin" in text
     assert D.dforce_dq.shape == (2, 3, 6) and D.dforce_dnu.shape == (2, 3, 3) and D.dforce_dtau.shape == (2, 3, 2)
     assert D.dmu_dq_manifold.shape == (2, len(D.positions))
+
+
+@pytest.mark.parametrize("args, expected", [
+    ((np.zeros(5), np.zeros(3), np.zeros(2)), "q has 5 values; expected 6 values"),
+    ((np.zeros(6), np.zeros(3), np.zeros(3)), "tau has 3 values; expected 2 values"),
+    ((np.zeros(6), np.array([0.0, np.nan, 0.0]), np.zeros(2)), "nu"),
+])
+def test_bad_input_is_one_line(args, expected):
+    robot = Robot(module("quasimoro").SPEC)
+    with pytest.raises(InputError) as err:
+        robot.contact_force_derivatives(*args)
+    assert expected in str(err.value) and "\n" not in str(err.value)

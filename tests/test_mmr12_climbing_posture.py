@@ -62,3 +62,22 @@ def test_posture_problem_refuses_bad_variables_in_one_line():
         PostureProblem(robot, q0, ["theta_C3", "theta_C4"])  # the tips' contact ties them, given the base
     with pytest.raises(InputError, match="unknown wheel"):
         PostureProblem(robot, q0, ["lambda2"], friction_wheels=["W_X"])
+
+
+def test_cli_prints_the_apis_optimum(capsys, solutions):
+    """`robotdyn climbing-posture mmr12_eod --slope 20 --json`: the API's optimum (one story through both doors);
+    another robot is refused in one line, exit status 2."""
+    import json
+
+    from robotdyn.cli import main
+
+    assert main(["climbing-posture", "mmr12_eod", "--slope", "20", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    sol = solutions["analytic"]
+    assert out["success"] and out["peak_mu"] == pytest.approx(sol.peak_mu, abs=1e-9)
+    assert out["bound"] == pytest.approx(sol.peak_mu, rel=1e-7)
+    assert out["default_posture_mu"] == pytest.approx(0.409582, abs=5e-7)
+    assert list(out["posture"]) == sol.variables and out["loads"]["tip3"] == pytest.approx(out["min_tip_load"])
+    assert main(["climbing-posture", "quasimoro", "--slope", "20"]) == 2
+    err = capsys.readouterr().err
+    assert "expected mmr12_eod" in err and err.count("\n") == 1

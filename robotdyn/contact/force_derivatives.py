@@ -72,6 +72,9 @@ from .contact_forces import DETERMINED_TOL, constraint_forces, floating_twin
 from .sliding import sliding_now, tangential
 from .sliding_derivatives import TANGENT, law_jacobian
 
+CONSISTENT = 1e-7
+"""Relative gap above which the differentiated multipliers are not those of the reported forces (refused)."""
+
 TWIN_NOTE = "normal loads from the out-of-plane equilibrium"
 """How :func:`~robotdyn.contact.contact_forces.constraint_forces` notes that a planar model's loads come from its
 floating twin (the derivatives then follow the same path)."""
@@ -108,6 +111,9 @@ class ContactForceDerivatives:
         tangent: (n, p) :math:`\\partial q/\\partial q_P` along the holonomic manifold.
         coordinates, velocities, motors: Names of q, nu and tau.
         source: ``model`` or ``floating twin`` (where the planar model's loads come from).
+        numerical: The pieces computed by finite differences (empty: everything analytic), as
+            :attr:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives.numerical`, with a friction law
+            without an analytic derivative (:func:`robotdyn.contact.sliding_derivatives.law_jacobian`).
         dynamics: The :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` at the state (the
             accelerations and their derivatives, computed on the way).
     """
@@ -135,6 +141,7 @@ class ContactForceDerivatives:
     velocities: list[str] = field(default_factory=list)
     motors: list[str] = field(default_factory=list)
     source: str = "model"
+    numerical: tuple[str, ...] = ()
     dynamics: object = field(default=None, repr=False)
 
     @property
@@ -187,6 +194,7 @@ class _Layer:
     dtau: np.ndarray
     wheels: list
     residual: float
+    numerical: set
 
 
 def _projector_derivative(Zp: np.ndarray, dZ: np.ndarray, Po: np.ndarray) -> np.ndarray:
@@ -322,7 +330,7 @@ def layer(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau: np.ndarray, s
     dq, dv = solve(r1, r2), solve(np.zeros((m, n)), r2v)
     da = solve(np.zeros((m, n)), M)
     dtau = solve(np.zeros((m, B.shape[1])), -B)
-    return _Layer(labels, lam, dq, dv, da, dtau, wheels, residual)
+    return _Layer(labels, lam, dq, dv, da, dtau, wheels, residual, numerical)
 
 
 def _wheel_forces(lay: _Layer, Vq: np.ndarray, S: np.ndarray, Dq: np.ndarray, Dnu: np.ndarray, Dtau: np.ndarray
@@ -402,6 +410,14 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
     dlam_dnu = Lv @ S + La @ a_nu
     dlam_dtau = lay.dtau + La @ a_tau
     F, FQ, FV, FT = _wheel_forces(lay, pc.Vq, S, dlam_dq, dlam_dnu, dlam_dtau)
+    # one story: the multipliers differentiated are those of the forces reported (else a structure not mirrored)
+    reported = np.array([w.force for w in forces.wheels]).reshape(-1, 3)
+    scale = max(1.0, float(np.abs(reported).max(initial=0.0)))
+    gap = float(np.abs(np.array(F).reshape(-1, 3) - reported).max(initial=0.0)) if len(F) == len(reported) else np.inf
+    if gap > CONSISTENT * scale or lay.residual > CONSISTENT:
+        raise InputError(f"contact force derivatives: the forces at this state come from a structure not "
+                         f"differentiated here (gap {gap:.3g} N to the reported ones); expected rigid or "
+                         "smoothly slipping wheels, loads from rigid-body dynamics or the rigid limit of compliance")
     names = [w["name"] for w in lay.wheels]
     W = len(names)
     n, k, nm = len(q), len(nu), len(tau)
@@ -431,8 +447,10 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
     out = ContactForceDerivatives(names, force, dF_q, dF_nu, dF_tau, mu, *dmu, rough, known, list(unloaded),
                                   lay.labels, lay.lam, dlam_dq, dlam_dnu, dlam_dtau, D.positions, D.tangent,
                                   list(robot.coordinates), list(robot.velocity_names),
-                                  [mo.name for mo in robot.motors], "floating twin" if twin else "model", D)
-    for name in ("force", "dforce_dq", "dforce_dnu", "dforce_dtau", "dlam_dq", "dlam_dnu", "dlam_dtau"):
+                                  [mo.name for mo in robot.motors], "floating twin" if twin else "model",
+                                  tuple(sorted(set(D.numerical) | lay.numerical)), D)
+    for name in ("force", "dforce_dq", "dforce_dnu", "dforce_dtau", "dmu_dq", "dmu_dnu", "dmu_dtau", "dlam_dq",
+                 "dlam_dnu", "dlam_dtau"):
         if not np.all(np.isfinite(getattr(out, name))):
             raise NonFiniteError(f"contact force derivatives: {name} is not finite at this state")
     return out

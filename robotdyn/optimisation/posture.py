@@ -3,8 +3,9 @@
 The problem (one robot at rest, :math:`\\nu = 0`):
 
 .. math:: \\min_{x,\\,\\tau,\\,s} s \\quad\\text{s.t.}\\quad \\dot\\nu(q(x), 0, \\tau) = 0,\\quad
-          \\|F_{t,i}\\| - s\\,F_{n,i} \\le 0\\ (i \\in \\text{friction wheels}),\\quad F_{n,i} \\ge F_{\\min,i}\\ (\\text{all
-          wheels}),\\quad x_{lo} \\le x \\le x_{hi},\\; \\tau_{lo} \\le \\tau \\le \\tau_{hi},
+          \\|F_{t,i}\\| - s\\,F_{n,i} \\le 0\\ (i \\in \\text{friction wheels}),\\quad
+          F_{n,i} \\ge F_{\\min,i}\\ (\\text{all wheels}),\\quad x_{lo} \\le x \\le x_{hi},\\;
+          \\tau_{lo} \\le \\tau \\le \\tau_{hi},
 
 with x the chosen posture coordinates (each one coordinate, or a group of coordinates moved together), q(x) the
 configuration on the holonomic manifold with every other independent position coordinate held
@@ -99,6 +100,8 @@ class PostureProblem:
             description's joint ranges.
         friction_wheels: Wheels whose required mu is minimised (default: every wheel that is not a support wheel).
         min_load: Smallest normal load [N] of every wheel: one number, or {wheel: value} (default 0).
+        held: Coordinates held at q0's values, never among those the holonomic rows move (e.g. the base's x, y, yaw);
+            default: none named (the dependent coordinates are then chosen among all non-variables).
         tau_bounds: ``(lower, upper)`` motor torques [N m or N], each a number or one per motor (default: none).
         derivatives: ``analytic`` (default) or ``finite-difference``.
 
@@ -107,7 +110,7 @@ class PostureProblem:
     """
 
     def __init__(self, robot, q0, variables, bounds: dict | None = None, friction_wheels=None,
-                 min_load: float | dict = 0.0, tau_bounds=None, derivatives: str = "analytic") -> None:
+                 min_load: float | dict = 0.0, held=(), tau_bounds=None, derivatives: str = "analytic") -> None:
         if derivatives not in DERIVATIVES:
             raise InputError(f"derivatives = {derivatives!r}; expected one of {', '.join(DERIVATIVES)}")
         self.robot, self.derivatives = robot, derivatives
@@ -131,13 +134,14 @@ class PostureProblem:
         # dependent ones chosen among the others
         rows = robot.rows_at(self.q0)
         chosen = sorted({i for g in self.groups for i in g})
-        others = np.array([i for i in range(robot.nq) if i not in chosen], int)
+        keep = {robot.coordinate_index(c) for c in held}
+        others = np.array([i for i in range(robot.nq) if i not in chosen and i not in keep], int)
         positions, _ = position_coordinates(rows.A[rows.holonomic], others)
         self.positions = list(positions)
-        dependent = [robot.coordinates[i] for i in chosen if i not in self.positions]
+        dependent = [robot.coordinates[i] for i in sorted(set(chosen) | keep) if i not in self.positions]
         if dependent:
-            raise InputError(f"posture variables {dependent} are fixed by the holonomic constraints once the others "
-                             "are given; expected independent coordinates (drop them, or move them as a group)")
+            raise InputError(f"posture variables or held coordinates {dependent} are fixed by the holonomic "
+                             "constraints once the others are given; expected independent coordinates (drop some)")
         self.variables = ["=".join(v) if not isinstance(v, str) else v for v in variables]
         self.wheels = list(d0.wheels)
         kinds = {w.name: w.kind for w in robot.contact_forces(self.q0, np.zeros(self.k), self.tau0).wheels}

@@ -705,6 +705,9 @@ FLAG_CASES: dict = {
     "--bound": (["--bound", "theta3=1:0"], ("--bound",)),
     "--tau-max": (["--tau-max", "-1"], ("--tau-max",)),
     "--derivatives": (["--derivatives", "bogus"], ("--derivatives",)),
+    "--min-load": (["--min-load", "-1"], ("--min-load",)),
+    "--mu-max": (["--mu-max", "nan"], ("--mu-max",)),
+    "--cost": (["--cost", "bogus"], ("--cost",)),
     "--slope": (["--slope", "90"], ("--slope",)),
     "--min-tip-load": (["--min-tip-load", "-5"], ("--min-tip-load",)),
 }

@@ -32,7 +32,7 @@ from ..constraints.row_derivatives import FramePass, velocity_dq, wheel_velocity
 from ..errors import InputError
 from ..reduction.dynamics_derivatives import DynamicsDerivatives, motor_rows, pieces, result
 from .friction import ExactCoulomb, LinearTyre, RegularisedCoulomb
-from .sliding import PAINLEVE_CONDITION, SlippingWheel, painleve_error, redundant_load_error, sliding_now, tangential
+from .sliding import PAINLEVE_CONDITION, SlippingWheel, painleve_error, sliding_now, tangential
 
 TANGENT = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 """The tangential rows (t1, t2) of a wheel's contact frame."""
@@ -112,8 +112,11 @@ def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
     for wheel in wheels:
         row = rows.labels.index(f"{wheel.name}.normal")
         hit = np.flatnonzero(kept == row)
-        if not hit.size:
-            raise redundant_load_error(wheel)
+        if not hit.size:  # a statically indeterminate chassis: its loads are the rigid limit's (coupled solve)
+            raise InputError(f"dynamics derivatives: slipping wheel {wheel.name!r} has a redundant normal row (a "
+                             "statically indeterminate chassis, whose loads forward dynamics takes from the rigid "
+                             "limit of compliance solved with the friction): that coupled solve has no derivative "
+                             "rule yet; expected slipping wheels whose loads rigid-body dynamics determine")
         J, s = tangential(wheel, pc.kin)
         c = wheel.friction_coefficient(s)
         G[:, hit[0]] -= J.T @ c

@@ -18,7 +18,8 @@ the control the collocation assumed, and a re-simulation with the exact model ch
 Jacobian is block-sparse (two state blocks and two torque blocks per interval) and built from
 :math:`\\partial f/\\partial x, \\partial f/\\partial\\tau` at each node: analytic
 (:meth:`robotdyn.robot.Robot.dynamics_derivatives`: ``dqdot_dq``, ``S``, ``dq``, ``dnu``, ``dtau``) or, for
-comparison, central finite differences of the forward dynamics (``derivatives="finite-difference"``). The cost is
+comparison, central finite differences of the forward dynamics (``derivatives="finite-difference"``; with holonomic
+rows the coordinates are stepped along their level set, :mod:`robotdyn.optimisation.manifold_steps`). The cost is
 quadratic and its gradient exact in both cases; IPOPT's Hessian is its limited-memory (L-BFGS) approximation, in
 both cases, so that the two differ only in the constraint Jacobian.
 

@@ -8,6 +8,10 @@ the same cost to 1e-15 with finite differences, measured: one solve takes 15-30 
 notebook ``rover_path_traction.ipynb`` solves it and this file checks the stored optimum against the current model)
 has zero defects and holonomic residuals, keeps the loads and the cone, the cone binding where the unconstrained
 optimum violates it; a re-simulation of its torques with the exact model keeps them too.
+
+The cache holds ``free_*`` (``mu_max=None``) and ``limited_*`` (``mu_max=0.15``) ``q``, ``nu``, ``tau`` and ``cost`` of
+``traction_path(mu_max, robot=robotdyn.load("linkage_suspension")).solve()``: solve again and ``np.savez`` them
+where a change of the model moves the optimum.
 """
 
 from __future__ import annotations

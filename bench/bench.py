@@ -343,8 +343,10 @@ def controller_bench() -> None:
     dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
     print(f"{'quasimoro / LQR (lqr_law)':<36} {10.0:>8.1f} {1e3 * ws / 10:>11.2f} {1e3 * wc / 10:>14.3f} "
           f"{ws / wc:>8.1f}x {dev:>15.2e} {ref.stats['nfev']:>10d}/{fast.stats['nfev']:<10d}")
-    print("  the linkage's compiled evaluation costs ~110 us (25 coordinates, loop closures) on either loop: its runs "
-          "are bound by the evaluation, not by Python; compiled Adams steps onto each of the scenario's 400 samples "
+    print("  the linkage's compiled right-hand side costs ~35 us of CPU (25 coordinates, loop closures, the pull-back; "
+          "~100 us before the pull-back's SVD gave way to a complete orthogonal decomposition: see 'where a compiled "
+          "evaluation's time goes') on either loop: its runs are bound by the evaluation, not by Python; compiled "
+          "Adams steps onto each of the scenario's 400 samples "
           "per second (3,700 evaluations where DOP853 interpolates with 1,650); with 11 samples it needs half "
           "DOP853's")
     print("  still a Python callable (scipy only): omni_caster ellipse (tangent heading: u'' is not a polynomial or "

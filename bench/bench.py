@@ -145,6 +145,7 @@ def main() -> None:
     side_by_side_bench()
     startup_bench()
     compiled_engine_bench()
+    evaluation_profile_bench()
     controller_bench()
     compiled_forces_bench()
     rigid_limit_bench()
@@ -253,6 +254,35 @@ def compiled_engine_bench() -> None:
               f"{np.max(np.abs(traj.q - ref.q)):>17.2e} {np.max(np.abs(traj.nu - ref.nu)):>19.2e} {drift:>13.2e}")
 
 
+def evaluation_profile_bench() -> None:
+    """Where a compiled evaluation's time goes (Evaluator.profile: each part timed in C++, this thread's CPU time, no
+    Python in the loop), next to Pinocchio's own C++ CRBA + RNEA + frame placements and Jacobians on the same model,
+    at the state a second into each robot's first scenario (the holonomic residuals are then nonzero, so the
+    simulation's right-hand side pays the pull-back). Parts: rows = constraint rows, residuals and B; projection = S
+    (LU of A_d, condition estimate, span check); drift = the rows' drift and w after RNEA; reduce = M_r, h, g_r, B_r;
+    rhs = the whole right-hand side of a compiled simulation with the pull-back at gain 1."""
+    parts = ("crba", "rnea", "frames", "rows", "projection", "drift", "reduce", "pull_back")
+    print("\nwhere a compiled evaluation's time goes [us, C++ CPU time per call] (issue 26: pinocchio = Pinocchio's own "
+          "CRBA + RNEA + frame Jacobians on the same model)")
+    print(f"{'robot':<20} {'evaluation':>10} {'pinocchio':>9} {'ratio':>6} {'rhs':>7} " + " ".join(f"{p:>10}" for p in parts))
+    for name in names():
+        robot = robotdyn.load(name)
+        fast = compiled_model(robot)
+        scenarios = getattr(module(name), "SCENARIOS", {})
+        if fast is None or not scenarios:
+            continue
+        try:
+            traj = next(iter(scenarios.values())).run(robot, t_end=1.0, progress=False)
+            fast.compute(traj.q[-1], traj.nu[-1])
+            t = fast.ev.profile(traj.q[-1], traj.nu[-1], 2000 if robot.nq < 20 else 500, 1.0)
+        except Exception as exc:  # a benchmark reports, it does not stop
+            print(f"{name:<20} skipped: {exc}")
+            continue
+        print(f"{name:<20} {1e6 * t['evaluation']:>10.2f} {1e6 * t['pinocchio']:>9.2f} "
+              f"{t['evaluation'] / t['pinocchio']:>6.2f} {1e6 * t['rhs']:>7.2f} "
+              + " ".join(f"{1e6 * t[p]:>10.2f}" for p in parts))
+
+
 def controller_bench() -> None:
     """The built-in controller scenarios (robotdyn.simulation.feedback: feedback laws as data) on the compiled loop
     against the same law on the scipy loop, at each scenario's tolerances: cost per simulated second (whole
@@ -313,8 +343,10 @@ def controller_bench() -> None:
     dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
     print(f"{'quasimoro / LQR (lqr_law)':<36} {10.0:>8.1f} {1e3 * ws / 10:>11.2f} {1e3 * wc / 10:>14.3f} "
           f"{ws / wc:>8.1f}x {dev:>15.2e} {ref.stats['nfev']:>10d}/{fast.stats['nfev']:<10d}")
-    print("  the linkage's compiled evaluation costs ~110 us (25 coordinates, loop closures) on either loop: its runs "
-          "are bound by the evaluation, not by Python; compiled Adams steps onto each of the scenario's 400 samples "
+    print("  the linkage's compiled right-hand side costs ~35 us of CPU (25 coordinates, loop closures, the pull-back; "
+          "~100 us before the pull-back's SVD gave way to a complete orthogonal decomposition: see 'where a compiled "
+          "evaluation's time goes') on either loop: its runs are bound by the evaluation, not by Python; compiled "
+          "Adams steps onto each of the scenario's 400 samples "
           "per second (3,700 evaluations where DOP853 interpolates with 1,650); with 11 samples it needs half "
           "DOP853's")
     print("  still a Python callable (scipy only): omni_caster ellipse (tangent heading: u'' is not a polynomial or "
@@ -510,5 +542,7 @@ def trajectory_optimisation_bench() -> None:
 if __name__ == "__main__":
     if sys.argv[1:] == ["controllers"]:  # only this section: python bench/bench.py controllers
         controller_bench()
+    elif sys.argv[1:] == ["profile"]:  # only this section: python bench/bench.py profile
+        evaluation_profile_bench()
     else:
         main()

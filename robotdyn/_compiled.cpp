@@ -47,6 +47,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <thread>
 #include <limits>
@@ -869,6 +870,87 @@ class Evaluator {
     return result;
   }
 
+  // Where an evaluation's time goes (make bench): CPU seconds per call, each part timed over `repeat` calls at (q, nu),
+  // next to Pinocchio's own C++ algorithms on the same model: "evaluation" (configure + dynamics, as compute),
+  // "pinocchio" (CRBA + RNEA + the frames' placements and Jacobians, the rigid-body work inside it), "crba", "rnea",
+  // "frames", "rows" (constraint rows, residuals, B), "projection", "drift" (drift and w, after RNEA), "reduce"
+  // (M_r, h, g_r, B_r), "rhs" (the simulation's right-hand side with the pull-back at gain `alpha`) and "pull_back".
+  // The evaluator is left evaluated at (q, nu).
+  py::dict profile(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu, int repeat, double alpha) {
+    if (repeat < 1) throw std::invalid_argument("repeat must be >= 1");
+    configure(q);
+    dynamics(nu);
+    const VectorXd q0 = q, nu0 = nu;
+    const VectorXd tau = VectorXd::Zero(Br_.cols());
+    VectorXd out(nv_ + nu.size());
+    auto seconds = [repeat](auto&& f) {  // this thread's CPU time (the machine may be shared), else wall time
+#ifdef CLOCK_THREAD_CPUTIME_ID
+      timespec a, b;
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+      for (int i = 0; i < repeat; ++i) f();
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+      return ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / repeat;
+#else
+      const auto start = std::chrono::steady_clock::now();
+      for (int i = 0; i < repeat; ++i) f();
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeat;
+#endif
+    };
+    auto frames = [&] {
+      pin::updateFramePlacements(model_, data_);
+      for (size_t f = 0; f < frames_.size(); ++f) {
+        Jf_[f].setZero(6, nv_);
+        pin::getFrameJacobian(model_, data_, frames_[f], pin::LOCAL_WORLD_ALIGNED, Jf_[f]);
+      }
+    };
+    auto rows = [&] {
+      A_.setZero(nrows(), nv_);
+      residual_.setZero(nrows());
+      int row = 0;
+      for (const auto& [kind, i] : order_)
+        row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
+      motor_columns(motors_, model_, data_, Jf_, nv_, B_);
+    };
+    auto drift = [&] {
+      drift_.setZero(nrows());
+      int row = 0;
+      for (const auto& [kind, i] : order_)
+        row = kind == 0 ? wheel_drift(i, row) : kind == 1 ? closure_drift(i, row) : coupling_drift(i, row);
+      w_.setZero(nv_);
+      if (operational_)
+        drift_acceleration_operational(drift_, rows_, op_select_, model_, data_, frames_[op_frame_], op_local_, nv_,
+                                       Kinv_, rhs_, w_);
+      else
+        drift_acceleration_selection(drift_, rows_, dependent_, lu_, lus_, rhs_, wd_, w_);
+    };
+    py::dict t;
+    t["evaluation"] = seconds([&] { configure(q0); dynamics(nu0); });
+    t["pinocchio"] = seconds([&] {
+      pin::crba(model_, data_, q_, pin::Convention::WORLD);
+      pin::rnea(model_, data_, q_, v_, zero_);
+      frames();
+    });
+    t["crba"] = seconds([&] { pin::crba(model_, data_, q_, pin::Convention::WORLD); });
+    t["frames"] = seconds(frames);
+    t["rows"] = seconds(rows);
+    t["projection"] = seconds([&] { project(); });
+    t["rnea"] = seconds([&] {
+      pin::rnea(model_, data_, q_, v_, zero_);
+      for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) data_.a[i] = data_.a_gf[i];
+    });
+    t["drift"] = seconds(drift);
+    const VectorXd Cv = data_.tau;
+    t["reduce"] = seconds([&] {
+      data_.tau = Cv;
+      reduce(data_.M, S_, g_, data_.tau, w_, B_, SM_, Mr_, hr_, gr_, Br_);
+    });
+    t["rhs"] = seconds([&] { rhs_into(q0, nu0, tau, alpha, out); });
+    t["pull_back"] = seconds([&] { pull_back(alpha, out); });
+    configure(q0);
+    dynamics(nu0);
+    return t;
+  }
+
   // Many states: stacked M_r (N, k, k), h (N, k), g (N, k), S (N, n, k), w (N, n), B_r (N, k, motors).
   py::tuple evaluate_many(const Eigen::Ref<const RowMat>& Q, const Eigen::Ref<const RowMat>& NU) {
     const int N = static_cast<int>(Q.rows());
@@ -926,9 +1008,7 @@ class Evaluator {
     check_span(A_, S_, AS_);
   }
 
-  void pull_back(double alpha, Eigen::Ref<VectorXd> out) {
-    kernels::pull_back(holonomic_, residual_, A_, nv_, alpha, svd_, out);
-  }
+  void pull_back(double alpha, Eigen::Ref<VectorXd> out) { pull_back_.apply(holonomic_, residual_, A_, nv_, alpha, out); }
 
   pin::Model model_;
   pin::Data data_;
@@ -962,7 +1042,7 @@ class Evaluator {
   Matrix6x Jc_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   Eigen::LLT<MatrixXd> llt_;
-  Eigen::JacobiSVD<MatrixXd> svd_;
+  PullBack pull_back_;  // the pull-back's decomposition and buffers
   double cond_ = 1.0;
   RigidLimit rigid_;  // the rigid limit's split (forces) and its buffers
   SlipSystem slip_;   // the slipping wheels' system (slip_rhs_into), its results and buffers
@@ -1085,6 +1165,8 @@ PYBIND11_MODULE(_compiled, m) {
         return py::make_tuple(e, r);
       })
       .def("evaluate_many", &Evaluator::evaluate_many)
+      .def("profile", &Evaluator::profile, py::arg("q"), py::arg("nu"), py::arg("repeat"), py::arg("alpha") = 0.0,
+           "seconds per call of each part of an evaluation, and of Pinocchio's CRBA + RNEA + frame Jacobians")
       .def_property_readonly("condition", &Evaluator::condition,
                              "1-norm condition number of the last projection's block: LAPACK's estimate below 1e8, "
                              "exact above (operational velocities: exact)")

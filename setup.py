@@ -30,7 +30,9 @@ def _extension() -> list[Extension]:
         Extension(
             "robotdyn._compiled",
             ["robotdyn/_compiled.cpp"],
-            depends=["robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp", "robotdyn/_controller.hpp"],
+            depends=["robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp", "robotdyn/_controller.hpp",
+                     "robotdyn/_stiff_integrator.hpp", "robotdyn/kernels/compliant_contact.hpp",
+                     "robotdyn/kernels/joint_springs.hpp"],
             include_dirs=[pybind11.get_include(), *pinocchio, *(str(Path(e) / "eigen3") for e in eigen)],
             define_macros=[
                 ("NDEBUG", None),

@@ -407,11 +407,14 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
             tau = robot.check_tau(tau)
     a = red.S @ nudot + red.w
     out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
+    unsupported = False  # a planar model whose wheels cannot hold its out-of-plane equilibrium
     if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
+        planar = out
         out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
+        unsupported = out is planar
     if st is not None and st.lam is not None:  # the loads of the coupled solve (rigid limit with friction)
         apply_rigid_limit(robot, out, st.lam, st.unloaded)
-    elif compliance and not friction:
+    elif compliance and not friction and not unsupported:  # no equilibrium to split where support is lacking
         apply_rigid_limit(robot, out)
     from ..reduction.conditioning import WARN_CONDITION, IllConditioned
 
@@ -683,7 +686,10 @@ def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
     others = N.shape[1] - len(zero)
     if others > 0:
         mixed = sorted({lab for col in N.T for lab, c in zip(labels, col) if abs(c) > DETERMINED_TOL} - set(zero))
-        out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: the rows are "
-                   "redundant, e.g. more wheels than a rigid body needs; the normal loads among them are split by "
-                   "the rigid limit of the wheels' normal compliance)")
+        if any(lab.endswith(".normal") for lab in mixed):
+            why = "the rows are redundant, e.g. more wheels than a rigid body needs"
+        else:  # only tangential rows: wheels pushing against each other, which normal compliance does not fix
+            why = ("wheels pushing against each other along these directions, which no motion tells apart; no "
+                   "normal load is among them, so the values shown are the minimum-norm choice")
+        out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: {why})")
     return out

@@ -28,7 +28,7 @@ from ..reduction.projection import solve
 from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
-from ..contact.sliding import lift_off_message, slipping_wheels
+from ..contact.sliding import contact_load, lift_off_message, slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
 from ..contact.compliant_contact import compliant_wheels
 from ..contact.applied_forces import applied, has_applied
@@ -231,7 +231,7 @@ def simulate(
         def lift_off(t: float, y: np.ndarray) -> float:  # the smallest normal load of a slipping wheel [N]
             q, nu = y[:n], y[n:n + k]
             tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
-            return float(np.min(forward_sliding(robot, q, nu, tau).normal))
+            return contact_load(robot, forward_sliding(robot, q, nu, tau))
 
         lift_off.terminal, lift_off.direction = True, -1.0
         events = [lift_off]

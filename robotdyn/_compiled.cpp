@@ -587,11 +587,7 @@ class Evaluator {
     }
     return out;
   }
-  // How many further steps one Jacobian may serve in one contact mode (rosenbrock4; 0: a fresh one every step).
-  void set_jacobian_reuse(int n) {
-    if (n < 0) throw std::invalid_argument("jacobian reuse must be >= 0");
-    jacobian_reuse_ = n;
-  }
+
   // Q (Qa_), the friction and damper powers and each contact's state, after configure(q) and v_ = S nu.
   void applied_forces() {
     Qa_.setZero(nv_);
@@ -1283,7 +1279,16 @@ class Evaluator {
           robotdyn::Crossings<decltype(depths)> flights(depths);
           auto mode = [this] { return contact_mode(); };
           out = robotdyn::integrate_stiff(system, y0, t0, t_end, samples, next, breaks, rtol, atol, nv_ + k, observer,
-                                          poll, flights, mode, jacobian_reuse_);
+                                          poll, flights, mode);
+          for (const auto& [te, i, direction] : flights.found)
+            if (te <= out.t) crossings.emplace_back(te, i, direction);
+        } else if (!contacts_.empty()) {  // explicit, with the flight phases on the dense output
+          auto depths = [this, &rechoose](double, const robotdyn::State& y, std::vector<double>& d) {
+            penetrations(y.data(), rechoose, d);
+          };
+          robotdyn::Crossings<decltype(depths)> flights(depths);
+          out = robotdyn::integrate_crossings(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol,
+                                              observer, poll, flights);
           for (const auto& [te, i, direction] : flights.found)
             if (te <= out.t) crossings.emplace_back(te, i, direction);
         } else {
@@ -1755,7 +1760,6 @@ class Evaluator {
   VectorXd Qa_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> Ac_;
   double friction_power_ = 0.0, damper_power_ = 0.0;
-  int jacobian_reuse_ = 0;
   Eigen::JacobiSVD<MatrixXd> slip_svd_;
   double slip_kappa1_ = 0.0, slip_kappa2_ = 0.0;  // the last Painleve test (slip_condition)
   double slip_min_ = HUGE_VAL, event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
@@ -1833,7 +1837,6 @@ PYBIND11_MODULE(_compiled, m) {
       .def("add_spring", &Evaluator::add_spring)
       .def("add_compliant_wheel", &Evaluator::add_compliant_wheel)
       .def("applied_state", &Evaluator::applied_state)
-      .def("set_jacobian_reuse", &Evaluator::set_jacobian_reuse)
       .def_property_readonly("slipping", &Evaluator::slipping)
       .def_readonly("last_t", &Evaluator::last_t_, "Time [s] of the last right-hand side a simulation evaluated")
       .def_property_readonly("slip_condition", &Evaluator::slip_condition,

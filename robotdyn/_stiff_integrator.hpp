@@ -2,7 +2,8 @@
 // embedded order-3 error estimate; Shampine's coefficients) under its step-size controller (rosenbrock4_controller,
 // error in the RMS norm of |err_i| / (atol + rtol max(|y_i|, |y_new,i|))) with its dense output
 // (rosenbrock4_dense_output), driven by run_dense of _integrator.hpp like the explicit dense-output steppers:
-// samples interpolated, restarts at breakpoints, poll every ~50 ms, FAILED on a vanishing step or a non-finite state.
+// samples interpolated, restarts at breakpoints, poll every ~50 ms, FAILED on a vanishing step (below the spacing of
+// doubles at t) or a non-finite state.
 // (Used for compliant wheel contacts, whose stiffness makes explicit steppers take steps of ~0.1 / omega.)
 //
 // The Jacobian df/dy that a Rosenbrock step needs is taken by forward differences of the right-hand side, one
@@ -12,8 +13,8 @@
 // side may switch between smooth modes (a compliant wheel touching down: its damper force jumps from zero to
 // c deltadot): `mode()` names the mode of the last evaluation (a bit pattern), and a difference whose perturbed state
 // left the mode of y is taken backwards instead (a difference across the jump would put jump / step ~ 1e10 into J).
-// Optionally (`reuse` > 0) a Jacobian serves up to `reuse` further steps while the mode stays the same (a W-method
-// use of rosenbrock4: the error estimate still controls the step; default 0). Why differences: the right-hand side is a projected multibody model
+// (A Jacobian kept over several steps, as W-methods allow, is no option here: rosenbrock4's error estimate then
+// collapses the steps: on the compliant linkage rover, 3 reuses took 11x more steps.) Why differences: the right-hand side is a projected multibody model
 // (S(q), its drift, the contact geometry) without compiled derivatives; differences cost `active` + 1 evaluations
 // per step, against the 6 evaluations of the step itself, and their error (~1e-8 relative) only perturbs the
 // Rosenbrock matrix, which changes the error estimate, never the consistency of the accepted solution.
@@ -43,9 +44,9 @@ class StiffStepper {
   using Mat = boost::numeric::ublas::matrix<double>;
   using Dense = odeint::rosenbrock4_dense_output<odeint::rosenbrock4_controller<odeint::rosenbrock4<double>>>;
 
-  StiffStepper(double atol, double rtol, int active, OnStep& on_step, Mode& mode, int reuse)
+  StiffStepper(double atol, double rtol, int active, OnStep& on_step, Mode& mode)
       : dense_(odeint::rosenbrock4_controller<odeint::rosenbrock4<double>>(atol, rtol)), active_(active),
-        on_step_(on_step), mode_(mode), reuse_(reuse) {}
+        on_step_(on_step), mode_(mode) {}
 
   void initialize(const State& y0, double t0, double dt0) {
     to_vec(y0, u_);
@@ -111,16 +112,8 @@ class StiffStepper {
       dfdt = dfdt_;
       return;
     }
-    if (jac_.size1() == n && uses_ < reuse_ && mode0 == jac_mode_) {  // W-method reuse (see the top of the file)
-      ++uses_;
-      J = jac_;
-      dfdt = dfdt_;
-      return;
-    }
-    uses_ = 0;
     jac_t_ = t;
     jac_x_ = xs_;
-    jac_mode_ = mode0;
     f0_ = last_f_;
     J.resize(n, n, false);
     J.clear();
@@ -152,13 +145,12 @@ class StiffStepper {
   int active_;
   OnStep& on_step_;
   Mode& mode_;
-  int reuse_, uses_ = 0;
   bool started_ = false;
   Vec u_, tmp_, dfdt_;
   Mat jac_;
   State cur_, xs_, ds_, xp_, fp_, f0_, last_x_, last_f_, jac_x_;
   double last_t_ = std::numeric_limits<double>::quiet_NaN(), jac_t_ = std::numeric_limits<double>::quiet_NaN();
-  unsigned long long last_mode_ = 0, jac_mode_ = 0;
+  unsigned long long last_mode_ = 0;
 };
 
 // Non-terminal events: m functions g(y) of the state (`values(t, y, out)` fills them) whose crossings of zero are
@@ -207,14 +199,74 @@ struct NoCrossings {
 
 // The stiff run from (t0, y0) to t_end (see the top of this file): rtol, atol on every component; columns of the
 // Jacobian from `active` on are zero; on_step as Crossings (or NoCrossings); mode() the right-hand side's mode at
-// its last evaluation; a Jacobian serves up to `reuse` further steps in one mode.
+// its last evaluation.
 template <class System, class Observer, class Poll, class OnStep, class Mode>
 Outcome integrate_stiff(System& system, const State& y0, double t0, double t_end, const std::vector<double>& samples,
                         size_t& next, const std::vector<double>& breaks, double rtol, double atol, int active,
-                        Observer&& observer, Poll&& poll, OnStep& on_step, Mode& mode, int reuse = 0) {
+                        Observer&& observer, Poll&& poll, OnStep& on_step, Mode& mode) {
   const double dt0 = std::min(1e-4, 1e-3 * (t_end - t0));
-  StiffStepper<OnStep, Mode> stepper(atol, rtol, active, on_step, mode, reuse);
-  return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll);
+  StiffStepper<OnStep, Mode> stepper(atol, rtol, active, on_step, mode);
+  // a step across a compliant wheel's touch-down (its damper force jumps) is accepted only once it is about
+  // tolerance / jump long: steps down to the spacing of doubles at t are allowed (unit 0), not only 8 eps
+  return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, NoEvent(), 0.0);
+}
+
+}  // namespace robotdyn
+
+namespace robotdyn {
+
+// An explicit dense-output stepper of _integrator.hpp (dopri5, bulirsch_stoer) with non-terminal crossing events
+// (Crossings) located on its dense output after each accepted step, as StiffStepper does.
+template <class Stepper, class OnStep>
+class WithCrossings {
+ public:
+  WithCrossings(Stepper& stepper, OnStep& on_step) : stepper_(stepper), on_step_(on_step) {}
+  void initialize(const State& y0, double t0, double dt0) {
+    stepper_.initialize(y0, t0, dt0);
+    if (!started_) {
+      started_ = true;
+      on_step_.start(t0, y0);
+    }
+  }
+  template <class Sys>
+  void do_step(Sys& sys) {
+    stepper_.do_step(sys);
+    on_step_(*this);
+  }
+  void calc_state(double t, State& y) {
+    y.resize(stepper_.current_state().size());
+    stepper_.calc_state(t, y);
+  }
+  const State& current_state() const { return stepper_.current_state(); }
+  double current_time() const { return stepper_.current_time(); }
+  double previous_time() const { return stepper_.previous_time(); }
+  double current_time_step() const { return stepper_.current_time_step(); }
+
+ private:
+  Stepper& stepper_;
+  OnStep& on_step_;
+  bool started_ = false;
+};
+
+// dopri5 or bulirsch_stoer (as integrate of _integrator.hpp) with crossing events; steps down to the spacing of
+// doubles at t, as integrate_stiff (a touch-down's damper force jumps).
+template <class System, class Observer, class Poll, class OnStep>
+Outcome integrate_crossings(const std::string& method, System& system, const State& y0, double t0, double t_end,
+                            const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
+                            double rtol, double atol, Observer&& observer, Poll&& poll, OnStep& on_step) {
+  const double dt0 = std::min(1e-3, 1e-3 * (t_end - t0));
+  if (method == "bulirsch_stoer") {
+    odeint::bulirsch_stoer_dense_out<State> stepper(atol, rtol, 1.0, 0.0);
+    WithCrossings<decltype(stepper), OnStep> with(stepper, on_step);
+    return run_dense(with, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, NoEvent(), 0.0);
+  }
+  if (method == "dopri5") {
+    auto stepper = odeint::make_dense_output(atol, rtol, odeint::runge_kutta_dopri5<State>());
+    WithCrossings<decltype(stepper), OnStep> with(stepper, on_step);
+    return run_dense(with, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, NoEvent(), 0.0);
+  }
+  throw std::invalid_argument("flight phases need a dense-output integrator (dopri5, bulirsch_stoer, rosenbrock4), not " +
+                              method);
 }
 
 }  // namespace robotdyn

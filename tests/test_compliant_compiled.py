@@ -1,7 +1,8 @@
 """Joint springs and compliant wheels on the compiled engine (robotdyn/kernels/joint_springs.hpp,
-robotdyn/kernels/compliant_contact.hpp, the stiff integrator robotdyn/_stiff_integrator.hpp: Boost.Odeint's
-rosenbrock4), against the closed forms of tests/test_compliant_contact.py and against the scipy path (LSODA for
-compliant wheels, DOP853 for springs), the reference:
+robotdyn/kernels/compliant_contact.hpp; Dormand-Prince by default, the stiff Boost.Odeint rosenbrock4 of
+robotdyn/_stiff_integrator.hpp on request, flight phases on their dense output), against the closed forms of
+tests/test_compliant_contact.py and against the scipy path (LSODA for compliant wheels, DOP853 for springs), the
+reference:
 
 - the applied forces (generalised force Q, friction and damper powers, penetrations, contact forces) and the stored
   energy at one state equal robotdyn.contact.applied_forces' to rounding;
@@ -109,14 +110,15 @@ def test_applied_forces_and_energy_equal_the_python_path(which):
     assert energy == pytest.approx(robot.energy(q, v), rel=1e-12, abs=1e-9)
 
 
+@pytest.mark.parametrize("method", [None, "rosenbrock4"])
 @pytest.mark.parametrize("zeta", [0.0, 0.5])
-def test_dropped_disc_damped_oscillator_on_rosenbrock4(zeta):
+def test_dropped_disc_damped_oscillator(zeta, method):
     k, v_in, gap = 2.0e4, 1.0, 0.01
     c = 2 * zeta * np.sqrt(k * M)
     robot = disc(normal_stiffness=k, normal_damping=c)
     q0, nu0 = state(robot, R + gap, -v_in)
-    traj = simulate(robot, 0.1, q0, nu0, n_out=101, rtol=1e-10, atol=1e-13, progress=False)
-    assert traj.stats["engine"] == "compiled (rosenbrock4)"
+    traj = simulate(robot, 0.1, q0, nu0, n_out=101, rtol=1e-10, atol=1e-13, progress=False, method=method)
+    assert traj.stats["engine"] == f"compiled ({method or 'dopri5'})"
     wn = np.sqrt(k / M)
     s, wd = zeta * wn, wn * np.sqrt(1 - zeta**2)
     theta = np.pi - np.arctan2(2 * zeta * np.sqrt(1 - zeta**2), 1 - 2 * zeta**2)  # where k x + c x' returns to 0
@@ -159,7 +161,7 @@ def test_sprung_car_braking_equals_the_scipy_path():
 
 def test_bump_base_example_equals_lsoda():
     """examples/bump_base.toml's scenario: the front wheels leave the bump's crest; the compiled run
-    (rosenbrock4) and the scipy path (LSODA) at rtol 1e-9 agree on the trajectory, the works and the flight phases;
+    (dopri5) and the scipy path (LSODA) at rtol 1e-9 agree on the trajectory, the works and the flight phases;
     its energy balance E(t) - E(0) = friction work + damper work (coasting: no motor work) holds at every sample."""
     robot, sc = bump_base()
     q0, nu0 = sc.initial_state(robot)
@@ -167,7 +169,7 @@ def test_bump_base_example_equals_lsoda():
     a = simulate(robot, T_BUMP, q0, nu0, sc.torque, **options)
     with use_compiled(False):
         b = simulate(robot, T_BUMP, q0, nu0, sc.torque, **options)
-    assert (a.stats["engine"], b.stats["engine"]) == ("compiled (rosenbrock4)", "scipy (LSODA)")
+    assert (a.stats["engine"], b.stats["engine"]) == ("compiled (dopri5)", "scipy (LSODA)")
     assert [e["event"] for e in a.stats["flight"]] == ["lift-off", "lift-off"]  # the front wheels, off the crest
     same_flights(a, b, 1e-6)
     assert np.max(np.abs(a.q - b.q)) < 1e-6
@@ -189,7 +191,7 @@ def test_compliant_linkage_rover_over_the_bump_equals_lsoda():
 
     rigid, soft = Robot(SPEC), Robot(compliant_spec())
     a = bump_run(soft, T_ROVER, rigid, speed=25.0, feedback=True, rtol=1e-8, atol=1e-10, n_out=46)
-    assert a.stats["engine"] == "compiled (rosenbrock4)"
+    assert a.stats["engine"] == "compiled (dopri5)"
     assert len(a.stats["flight"]) >= 4  # wheels leave the ground and land
     law = hold_speed_law(soft, 25.0).bound(soft)
     from robotdyn.fast.compiled_applied import applied_model
@@ -203,18 +205,18 @@ def test_compliant_linkage_rover_over_the_bump_equals_lsoda():
     first = a.stats["flight"][0]
     i = int(np.searchsorted(a.t, first["t"])) - 1
     t0, t1 = float(a.t[i]), float(a.t[i]) + 0.02
-    runs = []
-    for compiled in (True, False):
-        with use_compiled(compiled):
-            runs.append(simulate(soft, t1, a.q[i], a.nu[i], law, t0=t0, n_out=3, rtol=1e-9, atol=1e-11,
-                                 progress=False))
-    c, p = runs
-    assert (c.stats["engine"], p.stats["engine"]) == ("compiled (rosenbrock4)", "scipy (LSODA)")
-    assert (first["wheel"], first["event"]) == (c.stats["flight"][0]["wheel"], c.stats["flight"][0]["event"])
-    same_flights(c, p, 1e-7)
-    assert np.max(np.abs(c.q - p.q)) < 1e-7
-    assert np.max(np.abs(c.nu - p.nu)) < 1e-5 * np.max(np.abs(p.nu))
-    assert np.max(np.abs(c.damper_work - p.damper_work)) < 1e-7 * abs(p.energy[0])
+    options = dict(t0=t0, n_out=3, rtol=1e-9, atol=1e-11, progress=False)
+    with use_compiled(False):
+        p = simulate(soft, t1, a.q[i], a.nu[i], law, **options)
+    assert p.stats["engine"] == "scipy (LSODA)"
+    for method in ("dopri5", "rosenbrock4"):
+        c = simulate(soft, t1, a.q[i], a.nu[i], law, method=method, **options)
+        assert c.stats["engine"] == f"compiled ({method})"
+        assert (first["wheel"], first["event"]) == (c.stats["flight"][0]["wheel"], c.stats["flight"][0]["event"])
+        same_flights(c, p, 1e-7)
+        assert np.max(np.abs(c.q - p.q)) < 1e-7
+        assert np.max(np.abs(c.nu - p.nu)) < 1e-5 * np.max(np.abs(p.nu))
+        assert np.max(np.abs(c.damper_work - p.damper_work)) < 1e-7 * abs(p.energy[0])
 
 
 def test_what_stays_on_the_python_path_is_refused_in_one_line():
@@ -223,8 +225,8 @@ def test_what_stays_on_the_python_path_is_refused_in_one_line():
 
     robot = disc(normal_stiffness=2.0e4)
     q0, nu0 = state(robot, R + 0.01, -1.0)
-    with pytest.raises(RobotDynError, match="^engine = 'compiled' cannot run this simulation: compliant wheels are "
-                                            "integrated by rosenbrock4 on the compiled engine"):
+    with pytest.raises(RobotDynError, match="^engine = 'compiled' cannot run this simulation: compliant wheels' "
+                                            "flight phases are located on a dense output"):
         simulate(robot, 0.05, q0, nu0, method="adams", progress=False)
     with pytest.raises(RobotDynError, match="compliant wheels \\(normal force laws\\) are evaluated on the Python "
                                             "path"):

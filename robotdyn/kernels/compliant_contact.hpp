@@ -1,6 +1,7 @@
-// Wheels that fly and land: the normal force law of penetration and the tangential friction law of a compliant
-// wheel, the formulas of robotdyn/contact/compliant_contact.py (NormalLaw, CompliantWheel.state) and
-// robotdyn/contact/friction.py (RegularisedCoulomb, LinearTyre), in their order of operations.
+// robotdyn/kernels/compliant_contact.hpp: wheels that fly and land, twin of robotdyn/contact/compliant_contact.py
+// (NormalLaw, CompliantWheel.state) with the friction laws of robotdyn/contact/friction.py (RegularisedCoulomb,
+// LinearTyre): the normal force law of penetration and the tangential friction law of a compliant wheel, in their
+// order of operations.
 //
 // With the wheel's rolling rows A = E^T A_w (3, nv; rows t1, t2, n of its contact frame, A_w the world Jacobian of
 // the wheel's material point at the contact point) and its signed distance phi above the terrain:

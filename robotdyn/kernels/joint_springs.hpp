@@ -1,6 +1,6 @@
-// Springs and dampers on joints: the formulas of robotdyn/reduction/joint_springs.py (SpringForce), in its order of
-// operations. A spring on the one-coordinate joint j (velocity index j, natural coordinates: q and v share it)
-// applies the generalised force
+// robotdyn/kernels/joint_springs.hpp: springs and dampers on joints, twin of robotdyn/reduction/joint_springs.py
+// (SpringForce; summed as robotdyn/contact/applied_forces.py does), in its order of operations. A spring on the
+// one-coordinate joint j (velocity index j, natural coordinates: q and v share it) applies the generalised force
 //   Q_j = -k (q_j - q_j0) - c qdot_j                      [N or N m]
 // stores 1/2 k (q_j - q_j0)^2 [J] and its damper does the power -c qdot_j^2 [W] (<= 0).
 #pragma once

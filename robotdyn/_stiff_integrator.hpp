@@ -12,7 +12,9 @@
 // Columns from `active` on are zero without evaluation (states nothing depends on: accumulated work). The right-hand
 // side may switch between smooth modes (a compliant wheel touching down: its damper force jumps from zero to
 // c deltadot): `mode()` names the mode of the last evaluation (a bit pattern), and a difference whose perturbed state
-// left the mode of y is taken backwards instead (a difference across the jump would put jump / step ~ 1e10 into J).
+// left the mode of y is taken backwards instead (a difference across the jump would put jump / step ~ 1e10 into J);
+// mode.differencing(true / false) brackets the differences (the evaluator then skips checks that a state ~1e-8 off
+// the constraint manifold would fail, e.g. the projection's span check).
 // (A Jacobian kept over several steps, as W-methods allow, is no option here: rosenbrock4's error estimate then
 // collapses the steps: on the compliant linkage rover, 3 reuses took 11x more steps.) Why differences: the right-hand side is a projected multibody model
 // (S(q), its drift, the contact geometry) without compiled derivatives; differences cost `active` + 1 evaluations
@@ -115,6 +117,11 @@ class StiffStepper {
     jac_t_ = t;
     jac_x_ = xs_;
     f0_ = last_f_;
+    struct Bracket {  // mode_.differencing(true) until the differences are taken (or one throws)
+      Mode& m;
+      explicit Bracket(Mode& m_) : m(m_) { m.differencing(true); }
+      ~Bracket() { m.differencing(false); }
+    } bracket(mode_);
     J.resize(n, n, false);
     J.clear();
     const double root = std::sqrt(std::numeric_limits<double>::epsilon());

@@ -751,6 +751,10 @@ class Robot:
         if sliding_now(self):
             return forward_sliding(self, q, nu, tau).nudot
         red = self.reduced(q, nu)
+        if any(getattr(c, "rolling", False) for c in self.constraints):  # robotdyn.contact.compliant_rolling
+            from .contact.compliant_rolling import forward as rolling_forward
+
+            return rolling_forward(self, q, nu, tau, red=red).nudot
         out = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(self, red, q)[0])
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
@@ -789,6 +793,25 @@ class Robot:
         from .reduction.dynamics_derivatives import dynamics_derivatives
 
         return dynamics_derivatives(self, q, nu, tau)
+
+    def contact_force_derivatives(self, q, nu, tau):
+        """The wheel contact forces (normal load, tangential components in the contact frame) and each wheel's
+        required mu under motor torques ``tau``, with their derivatives in q (natural coordinates, and along the
+        holonomic manifold in the independent position coordinates of :meth:`dynamics_derivatives`), nu and tau:
+        a :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (Python path; see
+        :func:`robotdyn.contact.force_derivatives.contact_force_derivatives`).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] in the order of :attr:`coordinates`.
+            nu: Independent velocities (k,) [m/s, rad/s] in the order of :attr:`velocity_names`.
+            tau: Motor torques/forces (n_motors,) [N m or N] in the order of :attr:`motors`.
+
+        Returns:
+            A :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (forces [N]).
+        """
+        from .contact.force_derivatives import contact_force_derivatives
+
+        return contact_force_derivatives(self, q, nu, tau)
 
     def conditioning(self, q, nu, tau=None) -> list:
         """The ill-conditioned parts of the reduced solve at (q, nu) (the projection's :math:`A_d`, the reduced
@@ -885,12 +908,27 @@ class Robot:
         nudot = np.asarray(nudot, float)
         if nudot.shape != (self.mobility,):
             self.check_nu(nudot, "nudot")
+        self._refuse_rolling_contact(q, red.v, "inverse dynamics")
         Q = red.M @ nudot + red.h - reduced_applied(self, red, np.asarray(q, float))[0]
         self._warn_dropped(red, nudot)
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)
         return Q, tau, float(np.linalg.norm(red.B @ tau - Q))
+
+    def _refuse_rolling_contact(self, q, v, what: str) -> None:
+        """One-line InputError where compliant wheels roll in contact at (q, v) (their tangential rows are
+        constraints on top of the projection, :mod:`robotdyn.contact.compliant_rolling`), for ``what`` that does
+        not take those rows."""
+        if not any(getattr(c, "rolling", False) for c in self.constraints):
+            return
+        from .contact.compliant_rolling import contact_set
+
+        touching = contact_set(self, np.asarray(q, float), np.asarray(v, float))
+        if touching:
+            raise InputError(f"{what} with compliant wheels rolling in contact ({', '.join(touching)}) is not "
+                             "available: their rolling rows' forces and the motor torques are not separated by the "
+                             "accelerations here; expected motor torques (forward dynamics), or wheels in the air")
 
     def contact_forces(self, q, nu, tau=None, nudot=None, twin: bool = True):
         """Wheel-ground contact forces and loop-closure forces at (q, nu) for motor torques ``tau`` (forward

@@ -179,6 +179,15 @@ def simulate(
                                           stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times),
                         robot, torque)
     compliant = compliant_wheels(robot)
+    if any(w.rolling for w in compliant):  # compliant wheels rolling while in contact: a hybrid run
+        from .compliant_rolling import simulate_rolling
+
+        if slipping_wheels(robot):
+            raise RobotDynError("compliant wheels that roll (friction = 'rolling') with rigid slipping wheels are not "
+                                "simulated; expected contact = 'compliant' on the slipping wheels too")
+        return _applied(simulate_rolling(robot, t_end, q0, nu0, torque, np.linspace(t0, t_end, n_out) if times is None
+                                         else times, rtol, atol, method, stabilisation,
+                                         Progress(t_end, progress, time_limit), t0), robot, torque)
     method = method or (STIFF_METHOD if compliant else "DOP853")
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))

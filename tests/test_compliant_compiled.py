@@ -87,7 +87,7 @@ def sprung_car():
 @pytest.mark.parametrize("which", ["bump_base", "sprung_car"])
 def test_applied_forces_and_energy_equal_the_python_path(which):
     from robotdyn.contact.applied_forces import applied
-    from robotdyn.fast.compiled_applied import applied_model, applied_state
+    from robotdyn.fast.applied_model import applied_model, applied_state
 
     robot, sc = bump_base() if which == "bump_base" else sprung_car()
     q0, nu0 = sc.initial_state(robot)
@@ -198,7 +198,7 @@ def test_compliant_linkage_rover_over_the_bump_equals_lsoda():
     assert a.stats["engine"] == "compiled (dopri5)"
     assert len(a.stats["flight"]) >= 4  # wheels leave the ground and land
     law = hold_speed_law(soft, 25.0).bound(soft)
-    from robotdyn.fast.compiled_applied import applied_model
+    from robotdyn.fast.applied_model import applied_model
 
     fast = applied_model(soft)
     for t, q, nu in zip(a.t, a.q, a.nu):

@@ -99,7 +99,7 @@ def why_not(robot, applied: bool = False) -> str | None:
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
         applied: Whether joint springs and compliant wheels are compiled too (the compiled simulation's model,
-            :func:`robotdyn.fast.compiled_applied.applied_model`); default ``False``: they keep a robot on the
+            :func:`robotdyn.fast.applied_model.applied_model`); default ``False``: they keep a robot on the
             Python path.
 
     Returns:

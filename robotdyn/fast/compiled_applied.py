@@ -2,22 +2,18 @@
 :mod:`robotdyn.contact.applied_forces` encoded for ``robotdyn/_compiled.cpp`` (formulas in
 ``robotdyn/kernels/joint_springs.hpp`` and ``robotdyn/kernels/compliant_contact.hpp``).
 
-The general compiled model (:func:`robotdyn.fast.dispatch.compiled_model`, behind every door that evaluates a
-reduced model) still refuses robots with springs or compliant wheels in one line (:func:`robotdyn.fast.compiled.why_not`):
-their doors add the applied forces on the Python path. The compiled *simulation* of such robots
-(:mod:`robotdyn.simulation.compiled_engine`, default integrator ``rosenbrock4``) takes its own model from
-:func:`applied_model`, in which the evaluator adds :math:`S^T Q(q, v)` to the reduced equations, carries the
+This module encodes them for :class:`robotdyn.fast.compiled.CompiledModel`. The general compiled model
+(:func:`robotdyn.fast.dispatch.compiled_model`, behind every door that evaluates a reduced model) still refuses robots
+with springs or compliant wheels in one line (:func:`robotdyn.fast.compiled.why_not`): their doors add the applied
+forces on the Python path. The compiled *simulation* of such robots (:mod:`robotdyn.simulation.compiled_engine`)
+takes its own model from :func:`robotdyn.fast.applied_model.applied_model`, in which the evaluator adds :math:`S^T Q(q, v)` to the reduced equations, carries the
 friction and damper work as two extra states and counts the stored energy, exactly as the scipy path does with
 :func:`robotdyn.contact.applied_forces.applied`.
 """
 
 from __future__ import annotations
 
-import threading
-
 import numpy as np
-
-from ..errors import RobotDynError
 
 LAW_KINDS = {"linear": 0, "hunt_crossley": 1}
 """The C++ codes of the normal force laws (``kernels::NormalLaw``)."""
@@ -32,10 +28,8 @@ def compliant_refusal(wheel) -> str | None:
     Returns:
         A one-line reason, or ``None``.
     """
-    from ..contact.compliant_contact import HuntCrossley, LinearContact
-
-    law = wheel.normal_law
-    if type(law) not in (LinearContact, HuntCrossley):
+    law = wheel.normal_law  # (by its class's name: this stage does not import the contact stage)
+    if type(law).__name__ not in ("LinearContact", "HuntCrossley") or getattr(law, "name", None) not in LAW_KINDS:
         return f"wheel {wheel.name!r}: its normal law {law!r} is not compiled"
     if wheel.law is not None and wheel.law.encode() is None:
         return f"wheel {wheel.name!r}: its friction law {wheel.law!r} is not compiled"
@@ -74,57 +68,4 @@ def add_springs(ev, robot) -> None:
         ev.add_spring(int(s.index), float(s.stiffness), float(s.damping), float(s.rest))
 
 
-def _key(robot) -> tuple:
-    """What the applied model is built from (a change rebuilds it)."""
-    springs = tuple((s.index, s.stiffness, s.damping, s.rest) for s in getattr(robot, "springs", ()))
-    laws = tuple((id(c), getattr(c, "terrain", None), getattr(c, "radius", None), getattr(c, "law", None),
-                  repr(getattr(c, "normal_law", None))) for c in robot.constraints)
-    return springs, laws, tuple(robot.model.gravity.linear)
-
-
-def applied_model(robot):
-    """The robot's compiled model with its joint springs and compliant wheels, for the calling thread (built once
-    per thread and rebuilt when its constraints, laws, springs or gravity change), or ``None`` where the compiled
-    path is off or cannot serve it (:func:`robotdyn.fast.compiled.why_not` with ``applied=True`` names why).
-
-    Args:
-        robot: The :class:`~robotdyn.robot.Robot` (with springs or compliant wheels).
-
-    Returns:
-        The :class:`~robotdyn.fast.compiled.CompiledModel`, or ``None``.
-    """
-    from .compiled import CompiledModel, why_not
-    from .dispatch import enabled
-
-    if not enabled() or why_not(robot, applied=True) is not None:
-        return None
-    key = (threading.get_ident(), _key(robot))
-    cached = robot.__dict__.get("_applied_model")
-    if cached is not None and cached[0] == key:
-        return cached[1]
-    fast = CompiledModel(robot)
-    robot.__dict__["_applied_model"] = (key, fast)
-    return fast
-
-
-def applied_state(fast, q: np.ndarray, nu: np.ndarray) -> tuple:
-    """The compiled :func:`robotdyn.contact.applied_forces.applied` at (q, nu).
-
-    Args:
-        fast: An :func:`applied_model`.
-        q: Natural coordinates (n,) [m, rad].
-        nu: Independent velocities (k,).
-
-    Returns:
-        ``(Q, friction_power, damper_power, contacts)``: Q (n,) [N, N m], the powers [W], and per compliant wheel
-        (delta [m], rate [m/s], F_t1, F_t2, f_n [N]) as rows (w, 5).
-    """
-    if not fast.ready:
-        fast._choose(q, nu)
-    try:
-        return fast.ev.applied_state(np.asarray(q, float), np.asarray(nu, float))
-    except RuntimeError as exc:
-        raise RobotDynError(f"compiled applied forces: {exc}") from None
-
-
-__all__ = ["applied_model", "applied_state", "add_compliant_wheel", "add_springs", "compliant_refusal", "LAW_KINDS"]
+__all__ = ["add_compliant_wheel", "add_springs", "compliant_refusal", "LAW_KINDS"]

@@ -240,7 +240,7 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
 
 def engine_model(robot):
     """The compiled model a compiled simulation of ``robot`` runs on: with its joint springs and compliant wheels
-    where it has any (:func:`robotdyn.fast.compiled_applied.applied_model`), else the robot's compiled model.
+    where it has any (:func:`robotdyn.fast.applied_model.applied_model`), else the robot's compiled model.
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
@@ -249,7 +249,7 @@ def engine_model(robot):
         The :class:`~robotdyn.fast.compiled.CompiledModel`, or ``None`` where the compiled path cannot serve it.
     """
     if has_applied(robot):
-        from ..fast.compiled_applied import applied_model
+        from ..fast.applied_model import applied_model
 
         return applied_model(robot)
     return compiled_model(robot)

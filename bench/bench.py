@@ -452,7 +452,10 @@ def traction_bench() -> None:
 
 def compliant_bench() -> None:
     """The linkage rover over its 5 cm bump, rigid contacts against compliant tyres (about 1 mm static deflection,
-    robotdyn.robots.linkage_suspension.compliant), the same tolerances and samples: whole simulate() calls."""
+    robotdyn.robots.linkage_suspension.compliant), the same tolerances and samples: whole simulate() calls. Rigid:
+    the scipy loop on the compiled model (the speed held by a Python function) and the compiled engine (the same law
+    as data, adams); compliant: the compiled engine (its default dopri5, and the stiff rosenbrock4) and the Python
+    path (LSODA). Issue 23's target: the compliant compiled run <= 10x the rigid compiled run."""
     from robotdyn.robot import Robot
     from robotdyn.robots.linkage_suspension.compliant import bump_run, compliant_spec
     from robotdyn.robots.linkage_suspension.model import PEAK_SPEED, SPEC
@@ -461,22 +464,35 @@ def compliant_bench() -> None:
     k = soft.constraints[0].normal_law.stiffness
     options = dict(rtol=1e-8, atol=1e-10, n_out=101)
     print(f"\nlinkage rover over the bump (5 cm step), rtol 1e-8, 101 samples; compliant tyres k = {k:.4g} N/m "
-          "(1 mm static deflection) with a linear tyre law, on the Python path (compiled: not available)")
-    print(f"{'run':<44} {'sim [s]':>8} {'wall [s]':>9} {'evals':>7} {'/ rigid':>8} {'/ rigid Py':>11}  flight")
+          "(1 mm static deflection) with a linear tyre law")
+    print(f"{'run':<52} {'sim [s]':>8} {'wall [s]':>9} {'evals':>7} {'/ rigid':>8} {'/ rigid Py':>11}  flight")
+    runs = (("rigid, compiled model (scipy DOP853)", rigid, True, False, None),
+            ("rigid, compiled engine (adams)", rigid, True, True, None),
+            ("rigid, Python path", rigid, False, False, None),
+            ("compliant, compiled engine (dopri5)", soft, True, True, None),
+            ("compliant, compiled engine (rosenbrock4)", soft, True, True, "rosenbrock4"),
+            ("compliant, Python path (LSODA)", soft, False, False, None))
     for speed, t_end in ((PEAK_SPEED, 2.2), (25.0, 0.45)):
-        walls = {}
-        for name, robot, compiled in (("rigid, compiled", rigid, True), ("rigid, Python path", rigid, False),
-                                      ("compliant (LSODA)", soft, False)):
+        walls, trajs = {}, {}
+        for name, robot, compiled, feedback, method in runs:
             with use_compiled(compiled):
                 start = time.perf_counter()
-                traj = bump_run(robot, t_end, rigid, speed=speed, **options)
+                traj = bump_run(robot, t_end, rigid, speed=speed, feedback=feedback, method=method, **options)
                 walls[name] = wall = time.perf_counter() - start
+            trajs[name] = traj
             flight = traj.stats.get("flight")
             flights = "-" if flight is None else (f"{len(flight)} events" if flight else "none")
-            ratio = wall / walls["rigid, compiled"]
-            ratio_py = wall / walls.get("rigid, Python path", wall)
-            print(f"{name + f' at {speed:.3g} rad/s':<44} {t_end:>8.3g} {wall:>9.3f} {traj.stats['nfev']:>7} "
+            ratio = wall / walls[runs[0][0]]
+            ratio_py = wall / walls.get(runs[2][0], wall)
+            print(f"{name + f' at {speed:.3g} rad/s':<52} {t_end:>8.3g} {wall:>9.3f} {traj.stats['nfev']:>7} "
                   f"{ratio:>8.1f} {ratio_py:>11.1f}  {flights}")
+        b = trajs[runs[5][0]]
+        for name in (runs[3][0], runs[4][0]):
+            a = trajs[name]
+            print(f"  {name}: {walls[name] / walls[runs[0][0]]:.1f}x the rigid scipy loop on the compiled model, "
+                  f"{walls[name] / walls[runs[1][0]]:.1f}x the rigid compiled engine (issue 23 target <= 10x); vs "
+                  f"LSODA: max |q| difference {float(np.max(np.abs(a.q - b.q))):.1e}, flight events "
+                  f"{len(a.stats['flight'])} vs {len(b.stats['flight'])}")
 
 
 def simulate_many_bench(runs: int = 10_000) -> None:

@@ -24,38 +24,15 @@ import pytest
 
 from robotdyn.fast.compiled import available
 from robotdyn.fast.dispatch import use_compiled
-from robotdyn.robot import Parameter, Robot, RobotSpec, Wheel
+from robotdyn.robot import Robot
 from robotdyn.simulation.engine import simulate
+
+from compliant_disc import DISC, M, R, disc, phases, state  # noqa: F401 (tests/compliant_disc.py)
 
 pytestmark = pytest.mark.skipif(not available(), reason="the compiled extension was not built")
 
-DISC = Path(__file__).parent / "data" / "disc.urdf"
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-M, R = 2.0, 0.3  # tests/data/disc.urdf's mass; the wheel radius
 T_BUMP, T_ROVER = 0.1, 0.45  # durations [s] of the bump_base and rover runs compared
-
-
-def disc(g: float = 0.0, motors=(), **contact) -> Robot:
-    wheel = Wheel("disc", R, contact="compliant", friction="coulomb", mu=0.5, **contact)
-    spec = RobotSpec(name="disc", title="compliant disc", xacro=DISC, root="planar", wheels=[wheel],
-                     parameters=[Parameter("g", g, "m/s^2", xacro=False)], motors=list(motors))
-    return Robot(spec)
-
-
-def state(robot, z: float, vz: float, vx: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    q = np.zeros(robot.nq)
-    q[robot.coordinate_index("z")] = z
-    nu = np.zeros(robot.mobility)
-    nu[robot.velocity_names.index("z_dot")] = vz
-    nu[robot.velocity_names.index("x_dot")] = vx
-    return q, nu
-
-
-def phases(traj) -> dict[str, list[float]]:
-    out: dict[str, list[float]] = {"touch-down": [], "lift-off": []}
-    for e in traj.stats["flight"]:
-        out[e["event"]].append(e["t"])
-    return out
 
 
 def same_flights(a, b, tol: float) -> None:

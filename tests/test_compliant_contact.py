@@ -30,32 +30,9 @@ from robotdyn.reduction.joint_springs import JointSpring
 from robotdyn.robot import Parameter, Robot, RobotSpec, Wheel
 from robotdyn.simulation.engine import simulate
 
-DISC = Path(__file__).parent / "data" / "disc.urdf"
+from compliant_disc import DISC, M, R, disc, phases, state  # noqa: F401 (tests/compliant_disc.py)
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-M, R = 2.0, 0.3  # tests/data/disc.urdf's mass; the wheel radius
-
-
-def disc(g: float = 0.0, motors=(), **contact) -> Robot:
-    wheel = Wheel("disc", R, contact="compliant", friction="coulomb", mu=0.5, **contact)
-    spec = RobotSpec(name="disc", title="compliant disc", xacro=DISC, root="planar", wheels=[wheel],
-                     parameters=[Parameter("g", g, "m/s^2", xacro=False)], motors=list(motors))
-    return Robot(spec)
-
-
-def state(robot, z: float, vz: float, vx: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    q = np.zeros(robot.nq)
-    q[robot.coordinate_index("z")] = z
-    nu = np.zeros(robot.mobility)
-    nu[robot.velocity_names.index("z_dot")] = vz
-    nu[robot.velocity_names.index("x_dot")] = vx
-    return q, nu
-
-
-def phases(traj) -> dict[str, list[float]]:
-    out: dict[str, list[float]] = {"touch-down": [], "lift-off": []}
-    for e in traj.stats["flight"]:
-        out[e["event"]].append(e["t"])
-    return out
 
 
 @pytest.mark.parametrize("engine", ["auto", "scipy"])  # the compiled engine where built; the Python path (LSODA)

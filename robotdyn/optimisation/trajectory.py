@@ -56,7 +56,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, NonFiniteError
-from .callbacks import sparse_callback
+from .callbacks import _casadi, sparse_callback
 
 DERIVATIVES = ("analytic", "finite-difference")
 """How the dynamics' Jacobian is computed (``derivatives`` of :class:`TrajectoryProblem`)."""
@@ -65,14 +65,6 @@ COSTS = ("effort", "peak-mu")
 square of the largest required friction coefficient over wheels and nodes plus ``effort_weight`` times the effort."""
 HOLONOMIC_TOL = 1e-8
 """Largest holonomic residual [m or rad] accepted at q0 (the collocation keeps every node on the manifold)."""
-
-
-def _casadi():
-    try:
-        import casadi
-    except ImportError as exc:  # pragma: no cover - the test extra installs it
-        raise InputError("trajectory optimisation needs CasADi (pip install casadi, or the `test` extra)") from exc
-    return casadi
 
 
 @dataclass

@@ -104,6 +104,22 @@ def test_notebooks_import_nothing_from_tests():
                 assert not re.search(r"\boracles\b|[\"']tests[\"']|/ *\"tests\"|Path\.cwd\(\)", src), (path.name, src[:200])
 
 
+def test_notebooks_are_valid_nbformat_with_cell_ids():
+    """Every notebook validates against nbformat 4.5+ with an id on each cell (nbformat warns today, and will refuse
+    a notebook without them)."""
+    import warnings
+
+    import nbformat
+
+    for path in _tracked("notebooks/*.ipynb"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            nb = nbformat.read(path, as_version=4)
+            nbformat.validate(nb)
+        assert (nb.nbformat, nb.nbformat_minor) >= (4, 5), path.name
+        assert all("id" in cell for cell in nb.cells), path.name
+
+
 def _site(tmp_path: Path, index_body: str, other_body: str = "<h1 id='top'>x</h1>") -> Path:
     (tmp_path / "docs").mkdir()
     (tmp_path / "docs" / "index.html").write_text(f"<html><body>{index_body}</body></html>")

@@ -30,7 +30,8 @@ def _extension() -> list[Extension]:
         Extension(
             "robotdyn._compiled",
             ["robotdyn/_compiled.cpp"],
-            depends=["robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp", "robotdyn/_controller.hpp"],
+            depends=["robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp", "robotdyn/_controller.hpp",
+                     *sorted(str(p) for p in Path("robotdyn/kernels").glob("*.hpp"))],
             include_dirs=[pybind11.get_include(), *pinocchio, *(str(Path(e) / "eigen3") for e in eigen)],
             define_macros=[
                 ("NDEBUG", None),

@@ -29,6 +29,21 @@ from .compiled import Fallback
 from .dispatch import compiled_model
 
 
+class _CompiledDerivatives(DynamicsDerivatives):
+    """A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` whose manifold coordinates
+    (``positions``, ``tangent``, ``dq_manifold``: a pivoted QR of the holonomic rows) are chosen on first access, as
+    the Python path chooses them: a trajectory optimiser or a linearisation in natural coordinates never pays for
+    them."""
+
+    def __getattr__(self, name: str):
+        if name in ("positions", "tangent", "dq_manifold") and "_manifold" in self.__dict__:
+            A_h, prefer = self.__dict__.pop("_manifold")
+            positions, T = position_coordinates(A_h, prefer)
+            self.__dict__.update(positions=positions, tangent=T, dq_manifold=self.dq @ T)
+            return self.__dict__[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+
 def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives | None:
     """:math:`\\dot\\nu` and its derivatives at one state by the robot's compiled model, or ``None`` where the
     Python path must answer (no compiled model, operational-space velocities, slipping wheels, a compiled fallback).
@@ -56,10 +71,11 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
         nudot, dq, dnu, dtau, v, Vq, S, A = fast.ev.derivatives(q, nu, tau)
     except Fallback:
         return None
-    hol = np.asarray(fast.holonomic, bool)
-    positions, T = position_coordinates(A[hol], fast._hint.dependent)
-    out = DynamicsDerivatives(nudot, dq, dnu, dtau, v, Vq, S, positions, T, dq @ T, (), list(robot.coordinates),
-                              list(robot.velocity_names), [m.name for m in robot.motors])
+    out = _CompiledDerivatives.__new__(_CompiledDerivatives)
+    out.__dict__.update(nudot=nudot, dq=dq, dnu=dnu, dtau=dtau, qdot=v, dqdot_dq=Vq, S=S, numerical=(),
+                        coordinates=list(robot.coordinates), velocities=list(robot.velocity_names),
+                        motors=[m.name for m in robot.motors],
+                        _manifold=(A[np.asarray(fast.holonomic, bool)], fast._hint.dependent))
     for name in ("nudot", "dq", "dnu", "dtau", "dqdot_dq"):
         if not np.all(np.isfinite(getattr(out, name))):
             raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "

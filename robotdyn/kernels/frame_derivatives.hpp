@@ -13,6 +13,7 @@
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/frames-derivatives.hpp>
 
+#include <stdexcept>
 #include <vector>
 
 namespace robotdyn {
@@ -41,67 +42,99 @@ inline Matrix3x cross_d(const Vector3d& x, const Matrix3x& dx, const Vector3d& y
   return -skew3(y) * dx + skew3(x) * dy;
 }
 
-// One pass (FramePass): the kinematics derivatives at (q, x, 0) and, per frame, cached world-axes results.
+// One pass (FramePass): the kinematics derivatives at (q, x) (with accelerations: at (q, x, 0)) and, per frame,
+// cached world-axes results. Pinocchio's joint derivatives are taken in WORLD (the spatial velocity and
+// acceleration at the world origin, whose q-derivatives at fixed x are exact there) and carried to the frame
+// origin p: v_p = v_O + w x p, a_p = a_O + alpha x p + w x v_p (classical acceleration), differentiated with
+// dp/dq = J_p (the frame's LOCAL_WORLD_ALIGNED Jacobian's linear rows). The Python twin rotates the LOCAL
+// derivatives instead; both give the derivative of the LOCAL_WORLD_ALIGNED J(q) x at fixed x (and of its
+// classical acceleration), and the tests hold them equal to 1e-10.
 struct FramePass {
   pin::Data data;
   VectorXd x;
-  std::vector<char> has_vel, has_acc;
+  bool accelerations = false;
+  std::vector<char> has_vel, has_acc, has_jv, has_ja;
   std::vector<Vector6d> V, Acc;
-  std::vector<Matrix6x> dV, dAcc;
+  std::vector<Matrix6x> dV, dAcc, jdV, jdA;
   Matrix6x t1_, t2_, t3_, t4_;  // work
 
-  void run(const pin::Model& model, const VectorXd& q, const VectorXd& x_, size_t nframes) {
+  void run(const pin::Model& model, const VectorXd& q, const VectorXd& x_, bool with_accelerations) {
     if (data.oMi.size() != static_cast<size_t>(model.njoints) || data.oMf.size() != model.frames.size())
       data = pin::Data(model);
     x = x_;
-    pin::computeForwardKinematicsDerivatives(model, data, q, x, VectorXd::Zero(model.nv));
-    has_vel.assign(model.frames.size(), 0);
-    has_acc.assign(model.frames.size(), 0);
-    if (V.size() != model.frames.size()) {
-      V.resize(model.frames.size());
-      Acc.resize(model.frames.size());
-      dV.resize(model.frames.size());
-      dAcc.resize(model.frames.size());
+    accelerations = with_accelerations;
+    if (accelerations)
+      pin::computeForwardKinematicsDerivatives(model, data, q, x, VectorXd::Zero(model.nv));
+    else
+      pin::computeForwardKinematicsDerivatives(model, data, q, x);  // velocities only (first order)
+    const size_t nf = model.frames.size(), nj = static_cast<size_t>(model.njoints);
+    has_vel.assign(nf, 0);
+    has_acc.assign(nf, 0);
+    has_jv.assign(nj, 0);
+    has_ja.assign(nj, 0);
+    if (V.size() != nf) {
+      V.resize(nf);
+      Acc.resize(nf);
+      dV.resize(nf);
+      dAcc.resize(nf);
     }
-    (void)nframes;
+    if (jdV.size() != nj) {
+      jdV.resize(nj);
+      jdA.resize(nj);
+    }
+  }
+
+  // d(ov)/dq of a joint at fixed x, WORLD (6 x n)
+  const Matrix6x& joint_velocity_dq(const pin::Model& model, pin::JointIndex jid) {
+    if (!has_jv[jid]) {
+      jdV[jid].setZero(6, model.nv);
+      t2_.setZero(6, model.nv);
+      pin::getJointVelocityDerivatives(model, data, jid, pin::WORLD, jdV[jid], t2_);
+      has_jv[jid] = 1;
+    }
+    return jdV[jid];
   }
 
   // world-axes (LOCAL_WORLD_ALIGNED) frame velocity V = J x and dV/dq at fixed x (FramePass.velocity);
-  // R: the frame's rotation at q, Jw: its world angular Jacobian (3 x n)
-  void velocity(const pin::Model& model, pin::FrameIndex fid, const Matrix3d& R, const Matrix3x& Jw) {
+  // oMf: the frame's placement at q, J: its LOCAL_WORLD_ALIGNED Jacobian at q (6 x n)
+  void velocity(const pin::Model& model, pin::FrameIndex fid, const pin::SE3& oMf, const Matrix6x& J) {
     if (has_vel[fid]) return;
-    const int n = model.nv;
-    t1_.setZero(6, n);
-    t2_.setZero(6, n);
-    pin::getFrameVelocityDerivatives(model, data, fid, pin::LOCAL, t1_, t2_);
-    const pin::Motion local = pin::getFrameVelocity(model, data, fid, pin::LOCAL);
-    const Vector3d lin = R * local.linear(), ang = R * local.angular();
-    V[fid] << lin, ang;
-    dV[fid].resize(6, n);
-    dV[fid].topRows<3>() = R * t1_.topRows<3>() + rot_dq(lin, Jw);
-    dV[fid].bottomRows<3>() = R * t1_.bottomRows<3>() + rot_dq(ang, Jw);
+    const pin::JointIndex jid = model.frames[fid].parentJoint;
+    const Matrix6x& jd = joint_velocity_dq(model, jid);
+    const pin::Motion& ov = data.ov[jid];
+    const Vector3d p = oMf.translation(), w = ov.angular();
+    const Vector3d vp = ov.linear() + w.cross(p);
+    V[fid] << vp, w;
+    dV[fid].resize(6, model.nv);
+    dV[fid].topRows<3>() = jd.topRows<3>() - skew3(p) * jd.bottomRows<3>() + skew3(w) * J.topRows<3>();
+    dV[fid].bottomRows<3>() = jd.bottomRows<3>();
     has_vel[fid] = 1;
   }
 
   // world-axes classical acceleration at vdot = 0 and its q-derivative at fixed x (FramePass.acceleration)
-  void acceleration(const pin::Model& model, pin::FrameIndex fid, const Matrix3d& R, const Matrix3x& Jw) {
+  void acceleration(const pin::Model& model, pin::FrameIndex fid, const pin::SE3& oMf, const Matrix6x& J) {
     if (has_acc[fid]) return;
-    const int n = model.nv;
-    t1_.setZero(6, n);  // v_partial_dq (LOCAL)
-    t2_.setZero(6, n);  // a_partial_dq
-    t3_.setZero(6, n);  // a_partial_dv
-    t4_.setZero(6, n);  // a_partial_da
-    pin::getFrameAccelerationDerivatives(model, data, fid, pin::LOCAL, t1_, t2_, t3_, t4_);
-    const pin::Motion vl = pin::getFrameVelocity(model, data, fid, pin::LOCAL);
-    const pin::Motion al = pin::getFrameAcceleration(model, data, fid, pin::LOCAL);
-    const Vector3d v = vl.linear(), w = vl.angular();
-    const Vector3d lin = al.linear() + w.cross(v);
-    const Matrix3x lin_dq = t2_.topRows<3>() + cross_d(w, t1_.bottomRows<3>(), v, t1_.topRows<3>());
-    const Vector3d Rlin = R * lin, Rang = R * al.angular();
-    Acc[fid] << Rlin, Rang;
-    dAcc[fid].resize(6, n);
-    dAcc[fid].topRows<3>() = R * lin_dq + rot_dq(Rlin, Jw);
-    dAcc[fid].bottomRows<3>() = R * t2_.bottomRows<3>() + rot_dq(Rang, Jw);
+    if (!accelerations) throw std::logic_error("frame pass without accelerations");
+    velocity(model, fid, oMf, J);
+    const pin::JointIndex jid = model.frames[fid].parentJoint;
+    if (!has_ja[jid]) {
+      const int n = model.nv;
+      t1_.setZero(6, n);
+      jdA[jid].setZero(6, n);
+      t3_.setZero(6, n);
+      t4_.setZero(6, n);
+      pin::getJointAccelerationDerivatives(model, data, jid, pin::WORLD, t1_, jdA[jid], t3_, t4_);
+      has_ja[jid] = 1;
+    }
+    const Matrix6x& ja = jdA[jid];
+    const pin::Motion& oa = data.oa[jid];
+    const Vector3d p = oMf.translation(), w = data.ov[jid].angular(), al = oa.angular();
+    const Vector3d vp = V[fid].head<3>();
+    Acc[fid] << oa.linear() + al.cross(p) + w.cross(vp), al;
+    dAcc[fid].resize(6, model.nv);
+    dAcc[fid].topRows<3>() = ja.topRows<3>() - skew3(p) * ja.bottomRows<3>() + skew3(al) * J.topRows<3>() +
+                             skew3(w) * dV[fid].topRows<3>() - skew3(vp) * dV[fid].bottomRows<3>();
+    dAcc[fid].bottomRows<3>() = ja.bottomRows<3>();
     has_acc[fid] = 1;
   }
 
@@ -113,14 +146,9 @@ struct FramePass {
   }
 
   // world angular velocity of a joint's body and its q-derivative at fixed x (the motors' reaction terms)
-  void joint_angular(const pin::Model& model, pin::JointIndex jid, const Matrix3d& R, const Matrix3x& Jw,
-                     Vector3d& w, Matrix3x& dw) {
-    const int n = model.nv;
-    t1_.setZero(6, n);
-    t2_.setZero(6, n);
-    pin::getJointVelocityDerivatives(model, data, jid, pin::LOCAL, t1_, t2_);
-    w = R * data.v[jid].angular();
-    dw = R * t1_.bottomRows<3>() + rot_dq(w, Jw);
+  void joint_angular(const pin::Model& model, pin::JointIndex jid, Vector3d& w, Matrix3x& dw) {
+    w = data.ov[jid].angular();
+    dw = joint_velocity_dq(model, jid).bottomRows<3>();
   }
 };
 

@@ -64,7 +64,7 @@ struct ReducedDerivatives {
         const auto& g = ev.geo_[i];
         const int fid = ev.frames_[wh.frame];
         const auto& J = ev.Jf_[wh.frame];
-        fp.velocity(model, fid, ev.data_.oMf[fid].rotation(), J.template bottomRows<3>());
+        fp.velocity(model, fid, ev.data_.oMf[fid], J);
         const double xR = wh.radius_index >= 0 ? fp.x[wh.radius_index] : 0.0;
         const int nd = static_cast<int>(wh.D.rows());
         derivs::wheel_velocity_dq(g, ev.deriv_.geo[i], MatrixXd(wh.D), fp.V[fid], fp.dV[fid], xR,
@@ -115,8 +115,8 @@ struct ReducedDerivatives {
     for (const auto& c : ev.closures_)
       for (int f : {c.f1, c.f2}) {
         const int fid = ev.frames_[f];
-        fp.velocity(model, fid, ev.data_.oMf[fid].rotation(), ev.Jf_[f].template bottomRows<3>());
-        if (accelerations) fp.acceleration(model, fid, ev.data_.oMf[fid].rotation(), ev.Jf_[f].template bottomRows<3>());
+        fp.velocity(model, fid, ev.data_.oMf[fid], ev.Jf_[f]);
+        if (accelerations) fp.acceleration(model, fid, ev.data_.oMf[fid], ev.Jf_[f]);
       }
   }
 
@@ -132,9 +132,7 @@ struct ReducedDerivatives {
         const auto& g = ev.geo_[i];
         const int fid = ev.frames_[wh.frame];
         const auto& J = ev.Jf_[wh.frame];
-        const Matrix3d R = ev.data_.oMf[fid].rotation();
-        fp.velocity(model, fid, R, J.template bottomRows<3>());
-        fp.acceleration(model, fid, R, J.template bottomRows<3>());
+        fp.acceleration(model, fid, ev.data_.oMf[fid], J);
         fp.jacobian_dot(model, fid, ws.dJ1);
         const int nd = static_cast<int>(wh.D.rows());
         derivs::wheel_drift_dq(g, ws.geo[i], MatrixXd(wh.D), ev.terrain_, ev.terrain_.flat(), J, wh.radius_index, fp.x,
@@ -200,7 +198,7 @@ struct ReducedDerivatives {
     ws.dA.resize(k + 2);
     for (int l = 0; l < k + 2; ++l) {
       derivs::FramePass& fp = ws.passes[l];
-      fp.run(model, ev.q_, l < k ? VectorXd(S.col(l)) : l == k ? w : v, model.frames.size());
+      fp.run(model, ev.q_, l < k ? VectorXd(S.col(l)) : l == k ? w : v, l == k + 1);
       prepare(ev, fp, l == k + 1);
       velocity_dq(ev, fp, ws.dA[l]);
     }
@@ -273,15 +271,13 @@ struct ReducedDerivatives {
       }
       const Eigen::Vector3d axis = Jw.col(mo.index);
       const derivs::Matrix3x daxis = -derivs::skew3(axis) * Jw;
-      const Matrix3d Rc = ev.data_.oMi[jid].rotation();
       const int rf = ev.frames_[mo.reaction];
-      const Matrix3d Rr = ev.data_.oMf[rf].rotation();
       for (int l = 0; l < k; ++l) {
         derivs::FramePass& fp = ev.deriv_.passes[l];
         Eigen::Vector3d wc;
         derivs::Matrix3x dwc;
-        fp.joint_angular(model, jid, Rc, Jw, wc, dwc);
-        fp.velocity(model, rf, Rr, ev.Jf_[mo.reaction].template bottomRows<3>());
+        fp.joint_angular(model, jid, wc, dwc);
+        fp.velocity(model, rf, ev.data_.oMf[rf], ev.Jf_[mo.reaction]);
         const Eigen::Vector3d wr = fp.V[rf].template tail<3>();
         const derivs::Matrix3x dwr = fp.dV[rf].template bottomRows<3>();
         G.row(l) -= tau[j] * (axis.transpose() * (dwc - dwr) + (wc - wr).transpose() * daxis);

@@ -1,30 +1,40 @@
-// robotdyn._compiled: the reduced model evaluated in one compiled call (see robotdyn/compiled.py).
+// robotdyn._compiled: the reduced model evaluated in one compiled call (see robotdyn/fast/compiled.py).
 //
-// Same formulas as the Python reference, in the same order:
-//   rolling contact             robotdyn/rolling_contact.py (per wheel), robotdyn/wheel_group.py (fast path)
-//   terrains                    robotdyn/terrain.py (plane/ramp, sine, bump)
-//   loop closures               robotdyn/loop_closure.py
-//   joint couplings             robotdyn/joint_coupling.py (cosine laws)
-//   projection                  robotdyn/projection.py (_build: S = P [I; -Ad^-1 Ai], w = -Ad^-1 drift)
-//   operational velocities      robotdyn/operational_space.py (K = [A_r; J_o], K S = [0; I])
-//   motors                      robotdyn/actuation.py
-//   dynamics                    robotdyn/reduced_dynamics.py (M_r = S^T M S, h = S^T RNEA(q, S nu, w), here
-//                               S^T (C v + g + M w): two Pinocchio passes per state, CRBA (M, g from its
-//                               composite inertias) and RNEA without gravity (C v, and the drift's accelerations))
+// This file is the Evaluator's orchestration and its Python bindings. The formulas are the kernels under
+// robotdyn/kernels/, one header per constraint kind or reduction step, each named like its Python reference and
+// opening with its formulas (the same formulas in the same order of operations as the Python path):
+//   kernels/terrain.hpp            constraints/terrain.py (plane/ramp, sine, bump)
+//   kernels/rolling_contact.hpp    constraints/rolling_contact.py (a wheel's geometry, rows, residual, drift)
+//   kernels/loop_closure.hpp       constraints/loop_closure.py
+//   kernels/joint_coupling.hpp     constraints/joint_coupling.py (cosine laws)
+//   kernels/actuation.hpp          reduction/actuation.py (the motors' B)
+//   kernels/projection.hpp         reduction/projection.py (_build: S = P [I; -Ad^-1 Ai], w = -Ad^-1 drift)
+//   kernels/operational_space.hpp  reduction/operational_space.py (K = [A_r; J_o], K S = [0; I])
+//   kernels/reduced_dynamics.hpp   reduction/reduced_dynamics.py (M_r = S^T M S, h = S^T RNEA(q, S nu, w), here
+//                                  S^T (C v + g + M w): two Pinocchio passes per state, CRBA (M, g from its
+//                                  composite inertias) and RNEA without gravity (C v, and the drift's accelerations))
+//   kernels/pull_back.hpp          reduction/pull_back.py
+//   kernels/contact_forces.hpp     contact/contact_forces.py (lambda on the projection's rows, wheel forces)
+//   kernels/rigid_limit.hpp        contact/rigid_limit.py (the loads rigid-body dynamics leave open)
+//   kernels/sliding.hpp            contact/sliding.py and contact/friction.py (slipping wheels, friction laws)
+//   kernels/lu_solve.hpp           LU substitutions and LAPACK's 1-norm condition estimate (used by the above)
 // The rigid-body algorithms are Pinocchio's (header-only use of the installed Pinocchio 4), on a copy of the
-// robot's Pinocchio model rebuilt joint by joint; tests/test_compiled.py checks every output against the Python
+// robot's Pinocchio model rebuilt joint by joint; tests/test_compiled*.py check every output against the Python
 // path on every robot.
-#include <pinocchio/multibody.hpp>
-#include <pinocchio/algorithm/model.hpp>
-#include <pinocchio/algorithm/crba.hpp>
-#include <pinocchio/algorithm/rnea.hpp>
-#include <pinocchio/algorithm/jacobian.hpp>
-#include <pinocchio/algorithm/kinematics.hpp>
-#include <pinocchio/algorithm/frames.hpp>
-
-#include <Eigen/QR>
-#include <Eigen/SVD>
-
+#include "kernels/common.hpp"
+#include "kernels/terrain.hpp"
+#include "kernels/rolling_contact.hpp"
+#include "kernels/loop_closure.hpp"
+#include "kernels/joint_coupling.hpp"
+#include "kernels/actuation.hpp"
+#include "kernels/lu_solve.hpp"
+#include "kernels/projection.hpp"
+#include "kernels/operational_space.hpp"
+#include "kernels/reduced_dynamics.hpp"
+#include "kernels/pull_back.hpp"
+#include "kernels/contact_forces.hpp"
+#include "kernels/rigid_limit.hpp"
+#include "kernels/sliding.hpp"
 #include "_integrator.hpp"
 #include "_torque_profile.hpp"
 #include "_controller.hpp"
@@ -48,130 +58,10 @@
 #include <vector>
 
 namespace py = pybind11;
-namespace pin = pinocchio;
-using Eigen::Matrix3d;
-using Eigen::MatrixXd;
-using Eigen::Vector3d;
-using Eigen::VectorXd;
-using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-using Matrix6x = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+namespace kernels = robotdyn::kernels;
+using namespace robotdyn::kernels;  // pin, the Eigen names, RowMat, Matrix6x and the kernels
 
 namespace {
-
-// A failure the Python side handles by falling back to the reference path (which raises the proper error).
-struct Fallback : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-struct Wheel {
-  int frame;       // index into Evaluator::frames
-  Vector3d axis;   // axle in the wheel frame (unit)
-  double radius;   // m (plus q[radius_index] when radius_index >= 0)
-  int radius_index;
-  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3> D;  // (nd, 3) rows as coefficients of (t1, t2, n)
-};
-
-// A wheel whose tangential force follows a friction law (robotdyn/sliding.py, robotdyn/friction.py): F_t = -f_n c(s)
-// on its free directions (t1, t2), with the law
-//   0 RegularisedCoulomb   c = p0 s / sqrt(|s|^2 + p1^2)          (p0 = mu, p1 = slip velocity [m/s])
-//   1 LinearTyre           c = p0 s if p0 |s| <= p1, else p1 s/|s|  (p0 = stiffness [s/m], p1 = mu, inf allowed)
-struct Slip {
-  int wheel;       // index into Evaluator::wheels_
-  int normal_row;  // its normal row (index into the stacked rows)
-  int law;
-  double p0, p1;
-  Eigen::Vector2d free;  // 1: the direction follows the law, 0: it rolls (its no-slip row stays a constraint)
-};
-
-// The slipping wheels' contact problem cannot be solved here: kind 0 singular (Painleve; value: its 2-norm
-// condition number), kind 1 a slipping wheel's normal row is not among the projection's rows (value: the slip's
-// index). The Python side raises the reference path's error from it (robotdyn/compiled_simulation.py).
-struct SlipError : std::runtime_error {
-  SlipError(int kind_, double value_)
-      : std::runtime_error(kind_ == 0 ? "singular slipping contact problem" : "slipping wheel's normal row redundant"),
-        kind(kind_), value(value_) {}
-  int kind;
-  double value;
-};
-
-struct Coupling {  // q[i] = amplitude cos(rate q[j] + phase) + offset
-  int i, j;
-  double amplitude, rate, phase, offset;
-};
-
-// z = f(x, y): 0 plane h + gx x + gy y; 1 sine a sin(kx x + ky y + phase); 2 smooth step(s) (tanh), as terrain.py
-struct Terrain {
-  int kind = 0;
-  double c[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
-  bool flat() const { return kind == 0; }
-  void step(double x, double x0, double& f, double& fx, double& fxx) const {
-    const double h = c[0], w = c[2];
-    const double t = std::tanh((x - x0) / w), s = 1.0 - t * t;
-    f = 0.5 * h * (1 + t);
-    fx = 0.5 * h * s / w;
-    fxx = -h * t * s / (w * w);
-  }
-  // height, gradient and Hessian at (x, y)
-  void eval(double x, double y, double& f, Eigen::Vector2d& g, Eigen::Matrix2d& H) const {
-    if (kind == 0) {
-      f = c[0] + c[1] * x + c[2] * y;
-      g << c[1], c[2];
-      H.setZero();
-    } else if (kind == 1) {
-      const double arg = c[1] * x + c[2] * y + c[3];
-      f = c[0] * std::sin(arg);
-      const double co = c[0] * std::cos(arg);
-      g << co * c[1], co * c[2];
-      const double si = -c[0] * std::sin(arg);
-      H << si * c[1] * c[1], si * c[1] * c[2], si * c[2] * c[1], si * c[2] * c[2];
-    } else {
-      double fx, fxx;
-      step(x, c[1], f, fx, fxx);
-      if (!std::isnan(c[3])) {
-        double f2, fx2, fxx2;
-        step(x, c[1] + c[3], f2, fx2, fxx2);
-        f -= f2;
-        fx -= fx2;
-        fxx -= fxx2;
-      }
-      g << fx, 0.0;
-      H << fxx, 0.0, 0.0, 0.0;
-    }
-  }
-  Vector3d normal(double x, double y) const {
-    double f;
-    Eigen::Vector2d g;
-    Eigen::Matrix2d H;
-    eval(x, y, f, g, H);
-    Vector3d m(-g[0], -g[1], 1.0);
-    return m / m.norm();
-  }
-};
-
-struct Closure {
-  int f1, f2;              // indices into Evaluator::frames
-  std::vector<int> select; // components 0..5 (x y z rx ry rz) in frame 1's axes
-};
-
-struct Motor {
-  int index;     // velocity index of the driven joint
-  int joint;     // joint id
-  int reaction;  // index into frames, -1: the joint's parent (a unit column)
-};
-
-struct Geometry {  // configuration-level quantities of one wheel
-  Vector3d a, u, n, t1, t2;
-  Matrix3d N;  // dn/dp on a curved terrain
-  double na, nw, nc1, R;
-  Vector3d p;  // contact point (world)
-  int row;     // the wheel's first row
-};
-
-inline Matrix3d skew(const Vector3d& x) {
-  Matrix3d m;
-  m << 0.0, -x[2], x[1], x[2], 0.0, -x[0], -x[1], x[0], 0.0;
-  return m;
-}
 
 class Evaluator {
   template <class> friend struct robotdyn::ReducedDerivatives;  // kernels/reduced_dynamics_derivatives.hpp
@@ -270,7 +160,7 @@ class Evaluator {
 
   int nv() const { return nv_; }
   double condition() const { return cond_; }
-  py::tuple slip_condition() const { return py::make_tuple(slip_kappa1_, slip_kappa2_); }
+  py::tuple slip_condition() const { return py::make_tuple(slip_.kappa1, slip_.kappa2); }
   int nrows() const { return static_cast<int>(holonomic_.size()); }
   int mobility() const {
     return operational_ ? static_cast<int>(op_select_.size()) : static_cast<int>(independent_.size());
@@ -296,12 +186,7 @@ class Evaluator {
     // one pass: placements, world joint Jacobians, M (upper triangle) and the subtrees' composite inertias, from
     // which g_k = -J_k^T (Y_subtree(k) * gravity): the torque that holds the subtree's weight
     pin::crba(model_, data_, q_, pin::Convention::WORLD);
-    g_.resize(nv_);
-    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) {
-      const int col = model_.joints[i].idx_v();
-      const pin::Force weight = data_.oYcrb[i] * gravity_;
-      g_[col] = -(data_.J.col(col).head<3>().dot(weight.linear()) + data_.J.col(col).tail<3>().dot(weight.angular()));
-    }
+    gravity_torques(model_, data_, gravity_, nv_, g_);
     pin::updateFramePlacements(model_, data_);
     const int m = nrows();
     A_.setZero(m, nv_);
@@ -316,25 +201,7 @@ class Evaluator {
     int row = 0;
     for (const auto& [kind, i] : order_)
       row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
-    B_.setZero(nv_, motors_.size());
-    for (size_t j = 0; j < motors_.size(); ++j) {
-      const Motor& mo = motors_[j];
-      if (mo.reaction < 0) {
-        B_(mo.index, j) = 1.0;
-        continue;
-      }
-      // the joint's angular Jacobian is CRBA's world one (data_.J) on its supporting joints' columns (an angular
-      // velocity does not depend on the reference point), so no Jacobian of the joint is assembled; a prismatic
-      // joint's column is its axis in either convention
-      const Vector3d ang = data_.J.col(mo.index).tail<3>();
-      const Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(data_.J.col(mo.index).head<3>());
-      B_.col(j).noalias() = -(Jf_[mo.reaction].bottomRows<3>().transpose() * axis);
-      for (const pin::JointIndex s : model_.supports[mo.joint]) {
-        if (s == 0) continue;
-        const int c0 = model_.joints[s].idx_v();
-        for (int c = c0; c < c0 + model_.joints[s].nv(); ++c) B_(c, j) += data_.J.col(c).tail<3>().dot(axis);
-      }
-    }
+    motor_columns(motors_, model_, data_, Jf_, nv_, B_);
     project();
   }
 
@@ -351,27 +218,12 @@ class Evaluator {
     for (const auto& [kind, i] : order_)
       row = kind == 0 ? wheel_drift(i, row) : kind == 1 ? closure_drift(i, row) : coupling_drift(i, row);
     w_.setZero(nv_);
-    const int nr = static_cast<int>(rows_.size());
-    if (operational_) {
-      rhs_.resize(nv_);
-      for (int r = 0; r < nr; ++r) rhs_[r] = drift_[rows_[r]];
-      operational_drift(rhs_);
-      w_.noalias() = -Kinv_ * rhs_;
-    } else if (nr) {
-      rhs_.resize(nr);
-      for (int r = 0; r < nr; ++r) rhs_[r] = drift_[rows_[r]];
-      lu_solve(lu_, rhs_);
-      wd_ = -rhs_;
-      for (int r = 0; r < nr; ++r) w_[dependent_[r]] = wd_[r];
-    }
-    data_.M.triangularView<Eigen::StrictlyLower>() = data_.M.transpose().triangularView<Eigen::StrictlyLower>();
-    SM_.noalias() = data_.M.lazyProduct(S_);
-    Mr_.noalias() = S_.transpose().lazyProduct(SM_);
-    gr_.noalias() = S_.transpose() * g_;
-    data_.tau += g_;
-    hr_.noalias() = S_.transpose() * data_.tau;
-    hr_.noalias() += SM_.transpose() * w_;
-    Br_.noalias() = S_.transpose().lazyProduct(B_);
+    if (operational_)
+      drift_acceleration_operational(drift_, rows_, op_select_, model_, data_, frames_[op_frame_], op_local_, nv_,
+                                     Kinv_, rhs_, w_);
+    else
+      drift_acceleration_selection(drift_, rows_, dependent_, lu_, lus_, rhs_, wd_, w_);
+    reduce(data_.M, S_, g_, data_.tau, w_, B_, SM_, Mr_, hr_, gr_, Br_);
   }
 
   py::tuple evaluate(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
@@ -435,98 +287,23 @@ class Evaluator {
   }
 
   // ------------------------------------------------------------------------------------------ slipping wheels
-  // c(s) of a slipping wheel's law on its free directions (FrictionLaw.coefficient, SlippingWheel.
-  // friction_coefficient), in the Python formulas' order of operations.
-  static Eigen::Vector2d coefficient(const Slip& sl, const Eigen::Vector2d& slip) {
-    const Eigen::Vector2d s = slip.cwiseProduct(sl.free);
-    Eigen::Vector2d c;
-    if (sl.law == 0) {
-      c = sl.p0 * s / std::sqrt(s.dot(s) + sl.p1 * sl.p1);
-    } else {
-      const double speed = std::sqrt(s.dot(s));
-      c = speed * sl.p0 <= sl.p1 ? Eigen::Vector2d(sl.p0 * s) : Eigen::Vector2d(sl.p1 * s / speed);
-    }
-    return c.cwiseProduct(sl.free);
-  }
-
-  // d/dt of (q, nu, W) with slipping wheels (robotdyn/sliding.py forward): the accelerations and the normal loads
-  // from one linear system
-  //   [M S,  -(A_R^T - sum_i J_t,i^T c_i e_i^T)] [nudot; lambda] = B tau - RNEA(q, v, w),
-  // A_R the projection's rows, J_t,i = (t1, t2)^T A_w,i the tangential rows of slipping wheel i, s_i = J_t,i v its
-  // slip velocity, c_i = c(s_i), e_i selecting its normal load; W-dot = sum_i F_i . s_i, F_i = -f_n,i c_i (the
-  // friction power). The system's 2-norm condition number above 1e12 is the Painleve case (SlipError 0), decided
-  // as numpy.linalg.cond would: LAPACK's 1-norm estimate from the LU factors clears regular states, the singular
-  // values decide near the threshold (the rule below). Leaves the normal loads in slip_normal_ and their minimum
-  // (the lift-off event's value) in slip_min_, the condition numbers of the test in slip_kappa1_, slip_kappa2_.
+  // d/dt of (q, nu, W) with slipping wheels (robotdyn/contact/sliding.py forward; kernels/sliding.hpp): the
+  // accelerations and the normal loads from one linear system, W-dot the friction power. Leaves the normal loads
+  // and their minimum (the lift-off event's value) and the Painleve test's condition numbers in slip_.
   void slip_rhs_into(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                      const Eigen::Ref<const VectorXd>& tau, double alpha, Eigen::Ref<VectorXd> out) {
     configure(q);
     dynamics(nu);
     const int k = static_cast<int>(S_.cols());
     const int nr = static_cast<int>(rows_.size());
-    const int nw = static_cast<int>(slips_.size());
     if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
     if (out.size() != nv_ + k + 1) throw std::invalid_argument("state has the wrong length");
     if (k + nr != nv_) throw Fallback("rows and independent velocities do not make a square system");
-    Ks_.resize(nv_, nv_);
-    Ks_.leftCols(k) = SM_;  // M S (dynamics)
-    for (int r = 0; r < nr; ++r) Ks_.col(k + r) = -A_.row(rows_[r]).transpose();
-    slip_pos_.resize(nw);
-    slip_s_.resize(nw, 2);
-    slip_c_.resize(nw, 2);
-    Jt_.resize(2, nv_);
-    for (int i = 0; i < nw; ++i) {
-      const Slip& sl = slips_[i];
-      const auto hit = std::find(rows_.begin(), rows_.end(), sl.normal_row);
-      if (hit == rows_.end()) throw SlipError(1, i);
-      slip_pos_[i] = static_cast<int>(hit - rows_.begin());
-      const Geometry& g = geo_[sl.wheel];
-      Jt_.row(0).noalias() = g.t1.transpose() * Aw_[sl.wheel];
-      Jt_.row(1).noalias() = g.t2.transpose() * Aw_[sl.wheel];
-      const Eigen::Vector2d s = Jt_ * v_;
-      const Eigen::Vector2d c = coefficient(sl, s);
-      slip_s_.row(i) = s.transpose();
-      slip_c_.row(i) = c.transpose();
-      Ks_.col(k + slip_pos_[i]).noalias() += Jt_.transpose() * c;
-    }
-    bs_.noalias() = B_ * tau;
-    bs_ -= data_.tau;  // C v + g (dynamics)
-    bs_.noalias() -= data_.M * w_;
-    slip_lu_.compute(Ks_);
-    // Painleve test, the decision of the Python path's np.linalg.cond(K) > 1e12 (2-norm) without an O(n^3) inverse
-    // or SVD at regular states. From the LU factors just computed, LAPACK's O(n^2) estimate e of ||K^-1||_1 (the
-    // projection's estimator, inverse_norm_estimate) gives kappa_1 ~ ||K||_1 e. For n x n matrices
-    // kappa_2 <= n kappa_1, and e <= ||K^-1||_1 underestimates by a small factor in practice (the projection
-    // counts on 100: its estimate decides below 1e8 against its bound 1e10). So:
-    //   n ||K||_1 e <= 1e12 / 100  ->  regular, no further work (kappa_2 <= 1e12 unless e underestimates by > 100);
-    //   otherwise (near the threshold, beyond it, or NaN / inf from a zero pivot) the singular values decide,
-    //   exactly as numpy.linalg.cond does (kappa_2 = s_max / s_min, singular above 1e12 or not finite), and give
-    //   the value the Python path reports.
-    // The band [1e10 / n, 1e12] of estimates that pay for the SVD is a factor 100 n wide: only a state near
-    // Painleve pays there.
-    slip_kappa1_ = Ks_.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm_estimate(slip_lu_);
-    slip_kappa2_ = std::numeric_limits<double>::quiet_NaN();  // (not computed)
-    if (!(nv_ * slip_kappa1_ <= 1e12 / 100)) {  // NaN too
-      slip_svd_.compute(Ks_);
-      const VectorXd& sv = slip_svd_.singularValues();
-      const double cond = sv[0] / sv[sv.size() - 1];
-      slip_kappa2_ = std::isnan(cond) ? HUGE_VAL : cond;
-      if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, slip_kappa2_);
-    }
-    xs_ = slip_lu_.solve(bs_);
+    slip_.solve(slips_, rows_, A_, SM_, geo_, Aw_, v_, B_, tau, data_.tau, data_.M, w_, nv_, k, lus_);
     out.head(nv_) = v_;
     if (alpha != 0.0) pull_back(alpha, out);
-    out.segment(nv_, k) = xs_.head(k);
-    slip_normal_.resize(nw);
-    double power = 0.0;
-    slip_min_ = HUGE_VAL;
-    for (int i = 0; i < nw; ++i) {
-      const double fn = xs_[k + slip_pos_[i]];
-      slip_normal_[i] = fn;
-      slip_min_ = std::min(slip_min_, fn);
-      power += -fn * slip_c_(i, 0) * slip_s_(i, 0) + -fn * slip_c_(i, 1) * slip_s_(i, 1);
-    }
-    out[nv_ + k] = power;
+    out.segment(nv_, k) = slip_.x.head(k);
+    out[nv_ + k] = slip_.power;
   }
 
   // (d/dt (q, nu, W), normal loads (W,), slip velocities (W, 2), friction forces (W, 2)) at one state: the compiled
@@ -537,8 +314,8 @@ class Evaluator {
     VectorXd out(nv_ + nu.size() + 1);
     slip_rhs_into(q, nu, tau, alpha, out);
     RowMat force(slips_.size(), 2);
-    for (size_t i = 0; i < slips_.size(); ++i) force.row(i) = -slip_normal_[i] * slip_c_.row(i);
-    return py::make_tuple(out, slip_normal_, RowMat(slip_s_), force);
+    for (size_t i = 0; i < slips_.size(); ++i) force.row(i) = -slip_.normal[i] * slip_.c.row(i);
+    return py::make_tuple(out, slip_.normal, RowMat(slip_.s), force);
   }
 
   // ------------------------------------------------------------------------------------------ feedback laws
@@ -633,7 +410,7 @@ class Evaluator {
     }
     event_t_ = t;  // the lift-off event's value at this state (lift_off reuses it)
     event_y_ = y;
-    event_g_ = slip_min_;
+    event_g_ = slip_.min_normal;
   }
 
   // The lift-off event: the smallest normal load of the slipping wheels at (t, y) [N] (from the last evaluation
@@ -671,20 +448,8 @@ class Evaluator {
   // reports the others with the null space of A^T). After dynamics() (forward: nudot from the torques) or with a
   // given full acceleration a (forces_at).
   void lambda_from(const Eigen::Ref<const VectorXd>& tau) {
-    force_.noalias() = B_ * tau;
-    e_ -= force_;
-    lambda_.setZero(nrows());
-    const int nr = static_cast<int>(rows_.size());
-    if (!nr) return;
-    if (operational_) {  // K = [A_r; J_o] with K S = [0; I]: K^T (lambda_r, 0) = e, so lambda_r = (K^-T e)_head
-      lr_.noalias() = Kinv_.transpose() * e_;
-      lr_.conservativeResize(nr);
-    } else {
-      lr_.resize(nr);
-      for (int r = 0; r < nr; ++r) lr_[r] = e_[dependent_[r]];
-      lu_solve_transposed(lu_, lr_);
-    }
-    for (int r = 0; r < nr; ++r) lambda_[rows_[r]] = lr_[r];
+    constraint_multipliers(B_, tau, force_, e_, rows_, dependent_, operational_, Kinv_, lu_, lus_, nrows(), lr_,
+                           lambda_);
   }
 
   // Forward dynamics at (q, nu, tau) and the constraint forces, into buffers read through the views nudot, lam,
@@ -738,113 +503,18 @@ class Evaluator {
   // least-distance program) is the Python path's: Fallback. Nothing happens without redundant rows, where a row acts
   // on no coordinate (a planar root's normal rows), or with the split turned off (set_rigid_limit(false)).
   void rigid_limit_split() {
-    const int m = nrows();
-    const int nw = static_cast<int>(wheels_.size());
-    if (!rigid_limit_ || static_cast<int>(rows_.size()) >= m || nw == 0 || m == 0) return;
-    const double scale = std::max(1.0, A_.cwiseAbs().maxCoeff());
-    for (int r = 0; r < m; ++r)
-      if (A_.row(r).cwiseAbs().maxCoeff() <= 1e-12 * scale) return;
-    const int nr = static_cast<int>(rows_.size());
-    int d;
-    if (!operational_) {
-      // a basis of null(A^T) from the projection's own LU of A_d: each row j outside the projection's choice is
-      // A_j = c^T A_R with A_d^T c = (A_j on the dependent columns), so e_j - sum_r c_r e_{rows_r} is in null(A^T)
-      d = m - nr;
-      rl_N_.setZero(m, d);
-      rl_in_.assign(m, false);
-      for (int r = 0; r < nr; ++r) rl_in_[rows_[r]] = true;
-      int col = 0;
-      for (int j = 0; j < m; ++j) {
-        if (rl_in_[j]) continue;
-        rl_c_.resize(nr);
-        for (int r = 0; r < nr; ++r) rl_c_[r] = A_(j, dependent_[r]);
-        lu_solve_transposed(lu_, rl_c_);
-        rl_N_(j, col) = 1.0;
-        for (int r = 0; r < nr; ++r) rl_N_(rows_[r], col) = -rl_c_[r];
-        ++col;
-      }
-    } else {
-      rl_qr_.setThreshold(std::max(m, nv_) * std::numeric_limits<double>::epsilon());
-      rl_qr_.compute(A_);
-      d = m - static_cast<int>(rl_qr_.rank());
-      if (d <= 0) return;
-      rl_Q_ = rl_qr_.householderQ();
-      rl_N_ = rl_Q_.rightCols(d);
-    }
-    rl_P_.setZero(nw, d);
-    rl_n0_.setZero(nw);
-    for (int i = 0; i < nw; ++i) {
-      const Wheel& wh = wheels_[i];
-      const int row = geo_[i].row;
-      for (int r = 0; r < wh.D.rows(); ++r) {
-        const double c = wh.D(r, 2);
-        if (c == 0.0) continue;
-        rl_P_.row(i) += c * rl_N_.row(row + r);
-        rl_n0_[i] += c * lambda_[row + r];
-      }
-    }
-    rl_svd_.compute(rl_P_, Eigen::ComputeFullV);
-    const VectorXd& sv = rl_svd_.singularValues();
-    int p = 0;
-    while (p < sv.size() && sv[p] > 1e-9) ++p;
-    if (p == 0) return;
-    const MatrixXd& V = rl_svd_.matrixV();
-    if (rl_rk_.size() != nw) rl_rk_.setOnes(nw);  // 1 / sqrt(k) (set_normal_stiffness; equal without it)
-    rl_G_.noalias() = rl_P_ * V.leftCols(p);
-    rl_W_.noalias() = rl_rk_.asDiagonal() * rl_G_;
-    rl_H_.noalias() = rl_W_.transpose() * rl_W_;
-    rl_y_.noalias() = rl_W_.transpose() * rl_rk_.cwiseProduct(rl_n0_);
-    rl_llt_.compute(rl_H_);
-    rl_llt_.solveInPlace(rl_y_);
-    rl_y_ = -rl_y_;
-    rl_n_ = rl_n0_;
-    rl_n_.noalias() += rl_G_ * rl_y_;
-    const double big = std::max(rl_n0_.cwiseAbs().maxCoeff(), rl_n_.cwiseAbs().maxCoeff());
-    if (!rl_y_.allFinite()) throw Fallback("the rigid limit's split is not finite here");
-    if (rl_n_.minCoeff() < -1e-9 * big)
-      throw Fallback("a wheel would pull: the rigid limit's no-pull split is solved on the Python path");
-    rl_saved_ = lambda_;
-    rl_z_.noalias() = V.leftCols(p) * rl_y_;
-    lambda_.noalias() += rl_N_ * rl_z_;
-    if (d > p) {  // minimum norm along the open directions N V_o (Gram-Schmidt: N need not be orthonormal)
-      rl_O_.noalias() = rl_N_ * V.rightCols(d - p);
-      for (int c = 0; c < d - p; ++c) {
-        for (int b = 0; b < c; ++b) rl_O_.col(c) -= rl_O_.col(b).dot(rl_O_.col(c)) * rl_O_.col(b);
-        rl_O_.col(c) /= rl_O_.col(c).norm();
-      }
-      rl_t_.noalias() = rl_O_.transpose() * lambda_;
-      lambda_.noalias() -= rl_O_ * rl_t_;
-    }
-    rl_w_ = rl_N_.rowwise().squaredNorm();  // (a row's weight in null(A^T) is zero in every basis)
-    for (int r = 0; r < m; ++r)
-      if (rl_w_[r] <= 1e-16) lambda_[r] = rl_saved_[r];
+    rigid_.split(A_, rows_, dependent_, operational_, lu_, lus_, wheels_, geo_, nv_, lambda_);
   }
   void set_normal_stiffness(const Eigen::Ref<const VectorXd>& k) {
     if (k.size() != static_cast<Eigen::Index>(wheels_.size())) throw std::invalid_argument("one stiffness per wheel");
     if (!(k.array() > 0.0).all() || !k.allFinite()) throw std::invalid_argument("stiffnesses must be finite and > 0");
-    kstiff_ = k;
-    rl_rk_ = k.cwiseSqrt().cwiseInverse();
+    rigid_.set_stiffness(k);
   }
-  void set_rigid_limit(bool on) { rigid_limit_ = on; }
+  void set_rigid_limit(bool on) { rigid_.on = on; }
 
   // Per wheel: the force along (t1, t2, n), the same in world axes, the contact frame (rows t1, t2, n: (nw, 9),
   // row-major) and the contact point (nw, 3).
-  void fill_wheel_forces() {
-    const int nw = static_cast<int>(wheels_.size());
-    wl_.resize(nw, 3);
-    ww_.resize(nw, 3);
-    wf_.resize(nw, 9);
-    wp_.resize(nw, 3);
-    for (int i = 0; i < nw; ++i) {
-      const Geometry& g = geo_[i];
-      const Wheel& wh = wheels_[i];
-      const Vector3d f = wh.D.transpose() * lambda_.segment(g.row, wh.D.rows());
-      wl_.row(i) = f.transpose();
-      ww_.row(i) = (f[0] * g.t1 + f[1] * g.t2 + f[2] * g.n).transpose();
-      wf_.row(i) << g.t1.transpose(), g.t2.transpose(), g.n.transpose();
-      wp_.row(i) = g.p.transpose();
-    }
-  }
+  void fill_wheel_forces() { wheel_force_table(wheels_, geo_, lambda_, wl_, ww_, wf_, wp_); }
   py::tuple wheel_forces() {
     fill_wheel_forces();
     return py::make_tuple(wl_, ww_, wf_, wp_);
@@ -1228,355 +898,39 @@ class Evaluator {
   }
 
  private:
-  // A^-1 x in place, with LU factors P A = L U (the projection's A_d in lu_, the slipping system's K in slip_lu_):
-  // vector triangular solves, no temporaries
-  void lu_solve(const Eigen::PartialPivLU<MatrixXd>& lu, Eigen::Ref<VectorXd> x) {
-    // substitutions written out: for the small blocks of a projection they cost a fraction of Eigen's generic
-    // triangular solvers
-    const MatrixXd& LU = lu.matrixLU();
-    const auto& perm = lu.permutationP().indices();  // (P x)[perm[i]] = x[i]
-    const Eigen::Index n = x.size();
-    perm_.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) perm_[perm[i]] = x[i];
-    for (Eigen::Index i = 1; i < n; ++i) {  // L (unit lower)
-      double s = perm_[i];
-      for (Eigen::Index j = 0; j < i; ++j) s -= LU(i, j) * perm_[j];
-      perm_[i] = s;
-    }
-    for (Eigen::Index i = n - 1; i >= 0; --i) {  // U
-      double s = perm_[i];
-      for (Eigen::Index j = i + 1; j < n; ++j) s -= LU(i, j) * perm_[j];
-      perm_[i] = s / LU(i, i);
-    }
-    x = perm_;
-  }
-  // A^-T x in place (A = P^T L U, so A^T = U^T L^T P)
-  void lu_solve_transposed(const Eigen::PartialPivLU<MatrixXd>& lu, Eigen::Ref<VectorXd> x) {
-    const MatrixXd& LU = lu.matrixLU();
-    const Eigen::Index n = x.size();
-    for (Eigen::Index i = 0; i < n; ++i) {  // U^T (lower)
-      double s = x[i];
-      for (Eigen::Index j = 0; j < i; ++j) s -= LU(j, i) * x[j];
-      x[i] = s / LU(i, i);
-    }
-    for (Eigen::Index i = n - 2; i >= 0; --i) {  // L^T (unit upper)
-      double s = x[i];
-      for (Eigen::Index j = i + 1; j < n; ++j) s -= LU(j, i) * x[j];
-      x[i] = s;
-    }
-    const auto& perm = lu.permutationP().indices();  // (P^T x)[i] = x[perm[i]]
-    perm_.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) perm_[i] = x[perm[i]];
-    x = perm_;
-  }
-  // LAPACK's estimate of ||A^-1||_1 (Hager and Higham, as Eigen's rcond estimate) with the solves above: a lower
-  // bound of the exact norm (in exact arithmetic), in practice within a small factor of it
-  double inverse_norm_estimate(const Eigen::PartialPivLU<MatrixXd>& lu) {
-    const Eigen::Index n = lu.rows();
-    est_v_.setConstant(n, 1.0 / static_cast<double>(n));
-    lu_solve(lu, est_v_);
-    double lower = est_v_.lpNorm<1>();
-    if (n == 1) return lower;
-    auto signs = [](const VectorXd& v, VectorXd& out) {
-      out.resize(v.size());
-      for (Eigen::Index i = 0; i < v.size(); ++i) out[i] = v[i] >= 0.0 ? 1.0 : -1.0;
-    };
-    signs(est_v_, est_old_);
-    est_v_ = est_old_;
-    lu_solve_transposed(lu, est_v_);
-    Eigen::Index index, old_index;
-    est_v_.cwiseAbs().maxCoeff(&index);
-    double old_lower = lower;
-    for (int k = 0; k < 4; ++k) {
-      est_v_.setZero(n);
-      est_v_[index] = 1.0;
-      lu_solve(lu, est_v_);
-      lower = est_v_.lpNorm<1>();
-      if (lower <= old_lower) break;
-      signs(est_v_, est_s_);
-      if (est_s_ == est_old_) break;
-      est_v_ = est_s_;
-      lu_solve_transposed(lu, est_v_);
-      old_index = index;
-      est_v_.cwiseAbs().maxCoeff(&index);
-      if (index == old_index) break;
-      old_lower = lower;
-      est_old_ = est_s_;
-    }
-    double alternate = 1.0;
-    est_v_.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      est_v_[i] = alternate * (1.0 + static_cast<double>(i) / static_cast<double>(n - 1));
-      alternate = -alternate;
-    }
-    lu_solve(lu, est_v_);
-    return std::max(lower, 2.0 * est_v_.lpNorm<1>() / (3.0 * static_cast<double>(n)));
-  }
-
-  // Contact point and frame of wheel i (RollingWheel._geometry), its rows D E^T A_w and residuals.
+  // The kernels on this evaluator's state (robotdyn/kernels/), in row order: each returns the next row.
   int wheel_rows(size_t i, int row) {
     const Wheel& wh = wheels_[i];
-    const pin::SE3& oMf = data_.oMf[frames_[wh.frame]];
-    Geometry& g = geo_[i];
-    g.row = row;
-    g.R = wh.radius;
-    if (wh.radius_index >= 0) {
-      g.R += q_[wh.radius_index];
-      if (g.R <= 0) throw Fallback("radius not positive");
-    }
-    g.a.noalias() = oMf.rotation() * wh.axis;
-    const Vector3d c = oMf.translation();
-    const bool flat = terrain_.flat();
-    Vector3d n = terrain_.normal(c[0], c[1]), p;
-    int it = 0;
-    for (; it < 100; ++it) {
-      g.na = n.dot(g.a);
-      Vector3d wv = n - g.na * g.a;
-      g.nw = wv.norm();
-      if (g.nw < 1e-9) throw Fallback("wheel lying flat");
-      g.u = wv / g.nw;
-      p = c - g.R * g.u;
-      if (flat) break;
-      const Vector3d m = terrain_.normal(p[0], p[1]);
-      const double d2 = (m - n).squaredNorm();
-      n = m;
-      if (d2 < 1e-30) {
-        g.na = n.dot(g.a);
-        wv = n - g.na * g.a;
-        g.nw = wv.norm();
-        g.u = wv / g.nw;
-        p = c - g.R * g.u;
-        break;
-      }
-    }
-    if (it == 100) throw Fallback("contact point did not converge");
-    g.n = n;
-    g.p = p;
-    double f;
-    Eigen::Vector2d grad;
-    Eigen::Matrix2d H;
-    terrain_.eval(p[0], p[1], f, grad, H);
-    const double norm = std::sqrt(1.0 + grad.squaredNorm());
-    const double phi = (p[2] - f) / norm;
-    if (!flat) {  // Terrain.normal_derivative
-      Matrix3d dm = Matrix3d::Zero();
-      dm.block<2, 2>(0, 0) = -H;
-      g.N = (Matrix3d::Identity() - n * n.transpose()) * dm / norm;
-    }
-    const Vector3d c1 = g.a.cross(n);
-    g.nc1 = c1.norm();
-    g.t1 = c1 / g.nc1;
-    g.t2 = n.cross(g.t1);
-    const Matrix6x& J = Jf_[wh.frame];
-    const Vector3d r = -g.R * g.u;
-    MatrixXd& Aw = Aw_[i];
-    Aw = J.topRows<3>();
-    Aw.noalias() -= skew(r).lazyProduct(J.bottomRows<3>());
-    if (wh.radius_index >= 0) Aw.col(wh.radius_index) -= g.u;
-    Matrix3d ET;
-    ET.row(0) = g.t1.transpose();
-    ET.row(1) = g.t2.transpose();
-    ET.row(2) = n.transpose();
-    const int nd = static_cast<int>(wh.D.rows());
-    const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3> W = wh.D * ET;
-    A_.middleRows(row, nd).noalias() = W.lazyProduct(Aw);
-    for (int r2 = 0; r2 < nd; ++r2) residual_[row + r2] = wh.D(r2, 2) != 0.0 ? phi : 0.0;
-    return row + nd;
+    return kernels::wheel_rows(wh, terrain_, data_.oMf[frames_[wh.frame]], Jf_[wh.frame], q_, row, geo_[i], Aw_[i],
+                               A_, residual_);
   }
-
-  // Drift D (Edot^T s + E^T acc) of wheel i (RollingWheel.drift, WheelGroup._drift).
   int wheel_drift(size_t i, int row) {
     const Wheel& wh = wheels_[i];
-    const Geometry& g = geo_[i];
-    const int fid = frames_[wh.frame];
-    const pin::Motion vf = pin::getFrameVelocity(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion af = pin::getFrameClassicalAcceleration(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
-    const Vector3d omega = vf.angular(), cdot = vf.linear();
-    const double Rdot = wh.radius_index >= 0 ? v_[wh.radius_index] : 0.0;
-    const Vector3d& n = g.n;
-    const Vector3d adot = omega.cross(g.a);
-    const Vector3d rhs_const = -(n.dot(adot)) * g.a - g.na * adot;
-    Vector3d udot, ndot = Vector3d::Zero();
-    if (terrain_.flat()) {
-      udot = (rhs_const - g.u * g.u.dot(rhs_const)) / g.nw;
-    } else {
-      const Matrix3d P = (Matrix3d::Identity() - g.u * g.u.transpose()) / g.nw;
-      const Matrix3d QaN = (Matrix3d::Identity() - g.a * g.a.transpose()) * g.N;
-      const Matrix3d K = Matrix3d::Identity() + g.R * (P * QaN);
-      const Vector3d rhs = P * (QaN * (cdot - Rdot * g.u) + rhs_const);
-      udot = K.partialPivLu().solve(rhs);
-      ndot = g.N * (cdot - g.R * udot - Rdot * g.u);
-    }
-    const Vector3d r = -g.R * g.u, rdot = -g.R * udot - Rdot * g.u;
-    const Vector3d c1dot = adot.cross(n) + g.a.cross(ndot);
-    const Vector3d t1dot = (c1dot - g.t1 * g.t1.dot(c1dot)) / g.nc1;
-    const Vector3d t2dot = ndot.cross(g.t1) + n.cross(t1dot);
-    Vector3d acc = af.linear() + af.angular().cross(r) + omega.cross(rdot);
-    if (wh.radius_index >= 0) acc -= udot * Rdot;
-    const Vector3d s = Aw_[i] * v_;
-    const Vector3d d(t1dot.dot(s) + g.t1.dot(acc), t2dot.dot(s) + g.t2.dot(acc), ndot.dot(s) + n.dot(acc));
-    const int nd = static_cast<int>(wh.D.rows());
-    drift_.segment(row, nd).noalias() = wh.D * d;
-    return row + nd;
+    return kernels::wheel_drift(wh, geo_[i], terrain_, model_, data_, frames_[wh.frame], Aw_[i], v_, row, drift_);
   }
-
   int closure_rows(size_t i, int row) {
     const Closure& c = closures_[i];
-    const pin::SE3& M1 = data_.oMf[frames_[c.f1]];
-    const pin::SE3& M2 = data_.oMf[frames_[c.f2]];
-    const Matrix3d R1T = M1.rotation().transpose();
-    const Matrix6x& J1 = Jf_[c.f1];
-    const Matrix6x& J2 = Jf_[c.f2];
-    const Vector3d dp = M2.translation() - M1.translation();
-    Jrel_.resize(6, nv_);  // relative velocity in frame 1's axes (LoopClosure.jacobian)
-    K3_ = J2.topRows<3>() - J1.topRows<3>();
-    K3_.noalias() += skew(dp).lazyProduct(J1.bottomRows<3>());
-    Jrel_.topRows<3>().noalias() = R1T.lazyProduct(K3_);
-    K3_ = J2.bottomRows<3>() - J1.bottomRows<3>();
-    Jrel_.bottomRows<3>().noalias() = R1T.lazyProduct(K3_);
-    const Vector3d e_pos = R1T * dp;
-    const Vector3d e_rot = pin::log3(Matrix3d(R1T * M2.rotation()));
-    for (size_t r = 0; r < c.select.size(); ++r) {
-      const int s = c.select[r];
-      A_.row(row + r) = Jrel_.row(s);
-      residual_[row + r] = s < 3 ? e_pos[s] : e_rot[s - 3];
-    }
-    return row + static_cast<int>(c.select.size());
+    return kernels::closure_rows(c, data_.oMf[frames_[c.f1]], data_.oMf[frames_[c.f2]], Jf_[c.f1], Jf_[c.f2], nv_, row,
+                                 Jrel_, K3_, A_, residual_);
   }
-
-  int closure_drift(size_t i, int row) {  // LoopClosure.drift
+  int closure_drift(size_t i, int row) {
     const Closure& c = closures_[i];
-    const int f1 = frames_[c.f1], f2 = frames_[c.f2];
-    const pin::Motion V1 = pin::getFrameVelocity(model_, data_, f1, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion V2 = pin::getFrameVelocity(model_, data_, f2, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion a1 = pin::getFrameClassicalAcceleration(model_, data_, f1, pin::LOCAL_WORLD_ALIGNED);
-    const pin::Motion a2 = pin::getFrameClassicalAcceleration(model_, data_, f2, pin::LOCAL_WORLD_ALIGNED);
-    const Vector3d d = data_.oMf[f2].translation() - data_.oMf[f1].translation();
-    const Vector3d w1 = V1.angular();
-    const Vector3d ddot = V2.linear() - V1.linear();
-    const Vector3d kt = ddot + d.cross(w1);
-    const Vector3d dkt = a2.linear() - a1.linear() + ddot.cross(w1) + d.cross(a1.angular());
-    const Vector3d kr = V2.angular() - w1;
-    const Vector3d dkr = a2.angular() - a1.angular();
-    const Matrix3d R1T = data_.oMf[f1].rotation().transpose();
-    const Vector3d et = R1T * (dkt - w1.cross(kt)), er = R1T * (dkr - w1.cross(kr));
-    for (size_t r = 0; r < c.select.size(); ++r) {
-      const int s = c.select[r];
-      drift_[row + r] = s < 3 ? et[s] : er[s - 3];
-    }
-    return row + static_cast<int>(c.select.size());
+    return kernels::closure_drift(c, model_, data_, frames_[c.f1], frames_[c.f2], row, drift_);
   }
-
-  int coupling_rows(size_t i, int row) {  // JointCoupling.jacobian with a CosineLaw
-    const Coupling& c = couplings_[i];
-    const double arg = c.rate * q_[c.j] + c.phase;
-    A_(row, c.i) = 1.0;
-    A_(row, c.j) -= -c.amplitude * c.rate * std::sin(arg);
-    residual_[row] = q_[c.i] - (c.amplitude * std::cos(arg) + c.offset);
-    return row + 1;
-  }
-
-  int coupling_drift(size_t i, int row) {  // JointCoupling.drift: -f''(q_r) v_r^2
-    const Coupling& c = couplings_[i];
-    const double arg = c.rate * q_[c.j] + c.phase;
-    const double vr = v_[c.j];
-    drift_[row] = -(-c.amplitude * c.rate * c.rate * std::cos(arg)) * vr * vr;
-    return row + 1;
-  }
-
-  void operational_drift(VectorXd& out) {  // the last k entries: d/dt J_o at zero joint acceleration, times v
-    const int fid = frames_[op_frame_];
-    const pin::Motion a = op_local_ ? pin::getFrameAcceleration(model_, data_, fid, pin::LOCAL)
-                                    : pin::getFrameClassicalAcceleration(model_, data_, fid, pin::LOCAL_WORLD_ALIGNED);
-    const int base = static_cast<int>(rows_.size());
-    for (size_t r = 0; r < op_select_.size(); ++r) {
-      const int s = op_select_[r];
-      out[base + r] = s < 3 ? a.linear()[s] : a.angular()[s - 3];
-    }
-  }
+  int coupling_rows(size_t i, int row) { return kernels::coupling_rows(couplings_[i], q_, row, A_, residual_); }
+  int coupling_drift(size_t i, int row) { return kernels::coupling_drift(couplings_[i], q_, v_, row, drift_); }
 
   void project() {  // projection.py _build / operational_space.py project_operational, with the given rows
-    const double scale = std::max(1.0, A_.size() ? A_.cwiseAbs().maxCoeff() : 0.0);
-    if (operational_) {
-      const int k = static_cast<int>(op_select_.size());
-      const int nr = static_cast<int>(rows_.size());
-      if (nr + k != nv_) throw Fallback("operational rows do not match");
-      K_.resize(nv_, nv_);
-      for (int r = 0; r < nr; ++r) K_.row(r) = A_.row(rows_[r]);
-      Jc_.setZero(6, nv_);
-      pin::getFrameJacobian(model_, data_, frames_[op_frame_], op_local_ ? pin::LOCAL : pin::LOCAL_WORLD_ALIGNED, Jc_);
-      for (int r = 0; r < k; ++r) K_.row(nr + r) = Jc_.row(op_select_[r]);
-      lu_.compute(K_);
-      Kinv_ = lu_.inverse();
-      cond_ = K_.cwiseAbs().colwise().sum().maxCoeff() * Kinv_.cwiseAbs().colwise().sum().maxCoeff();
-      if (!(std::isfinite(cond_) && cond_ <= 1e10) || !Kinv_.allFinite()) throw Fallback("singular");
-      S_ = Kinv_.rightCols(k);
-    } else {
-      const int nd = static_cast<int>(dependent_.size());
-      const int k = static_cast<int>(independent_.size());
-      S_.setZero(nv_, k);
-      for (int j = 0; j < k; ++j) S_(independent_[j], j) = 1.0;
-      if (nd == 0) {
-        cond_ = 1.0;
-        return;
-      }
-      Ad_.resize(nd, nd);
-      Ai_.resize(nd, k);
-      for (int r = 0; r < nd; ++r) {
-        for (int c = 0; c < nd; ++c) Ad_(r, c) = A_(rows_[r], dependent_[c]);
-        for (int c = 0; c < k; ++c) Ai_(r, c) = A_(rows_[r], independent_[c]);
-      }
-      lu_.compute(Ad_);
-      // The Python path refuses a block whose 1-norm condition number exceeds 1e10 (projection.MAX_CONDITION).
-      // LAPACK's estimate (O(n^2), inverse_norm_estimate) decides far from that bound; from an estimate of 1e8 on, the exact
-      // number (an O(n^3) inverse) decides, as in Python. The exact number is reported by the Python side
-      // (robotdyn.compiled.LazyProjection), from A.
-      cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * inverse_norm_estimate(lu_);
-      if (std::isnan(cond_)) cond_ = std::numeric_limits<double>::infinity();
-      if (!(cond_ < 1e8)) {
-        Adinv_ = lu_.inverse();
-        cond_ = Ad_.cwiseAbs().colwise().sum().maxCoeff() * Adinv_.cwiseAbs().colwise().sum().maxCoeff();
-        if (!(std::isfinite(cond_) && cond_ <= 1e10)) throw Fallback("singular");
-      }
-      Sd_ = Ai_;
-      for (int c = 0; c < k; ++c) lu_solve(lu_, Sd_.col(c));
-      if (!Sd_.allFinite()) throw Fallback("singular");  // an exactly singular block (a zero pivot)
-      for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -Sd_.row(r);
-    }
-    if (A_.size() && S_.cols()) {  // (no independent velocity: nothing to check, and no maximum to take)
-      AS_.noalias() = A_.lazyProduct(S_);
-      if (!(AS_.cwiseAbs().maxCoeff() <= 1e-10 * scale)) throw Fallback("row choice no longer spans");  // NaN too
-    }
+    if (operational_)
+      project_operational(A_, rows_, op_select_, model_, data_, frames_[op_frame_], op_local_, nv_, K_, Jc_, lu_,
+                          Kinv_, cond_, S_);
+    else if (!project_selection(A_, rows_, independent_, dependent_, nv_, lus_, lu_, sel_, cond_, S_))
+      return;
+    check_span(A_, S_, AS_);
   }
 
   void pull_back(double alpha, Eigen::Ref<VectorXd> out) {
-    int nh = 0;
-    bool any = false;
-    for (size_t r = 0; r < holonomic_.size(); ++r)
-      if (holonomic_[r]) {
-        ++nh;
-        any = any || residual_[r] != 0.0;
-      }
-    if (!any) return;
-    MatrixXd Ah(nh, nv_);
-    VectorXd phi(nh);
-    int j = 0;
-    for (size_t r = 0; r < holonomic_.size(); ++r)
-      if (holonomic_[r]) {
-        Ah.row(j) = A_.row(r);
-        phi[j++] = residual_[r];
-      }
-    // truncated SVD: singular values below 1e-9 max(s_max, 1) count as zero (robotdyn/pull_back.py): rows with
-    // no rank, e.g. a wheel's normal row under a planar root, keep their residual as a constant offset
-    svd_.compute(Ah, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    const VectorXd& s = svd_.singularValues();
-    const double cut = 1e-9 * std::max(s.size() ? s[0] : 0.0, 1.0);
-    int rank = 0;
-    while (rank < s.size() && s[rank] > cut) ++rank;
-    if (rank == 0) return;
-    VectorXd c = svd_.matrixU().leftCols(rank).transpose() * phi;
-    c.array() /= s.head(rank).array();
-    out.head(nv_).noalias() -= alpha * (svd_.matrixV().leftCols(rank) * c);
+    kernels::pull_back(holonomic_, residual_, A_, nv_, alpha, svd_, out);
   }
 
   pin::Model model_;
@@ -1596,38 +950,27 @@ class Evaluator {
   int op_frame_ = -1;
   bool op_local_ = true, operational_ = false, selected_ = false;
   // state and work buffers (sized on first use, then reused)
-  VectorXd tau_, perm_, e_, lambda_, lr_, nudot_, a_;
+  VectorXd tau_, e_, lambda_, lr_, nudot_, a_;
   RowMat wl_, ww_, wf_, wp_;
   const double* fbuffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   long fgeneration_ = 0;
   std::optional<robotdyn::Controller> controller_;  // set_controller
   double control_t_ = 0.0;
   VectorXd control_tau_;
-  VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_, est_v_, est_s_, est_old_;
-  MatrixXd A_, S_, SM_, B_, Br_, Mr_, Adinv_, Kinv_, K_, Ad_, Ai_, Sd_, AS_, Jrel_;
+  VectorXd q_, v_, w_, zero_, g_, residual_, drift_, gr_, hr_, rhs_, wd_, force_;
+  MatrixXd A_, S_, SM_, B_, Br_, Mr_, Kinv_, K_, AS_, Jrel_;
+  SelectionBuffers sel_;  // the projection's A_d, A_i, A_d^-1, S_d
+  LuSolver lus_;          // the LU substitutions' buffers
   Eigen::Matrix<double, 3, Eigen::Dynamic> K3_;
   Matrix6x Jc_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   Eigen::LLT<MatrixXd> llt_;
   Eigen::JacobiSVD<MatrixXd> svd_;
   double cond_ = 1.0;
-  // slipping wheels' work buffers (slip_rhs_into), the lift-off event's cache and the state of a SlipError
-  MatrixXd Ks_, Jt_;
-  bool rigid_limit_ = true;
-  VectorXd kstiff_, rl_n0_, rl_saved_;
-  MatrixXd rl_Q_, rl_N_, rl_P_, rl_G_, rl_O_, rl_W_, rl_H_;
-  VectorXd rl_c_, rl_rk_, rl_y_, rl_n_, rl_z_, rl_t_, rl_w_;
-  Eigen::LLT<MatrixXd> rl_llt_;
-  std::vector<bool> rl_in_;
-  Eigen::ColPivHouseholderQR<MatrixXd> rl_qr_;
-  Eigen::JacobiSVD<MatrixXd> rl_svd_;
-  VectorXd bs_, xs_, slip_normal_;
-  Eigen::Matrix<double, Eigen::Dynamic, 2> slip_s_, slip_c_;
-  std::vector<int> slip_pos_;
-  Eigen::PartialPivLU<MatrixXd> slip_lu_;
-  Eigen::JacobiSVD<MatrixXd> slip_svd_;
-  double slip_kappa1_ = 0.0, slip_kappa2_ = 0.0;  // the last Painleve test (slip_condition)
-  double slip_min_ = HUGE_VAL, event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
+  RigidLimit rigid_;  // the rigid limit's split (forces) and its buffers
+  SlipSystem slip_;   // the slipping wheels' system (slip_rhs_into), its results and buffers
+  // the lift-off event's cache and the state of a SlipError
+  double event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
 
  public:
   double last_t_ = std::numeric_limits<double>::quiet_NaN();  // time of the last right-hand side evaluated
@@ -1635,7 +978,7 @@ class Evaluator {
  private:
   double slip_error_t_ = 0.0;
   std::vector<double> event_y_, event_dy_, slip_error_y_;
-  std::vector<Geometry> geo_;
+  std::vector<WheelGeometry> geo_;
   std::vector<Matrix6x> Jf_;
   std::vector<MatrixXd> Aw_;
   robotdyn::derivs::Workspace deriv_;  // the derivatives' passes (kernels/reduced_dynamics_derivatives.hpp)

@@ -751,6 +751,10 @@ class Robot:
         if sliding_now(self):
             return forward_sliding(self, q, nu, tau).nudot
         red = self.reduced(q, nu)
+        if any(getattr(c, "rolling", False) for c in self.constraints):  # robotdyn.contact.compliant_rolling
+            from .contact.compliant_rolling import forward as rolling_forward
+
+            return rolling_forward(self, q, nu, tau, red=red).nudot
         out = solve_mass(red.M, red.B @ tau - red.h + reduced_applied(self, red, q)[0])
         if not np.isfinite(out).all():
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
@@ -892,12 +896,27 @@ class Robot:
         nudot = np.asarray(nudot, float)
         if nudot.shape != (self.mobility,):
             self.check_nu(nudot, "nudot")
+        self._refuse_rolling_contact(q, red.v, "inverse dynamics")
         Q = red.M @ nudot + red.h - reduced_applied(self, red, np.asarray(q, float))[0]
         self._warn_dropped(red, nudot)
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)
         return Q, tau, float(np.linalg.norm(red.B @ tau - Q))
+
+    def _refuse_rolling_contact(self, q, v, what: str) -> None:
+        """One-line InputError where compliant wheels roll in contact at (q, v) (their tangential rows are
+        constraints on top of the projection, :mod:`robotdyn.contact.compliant_rolling`), for ``what`` that does
+        not take those rows."""
+        if not any(getattr(c, "rolling", False) for c in self.constraints):
+            return
+        from .contact.compliant_rolling import contact_set
+
+        touching = contact_set(self, np.asarray(q, float), np.asarray(v, float))
+        if touching:
+            raise InputError(f"{what} with compliant wheels rolling in contact ({', '.join(touching)}) is not "
+                             "available: their rolling rows' forces and the motor torques are not separated by the "
+                             "accelerations here; expected motor torques (forward dynamics), or wheels in the air")
 
     def contact_forces(self, q, nu, tau=None, nudot=None, twin: bool = True):
         """Wheel-ground contact forces and loop-closure forces at (q, nu) for motor torques ``tau`` (forward

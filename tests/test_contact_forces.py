@@ -208,3 +208,20 @@ def test_minimum_mu_over_undetermined_splits(robots):
     robot_d, qd = _disc_on_ramp(0.5)
     fd = robot_d.contact_forces(qd, np.zeros(robot_d.mobility))
     assert fd.minimum_mu() == pytest.approx(fd.wheels[0].required_mu, rel=1e-12)
+
+
+def test_a_planar_model_lacking_a_support_reports_no_split_loads():
+    """MMR12-EOD's built-in planar model stands on its two drive wheels only: its floating twin cannot hold the
+    out-of-plane equilibrium (it would pitch over), so no normal load has a value. The rigid limit used to split
+    them anyway (377.6 N per wheel against a weight of 968 N, labelled 'rigid limit of compliance', with a minimum
+    mu of 0.0014) beside the line saying the loads stay undetermined."""
+    import robotdyn
+
+    robot = robotdyn.load("mmr12_eod")
+    q, nu = robot.neutral(), np.zeros(robot.mobility)
+    for forces in (robot.contact_forces(q, nu, tau=np.zeros(len(robot.motors))),
+                   robot.contact_forces(q, nu, nudot=np.zeros(robot.mobility))):
+        assert any("lacks a support" in r for r in forces.undetermined_reason)
+        assert not any(w.known[2] for w in forces.wheels)
+        assert forces.minimum_mu() is None
+        assert "rigid limit" not in forces.table()

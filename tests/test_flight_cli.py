@@ -60,16 +60,20 @@ def test_bad_springs_are_one_line(tmp_path, entry, message):
     assert len(out.stderr.strip().splitlines()) == 1 and message in out.stderr, out.stderr
 
 
-def test_compliant_wheel_without_friction_law_is_one_line(tmp_path):
+def test_compliant_wheel_with_stick_slip_is_one_line(tmp_path):
+    """A compliant wheel takes friction = rolling (it rolls while in contact, robotdyn.contact.compliant_rolling),
+    coulomb or linear; stick_slip is refused in one line (it was 'rolling' that was refused before rolling while
+    compliant was modelled)."""
     text = (EXAMPLES / "bump_base.toml").read_text().replace('urdf = "skid_steer.urdf.xacro"',
                                                              f'urdf = "{EXAMPLES / "skid_steer.urdf.xacro"}"')
     path = tmp_path / "base.toml"
-    path.write_text(text.replace('friction = "linear"', 'friction = "rolling"', 1).replace("stiffness = 5.0         #",
-                                                                                          "#", 1))
+    path.write_text(text.replace('friction = "linear"', 'friction = "stick_slip"', 1).replace(
+        "stiffness = 5.0         #", "#", 1))
     out = run("info", "--constraints", str(path))
     assert out.returncode == 2
     assert len(out.stderr.strip().splitlines()) == 1
-    assert "contact = 'compliant' needs a friction law" in out.stderr, out.stderr
+    assert "contact = 'compliant' takes friction = 'rolling' (rolls while in contact), 'coulomb' or 'linear'" \
+        in out.stderr, out.stderr
 
 
 def test_compiled_engine_refuses_springs_in_one_line():

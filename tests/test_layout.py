@@ -198,3 +198,21 @@ def test_no_circles_but_the_known_lazy_ones():
 @pytest.mark.parametrize("pair", sorted(tuple(sorted(c)) for c in LAZY_CIRCLES))
 def test_known_lazy_circles_are_within_one_stage(pair):
     assert len({_stage(m) for m in pair}) == 1
+
+
+def test_compiled_kernels_name_their_python_twins():
+    """Each C++ kernel under robotdyn/kernels/ (issue 26, item 5) opens with a comment naming its Python reference,
+    whose module has the kernel's name (rolling_contact.hpp beside constraints/rolling_contact.py), so that a reader
+    finds each formula's two implementations side by side; the build knows every header (setup.py's depends)."""
+    import re
+
+    kernels = sorted((PKG / "kernels").glob("*.hpp"))
+    assert len(kernels) >= 10
+    helpers = {"common", "lu_solve"}  # shared by the kernels, no Python twin of their own
+    for path in kernels:
+        head = path.read_text().split("#pragma once")[0]
+        assert head.startswith(f"// robotdyn/kernels/{path.name}:"), path.name
+        twins = [t for t in re.findall(r"robotdyn/([\w/]+)\.py", head) if (PKG / f"{t}.py").exists()]
+        if path.stem not in helpers:
+            assert any(t.rpartition("/")[2] == path.stem for t in twins), f"{path.name} names no Python twin {twins}"
+    assert 'Path("robotdyn/kernels").glob("*.hpp")' in (PKG.parent / "setup.py").read_text()

@@ -92,3 +92,57 @@ def test_shading_names_what_it_marks():
     labels = [c.get_label() for c in ax_n.collections]
     assert labels == ["a wheel unloaded or beyond its mu"]
     np.testing.assert_array_equal(tr.broken().any(axis=1), [False, False, True, True, False])
+
+
+def test_flight_has_its_own_band():
+    """A compliant wheel in the air (load 0: flight, which its force law allows) is shaded in a band of its own,
+    labelled as flight; a rigid wheel unloaded or beyond its mu keeps the other band. Synthetic loads: the compliant
+    wheel "front" flies at samples 1-2, the rigid wheel "rear" needs mu 0.5 > 0.3 at sample 4."""
+    tr = _traction(["front", "rear"], [True, True], None)
+    tr.compliant = ["front"]
+    tr.mu[:] = 0.3
+    tr.normal[1:3, 0] = 0.0
+    tr.required_mu[1:3, 0] = np.inf
+    tr.required_mu[4, 1] = 0.5
+    np.testing.assert_array_equal(tr.in_air().any(axis=1), [False, True, True, False, False])
+    np.testing.assert_array_equal(tr.broken().any(axis=1), [False, False, False, False, True])
+    ax_n = plot_traction(tr).axes[0]
+    bands = {c.get_label(): c for c in ax_n.collections}
+    assert set(bands) == {"a compliant wheel in the air (flight)", "a wheel unloaded or beyond its mu"}
+    flight_x = np.concatenate([p.vertices[:, 0] for p in bands["a compliant wheel in the air (flight)"].get_paths()])
+    assert flight_x.min() == 0.25 and flight_x.max() == 0.5  # samples 1-2 of t = 0, 0.25, ..., 1
+    slip_x = np.concatenate([p.vertices[:, 0] for p in bands["a wheel unloaded or beyond its mu"].get_paths()])
+    assert slip_x.min() == 1.0 and slip_x.max() == 1.0
+    # the same wheel with a rigid contact: its zero load is a lift-off, shaded as such
+    tr.compliant = []
+    assert not tr.in_air().any()
+    np.testing.assert_array_equal(tr.broken().any(axis=1), [False, True, True, False, True])
+
+
+def test_traction_of_a_compliant_robot_names_its_flying_wheels():
+    """examples/bump_base.toml over its bump: the front wheels (compliant) leave the crest near t = 0.07 s; the
+    traction marks those samples as flight, not as a broken no-slip assumption."""
+    from robotdyn.contact.traction import traction
+    from robotdyn.interfaces.constraint_file import read
+    from robotdyn.simulation.engine import simulate
+
+    cf = read(ROOT / "examples/bump_base.toml")
+    robot, sc = cf.robot(), cf.SCENARIOS["bump"]
+    q0, nu0 = sc.initial_state(robot)
+    traj = simulate(robot, 0.1, q0, nu0, sc.torque, n_out=11, progress=False)
+    tr = traction(robot, traj, sc.torque)
+    assert set(tr.compliant) == set(tr.wheels)
+    air = tr.in_air()
+    flying = {w for j, w in enumerate(tr.wheels) if air[:, j].any()}
+    assert flying == {"front_left", "front_right"}
+    assert not tr.broken()[air].any()
+    assert (tr.normal[air] <= 0).all() and (tr.normal[~air] > 0).all()
+
+
+def test_a_constant_required_mu_is_drawn_inside_the_axes():
+    """A steady manoeuvre's required mu is constant (examples/cornering_car.toml: 0.491 all along); its line must lie
+    inside the friction panel, not on its upper frame (the axes ended at the line's value)."""
+    steady = 0.491 + 1e-12 * np.arange(5)  # (constant to rounding: the axes' autoscale ends at its value)
+    fig = plot_traction(_traction(["a", "b"], [False, False], steady))
+    bottom, top = fig.axes[1].get_ylim()
+    assert bottom == 0.0 and top >= 1.05 * 0.491

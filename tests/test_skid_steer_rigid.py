@@ -109,3 +109,28 @@ def test_the_compiled_engine_refuses_in_one_line(husky):
         simulate(robot, 0.1, robot.neutral(), np.zeros(robot.mobility), Constant(np.zeros(4)), engine="compiled",
                  progress=False)
     assert "\n" not in str(info.value)
+
+
+def test_a_wheel_the_rigid_limit_unloads_is_not_a_lift_off():
+    """Centre of mass near the front-left corner: on equal springs the rear-right wheel would pull (the linear
+    split W/4 (1 - x_G/a - y_G/b) < 0 for x_G/a + y_G/b > 1), so the rigid limit leaves it unloaded and the chassis
+    rests on the other three, whose loads are then the three-wheel statics (derived here): with wheels 1 (a, b),
+    2 (a, -b), 3 (-a, b),
+        F1 + F2 + F3 = W,   a (F1 + F2 - F3) = W x_G,   b (F1 - F2 + F3) = W y_G.
+    The run used to stop at t ~ 1e-6 s with 'lift-off of wheel rear_right'; the wheel is on the ground at zero load,
+    so the base must turn in place for the whole run."""
+    mod = read(EXAMPLES / "husky_like.toml", xacro_args={"com_x": "0.19", "com_y": "0.21"})
+    robot = mod.robot()
+    q = robot.neutral()
+    data = robot.model.createData()
+    G = pin.centerOfMass(robot.model, data, q)
+    W = float(sum(inertia.mass for inertia in robot.model.inertias)) * 9.81
+    assert G[0] / A + G[1] / B > 1.0  # the linear split would pull on the rear-right wheel
+    F = np.linalg.solve([[1, 1, 1], [A, A, -A], [B, -B, B]], [W, W * G[0], W * G[1]])
+    assert (F > 0).all()
+    forces = robot.contact_forces(q, np.zeros(robot.mobility), tau=np.zeros(4))
+    got = [forces.wheel(name).normal for name in ("front_left", "front_right", "rear_left", "rear_right")]
+    assert np.allclose(got, [*F, 0.0], rtol=0, atol=1e-9 * W)
+    spin = mod.SCENARIOS["turn_in_place"].run(robot, t_end=0.3, n_out=4, progress=False)
+    assert "event" not in spin.stats and spin.t[-1] == pytest.approx(0.3)
+    assert spin.column("yaw")[-1] > 0.01

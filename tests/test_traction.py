@@ -120,3 +120,18 @@ def test_cli_loads_use_the_torques_the_scenario_applied(tmp_path):
     for c in applied.columns():  # the friction the path needs comes from its torques: unactuated, it is ~0
         if "mu" in c:
             assert np.max(np.abs(applied.columns()[c] - idle.columns()[c])) > 0.5 * np.max(applied.columns()[c]), c
+
+
+def test_cli_json_gives_required_mu_only_where_determined(capsys):
+    """simulate --json: max_required_mu names only the wheels whose friction force rigid-body dynamics determine
+    (wheel2 and wheel5 share theirs with their axle partners: their own value would be an arbitrary split's, and
+    the text says "not determined"), as the streamed run already did."""
+    import json
+
+    rc = main(["simulate", "linkage_suspension", "--scenario", "straight_line", "--t-end", "0.2", "--quiet",
+               "--json"])
+    data = json.loads(capsys.readouterr().out)
+    assert rc == 0
+    mus = data["traction"]["max_required_mu"]
+    assert "wheel1" in mus and "wheel2" not in mus and "wheel5" not in mus
+    assert "friction of wheel2, wheel5 not determined" in data["traction"]["summary"]

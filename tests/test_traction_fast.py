@@ -264,3 +264,20 @@ def test_cli_csv_columns_equal_the_reference(tmp_path, monkeypatch):
         assert head == head_ref and "wheel_A.normal" in head and "mu_required_min" in head
         scale = np.max(np.abs(ref), axis=0)
         assert np.all(np.abs(fast - ref) <= RTOL * scale + 1e-300)
+
+
+def test_cone_minimum_with_two_open_combinations_equals_its_closed_form():
+    """d = 2 (SLSQP with its exact gradients): two pairs of wheels pushing against each other sideways, each pair
+    along its own combination, fn = 1 and 2. Pair 1: max(|3 + z1|, |1 - z1|) is smallest at z1 = -1 (value 2); pair
+    2: max(|5 + z2|, |z2 - 1|) / 2 is smallest at z2 = -2 (value 1.5); the minimum is the larger, 2. Mixing the
+    combinations by a rotation (another orthonormal basis of the open space) changes nothing."""
+    e1 = np.array([[0.0, 0.0], [1.0, 0.0]])
+    e2 = np.array([[0.0, 0.0], [0.0, 1.0]])
+    base = [(np.array([0.0, 3.0]), e1), (np.array([0.0, 1.0]), -e1), (np.array([0.0, 5.0]), e2),
+            (np.array([0.0, -1.0]), e2)]
+    fn = np.array([1.0, 1.0, 2.0, 2.0])
+    c, s = np.cos(0.3), np.sin(0.3)
+    for R in (np.eye(2), np.array([[c, -s], [s, c]])):
+        assert cone_minimum([(b, T @ R) for b, T in base], fn, 2) == pytest.approx(2.0, abs=1e-7)
+    base[2] = (np.array([0.0, 9.0]), e2)  # pair 2 now max(|9 + z2|, |z2 - 1|) / 2: at z2 = -4, 2.5 > 2
+    assert cone_minimum(base, fn, 2) == pytest.approx(2.5, abs=1e-7)

@@ -238,7 +238,8 @@ def cmd_dump(args) -> int:
         tau = _torques(robot, args.tau, args.tau_set)
         from ..contact.applied_forces import reduced_applied
 
-        nudot = robot.forward_dynamics(q, nu, tau, check=False) if sliding else \
+        rolling = any(getattr(c, "rolling", False) for c in robot.constraints)  # contact.compliant_rolling
+        nudot = robot.forward_dynamics(q, nu, tau, check=False) if sliding or rolling else \
             solve_mass(red.M, red.B @ tau - red.h + reduced_applied(robot, red, q)[0])  # springs, compliant wheels
         out["a"] = nudot
         out["ill_conditioned"] = [vars(f) for f in robot.warn_conditioning(red, nudot)]
@@ -257,7 +258,8 @@ def cmd_dump(args) -> int:
         if args.a is None and args.tau is None and not args.tau_set:
             raise RobotDynError("--forces needs --tau (forward dynamics) or --a (inverse dynamics)")
         # with sliding wheels the forces follow from the torques (with --a: those that produce the accelerations)
-        forces = robot.contact_forces(q, nu, tau=tau) if sliding else robot.contact_forces(q, nu, tau=tau, nudot=nudot)
+        forward = sliding or (args.a is None and any(getattr(c, "rolling", False) for c in robot.constraints))
+        forces = robot.contact_forces(q, nu, tau=tau) if forward else robot.contact_forces(q, nu, tau=tau, nudot=nudot)
         out["forces"] = forces.as_dict()
         text.append(forces.table())
     _emit(args, out, "\n".join(text))
@@ -378,7 +380,9 @@ def _simulate(args, limit) -> int:
     if tr is not None:
         out["traction"] = {"summary": tr.summary(), "wheels": tr.wheels, "undetermined": list(tr.undetermined),
                            "events": [vars(e) for e in tr.events],
-                           "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)},
+                           "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)
+                                               if tr.friction_determined[j]},  # (as the streamed run: no
+                                                                                # arbitrary split's value)
                            "min_normal_load": {w: float(np.min(tr.normal[:, j])) for j, w in enumerate(tr.wheels)}}
     text = [f"{args.robot} / {sc.name}: {sc.description}",
             f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations, "
@@ -398,7 +402,12 @@ def _simulate(args, limit) -> int:
         fw = 0.0 if traj.friction_work is None else float(traj.friction_work[-1])
         dw = 0.0 if traj.damper_work is None else float(traj.damper_work[-1])
         out["friction_work"], out["damper_work"] = fw, dw
-        text.append(f"work: friction {fw:.10g} J, dampers {dw:.10g} J (energy change = motor work + these)")
+        lost = getattr(traj, "impact_loss", None)  # rolling compliant wheels' touch-downs (simulation.compliant_rolling)
+        if lost is not None:
+            out["touchdown_loss"] = float(lost[-1] - lost[0])
+        text.append(f"work: friction {fw:.10g} J, dampers {dw:.10g} J" + (
+            "" if lost is None else f", touch-down impacts {-(lost[-1] - lost[0]):.10g} J")
+            + " (energy change = motor work + these)")
     if switches is not None:
         out["switches"] = switches
         text.append(f"stick-slip: {len(switches)} phase switch(es)" + "".join(

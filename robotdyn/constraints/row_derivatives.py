@@ -490,12 +490,19 @@ def kind(constraint, sliding: bool = False) -> str:
 
     Raises:
         InputError: A constraint without derivatives here (a wheel under a friction law unless ``sliding``, a
-            user's own constraint class): one line naming it.
+            compliant wheel, a user's own constraint class): one line naming it.
     """
     if hasattr(constraint, "sliding") and not sliding:
         raise InputError(f"dynamics derivatives: constraint {constraint.name!r} is a wheel under a friction law; "
                          "expected rolling wheels, loop closures and joint couplings here (smoothly slipping wheels: "
                          "Robot.dynamics_derivatives; exact stick-slip friction has no derivative)")
+    from ..contact.compliant_contact import CompliantWheel
+
+    if isinstance(constraint, CompliantWheel):
+        raise InputError(f"dynamics derivatives: wheel {constraint.name!r} is a compliant wheel (contact = "
+                         "'compliant': its normal force is a force law of penetration, with touch-down and lift-off "
+                         "events) and has no derivative rule; expected rigid rolling or slipping wheels, loop "
+                         "closures and joint couplings")
     if isinstance(constraint, RollingWheel):
         return "wheel"
     if isinstance(constraint, LoopClosure):

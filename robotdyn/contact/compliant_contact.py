@@ -12,6 +12,9 @@ contact point p, contact frame E = (t1, t2, n), :mod:`robotdyn.constraints.rolli
   velocity :math:`s = (t_1, t_2)^T A_w v`, on the wheel's own tangential directions (both for a standard wheel,
   the rollers' driving direction for an omni wheel, none for a support);
 
+(a wheel declared with ``friction = "rolling"`` has no friction law: while :math:`f_n > 0` its tangential rows are
+constraints of the motion instead, and its tangential force is their multiplier,
+:mod:`robotdyn.contact.compliant_rolling`; :meth:`CompliantWheel.state` gives its normal force only)
 and applies :math:`Q = A^T (F_{t1}, F_{t2}, f_n)` with :math:`A = E^T A_w` (3, nv) the rolling rows: the contact
 force on the wheel's material point at p. Energy: the law's elastic part stores :math:`U(\\delta)`, the rest of
 the normal force does the work :math:`-\\int (f_n - f_e(\\delta))\\,\\dot\\delta\\,dt \\le 0` (the damper's),
@@ -71,6 +74,20 @@ class NormalLaw:
         """
         raise NotImplementedError
 
+    def pressing(self, delta: float, rate: float) -> float:
+        """A continuous function [m] of the penetration and its rate that is > 0 exactly where the law pushes
+        (:math:`f_n > 0`): the contact indicator whose zero crossings are a rolling compliant wheel's touch-down
+        (upwards) and lift-off (downwards) events (:mod:`robotdyn.contact.compliant_rolling`).
+
+        Args:
+            delta: Penetration :math:`\\delta` [m].
+            rate: Its rate :math:`\\dot\\delta` [m/s].
+
+        Returns:
+            The indicator [m] (> 0: the law pushes).
+        """
+        raise NotImplementedError
+
     def potential(self, delta: float) -> float:
         """Stored energy :math:`U(\\delta) = \\int_0^\\delta f_e` [J] (zero for :math:`\\delta \\le 0`).
 
@@ -103,6 +120,9 @@ class LinearContact(NormalLaw):
     def elastic(self, delta: float) -> float:
         return self.stiffness * delta if delta > 0.0 else 0.0
 
+    def pressing(self, delta: float, rate: float) -> float:
+        return min(delta, delta + self.damping / self.stiffness * rate)  # > 0 iff delta > 0 and k d + c d' > 0
+
     def potential(self, delta: float) -> float:
         return 0.5 * self.stiffness * delta * delta if delta > 0.0 else 0.0
 
@@ -133,6 +153,9 @@ class HuntCrossley(NormalLaw):
 
     def elastic(self, delta: float) -> float:
         return self.stiffness * delta ** self.exponent if delta > 0.0 else 0.0
+
+    def pressing(self, delta: float, rate: float) -> float:
+        return min(delta, delta * (1.0 + self.damping / self.stiffness * rate))  # > 0 iff d > 0, k + lambda d' > 0
 
     def potential(self, delta: float) -> float:
         n = self.exponent
@@ -176,33 +199,80 @@ def make_normal_law(name: str, stiffness: float, damping: float | None, exponent
 
 
 class CompliantWheel(RollingWheel):
-    """A wheel whose normal contact is a force law (it can leave the ground and land) and whose tangential force
-    follows a friction law (see the module).
+    """A wheel whose normal contact is a force law (it can leave the ground and land) and whose tangential side
+    follows a friction law, or rolls without slipping while in contact (see the module).
 
     Args:
         description, frame, radius: As :class:`~robotdyn.constraints.rolling_contact.RollingWheel`.
         normal: Its :class:`NormalLaw`.
-        law: Its :class:`~robotdyn.contact.friction.FrictionLaw` (``None``: frictionless, e.g. a support).
-        directions: The tangential directions the law acts on, as rows of coefficients of (t1, t2): (2, 2)
-            identity for a standard wheel, the rollers' driving direction (1, 2) for an omni wheel, (0, 2) for a
-            frictionless support.
+        law: Its :class:`~robotdyn.contact.friction.FrictionLaw` (``None``: frictionless, e.g. a support, or
+            rolling).
+        directions: The tangential directions the law (or the rolling rows) act on, as rows of coefficients of
+            (t1, t2): (2, 2) identity for a standard wheel, the rollers' driving direction (1, 2) for an omni
+            wheel, (0, 2) for a frictionless support.
         kind: ``standard``, ``omni`` or ``support`` (reports).
+        rolling: ``True``: while the normal force is > 0 the wheel rolls without slipping along ``directions``
+            (those rows are constraints of the motion, :mod:`robotdyn.contact.compliant_rolling`); ``law`` must
+            then be ``None``.
         **kwargs: axis, terrain, radius_joint, name (as RollingWheel).
     """
 
     compliant = True
 
     def __init__(self, description, frame: str, radius: float, normal: NormalLaw, law=None,
-                 directions=np.eye(2), kind: str = "standard", **kwargs) -> None:
+                 directions=np.eye(2), kind: str = "standard", rolling: bool = False, **kwargs) -> None:
         super().__init__(description, frame, radius, **kwargs)
         self.normal_law = normal
         self.law = law
         self.tangent_directions = np.atleast_2d(np.asarray(directions, float)).reshape(-1, 2)
         self.kind = kind
+        self.rolling = bool(rolling) and self.tangent_directions.shape[0] > 0 and law is None
+        # the rolling rows D (t1, t2)^T A_w through RollingWheel.jacobian/drift (self's own give no rows)
+        self._directions = np.hstack([self.tangent_directions, np.zeros((self.tangent_directions.shape[0], 1))])
+
+    def rolling_labels(self) -> list[str]:
+        """Labels of the rolling rows, in the order of :meth:`tangential_rows`.
+
+        Returns:
+            ``<name>.longitudinal``, ``<name>.lateral`` for a standard wheel, ``<name>.driving`` for an omni wheel;
+            an empty list for a wheel that does not roll (a friction law, a support).
+        """
+        if not self.rolling:
+            return []
+        rows = ("longitudinal", "lateral") if self.kind == "standard" else ("driving",)
+        return [f"{self.name}.{r}" for r in rows]
+
+    def tangential_rows(self, kin: KinematicState) -> tuple[np.ndarray, np.ndarray]:
+        """The rolling rows :math:`G = D\\,(t_1, t_2)^T A_w` (d, nv) and their drift :math:`\\dot G v` (d,)
+        [m/s^2]: the velocity of the wheel's material point at the contact along its tangential directions D
+        (the rigid wheel's tangential rows, :class:`~robotdyn.constraints.rolling_contact.RollingWheel`).
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v).
+
+        Returns:
+            ``(G, Gdot_v)``.
+        """
+        return RollingWheel.jacobian(self, kin).A, RollingWheel.drift(self, kin)
+
+    def pressing(self, kin: KinematicState) -> float:
+        """The normal law's contact indicator :meth:`NormalLaw.pressing` [m] at (q, v) of ``kin``: > 0 exactly
+        where the normal force is > 0.
+
+        Args:
+            kin: The :class:`~robotdyn.constraints.constraint.KinematicState` at (q, v) (v: full velocities).
+
+        Returns:
+            The indicator [m].
+        """
+        Aw, geo = self._world_jacobian(kin)
+        rate = float(geo[9][:, 2] @ (Aw @ kin.v))
+        return self.normal_law.pressing(-float(geo[7]), -rate)
 
     def __repr__(self) -> str:
         return (f"CompliantWheel(frame={self.frame!r}, radius={self.radius}, normal={self.normal_law!r}, "
-                f"law={self.law!r}, terrain={self.terrain!r})")
+                + (f"law={self.law!r}, " if not self.rolling else "rolling while in contact, ")
+                + f"terrain={self.terrain!r})")
 
     # no constraint rows: the normal direction is a force law, the tangential ones a friction law
     def _labels(self) -> list[str]:
@@ -293,7 +363,8 @@ def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> C
     :mod:`robotdyn.contact.compliance` (1 mm static deflection under an equal share of the weight; for
     hunt_crossley the same deflection: :math:`k = (m g / n) / \\delta_0^{\\,n}`, damping
     :math:`1.5\\,\\alpha k`). The friction law (``friction`` = coulomb or linear, with its mu, slip_velocity,
-    stiffness) acts on the wheel's tangential directions by kind; a support wheel is frictionless.
+    stiffness) acts on the wheel's tangential directions by kind; with ``friction = "rolling"`` (the default) the
+    wheel rolls without slipping along them while it presses on the ground; a support wheel is frictionless.
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot` under construction (description, mass, gravity and spec wheels
@@ -310,8 +381,9 @@ def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> C
         The :class:`CompliantWheel`.
 
     Raises:
-        InputError: contact not rigid/compliant, a compliant wheel without a friction law (rolling while in
-            contact is not modelled for compliant wheels), stick_slip or slip = 'lateral' on one, bad numbers.
+        InputError: contact not rigid/compliant, stick_slip or slip = 'lateral' on a compliant wheel, a friction
+            law on a support, bad numbers. (``friction = "rolling"``, the default, on a standard or omni wheel:
+            it rolls without slipping while in contact, :mod:`robotdyn.contact.compliant_rolling`.)
     """
     from .compliance import STATIC_DEFLECTION, normal_compliance, weight
     from .friction import make_law
@@ -322,19 +394,21 @@ def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> C
     if w.kind not in ("standard", "omni", "support"):
         raise InputError(f"wheel {name!r}: kind {w.kind!r}; expected 'standard', 'omni' or 'support'")
     law = None
+    rolling = False
     if w.kind == "support":
         if w.friction not in ("rolling", None):
             raise InputError(f"wheel {name!r}: friction law {w.friction!r} on a support wheel (frictionless)")
         directions = np.zeros((0, 2))
     else:
-        if w.friction in ("rolling", None):
-            raise InputError(f"wheel {name!r}: contact = 'compliant' needs a friction law for its tangential "
-                             "force (friction = 'coulomb' or 'linear'); rolling without slipping while in contact "
-                             "is not modelled for compliant wheels")
         if w.friction == "stick_slip" or w.slip != "both":
-            raise InputError(f"wheel {name!r}: contact = 'compliant' takes friction = 'coulomb' or 'linear' with "
-                             "slip = 'both'")
-        law = make_law(w.friction, w.mu, w.slip_velocity, w.stiffness, wheel=name)
+            raise InputError(f"wheel {name!r}: contact = 'compliant' takes friction = 'rolling' (rolls while in "
+                             "contact), 'coulomb' or 'linear' with slip = 'both'")
+        if w.friction in ("rolling", None):
+            if w.mu is not None and not (math.isfinite(float(w.mu)) and float(w.mu) >= 0):
+                raise InputError(f"wheel {name!r}: mu = {w.mu}; expected a friction coefficient >= 0")
+            rolling = True  # robotdyn.contact.compliant_rolling: its tangential rows hold while it presses
+        else:
+            law = make_law(w.friction, w.mu, w.slip_velocity, w.stiffness, wheel=name)
         directions = np.eye(2) if w.kind == "standard" else \
             np.array([[math.cos(roller_angle), math.sin(roller_angle)]])
     if w.normal_stiffness is not None:
@@ -351,4 +425,4 @@ def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> C
         i = names.index(name) if name in names else 0
         damping = float(rule.damping[i])  # c = 2 * 0.3 * sqrt(k m / n) with this wheel's k
     normal = make_normal_law(w.contact_law, k, damping, w.contact_exponent, wheel=name)
-    return CompliantWheel(robot.description, w.frame, radius, normal, law, directions, w.kind, **kwargs)
+    return CompliantWheel(robot.description, w.frame, radius, normal, law, directions, w.kind, rolling, **kwargs)

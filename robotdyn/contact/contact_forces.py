@@ -46,6 +46,8 @@ from ..constraints.loop_closure import LoopClosure
 from ..constraints.rolling_contact import RollingWheel
 from .sliding import forward as forward_sliding
 from .sliding import sliding_now, tangential
+from .compliant_rolling import forward as rolling_forward
+from .compliant_rolling import rolling_wheels
 from .applied_forces import applied, has_applied, reduced_applied
 from . import rigid_limit
 from .compliance import wheel_stiffness
@@ -55,6 +57,10 @@ ILL_DETERMINED = 1e3
 
 DETERMINED_TOL = 1e-8
 """A row (or force component) is determined when its weight in every null-space direction is below this."""
+
+
+COMPLIANT_SOURCE = "compliant contact"
+"""How a compliant wheel's normal load is reported (its force law of penetration and its rate)."""
 
 
 @dataclass
@@ -90,7 +96,9 @@ class WheelForce:
     @property
     def source(self) -> str:
         """Which model produced the normal load: ``rigid`` (rigid-body dynamics), ``rigid limit of compliance``,
-        or ``open`` (neither determines it)."""
+        ``compliant contact`` (a compliant wheel's force law of penetration), or ``open`` (none determines it)."""
+        if self.kind == "compliant":
+            return COMPLIANT_SOURCE
         if self.determined[2]:
             return "rigid"
         return rigid_limit.MODEL if self.compliance[2] else "open"
@@ -202,12 +210,16 @@ class ConstraintForces:
         """
         if not self.wheels or not all(w.known[2] for w in self.wheels):
             return None
-        fn = np.array([w.normal for w in self.wheels])
+        # a compliant wheel in the air carries nothing and needs no friction (robotdyn.contact.compliant_contact)
+        pairs = [(t, w) for t, w in zip(self._tangential, self.wheels) if not (w.kind == "compliant" and w.normal <= 0)]
+        if not pairs:
+            return 0.0
+        fn = np.array([w.normal for _, w in pairs])
         if np.any(fn <= 0):
             return float("inf")
         space = self.open
         maps = []  # f_t,i(z) = base_i + T_i z
-        for (idx, D, friction), w in zip(self._tangential, self.wheels):
+        for (idx, D, friction), w in pairs:
             if friction is not None:
                 maps.append((np.asarray(friction, float), np.zeros((2, space.shape[1]))))
             else:
@@ -343,11 +355,17 @@ def cone_minimum(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: i
         return min(float(res.fun), ratio(np.zeros(1)))
     from scipy.optimize import minimize
 
-    cons = [{"type": "ineq", "fun": (lambda x, b=b, T=T, f=f: (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2))}
-            for (b, T), f in zip(maps, fn)]
+    def cone(x, b, T, f):  # (t f)^2 - |b + T z|^2 >= 0 for x = (z, t)
+        return (x[-1] * f) ** 2 - np.sum((b + T @ x[:-1]) ** 2)
+
+    def cone_jac(x, b, T, f):  # its gradient in (z, t): the exact one, so SLSQP needs no differences
+        return np.append(-2.0 * (b + T @ x[:-1]) @ T, 2.0 * x[-1] * f * f)
+
+    cons = [{"type": "ineq", "fun": cone, "jac": cone_jac, "args": (b, T, f)} for (b, T), f in zip(maps, fn)]
+    last = np.append(np.zeros(d), 1.0)
     x0 = np.append(np.zeros(d), ratio(np.zeros(d)))
-    res = minimize(lambda x: x[-1], x0, constraints=cons, bounds=[(None, None)] * d + [(0, None)],
-                   method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
+    res = minimize(lambda x: x[-1], x0, jac=lambda x: last, constraints=cons,
+                   bounds=[(None, None)] * d + [(0, None)], method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
     return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
 
 
@@ -385,6 +403,7 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
     forward = nudot is None  # accelerations solved from the mass matrix (its conditioning then matters)
     friction = {}  # slipping wheels: name -> (J_t, friction force in (t1, t2))
     st = None
+    jrows = red.jacobian_rows
     if sliding_now(robot):
         if nudot is not None:
             raise InputError("with slipping wheels the forces follow from motor torques: give tau, not nudot")
@@ -394,6 +413,15 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         kin_v = KinematicState(robot.model, robot.data, q, red.v)
         for i, wheel in enumerate(sliding_now(robot)):
             friction[wheel.name] = (tangential(wheel, kin_v)[0], st.force[i])
+    elif nudot is None and rolling_wheels(robot):  # compliant wheels rolling while they press: their rows join
+        tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
+        rolled = rolling_forward(robot, q, nu, tau, red=red)  # robotdyn.contact.compliant_rolling
+        nudot = rolled.nudot
+        if rolled.contact:  # their multipliers (minimum-norm, with the open part in the null space) are their forces
+            labels = [lab for w in rolling_wheels(robot) if w.name in rolled.contact for lab in w.rolling_labels()]
+            m = len(labels)
+            jrows = ConstraintRows.stack([jrows, ConstraintRows(rolled.rows, None, np.zeros(m), np.zeros(m, bool),
+                                                                labels)], robot.model.nv)
     elif nudot is None:
         tau = robot.check_tau(np.zeros(len(robot.motors)) if tau is None else tau)
         from ..reduction.reduced_dynamics import solve_mass
@@ -406,12 +434,15 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         else:
             tau = robot.check_tau(tau)
     a = red.S @ nudot + red.w
-    out = _forces(robot, q, red.v, a, tau, red.jacobian_rows, friction, nudot)
+    out = _forces(robot, q, red.v, a, tau, jrows, friction, nudot)
+    unsupported = False  # a planar model whose wheels cannot hold its out-of-plane equilibrium
     if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
+        planar = out
         out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
+        unsupported = out is planar
     if st is not None and st.lam is not None:  # the loads of the coupled solve (rigid limit with friction)
         apply_rigid_limit(robot, out, st.lam, st.unloaded)
-    elif compliance and not friction:
+    elif compliance and not friction and not unsupported:  # no equilibrium to split where support is lacking
         apply_rigid_limit(robot, out)
     from ..reduction.conditioning import WARN_CONDITION, IllConditioned
 
@@ -519,9 +550,15 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     for c in robot.constraints:
         if getattr(c, "compliant", False):  # its force is its laws' (robotdyn.contact.compliant_contact)
             st = compliant[c.name]
-            out.wheels.append(WheelForce(c.name, "compliant", st["force"], np.ones(3, bool), st["E"] @ st["force"],
+            force, known = st["force"].copy(), np.ones(3, bool)
+            idx = [index[lab] for lab in c.rolling_labels() if lab in index]  # rolling in contact: its rows
+            if idx:
+                force[:2] = c.tangent_directions.T @ lam[idx]
+                if N.shape[1]:  # an open split (e.g. the side force of two wheels on one axle)
+                    known[:2] = np.linalg.norm(c.tangent_directions.T @ N[idx], axis=1) <= DETERMINED_TOL
+            out.wheels.append(WheelForce(c.name, "compliant", force, known, st["E"] @ force,
                                          np.array(st["point"], float)))
-            out._tangential.append(([], np.zeros((0, 3)), st["force"][:2]))
+            out._tangential.append((idx, c._directions, None) if idx else ([], np.zeros((0, 3)), force[:2]))
         elif isinstance(c, RollingWheel):
             fr = friction.get(c.name, (None, None))[1]
             if served is not None:
@@ -683,7 +720,10 @@ def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
     others = N.shape[1] - len(zero)
     if others > 0:
         mixed = sorted({lab for col in N.T for lab, c in zip(labels, col) if abs(c) > DETERMINED_TOL} - set(zero))
-        out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: the rows are "
-                   "redundant, e.g. more wheels than a rigid body needs; the normal loads among them are split by "
-                   "the rigid limit of the wheels' normal compliance)")
+        if any(lab.endswith(".normal") for lab in mixed):
+            why = "the rows are redundant, e.g. more wheels than a rigid body needs"
+        else:  # only tangential rows: wheels pushing against each other, which normal compliance does not fix
+            why = ("wheels pushing against each other along these directions, which no motion tells apart; no "
+                   "normal load is among them, so the values shown are the minimum-norm choice")
+        out.append(f"{others} combination(s) of rows {', '.join(mixed)} (statically indeterminate: {why})")
     return out

@@ -52,7 +52,7 @@ class FrictionLaw:
         return -float(normal) * self.coefficient(np.asarray(s, float))
 
     def encode(self) -> tuple[int, float, float] | None:
-        """The law as data for the compiled engine (``robotdyn/_compiled.cpp``, ``Slip``): ``(code, p0, p1)``, or
+        """The law as data for the compiled engine (``robotdyn/kernels/sliding.hpp``, ``Slip``): ``(code, p0, p1)``, or
         ``None`` where its formula is not compiled (the robot then runs on the Python path).
 
         Returns:

@@ -1,4 +1,5 @@
-"""Impulsive contact with a fixed, frictionless surface in minimal (e.g. operational) coordinates.
+"""Impulsive contact with a fixed, frictionless surface in minimal (e.g. operational) coordinates, and the plastic
+impact that stops several velocity rows at once (:func:`plastic_impact`: wheels touching down while rolling).
 
 With the reduced inertia :math:`M` (k x k) in velocities :math:`\\nu`, an impulse :math:`\\hat F n` along a
 direction :math:`n` of generalised force (the surface normal expressed in the same coordinates, e.g.
@@ -108,6 +109,76 @@ def impact(M, n, nu, e: float) -> Impulse:
     return Impulse(F, n, dnu, after, vn, float(n @ after), float(1.0 / (n @ Minv_n)))
 
 
+@dataclass
+class PlasticImpulse:
+    """Result of a plastic impact on several velocity rows at once (:func:`plastic_impact`).
+
+    Attributes:
+        impulse: :math:`\\hat\\Lambda` (m,) [N s for rows of point velocities], one per row (minimum-norm on
+            redundant rows).
+        delta_nu: Velocity jump :math:`M^{-1} G^T \\hat\\Lambda` (k,).
+        nu_after: :math:`\\nu^+` (k,), with :math:`G\\nu^+ = 0`.
+        rows_before: :math:`G\\nu^-` (m,).
+        energy_lost: :math:`\\tfrac12\\nu^{-T} M\\nu^- - \\tfrac12\\nu^{+T} M\\nu^+ \\ge 0` [J].
+        rank: The rank of :math:`G M^{-1} G^T` used.
+    """
+
+    impulse: np.ndarray
+    delta_nu: np.ndarray
+    nu_after: np.ndarray
+    rows_before: np.ndarray
+    energy_lost: float
+    rank: int
+
+
+def plastic_impact(M, G, nu, rcond: float = 1e-10) -> PlasticImpulse:
+    """The plastic impact that stops the velocity rows :math:`G\\nu` (e.g. the slip of wheels touching down while
+    rolling without slipping): the impulse :math:`G^T\\hat\\Lambda` with :math:`G\\nu^+ = 0`,
+
+    .. math:: (G M^{-1} G^T)\\,\\hat\\Lambda = -G\\nu^-,\\qquad \\nu^+ = \\nu^- + M^{-1}G^T\\hat\\Lambda,
+
+    the multi-row form of :func:`impact` with e = 0 (for one row along n it is that impact exactly). By
+    Kelvin's theorem the energy lost is :math:`\\tfrac12 (G\\nu^-)^T (G M^{-1} G^T)^{-1} G\\nu^-` (the kinetic energy of
+    the relative motion the impulse stops). Redundant rows (a rank-deficient :math:`G M^{-1} G^T`, eigenvalues below
+    ``rcond`` times the largest) get the minimum-norm impulse; rows that cannot all vanish are refused.
+
+    Args:
+        M: Reduced inertia (k, k), symmetric positive definite.
+        G: Rows (m, k) in the coordinates of M's velocities (m may be 0).
+        nu: Velocity just before impact (k,).
+        rcond: Relative eigenvalue cut for redundant rows.
+
+    Returns:
+        The :class:`PlasticImpulse`.
+
+    Raises:
+        InputError: Bad shapes, non-finite values, or rows that no impulse can bring to zero together.
+    """
+    M, _ = _check(M, np.ones(np.asarray(M).shape[0]), 0.0)
+    k = M.shape[0]
+    G = np.asarray(G, float).reshape(-1, k) if np.size(G) else np.zeros((0, k))
+    nu = np.asarray(nu, float)
+    if nu.shape != (k,) or not (np.all(np.isfinite(nu)) and np.all(np.isfinite(G))):
+        raise InputError(f"velocity has {nu.size} values and rows {G.shape}; expected {k} finite numbers and (m, {k})")
+    before = G @ nu
+    if G.shape[0] == 0:
+        return PlasticImpulse(np.zeros(0), np.zeros(k), nu.copy(), before, 0.0, 0)
+    MinvGT = np.linalg.solve(M, G.T)
+    W = G @ MinvGT
+    W = 0.5 * (W + W.T)
+    vals, vecs = np.linalg.eigh(W)
+    keep = vals > rcond * max(vals.max(initial=0.0), np.finfo(float).tiny)
+    Lam = -vecs[:, keep] @ ((vecs[:, keep].T @ before) / vals[keep])
+    dnu = MinvGT @ Lam
+    after = nu + dnu
+    left = np.abs(G @ after).max(initial=0.0)
+    if left > 1e-8 * np.abs(before).max(initial=0.0) + 1e-12:  # [m/s] for rows of point velocities
+        raise InputError(f"the rows cannot all be stopped by one impulse (|G nu+| = {left:.3g}); expected "
+                         "consistent rows")
+    lost = 0.5 * float(-before @ Lam)  # = 1/2 before^T W^+ before >= 0
+    return PlasticImpulse(Lam, dnu, after, before, lost, int(keep.sum()))
+
+
 def impulse_curve(M, e: float, speed: float = 1.0, plane: tuple[int, int] = (0, 1), samples: int = 361
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Impulse against a wall hit head-on at ``speed`` in every direction of a plane of velocity components.
@@ -137,4 +208,4 @@ def impulse_curve(M, e: float, speed: float = 1.0, plane: tuple[int, int] = (0, 
     return angles, (1.0 + e) * speed / quad
 
 
-__all__ = ["Impulse", "impact", "effective_mass", "impulse_curve"]
+__all__ = ["Impulse", "impact", "effective_mass", "impulse_curve", "PlasticImpulse", "plastic_impact"]

@@ -392,6 +392,26 @@ def redundant_load_error(wheel) -> ConstraintError:
                            "(and its friction) is not determined by rigid-body dynamics")
 
 
+def contact_load(robot, st: SlidingState) -> float:
+    """The smallest normal load [N] of the slipping wheels that carry load at a state: the lift-off event's value
+    (it reaches zero where a wheel would have to leave the ground).
+
+    Wheels that the rigid limit of normal compliance leaves unloaded (``st.unloaded``: on a statically
+    indeterminate chassis, a wheel that would pull) are left out: they stay on the ground at zero load while the
+    chassis rests on the others, which is not a lift-off (the rigid-limit split unloads and reloads them itself).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        st: Its :class:`SlidingState` at the state (:func:`forward`).
+
+    Returns:
+        The smallest load [N] among the loaded slipping wheels (the smallest of all where every wheel is unloaded).
+    """
+    names = [w.name for w in sliding_now(robot)]
+    loaded = np.array([name not in st.unloaded for name in names], bool)
+    return float(np.min(st.normal[loaded] if loaded.any() else st.normal))
+
+
 def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> str:
     """``stats["event"]`` of a run stopped where a slipping wheel's normal load reached zero at time t [s] and
     state (q, nu), with torques tau there (the same on every engine).
@@ -408,8 +428,9 @@ def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.nda
     """
     wheels = sliding_now(robot)
     st = forward(robot, q, nu, tau)
-    wheel = wheels[int(np.argmin(st.normal))].name
-    return (f"lift-off of wheel {wheel} at t = {t:.6g} s (normal load {np.min(st.normal):.3g} N): "
+    load = np.array([np.inf if w.name in st.unloaded else f for w, f in zip(wheels, st.normal)])
+    i = int(np.argmin(load)) if np.isfinite(load).any() else int(np.argmin(st.normal))
+    return (f"lift-off of wheel {wheels[i].name} at t = {t:.6g} s (normal load {st.normal[i]:.3g} N): "
             "the run stops there (a wheel in flight is not modelled)")
 
 

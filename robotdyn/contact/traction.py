@@ -81,6 +81,9 @@ class Traction:
         sliding: Wheels whose tangential force follows a friction law (they slip by design: no no-slip check).
         compliance: Wheels whose normal loads rigid-body dynamics leave open at some sample and the rigid limit of
             the wheels' normal compliance gives (:mod:`robotdyn.contact.rigid_limit`).
+        compliant: Wheels whose normal contact is a force law of the penetration (``contact = "compliant"``,
+            :mod:`robotdyn.contact.compliant_contact`): their zero load is flight (:meth:`in_air`), not a broken
+            assumption.
         method: Which pass computed the loads: ``fast`` (:mod:`robotdyn.contact.traction_fast`, a few samples
             possibly by the reference) or ``reference`` (:func:`~robotdyn.contact.contact_forces.constraint_forces`
             at every sample).
@@ -99,18 +102,31 @@ class Traction:
     method: str = "reference"
     sliding: list[str] = field(default_factory=list)
     compliance: list[str] = field(default_factory=list)
+    compliant: list[str] = field(default_factory=list)
+
+    def in_air(self) -> np.ndarray:
+        """(N, W) where a compliant wheel (:attr:`compliant`) is in the air: its load is zero (a force law that
+        never pulls), the flight its model allows.
+
+        Returns:
+            A boolean array (N, W), samples by wheels in wheel order, ``True`` where that wheel flies.
+        """
+        flies = np.array([w in self.compliant for w in self.wheels], bool)
+        return (self.normal <= 0) & flies
 
     def broken(self) -> np.ndarray:
-        """(N, W) where the no-slip assumption is broken: load <= 0, or required friction above mu (every wheel
-        where no admissible split of the open forces stays within mu).
+        """(N, W) where the no-slip assumption is broken: a rigid contact's load <= 0 (it would pull: lift-off),
+        or required friction above mu (every wheel where no admissible split of the open forces stays within mu).
+        A compliant wheel in the air is flight (:meth:`in_air`), not counted here.
 
         Returns:
             A boolean array (N, W), samples by wheels in wheel order, ``True`` where the assumption is broken.
         """
-        out = self.normal <= 0
+        air = self.in_air()
+        out = (self.normal <= 0) & ~air
         rolling = np.array([w not in self.sliding for w in self.wheels], bool)
         known = np.isfinite(self.mu) & self.friction_determined & rolling
-        out[:, known] |= self.required_mu[:, known] > self.mu[known]
+        out[:, known] |= (self.required_mu[:, known] > self.mu[known]) & ~air[:, known]
         over = self._split_over()
         if over is not None:
             out[over] = True
@@ -238,8 +254,11 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
                    _friction_coefficients(robot, wheels, mu), friction_known, undetermined)
     out.minimum_mu = loads.minimum_mu
     out.method = used
-    by_law = {c.name for c in robot.constraints if getattr(c, "sliding", False) or hasattr(c, "law")}
+    by_law = {c.name for c in robot.constraints if getattr(c, "sliding", False)
+              or (hasattr(c, "law") and not getattr(c, "rolling", False))}  # rolling compliant: no law, no slip
     out.sliding = [w for w in wheels if w in by_law]  # (they slip by design: their friction is their law's)
+    compliant = {(w.name or w.frame) for w in robot.spec.wheels if getattr(w, "contact", "rigid") == "compliant"}
+    out.compliant = [w for w in wheels if w in compliant]  # (a zero load is flight)
     if loads.compliance is not None:
         out.compliance = [names[j] for j in keep if loads.compliance[:, j].any()]
     out.events = _events(out)

@@ -231,6 +231,9 @@ class _Model:
         self.m = len(fast.labels)
         self.C = normal_map(self.rows, self.directions, self.m)
         self.k = wheel_stiffness(robot, [c.name for c in self.wheels])
+        # a planar root's own loads are never split (as constraint_forces: they come from its floating twin where
+        # it holds the out-of-plane equilibrium, and stay undetermined where it does not)
+        self.split = index is not None or robot.spec.root != "planar"
 
     def lift(self, X: np.ndarray) -> np.ndarray:
         """Planar coordinates (or velocities) (B, n) into the twin's (B, n_twin), zero elsewhere."""
@@ -293,7 +296,7 @@ class _Model:
                     # on no coordinate, a planar root's normal rows, nor where every normal load is determined)
                     scale = np.maximum(np.max(np.abs(rows[sel]), axis=(1, 2)), 1.0)
                     inert = np.any(np.max(np.abs(rows[sel]), axis=2) <= 1e-12 * scale[:, None], axis=1)
-                    split = (r < self.m) & ~inert & ~determined[sel, :, 2].all(axis=1)
+                    split = (r < self.m) & ~inert & ~determined[sel, :, 2].all(axis=1) & self.split
                     Os, count = Ns, np.full(len(sel), Ns.shape[2])
                     if split.any():
                         lr, op, _, cnt = split_many(lm[split], Ns[split], self.C, self.k)

@@ -3,7 +3,9 @@
 :class:`CompiledModel` evaluates :math:`M_r = S^TMS`, :math:`h = C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, S\\nu, w)`,
 :math:`g_r`, :math:`B_r`, :math:`S` and :math:`w = \\dot S\\nu` with the formulas of the Python reference
 (:mod:`robotdyn.constraints.rolling_contact` on a plane, :mod:`robotdyn.constraints.loop_closure`, :mod:`robotdyn.reduction.projection`,
-:mod:`robotdyn.reduction.operational_space`, :mod:`robotdyn.reduction.actuation`) in C++ (``robotdyn/_compiled.cpp``), on a copy of
+:mod:`robotdyn.reduction.operational_space`, :mod:`robotdyn.reduction.actuation`) in C++ (``robotdyn/_compiled.cpp``: the
+evaluator; its formulas are the kernels of ``robotdyn/kernels/``, one header per constraint kind named like its Python
+module), on a copy of
 the robot's Pinocchio model rebuilt joint by joint and checked against it when built (M, g and RNEA at a random
 state). Pinocchio's own C++ algorithms do the rigid-body work, two passes per state: CRBA in the world convention
 (M, the joint Jacobians and, from its composite inertias, :math:`g_k = -J_k^T (Y_k a_g)`) and RNEA without gravity
@@ -104,6 +106,8 @@ def why_not(robot) -> str | None:
         return "the compiled extension robotdyn._compiled was not built"
     if getattr(robot, "springs", None):  # robotdyn.reduction.joint_springs
         return "joint springs and dampers are evaluated on the Python path (not compiled)"
+    if any(getattr(c, "rolling", False) for c in robot.constraints):  # robotdyn.contact.compliant_rolling
+        return "compliant wheels that roll while in contact (friction = 'rolling') are simulated on the Python path"
     if any(getattr(c, "compliant", False) for c in robot.constraints):  # robotdyn.contact.compliant_contact
         return "compliant wheels (normal force laws) are evaluated on the Python path (not compiled)"
     for i in range(1, robot.model.njoints):
@@ -134,7 +138,7 @@ class LazyProjection(Projection):
     velocities and rows, with :math:`A_d^{-1}` and the exact 1-norm condition number computed from A on first
     access (by the formulas of :func:`robotdyn.reduction.projection.project`). The compiled path itself needs neither: it
     solves with the LU factors and decides singularity by LAPACK's condition estimate, switching to the exact
-    number from an estimate of 1e8 on (``robotdyn/_compiled.cpp``).
+    number from an estimate of 1e8 on (``robotdyn/kernels/projection.hpp``).
 
     Args:
         S: (n, k) with v = S nu.

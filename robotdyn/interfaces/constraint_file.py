@@ -65,8 +65,9 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
     normal_damping = 600.0              # radial damping [N s/m] (default: damping ratio 0.3 of the wheel's share
                                         # of the mass on its default stiffness)
     contact = "rigid"                   # rigid (normal row a constraint, default) | compliant (a force law of the
-                                        # penetration: the wheel can fly and land; needs friction = coulomb or
-                                        # linear; robotdyn.contact.compliant_contact)
+                                        # penetration: the wheel can fly and land; robotdyn.contact.
+                                        # compliant_contact); friction = rolling: it rolls while in contact
+                                        # (robotdyn.contact.compliant_rolling), or coulomb / linear
     contact_law = "linear"              # compliant: linear (k delta + c delta') | hunt_crossley (delta^n (k +
                                         # lambda delta'): normal_stiffness in N/m^n, normal_damping lambda)
     contact_exponent = 1.5              # hunt_crossley's n

@@ -95,8 +95,10 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "wheels[].normal_damping": ("normal (radial) damping c [N s/m]", "2 * 0.3 * sqrt(k m / n): damping ratio 0.3 on "
                                 "the wheel's share of the mass", "normal_damping = 400.0"),
     "wheels[].contact": ("rigid (the normal row is a constraint) | compliant (a force law of the penetration "
-                         "[m]: the wheel can fly and land; needs friction = coulomb or linear with slip = both, "
-                         "except a support, which is frictionless)", "rigid", 'contact = "compliant"'),
+                         "[m]: the wheel can fly and land; with friction = rolling it rolls without slipping while "
+                         "its normal force is > 0, a plastic tangential impact at each touch-down, or it follows "
+                         "friction = coulomb or linear with slip = both; a support is frictionless)", "rigid",
+                         'contact = "compliant"'),
     "wheels[].contact_law": ("a compliant wheel's normal force law: linear, f = k d + c d' [N] (k in N/m, c in "
                              "N s/m) | hunt_crossley, f = d^n (k + lambda d') [N] (normal_stiffness k in N/m^n, "
                              "normal_damping lambda in N s/m^(n+1)); only with contact = compliant", "linear",

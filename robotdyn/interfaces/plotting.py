@@ -184,8 +184,10 @@ def wheel_order(robot, wheels: Sequence[str]) -> tuple[list[str], set[str]]:
 
 def plot_traction(tr, path=None, title: str = "", robot=None):
     """Plot a :class:`~robotdyn.contact.traction.Traction`: normal loads (top) and required friction (bottom)
-    per wheel against time, shaded where a wheel is unloaded (load <= 0: lifting off, or in the air for a compliant
-    wheel) or a rolling wheel needs more friction than its mu (drawn dashed): where the no-slip assumption breaks.
+    per wheel against time, shaded where a rigid wheel is unloaded (load <= 0: lifting off) or a rolling wheel needs
+    more friction than its mu (drawn dashed): where the no-slip assumption breaks; and, in a band of its own, where
+    a compliant wheel is in the air (:meth:`~robotdyn.contact.traction.Traction.in_air`: flight, which its model
+    allows).
 
     Drive wheels come first. Every wheel that can slip has its required friction ``|f_t|/f_n`` drawn where it is
     determined; where rigid-body dynamics split a force between wheels only as a sum (e.g. two wheels on one
@@ -205,6 +207,7 @@ def plot_traction(tr, path=None, title: str = "", robot=None):
     """
     fig, (ax_n, ax_mu) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True)
     broken = tr.broken().any(axis=1) if tr.wheels else np.zeros(len(tr.t), bool)
+    flying = tr.in_air().any(axis=1) if tr.wheels else np.zeros(len(tr.t), bool)
     order, supports = wheel_order(robot, tr.wheels)
     pending = []  # wheels that can slip but whose own friction force is not determined
     for name in order:
@@ -231,9 +234,14 @@ def plot_traction(tr, path=None, title: str = "", robot=None):
         if broken.any():
             ax.fill_between(tr.t, 0, 1, where=broken, transform=ax.get_xaxis_transform(), color="C3", alpha=0.15,
                             label="a wheel unloaded or beyond its mu" if ax is ax_n else None)
+        if flying.any():
+            ax.fill_between(tr.t, 0, 1, where=flying, transform=ax.get_xaxis_transform(), color="C0", alpha=0.12,
+                            hatch="//", label="a compliant wheel in the air (flight)" if ax is ax_n else None)
         ax.grid(alpha=0.3)
     ax_n.axhline(0.0, color="k", lw=0.8)
-    ax_mu.set_ylim(bottom=0.0)
+    drawn = [y for line in ax_mu.lines for y in np.asarray(line.get_ydata(), float).ravel() if np.isfinite(y)]
+    top = max(ax_mu.get_ylim()[1], 1.1 * max(drawn)) if drawn else None
+    ax_mu.set_ylim(bottom=0.0, top=top)  # (a constant line, e.g. a steady turn's mu, not hidden on the frame)
     ax_n.set_ylabel("normal load [N]")
     ax_mu.set_ylabel("required friction |f_t|/f_n")
     ax_mu.set_xlabel("t [s]")

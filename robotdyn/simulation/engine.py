@@ -28,7 +28,7 @@ from ..reduction.projection import solve
 from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
-from ..contact.sliding import lift_off_message, slipping_wheels
+from ..contact.sliding import contact_load, lift_off_message, slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
 from ..contact.compliant_contact import compliant_wheels
 from ..contact.applied_forces import applied, has_applied
@@ -178,6 +178,15 @@ def simulate(
                                           stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times),
                         robot, torque)
     compliant = compliant_wheels(robot)
+    if any(w.rolling for w in compliant):  # compliant wheels rolling while in contact: a hybrid run
+        from .compliant_rolling import simulate_rolling
+
+        if slipping_wheels(robot):
+            raise RobotDynError("compliant wheels that roll (friction = 'rolling') with rigid slipping wheels are not "
+                                "simulated; expected contact = 'compliant' on the slipping wheels too")
+        return _applied(simulate_rolling(robot, t_end, q0, nu0, torque, np.linspace(t0, t_end, n_out) if times is None
+                                         else times, rtol, atol, method, stabilisation,
+                                         Progress(t_end, progress, time_limit), t0), robot, torque)
     method = method or (STIFF_METHOD if compliant else "DOP853")
     n = robot.nq
     zero_tau = np.zeros(len(robot.motors))
@@ -230,7 +239,7 @@ def simulate(
         def lift_off(t: float, y: np.ndarray) -> float:  # the smallest normal load of a slipping wheel [N]
             q, nu = y[:n], y[n:n + k]
             tau = zero_tau if torque is None else np.asarray(torque(t, q, nu), float)
-            return float(np.min(forward_sliding(robot, q, nu, tau).normal))
+            return contact_load(robot, forward_sliding(robot, q, nu, tau))
 
         lift_off.terminal, lift_off.direction = True, -1.0
         events = [lift_off]

@@ -100,7 +100,8 @@ def flight_summary(phases: list[dict], start: list[str] = ()) -> list[str]:
     """
     wheels: dict[str, list[str]] = {name: ["in the air at the start"] for name in start}
     for e in phases:
-        wheels.setdefault(e["wheel"], []).append(f"{e['event']} {e['t']:.6g} s")
+        lost = f" (impact -{e['loss']:.4g} J)" if e.get("loss") else ""  # a rolling wheel's touch-down
+        wheels.setdefault(e["wheel"], []).append(f"{e['event']} {e['t']:.6g} s{lost}")
     return [f"wheel {name}: {', '.join(items)}" for name, items in wheels.items()]
 
 

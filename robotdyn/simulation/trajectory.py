@@ -29,6 +29,10 @@ class Trajectory:
         damper_work: Work done by joint dampers and compliant contacts' damping since t = 0 (N,) [J] (<= 0;
             ``None`` without them): E(t) - E(0) = motor work + friction_work + damper_work, with E counting the
             springs' and contacts' elastic energy.
+        impact_loss: Kinetic energy taken by the touch-down impacts of rolling compliant wheels up to each sample
+            (N,) [J] (>= 0, non-decreasing; ``None`` without such wheels,
+            :mod:`robotdyn.simulation.compliant_rolling`): E(t) - E(0) = motor work + friction_work + damper_work -
+            (impact_loss(t) - impact_loss(0)).
         robot, torque: The robot simulated and the torque law applied (``None``: unactuated), as
             :func:`~robotdyn.simulation.engine.simulate` received them: what a post-pass (wheel loads,
             :func:`robotdyn.contact.traction.traction`) must use, also where a scenario built its own controller
@@ -48,6 +52,7 @@ class Trajectory:
     robot: object | None = field(default=None, repr=False, compare=False)
     torque: object | None = field(default=None, repr=False, compare=False)
     damper_work: np.ndarray | None = None
+    impact_loss: np.ndarray | None = None
 
     def __repr__(self) -> str:
         return f"Trajectory(t=[{self.t[0]:g}, {self.t[-1]:g}] s, N={len(self.t)}, wall={self.stats.get('wall', 0):.3g} s)"

@@ -249,6 +249,9 @@ def energy_drift(traj, torque) -> float | None:
     damper = getattr(traj, "damper_work", None)  # joint dampers and compliant contacts' damping
     if damper is not None:
         e = e - damper[start:]
+    impacts = getattr(traj, "impact_loss", None)  # touch-downs of rolling compliant wheels
+    if impacts is not None:
+        e = e + impacts[start:]
     return float(np.max(np.abs(e - e[0])))
 
 

@@ -4,11 +4,14 @@ Model: :mod:`robotdyn.robots.adaptable_wheel.model` (Pinocchio, ``urdf/adaptable
 Mardani & Ebrahimi 2016, ``docs/bibliography.md``) and its missions (:mod:`robotdyn.robots.adaptable_wheel.missions`, section 7).
 :func:`model_configuration` puts an IK solution of the paper into the model's coordinates,
 :func:`model_static_check` tests eqs 25-34 against the model's generalised equilibrium, :func:`compare` the printed
-numbers of section 7 and Table 2. The ``ik`` CLI subcommand shows the paper's IK and statics beside the model's
-coordinates. Verdicts and evidence: ``docs/errata/adaptable_wheel.md``.
+numbers of section 7 and Table 2, :func:`loads_comparison` sec 5's wheel loads against robotdyn's (:func:`hold_loads`).
+The ``ik`` CLI subcommand shows the paper's IK and statics beside the model's coordinates. Verdicts and evidence:
+``docs/errata/adaptable_wheel.md``.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -32,6 +35,9 @@ from .paper import (
     solve_ik,
     static_torques,
 )
+
+if TYPE_CHECKING:
+    from ...contact.contact_forces import ConstraintForces
 
 
 def euler_zyx(R: np.ndarray) -> tuple[float, float, float]:
@@ -191,6 +197,7 @@ def compare(robot: Robot | None = None, runs: dict | None = None) -> Comparison:
         cmp.add(f"Table 2: torque {tag}, eq 35 at Table 2's angle [N m]", torque,
                 abs(paper_torque_eq35(np.radians(angle), params)), 0.05,
                 note="internal consistency of Table 2 with eq 35")
+    cmp.rows.extend(loads_comparison({k: v for k, v in params.items() if k != "lateral"}).rows)
     return cmp
 
 
@@ -287,3 +294,58 @@ def register_cli(subparsers, parents) -> None:
     p.add_argument("--mission", choices=sorted(MISSIONS), help="run a whole mission of section 7 instead")
     p.add_argument("--csv", help="with --mission: write the solution at every step to this CSV file")
     p.set_defaults(func=cmd_ik)
+
+
+# ------------------------------------------------------------------------------------------- wheel loads (sec 5)
+def hold_loads(terrain: str = "flat", lateral: str = "rolling",
+               params: dict | None = None) -> tuple[Robot, np.ndarray, np.ndarray, ConstraintForces]:
+    """robotdyn's wheel loads with the robot at rest on ``terrain`` (the ``hold`` scenario's pose: the paper's IK at
+    the path origin, h_CG = 0.15 m, body level, and its least-squares holding torques).
+
+    On flat ground the rolling model is singular (the two front wheels' lateral rows coincide, errata), so the
+    loads there are taken with ``lateral="slip"``: at rest nothing pushes sideways, so dropping the lateral rows
+    changes no force.
+
+    Args:
+        terrain: ``flat``, ``ramp`` (mission 2) or ``rough`` (Table 1).
+        lateral: The ``lateral`` parameter of :data:`.model.SPEC` (``rolling`` or ``slip``).
+        params: Further parameters of :data:`.model.SPEC` (default ``None``: the defaults).
+
+    Returns:
+        ``(robot, q, tau, forces)``: the robot, the configuration (n,), the holding torques (6,) [N m] (spin fr, fl,
+        r, adjust fr, fl, r) and the :class:`~robotdyn.contact.contact_forces.ConstraintForces`.
+    """
+    from .model import HoldScenario
+
+    robot = Robot(SPEC, {**(params or {}), "terrain": terrain, "lateral": lateral})
+    hold = HoldScenario("hold", "at rest", 1.0)
+    q, nu = hold.initial_state(robot)
+    return robot, q, hold.holding, robot.contact_forces(q, nu, tau=hold.holding)
+
+
+def loads_comparison(params: dict | None = None) -> Comparison:
+    """Sec 5's equal share m g / 3 against robotdyn's loads at rest on flat ground, and eq 35's torques against
+    robotdyn's holding torques at the same angles.
+
+    Tolerance 0.05 N on loads and 0.005 N m on torques (both are closed forms on either side).
+
+    Args:
+        params: Parameters of :data:`.model.SPEC` (default ``None``: the defaults).
+
+    Returns:
+        The :class:`~robotdyn.interfaces.comparison.Comparison`.
+    """
+    from .paper import paper_flat_loads
+
+    robot, q, tau, forces = hold_loads("flat", "slip", params)
+    p = robot.params
+    share = paper_flat_loads(p)
+    cmp = Comparison("Mardani & Ebrahimi 2016, sec 5 (wheel loads on flat ground) vs robotdyn")
+    for k, w in enumerate(forces.wheels):
+        cmp.add(f"sec 5: load {w.name}, flat ground (m g / 3) [N]", share[k], w.normal, 0.05,
+                note="robotdyn: Robot.contact_forces at rest; the lever rule gives m g/4 (front), m g/2 (rear)")
+    angles = np.array([q[robot.coordinate_index(f"q_{t}")] for t in WHEELS])
+    for k, t in enumerate(WHEELS):
+        cmp.add(f"eq 35: holding torque {t}, flat ground [N m]", abs(paper_torque_eq35(angles[k], p)),
+                abs(tau[3 + k]), 0.005, note="robotdyn: least-squares holding torques of the rolling model")
+    return cmp

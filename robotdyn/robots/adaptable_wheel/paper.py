@@ -411,3 +411,20 @@ def static_torques(cmd: Commands, x: np.ndarray, p: dict, terrain: Terrain,
 
 TABLE2 = {"r": (3.9, 115.0), "fl": (1.7, 55.0), "fr": (3.4, 160.0)}
 """Table 2 (mission 2): torque [N m] and angle [deg] of each adjustment motor."""
+
+
+EQ35_LOAD_SHARE = 1.0 / 3.0
+"""Sec 5, before eq 35: "the contact forces exerted to each wheel are equal to the one-third of the robot weight"
+(the paper's flat-ground "worst case"), as a fraction of m g per wheel."""
+
+
+def paper_flat_loads(p: dict) -> np.ndarray:
+    """The wheel loads sec 5 assumes on flat ground: m g / 3 on each wheel [N] (fr, fl, r).
+
+    Args:
+        p: The parameters as a plain dict (Table 1 names of :data:`.model.SPEC`: m [kg], g [m/s^2], ...).
+
+    Returns:
+        (3,) loads [N] in the order fr, fl, r.
+    """
+    return np.full(3, EQ35_LOAD_SHARE * p["m"] * p["g"])

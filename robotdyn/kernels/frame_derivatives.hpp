@@ -1,11 +1,12 @@
-// Frame velocities and accelerations with their configuration derivatives at one state (q, x).
-// Python twin: robotdyn/constraints/row_derivatives.py (FramePass, _rot_dq, _cross_d).
+// robotdyn/kernels/frame_derivatives.hpp: frame velocities and accelerations with their configuration derivatives
+// at one state (q, x), twin of robotdyn/constraints/row_derivatives.py (FramePass, _rot_dq, _cross_d).
 //
-// One computeForwardKinematicsDerivatives(q, x, 0) on a Pinocchio data of its own; per frame, Pinocchio's
-// getFrameVelocityDerivatives / getFrameAccelerationDerivatives in LOCAL axes, rotated to world axes here (as in
-// Python: Pinocchio's LOCAL_WORLD_ALIGNED velocity derivative is not the derivative of the LOCAL_WORLD_ALIGNED
-// Jacobian times a fixed velocity, which is what the constraint rows need). Rotations and world Jacobians come
-// from the evaluator's configuration pass (its data and frame Jacobians at q).
+// One computeForwardKinematicsDerivatives per pass, on a Pinocchio data of its own (first order where no
+// acceleration is needed); per joint, Pinocchio's getJointVelocityDerivatives / getJointAccelerationDerivatives in
+// WORLD, carried to each frame's origin (FramePass below). The Python twin rotates the LOCAL frame derivatives to
+// world axes instead; both are the derivatives of the LOCAL_WORLD_ALIGNED J(q) x at fixed x and of its classical
+// acceleration, which is what the constraint rows need. Placements and world Jacobians come from the evaluator's
+// configuration pass (its data and frame Jacobians at q).
 #pragma once
 
 #include <pinocchio/multibody.hpp>

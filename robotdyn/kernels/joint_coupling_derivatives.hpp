@@ -1,8 +1,8 @@
-// Configuration derivatives of a joint coupling's row q_i = f(q_j), f = amplitude cos(rate q_j + phase) + offset
-// (a CosineLaw, the only law the evaluator compiles): d(A x)/dq = -f''(q_j) x_j e_j^T, dgamma/dq = -f'''(q_j) v_j^2
-// e_j^T and Adot = -f''(q_j) v_j e_j^T.
-// Python twin: robotdyn/constraints/row_derivatives.py (coupling_velocity_dq, _third, drift_dq) and
-// robotdyn/constraints/joint_coupling.py (JointCoupling.rows' Adot).
+// robotdyn/kernels/joint_coupling_derivatives.hpp: configuration derivatives of a joint coupling's row
+// q_i = f(q_j), f = amplitude cos(rate q_j + phase) + offset (a CosineLaw, the only law the evaluator compiles), twin
+// of robotdyn/constraints/row_derivatives.py (coupling_velocity_dq, _third, drift_dq) beside joint_coupling.hpp
+// (robotdyn/constraints/joint_coupling.py): d(A x)/dq = -f''(q_j) x_j e_j^T, dgamma/dq = -f'''(q_j) v_j^2 e_j^T and
+// Adot = -f''(q_j) v_j e_j^T.
 #pragma once
 
 #include <cmath>

@@ -1,7 +1,7 @@
-// Configuration derivatives of a loop closure's rows: d(A x)/dq at fixed x, the drift's dgamma/dq at fixed v, and
-// the rows' time derivative Adot.
-// Python twin: robotdyn/constraints/row_derivatives.py (closure_velocity_dq, closure_drift_dq) and, for Adot,
-// robotdyn/constraints/loop_closure.py (LoopClosure.rows).
+// robotdyn/kernels/loop_closure_derivatives.hpp: configuration derivatives of a loop closure's rows, twin of
+// robotdyn/constraints/row_derivatives.py (closure_velocity_dq, closure_drift_dq) beside the closure's values in
+// loop_closure.hpp (robotdyn/constraints/loop_closure.py, whose LoopClosure.rows gives Adot): d(A x)/dq at fixed x,
+// the drift's dgamma/dq at fixed v, and Adot.
 #pragma once
 
 #include <vector>

@@ -1,8 +1,8 @@
-// Derivatives of the reduced forward dynamics nudot(q, nu, tau) on the compiled path: the projection's chain rule
-// (dS = -K^-1 dK S, dw = -K^-1 (dK w + d gamma)), the multiplier mu = K^-T rho, Pinocchio's
-// computeRNEADerivatives for the tree, the motors' reaction terms, and the reduced solve.
-// Python twin: robotdyn/reduction/dynamics_derivatives.py (pieces, Pieces.Aq, motor_rows, dynamics_derivatives),
-// the same formulas in the same order; the per-constraint pieces are the <kind>_derivatives.hpp beside this file.
+// robotdyn/kernels/reduced_dynamics_derivatives.hpp: derivatives of the reduced forward dynamics nudot(q, nu, tau),
+// twin of robotdyn/reduction/dynamics_derivatives.py (pieces, Pieces.Aq, motor_rows, dynamics_derivatives), the same
+// formulas in the same order: the projection's chain rule (dS = -K^-1 dK S, dw = -K^-1 (dK w + d gamma)), the
+// multiplier mu = K^-T rho, Pinocchio's computeRNEADerivatives for the tree, the motors' reaction terms and the
+// reduced solve; the per-constraint pieces are the <kind>_derivatives.hpp beside this file.
 //
 // Served here: independent velocities that are a selection of v (operational-space velocities and slipping wheels
 // throw, and the Python side takes its reference path). The evaluator hands over its state after configure(q)

@@ -1,8 +1,8 @@
-// Configuration derivatives of a rolling wheel's rows: d(A x)/dq at fixed x, the drift's dgamma/dq at fixed v and
-// the rows' time derivative Adot (flat and curved terrain, constant or joint-driven radius).
-// Python twin: robotdyn/constraints/row_derivatives.py (wheel_geometry_dq, wheel_velocity_dq, terrain_normal_dp,
-// wheel_drift_dq) and, for Adot, robotdyn/constraints/rolling_contact.py (RollingWheel.rows): the same formulas in
-// the same order.
+// robotdyn/kernels/rolling_contact_derivatives.hpp: configuration derivatives of a rolling wheel's rows, twin of
+// robotdyn/constraints/row_derivatives.py (wheel_geometry_dq, wheel_velocity_dq, terrain_normal_dp, wheel_drift_dq)
+// beside the wheel's values in rolling_contact.hpp (robotdyn/constraints/rolling_contact.py): d(A x)/dq at fixed x,
+// the drift's dgamma/dq at fixed v and the rows' time derivative Adot (RollingWheel.rows), flat and curved terrain,
+// constant or joint-driven radius, the same formulas in the same order.
 #pragma once
 
 #include <cmath>

@@ -801,6 +801,25 @@ class Robot:
         fast = compiled_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves
         return fast if fast is not None else dynamics_derivatives(self, q, nu, tau)
 
+    def contact_force_derivatives(self, q, nu, tau):
+        """The wheel contact forces (normal load, tangential components in the contact frame) and each wheel's
+        required mu under motor torques ``tau``, with their derivatives in q (natural coordinates, and along the
+        holonomic manifold in the independent position coordinates of :meth:`dynamics_derivatives`), nu and tau:
+        a :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (Python path; see
+        :func:`robotdyn.contact.force_derivatives.contact_force_derivatives`).
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] in the order of :attr:`coordinates`.
+            nu: Independent velocities (k,) [m/s, rad/s] in the order of :attr:`velocity_names`.
+            tau: Motor torques/forces (n_motors,) [N m or N] in the order of :attr:`motors`.
+
+        Returns:
+            A :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (forces [N]).
+        """
+        from .contact.force_derivatives import contact_force_derivatives
+
+        return contact_force_derivatives(self, q, nu, tau)
+
     def conditioning(self, q, nu, tau=None) -> list:
         """The ill-conditioned parts of the reduced solve at (q, nu) (the projection's :math:`A_d`, the reduced
         mass matrix :math:`S^TMS`) that make its results (with motor torques ``tau``: the accelerations they

@@ -640,10 +640,11 @@ dd_case("i24-links-3000", "links", urdf_text(extra="".join(
 
 
 # ----------------------------------------------------------- generated: every flag of every subcommand (item 7)
-GENERATED_ROBOT = {"impulse": "omni_caster", "ik": "adaptable_wheel", "list": None, "linkage-posture": None}
+GENERATED_ROBOT = {"impulse": "omni_caster", "ik": "adaptable_wheel", "list": None, "linkage-posture": None,
+                   "climbing-posture": "mmr12_eod"}
 """The robot each command's generated cases use (default quasimoro; None: the command takes none)."""
 GENERATED_BASE = {**REQUIRED, "ik": [], "sweep": ["--out", "{d}/s", "--workers", "0", "--quiet", "--no-plot"],
-                  "optimise": ["--t-end", "3", "--nodes", "5", "--end", "x=0.1"]}
+                  "optimise": ["--t-end", "3", "--nodes", "5", "--end", "x=0.1"], "climbing-posture": ["--slope", "20"]}
 """What each command needs besides the flag under test (so that a case fails for that flag only)."""
 FLAG_CASES: dict = {
     # flag: (the bad arguments, texts the one line may name: any one of them), for every command taking the flag
@@ -704,6 +705,11 @@ FLAG_CASES: dict = {
     "--bound": (["--bound", "theta3=1:0"], ("--bound",)),
     "--tau-max": (["--tau-max", "-1"], ("--tau-max",)),
     "--derivatives": (["--derivatives", "bogus"], ("--derivatives",)),
+    "--min-load": (["--min-load", "-1"], ("--min-load",)),
+    "--mu-max": (["--mu-max", "nan"], ("--mu-max",)),
+    "--cost": (["--cost", "bogus"], ("--cost",)),
+    "--slope": (["--slope", "90"], ("--slope",)),
+    "--min-tip-load": (["--min-tip-load", "-5"], ("--min-tip-load",)),
 }
 FLAG_CASE_OVERRIDES: dict = {  # (command, flag): a different bad use where the generic one does not fit
     ("sweep", "--t-end"): (["--t-end", "nan"], ("t_end",)),

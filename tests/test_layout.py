@@ -37,6 +37,7 @@ UPWARD = {
     ("robots.adaptable_wheel.comparison", "cli.commands"),
     ("robots.linkage_suspension.model", "cli.commands"),
     ("robots.mmr12_eod.model", "cli.fk"),
+    ("robots.mmr12_eod.climbing_posture", "cli.commands"),
     ("robots.omni_caster.model", "cli.commands"),
     # simulate_many(robot="quasimoro"): a robot given by its registered name
     ("simulation.many_runs", ""),
@@ -48,7 +49,9 @@ LAZY_CIRCLES = {
     frozenset({"cli.commands", "cli.fk"}),
     frozenset({"cli.commands", "cli.linearize"}),  # the linearize subcommand registers itself, prints with _emit
     frozenset({"cli.commands", "cli.optimise"}),  # the optimise subcommand likewise
-    frozenset({"sweep.chunk", "sweep.batched"}),  # a chunk's batched runs; the batch reuses the per-run summary
+    frozenset({"sweep.chunk", "sweep.batched"}),
+    # MMR12-EOD's CLI hook (model) registers the climbing-posture command, which builds on the model's climbing robot
+    frozenset({"robots.mmr12_eod.model", "robots.mmr12_eod.climbing_posture"}),  # a chunk's batched runs; the batch reuses the per-run summary
     # the adaptable wheel's hold scenario (model) starts from the paper's IK placement (comparison, missions)
     frozenset({"robots.adaptable_wheel.model", "robots.adaptable_wheel.comparison", "robots.adaptable_wheel.missions"}),
 }

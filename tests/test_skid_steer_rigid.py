@@ -134,3 +134,15 @@ def test_a_wheel_the_rigid_limit_unloads_is_not_a_lift_off():
     spin = mod.SCENARIOS["turn_in_place"].run(robot, t_end=0.3, n_out=4, progress=False)
     assert "event" not in spin.stats and spin.t[-1] == pytest.approx(0.3)
     assert spin.column("yaw")[-1] > 0.01
+
+
+def test_derivatives_of_a_rigid_chassis_with_slipping_wheels_are_refused_saying_why(husky):
+    """Forward dynamics splits the husky's open loads by the rigid limit solved with the friction; that coupled
+    solve has no derivative rule: one line that says so (it used to say the load is not determined, which
+    contact_forces contradicts)."""
+    from robotdyn.errors import InputError
+
+    _, robot = husky
+    with pytest.raises(InputError, match="redundant normal row.*rigid limit") as info:
+        robot.dynamics_derivatives(robot.neutral(), np.zeros(robot.mobility), np.zeros(4))
+    assert "\n" not in str(info.value)

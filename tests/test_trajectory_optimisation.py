@@ -105,10 +105,16 @@ def test_repr_and_bad_input(robot):
         rest_to_rest(pitch_max=0.0, robot=robot)
 
 
-def test_robot_with_holonomic_rows_is_refused_in_one_line():
+def test_start_off_the_holonomic_manifold_is_refused_in_one_line():
+    """Robots with holonomic rows are collocated on their manifold (every node on it): a q0 off it is an error."""
+    from robotdyn.errors import ConstraintError
+
     robot = robotdyn.load("linkage_suspension")
-    with pytest.raises(InputError, match="holonomic constraint row"):
-        TrajectoryProblem(robot, 1.0, 5, robot.neutral())
+    q0 = robot.neutral()
+    q0[robot.coordinate_index("z")] += 0.01
+    with pytest.raises(ConstraintError) as err:
+        TrajectoryProblem(robot, 1.0, 5, q0)
+    assert len(str(err.value).splitlines()) == 1
 
 
 CLI = ["optimise", "quasimoro", "--t-end", "3", "--nodes", str(NODES), "--end", "x=1", "--end", "y=0", "--end",

@@ -25,7 +25,8 @@ def _ranges(items, option: str) -> dict[str, tuple[float, float]]:
 
 def cmd_optimise(args) -> int:
     """``robotdyn optimise ROBOT --t-end T [--nodes N] [--q0 ...] [--end NAME=VALUE ...] [--bound NAME=LO:HI ...]
-    [--tau-max X] [--derivatives analytic|finite-difference] [--csv FILE]``.
+    [--tau-max X] [--min-load N] [--mu-max MU] [--cost effort|peak-mu] [--derivatives analytic|finite-difference]
+    [--csv FILE]``.
 
     Args:
         args: The parsed command line (argparse namespace of :func:`register`'s parser).
@@ -44,7 +45,8 @@ def cmd_optimise(args) -> int:
     bounds = _ranges(args.bound, "--bound")
     tau = None if args.tau_max is None else (-args.tau_max, args.tau_max)
     problem = TrajectoryProblem(robot, args.t_end, args.nodes, q0, q_end=end, tau_bounds=tau, bounds=bounds,
-                                derivatives=args.derivatives)
+                                derivatives=args.derivatives, min_load=args.min_load, mu_max=args.mu_max,
+                                cost=args.cost)
     s = problem.solve()
     if not s.success:  # nothing printed or written: an unconverged iterate is not a result
         raise RobotDynError(f"the optimisation did not converge: IPOPT {s.status} after {s.iterations} iterations "
@@ -59,11 +61,17 @@ def cmd_optimise(args) -> int:
            "iterations": s.iterations, "wall_time": s.wall_time, "max_defect": s.max_defect,
            "derivatives": s.derivatives, "t": s.t, "coordinates": s.coordinates, "q": s.q,
            "velocity_names": s.velocity_names, "nu": s.nu, "motors": s.motors, "tau": s.tau}
+    if s.forces is not None:
+        out.update({"wheels": s.wheels, "forces": s.forces, "required_mu": s.required_mu, "effort": s.effort})
     peak = ", ".join(f"{m} {np.max(np.abs(s.tau[:, i])):.6g}" for i, m in enumerate(s.motors))
     final = ", ".join(f"{c} {x:.6g}" for c, x in zip(s.coordinates, s.q[-1]))
     text = "\n".join([repr(problem), f"IPOPT: {s.status} after {s.iterations} iterations ({s.wall_time:.3g} s)",
-                      f"cost (integral of |tau|^2 dt) = {s.cost:.10g} N^2 m^2 s; largest defect {s.max_defect:.2g}",
+                      (f"cost (integral of |tau|^2 dt) = {s.cost:.10g} N^2 m^2 s" if args.cost == "effort" else
+                       f"cost (peak required mu squared + {problem.effort_weight:g} x effort) = {s.cost:.10g}")
+                      + f"; largest defect {s.max_defect:.2g}",
                       f"peak |tau| [N m or N]: {peak}", f"final coordinates: {final}"]
+                     + ([f"least wheel load [N]: {np.min(s.forces[..., 2]):.6g}; peak required mu: "
+                         f"{np.max(s.required_mu):.6g}; effort {s.effort:.10g} N^2 m^2 s"] if s.forces is not None else [])
                      + ([f"node table written to {args.csv}"] if args.csv else []))
     _emit(args, out, text)
     return 0
@@ -79,6 +87,19 @@ def _positive(text: str) -> float:
         value = float("nan")
     if not (np.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"{text!r}; expected a finite number > 0 [N m or N]")
+    return value
+
+
+def _nonnegative(text: str) -> float:
+    """An argparse type: a finite number >= 0 (argparse names the option in its one-line error)."""
+    import argparse
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (np.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"{text!r}; expected a finite number >= 0")
     return value
 
 
@@ -104,6 +125,12 @@ def register(sub, parents) -> None:
     p.add_argument("--tau-max", type=_positive, default=None, help="bound on every motor torque |tau| [N m or N]")
     p.add_argument("--derivatives", choices=("analytic", "finite-difference"), default="analytic",
                    help="the constraint Jacobian from the analytic derivatives (default) or finite differences")
+    p.add_argument("--min-load", type=_nonnegative, default=None,
+                   help="least normal load of every wheel at every node [N]")
+    p.add_argument("--mu-max", type=_nonnegative, default=None,
+                   help="largest required friction coefficient |f_t|/f_n of every wheel at every node")
+    p.add_argument("--cost", choices=("effort", "peak-mu"), default="effort",
+                   help="minimise the effort (default) or the peak required mu over wheels and nodes")
     p.add_argument("--csv", help="write the node table (t, q, nu, tau columns) to this CSV file")
     p.set_defaults(func=cmd_optimise)
 

@@ -496,9 +496,7 @@ def kind(constraint, sliding: bool = False) -> str:
         raise InputError(f"dynamics derivatives: constraint {constraint.name!r} is a wheel under a friction law; "
                          "expected rolling wheels, loop closures and joint couplings here (smoothly slipping wheels: "
                          "Robot.dynamics_derivatives; exact stick-slip friction has no derivative)")
-    from ..contact.compliant_contact import CompliantWheel
-
-    if isinstance(constraint, CompliantWheel):
+    if getattr(constraint, "compliant", False):  # robotdyn.contact.compliant_contact.CompliantWheel
         raise InputError(f"dynamics derivatives: wheel {constraint.name!r} is a compliant wheel (contact = "
                          "'compliant': its normal force is a force law of penetration, with touch-down and lift-off "
                          "events) and has no derivative rule; expected rigid rolling or slipping wheels, loop "

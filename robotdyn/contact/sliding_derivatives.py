@@ -32,7 +32,7 @@ from ..constraints.row_derivatives import FramePass, velocity_dq, wheel_velocity
 from ..errors import InputError
 from ..reduction.dynamics_derivatives import DynamicsDerivatives, motor_rows, pieces, result
 from .friction import ExactCoulomb, LinearTyre, RegularisedCoulomb
-from .sliding import PAINLEVE_CONDITION, SlippingWheel, painleve_error, redundant_load_error, sliding_now, tangential
+from .sliding import PAINLEVE_CONDITION, SlippingWheel, painleve_error, sliding_now, tangential
 
 TANGENT = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 """The tangential rows (t1, t2) of a wheel's contact frame."""
@@ -71,7 +71,7 @@ def law_jacobian(wheel: SlippingWheel, s: np.ndarray, numerical: set[str]) -> np
     return f[:, None] * J * f[None, :]
 
 
-def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
+def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
     """:math:`\\dot\\nu` and its derivatives in q, :math:`\\nu`, :math:`\\tau` for a robot with slipping wheels
     (Python path; the same contents as :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`).
 
@@ -81,6 +81,8 @@ def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
         q: Natural coordinates (n,) [m, rad], in the order of ``robot.coordinates``.
         nu: Independent velocities (k,) in the order of ``robot.velocity_names`` [m/s, rad/s].
         tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+        pc: The derivative :class:`~robotdyn.reduction.dynamics_derivatives.Pieces` at (q, nu) when the caller
+            has them already (default None: computed here).
 
     Returns:
         A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`.
@@ -100,7 +102,7 @@ def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
         if isinstance(wheel.law, ExactCoulomb):
             raise InputError(f"dynamics derivatives: wheel {wheel.name!r} has exact (set-valued) Coulomb friction, "
                              "which has no derivative; expected friction = 'coulomb' (regularised) or 'linear'")
-    pc = pieces(robot, q, nu)
+    pc = pieces(robot, q, nu) if pc is None else pc
     model, tree, n, k = pc.model, pc.tree, pc.n, pc.k
     S, M, v, w, B, kin0 = pc.S, pc.M, pc.v, pc.w, pc.B, pc.kin0
     rows = pc.rows0
@@ -110,8 +112,11 @@ def sliding_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
     for wheel in wheels:
         row = rows.labels.index(f"{wheel.name}.normal")
         hit = np.flatnonzero(kept == row)
-        if not hit.size:
-            raise redundant_load_error(wheel)
+        if not hit.size:  # a statically indeterminate chassis: its loads are the rigid limit's (coupled solve)
+            raise InputError(f"dynamics derivatives: slipping wheel {wheel.name!r} has a redundant normal row (a "
+                             "statically indeterminate chassis, whose loads forward dynamics takes from the rigid "
+                             "limit of compliance solved with the friction): that coupled solve has no derivative "
+                             "rule yet; expected slipping wheels whose loads rigid-body dynamics determine")
         J, s = tangential(wheel, pc.kin)
         c = wheel.friction_coefficient(s)
         G[:, hit[0]] -= J.T @ c

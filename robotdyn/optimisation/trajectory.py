@@ -30,9 +30,20 @@ scipy's ``trust-constr`` is not a sparse interior-point solver for large NLPs. T
 CasADi ``Callback`` (all defects at once) whose Jacobian is another ``Callback`` with a declared sparsity pattern:
 the analytic derivatives are passed as callbacks; CasADi's automatic differentiation is not used through Pinocchio.
 
-Scope: robots without holonomic constraint rows (their natural coordinates are then all independent, e.g.
-Quasimoro; a robot with loop closures or terrain-following rows is refused in one line: its collocation would need
-the holonomic rows as path constraints, not built here).
+Holonomic rows (wheels on a terrain, loop closures, couplings): every node is kept on the constraint manifold. The
+defects of the dependent position coordinates (those the holonomic rows fix, :attr:`~robotdyn.reduction.
+dynamics_derivatives.DynamicsDerivatives.positions` naming the others) are replaced by the independent holonomic
+residuals :math:`\\phi(q_{j+1}) = 0` at nodes 1..N-1, whose Jacobian is the holonomic rows :math:`A_h`: the same
+number of equations, and the dependent coordinates follow the manifold instead of drifting off it by the
+trapezoid's error. The dynamics' derivatives in q are exact along the manifold's tangent; their part normal to it
+lies in the row space of :math:`A_h` and only changes the holonomic rows' multipliers, not the optimum.
+
+Traction limits (:mod:`robotdyn.optimisation.contact_limits`): with ``min_load`` or ``mu_max`` every node's wheel
+loads :math:`f_n \\ge f_{min}` and friction cones :math:`\\|f_t\\| \\le \\mu_{max} f_n` are path constraints; with
+``cost="peak-mu"`` the cost is the square of the largest required friction coefficient over wheels and nodes (an
+epigraph variable s with :math:`\\|f_t\\|^2 \\le s f_n^2` at every node) plus ``effort_weight`` times the effort.
+Their Jacobian comes from :meth:`robotdyn.robot.Robot.contact_force_derivatives` (``force_derivatives="analytic"``)
+or from central differences of the forces.
 """
 
 from __future__ import annotations
@@ -44,9 +55,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, NonFiniteError
+from .callbacks import sparse_callback
 
 DERIVATIVES = ("analytic", "finite-difference")
 """How the dynamics' Jacobian is computed (``derivatives`` of :class:`TrajectoryProblem`)."""
+COSTS = ("effort", "peak-mu")
+"""What :class:`TrajectoryProblem` minimises: ``effort`` :math:`\\int\\lVert\\tau\\rVert^2 dt`, or ``peak-mu`` the
+square of the largest required friction coefficient over wheels and nodes plus ``effort_weight`` times the effort."""
+HOLONOMIC_TOL = 1e-8
+"""Largest holonomic residual [m or rad] accepted at q0 (the collocation keeps every node on the manifold)."""
 
 
 def _casadi():
@@ -66,7 +83,8 @@ class TrajectorySolution:
         q: Natural coordinates at the nodes (N, n) [m, rad].
         nu: Independent velocities at the nodes (N, k) [m/s, rad/s].
         tau: Motor torques at the nodes (N, m) [N m or N]; linear in between.
-        cost: :math:`\\int_0^T \\lVert\\tau\\rVert^2 dt` by the trapezoid rule [N^2 m^2 s].
+        cost: The objective at the optimum: the effort [N^2 m^2 s] or (``peak-mu``) the squared peak required mu
+            plus ``effort_weight`` times the effort.
         status: IPOPT's return status (``Solve_Succeeded`` on success).
         success: Whether IPOPT converged.
         iterations: IPOPT iterations.
@@ -76,6 +94,13 @@ class TrajectorySolution:
         max_defect: Largest collocation defect at the optimum (state units).
         derivatives: ``analytic`` or ``finite-difference``.
         coordinates, velocity_names, motors: Column names of q, nu and tau.
+        forces: The ground's force on each wheel at the nodes (N, nw, 3) [N], (t1, t2, n) of its contact frame
+            (``None`` without contact constraints or the ``peak-mu`` cost).
+        wheels: The wheels' names, in the order of ``forces``.
+        effort: :math:`\\int_0^T \\lVert\\tau\\rVert^2 dt` by the trapezoid rule [N^2 m^2 s] (equal to ``cost`` for
+            the ``effort`` cost).
+        force_calls: Contact-force evaluations (rows and finite differences).
+        cost_kind: ``effort`` or ``peak-mu`` (the problem's ``cost``).
     """
 
     t: np.ndarray
@@ -94,6 +119,21 @@ class TrajectorySolution:
     coordinates: list[str] = field(default_factory=list)
     velocity_names: list[str] = field(default_factory=list)
     motors: list[str] = field(default_factory=list)
+    forces: np.ndarray | None = None
+    wheels: list[str] = field(default_factory=list)
+    effort: float = math.nan
+    force_calls: int = 0
+    cost_kind: str = "effort"
+
+    @property
+    def required_mu(self) -> np.ndarray | None:
+        """Each wheel's required friction coefficient :math:`\\lVert f_t\\rVert / f_n` at the nodes (N, nw)
+        (``None`` without ``forces``)."""
+        if self.forces is None:
+            return None
+        from .contact_limits import required_mu
+
+        return required_mu(self.forces)
 
     def profile(self):
         """The optimal torques as a :class:`~robotdyn.simulation.torque_profile.Table` (linear between nodes,
@@ -107,15 +147,17 @@ class TrajectorySolution:
         return Table(self.t, self.tau)
 
     def __repr__(self) -> str:
-        return (f"TrajectorySolution({self.status}, cost={self.cost:.6g} N^2 m^2 s, {len(self.t)} nodes, "
+        unit = " N^2 m^2 s" if self.cost_kind == "effort" else f" ({self.cost_kind})"
+        return (f"TrajectorySolution({self.status}, cost={self.cost:.6g}{unit}, {len(self.t)} nodes, "
                 f"{self.iterations} iterations, {self.wall_time:.3g} s, derivatives={self.derivatives})")
 
 
 class TrajectoryProblem:
-    """A minimum-effort motion of a robot between two states in a fixed time (see the module docstring).
+    """A minimum-effort (or least-peak-mu) motion of a robot between two states in a fixed time (see the module
+    docstring).
 
     Args:
-        robot: A :class:`~robotdyn.robot.Robot` without holonomic constraint rows.
+        robot: A :class:`~robotdyn.robot.Robot` (holonomic rows are kept at every node).
         t_end: Duration T [s] (> 0).
         nodes: Number of collocation nodes N (>= 3).
         q0: Initial natural coordinates (n,) [m, rad].
@@ -124,21 +166,36 @@ class TrajectoryProblem:
         nu_end: Final independent velocities (k,) (default: at rest); ``None`` entries are free.
         tau_bounds: ``(lower, upper)`` motor torques [N m or N], each a number or one per motor
             (default: unbounded).
-        bounds: Bounds on coordinates or velocities at every node, by name {name: (lower, upper)} [SI units].
+        bounds: Bounds on coordinates or velocities at every node, by name {name: (lower, upper)} [SI units]
+            (the coordinates are always kept within their joint ranges).
         derivatives: ``analytic`` (default) or ``finite-difference`` (central differences of the forward dynamics,
             the comparison).
         guess: Initial guess ``(q (N, n), nu (N, k), tau (N, m))`` (default: the coordinates from ``q0`` towards
             ``q_end`` along a smooth rest-to-rest ramp, the velocities that best follow it through S(q) in least
             squares, no torque; a guess at rest everywhere can make the defects' Jacobian rank-deficient for
             nonholonomic robots).
+        min_load: Least normal load of every wheel at every node [N] (default ``None``: none; 0 where ``mu_max`` or
+            the ``peak-mu`` cost is asked).
+        mu_max: Largest required friction coefficient :math:`\\|f_t\\|/f_n` of every wheel at every node (default
+            ``None``: none).
+        cost: ``effort`` (default, :math:`\\int\\|\\tau\\|^2dt`) or ``peak-mu`` (the squared peak required mu plus
+            ``effort_weight`` times the effort).
+        effort_weight: The effort's weight in the ``peak-mu`` cost [1/(N^2 m^2 s)] (default 1e-3).
+        force_derivatives: ``analytic`` or ``finite-difference``, the contact forces' Jacobian (default: as
+            ``derivatives``).
+        rate_weight: Weight of the torques' rate :math:`\\int\\|\\dot\\tau\\|^2 dt` added to either cost (default 0:
+            none) [cost units per N^2 m^2 / s]: it suppresses the node-to-node oscillation the trapezoidal rule
+            leaves free in directions without inertia of their own (a massless mechanism).
 
     Raises:
-        InputError: A wrong size, name or bound, a robot with holonomic rows, non-finite data.
+        InputError: A wrong size, name or bound, non-finite data.
+        ConstraintError: q0 off the holonomic constraint manifold (by more than :data:`HOLONOMIC_TOL`).
     """
 
     def __init__(self, robot, t_end: float, nodes: int, q0, nu0=None, q_end: dict | None = None,
                  nu_end=None, tau_bounds=None, bounds: dict | None = None, derivatives: str = "analytic",
-                 guess=None) -> None:
+                 guess=None, min_load: float | None = None, mu_max: float | None = None, cost: str = "effort",
+                 effort_weight: float = 1e-3, force_derivatives: str | None = None, rate_weight: float = 0.0) -> None:
         self.robot = robot
         self.t_end = _finite(t_end, "t_end")
         if not self.t_end > 0:
@@ -154,10 +211,27 @@ class TrajectoryProblem:
             raise InputError(f"robot {robot.spec.name!r} has no motors: nothing to optimise")
         self.q0 = robot.check_q(q0)
         self.nu0 = np.zeros(self.k) if nu0 is None else robot.check_nu(nu0)
-        holonomic = self._holonomic_rows()
-        if holonomic:
-            raise InputError(f"robot {robot.spec.name!r} has {holonomic} holonomic constraint row(s); trajectory "
-                             "optimisation supports robots whose coordinates are all independent")
+        self._holonomic_setup()
+        if cost not in COSTS:
+            raise InputError(f"cost = {cost!r}; expected one of {', '.join(COSTS)}")
+        self.cost_kind = cost
+        self.effort_weight = _finite(effort_weight, "effort_weight")
+        if self.effort_weight < 0:
+            raise InputError(f"effort_weight = {effort_weight!r}; expected a finite number >= 0")
+        self.rate_weight = _finite(rate_weight, "rate_weight")
+        if self.rate_weight < 0:
+            raise InputError(f"rate_weight = {rate_weight!r}; expected a finite number >= 0")
+        force_derivatives = derivatives if force_derivatives is None else force_derivatives
+        if force_derivatives not in DERIVATIVES:
+            raise InputError(f"force_derivatives = {force_derivatives!r}; expected one of {', '.join(DERIVATIVES)}")
+        self.limits = None
+        if min_load is not None or mu_max is not None or cost == "peak-mu":
+            from .contact_limits import ContactLimits
+
+            self.limits = ContactLimits(robot, self.q0, None if min_load is None else _finite(min_load, "min_load"),
+                                        None if mu_max is None else _finite(mu_max, "mu_max"),
+                                        peak=cost == "peak-mu", derivatives=force_derivatives)
+        self.force_derivatives = force_derivatives
         names = list(robot.coordinates) + list(robot.velocity_names)
         self.names = names
         nx = self.nx = self.n + self.k
@@ -174,11 +248,16 @@ class TrajectoryProblem:
                 self.x_end[self.n + i] = _finite(value, f"nu_end[{i}]")
         self.tau_lo, self.tau_hi = _pair(tau_bounds, self.m, "tau_bounds")
         self.x_lo, self.x_hi = np.full(nx, -np.inf), np.full(nx, np.inf)
+        self.x_lo[:self.n] = robot.description.lower  # the joint ranges (the dynamics refuse a q beyond them)
+        self.x_hi[:self.n] = robot.description.upper
         for name, pair in (bounds or {}).items():
             if name not in names:
                 raise InputError(f"bounds names {name!r}; expected a coordinate or velocity name of {names}")
             lo, hi = _pair(pair, 1, f"bounds[{name!r}]")
-            self.x_lo[names.index(name)], self.x_hi[names.index(name)] = lo[0], hi[0]
+            i = names.index(name)
+            self.x_lo[i], self.x_hi[i] = max(lo[0], self.x_lo[i]), min(hi[0], self.x_hi[i])
+            if self.x_lo[i] > self.x_hi[i]:
+                raise InputError(f"bounds[{name!r}] = {pair!r} lies outside the joint range of {name}")
         x0 = np.concatenate([self.q0, self.nu0])
         for what, x in (("the initial state", x0), ("the final state", self.x_end)):
             bad = [names[i] for i in range(nx) if np.isfinite(x[i]) and not self.x_lo[i] <= x[i] <= self.x_hi[i]]
@@ -186,30 +265,92 @@ class TrajectoryProblem:
                 raise InputError(f"{what} is outside the bounds on {', '.join(bad)}")
         self.guess = guess
         self.calls = {"dynamics": 0, "derivatives": 0}
+        self._fast = None
+        self._fast = self._compiled_rhs()
         self._defect_cache = self._jac_cache = (None, None)
 
-    def _holonomic_rows(self) -> int:
-        """Number of coordinates fixed by holonomic rows at q0 (n less the independent position coordinates)."""
-        d = self.robot.dynamics_derivatives(self.q0, self.nu0, np.zeros(self.m))
-        return self.n - len(d.positions)
+    def _holonomic_setup(self) -> None:
+        """The holonomic rows at q0: which are independent (:attr:`hrows`), the independent position coordinates
+        (:attr:`positions`, those whose defects are kept) and the defect rows kept (:attr:`keep`)."""
+        from ..reduction.projection import independent_rows
+
+        rows = self.robot.rows_at(self.q0)
+        A_h = rows.A[rows.holonomic]
+        self.hrows = independent_rows(A_h) if A_h.size else np.zeros(0, int)
+        self.mh = len(self.hrows)
+        if self.mh:
+            self.robot.check_constraints(self.q0, tol=HOLONOMIC_TOL, rows=rows)
+            d = self.robot.dynamics_derivatives(self.q0, self.nu0, np.zeros(self.m))
+            self.positions = np.asarray(d.positions, int)
+            if len(self.positions) != self.n - self.mh:
+                raise InputError(f"robot {self.robot.spec.name!r}: {self.n - len(self.positions)} coordinates follow "
+                                 f"from {self.mh} independent holonomic rows at q0; expected as many")
+        else:
+            self.positions = np.arange(self.n)
+        self.keep = np.concatenate([self.positions, self.n + np.arange(self.k)])
+
+    def _holonomic(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The independent holonomic rows' residuals (mh,) [m or rad] at q and their Jacobian (mh, n) (the rows
+        A_h, exactly the residuals' gradient on the manifold)."""
+        rows = self.robot.rows_at(q)
+        hol = np.flatnonzero(rows.holonomic)[self.hrows]
+        return rows.residual[hol], rows.A[hol]
 
     def __repr__(self) -> str:
         fixed = [self.names[i] for i in range(self.nx) if np.isfinite(self.x_end[i])]
         bounded = [self.names[i] for i in range(self.nx) if np.isfinite(self.x_lo[i]) or np.isfinite(self.x_hi[i])]
         return (f"TrajectoryProblem(robot={self.robot.spec.name!r}, t_end={self.t_end:g} s, nodes={self.nodes}, "
                 f"final={fixed}, bounded={bounded}, tau in [{_fmt(self.tau_lo)}, {_fmt(self.tau_hi)}], "
-                f"derivatives={self.derivatives!r})")
+                f"derivatives={self.derivatives!r}"
+                + ("" if self.limits is None else f", min_load={self.limits.min_load}, mu_max={self.limits.mu_max}")
+                + ("" if self.cost_kind == "effort" else f", cost='peak-mu', effort_weight={self.effort_weight:g}")
+                + ")")
 
     # --- the dynamics at the nodes -------------------------------------------------------------------------------
 
+    @property
+    def nz(self) -> int:
+        """Length of the decision vector: the states, the torques and (cost ``peak-mu``) the peak variable."""
+        return self.nodes * (self.nx + self.m) + (self.cost_kind == "peak-mu")
+
     def _split(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         N, nx = self.nodes, self.nx
-        return z[:N * nx].reshape(N, nx), z[N * nx:].reshape(N, self.m)
+        return z[:N * nx].reshape(N, nx), z[N * nx:N * (nx + self.m)].reshape(N, self.m)
+
+    def _peak(self, z: np.ndarray) -> float:
+        return float(z[-1]) if self.cost_kind == "peak-mu" else 0.0
+
+    def _compiled_rhs(self):
+        """The robot's compiled one-call :math:`(S\\nu, \\dot\\nu)` (:meth:`robotdyn.fast.compiled.CompiledModel.rhs`,
+        what the simulation integrates) where it serves this robot and equals the Python path at q0, else None."""
+        from ..contact.applied_forces import has_applied
+        from ..contact.sliding import slipping_wheels
+        from ..fast.dispatch import compiled_model
+
+        fast = None if slipping_wheels(self.robot) or has_applied(self.robot) else compiled_model(self.robot)
+        if fast is None:
+            return None
+        self._fast = None
+        tau = np.linspace(-1.0, 1.0, self.m)
+        nu = np.linspace(0.1, 0.2, self.k)
+        try:
+            ok = np.allclose(fast.rhs(self.q0, nu, tau, 0.0), self._f(np.concatenate([self.q0, nu]), tau),
+                             rtol=1e-9, atol=1e-9)
+        except Exception:  # a compiled fallback: the Python path serves
+            ok = False
+        return fast if ok else None
 
     def _f(self, x: np.ndarray, u: np.ndarray) -> np.ndarray:
         """:math:`f(x, \\tau) = (S\\nu, \\dot\\nu)` at one node."""
         self.calls["dynamics"] += 1
         q, nu = x[:self.n], x[self.n:]
+        if self._fast is not None:
+            from ..fast.compiled import Fallback
+
+            try:
+                return np.array(self._fast.rhs(q, nu, u, 0.0))
+            except Fallback:
+                pass
         S = self.robot.reduced(q, nu).S
         nudot = self.robot.forward_dynamics(q, nu, u, check=False)
         return np.concatenate([S @ nu, nudot])
@@ -237,8 +378,8 @@ class TrajectoryProblem:
         """Trapezoidal defects :math:`x_{j+1} - x_j - \\tfrac{h}{2}(f_j + f_{j+1})`, (N-1, nx) flattened.
 
         Args:
-            z: Decision vector (N (nx + m),): the states :math:`x_j = (q_j, \\nu_j)` node after node, then the
-                torques :math:`\\tau_j` node after node [SI units].
+            z: Decision vector (:attr:`nz`,): the states :math:`x_j = (q_j, \\nu_j)` node after node, then the
+                torques :math:`\\tau_j` node after node [SI units], then (cost ``peak-mu``) the peak variable.
 
         Returns:
             The defects ((N-1) nx,), node-major, in the state's (q, nu) order.
@@ -255,23 +396,72 @@ class TrajectoryProblem:
         self._defect_cache = (key, out)
         return out
 
-    def _pattern(self):
-        """Triplets (rows, cols) of the defects' Jacobian, block by block in the order :meth:`jacobian_values`
+    def constraints(self, z: np.ndarray) -> np.ndarray:
+        """The NLP's constraint vector: the defects of the independent position coordinates and the velocities
+        ((N-1) (p + k)), the independent holonomic residuals at nodes 1..N-1 ((N-1) mh, the dependent coordinates
+        follow from them instead of their defects), then the contact rows of every node (N c,
+        :class:`~robotdyn.optimisation.contact_limits.ContactLimits`).
+
+        Args:
+            z: Decision vector, as for :meth:`defects`.
+
+        Returns:
+            The constraint values, in that order.
+        """
+        N = self.nodes
+        parts = [self.defects(z).reshape(N - 1, self.nx)[:, self.keep].ravel()]
+        X, U = self._split(z)
+        if self.mh:
+            parts.append(np.concatenate([self._holonomic(X[j, :self.n])[0] for j in range(1, N)]))
+        if self.limits is not None:
+            s = self._peak(z)
+            parts.append(np.concatenate([self.limits.values(X[j, :self.n], X[j, self.n:], U[j], s)
+                                         for j in range(N)]))
+        return np.concatenate(parts)
+
+    def _blocks(self) -> list[tuple[int, int, int, int]]:
+        """The Jacobian's dense blocks ``(row, column, rows, columns)``, in the order :meth:`jacobian_values`
         fills them."""
-        N, nx, m = self.nodes, self.nx, self.m
-        rows, cols = [], []
+        N, nx, m, nd = self.nodes, self.nx, self.m, len(self.keep)
+        out = []
         for j in range(N - 1):
-            r = j * nx + np.arange(nx)
-            for c0, width in ((j * nx, nx), ((j + 1) * nx, nx), (N * nx + j * m, m), (N * nx + (j + 1) * m, m)):
-                rr, cc = np.meshgrid(r, c0 + np.arange(width), indexing="ij")
-                rows.append(rr.ravel())
-                cols.append(cc.ravel())
+            r = j * nd
+            out += [(r, j * nx, nd, nx), (r, (j + 1) * nx, nd, nx), (r, N * nx + j * m, nd, m),
+                    (r, N * nx + (j + 1) * m, nd, m)]
+        r0 = (N - 1) * nd
+        for j in range(1, N) if self.mh else ():
+            out.append((r0 + (j - 1) * self.mh, j * nx, self.mh, self.n))
+        r0 += (N - 1) * self.mh
+        if self.limits is not None:
+            c = self.limits.rows_per_node
+            for j in range(N):
+                out += [(r0 + j * c, j * nx, c, nx), (r0 + j * c, N * nx + j * m, c, m)]
+                if self.cost_kind == "peak-mu":
+                    out.append((r0 + j * c, self.nz - 1, c, 1))
+        return out
+
+    @property
+    def n_constraints(self) -> int:
+        """Length of :meth:`constraints`."""
+        c = self.limits.rows_per_node if self.limits is not None else 0
+        return (self.nodes - 1) * (len(self.keep) + self.mh) + self.nodes * c
+
+    def _pattern(self):
+        """Triplets (rows, cols) of the constraints' Jacobian, block by block in the order :meth:`jacobian_values`
+        fills them."""
+        rows, cols = [], []
+        for r0, c0, nr, nc in self._blocks():
+            rr, cc = np.meshgrid(r0 + np.arange(nr), c0 + np.arange(nc), indexing="ij")
+            rows.append(rr.ravel())
+            cols.append(cc.ravel())
         return np.concatenate(rows), np.concatenate(cols)
 
     def jacobian_values(self, z: np.ndarray) -> np.ndarray:
-        """Values of the defects' Jacobian :math:`\\partial(\\text{defects})/\\partial z` at its structural nonzeros,
-        interval after interval (blocks :math:`\\partial/\\partial x_j, \\partial/\\partial x_{j+1},
-        \\partial/\\partial\\tau_j, \\partial/\\partial\\tau_{j+1}`, each row-major), from the node Jacobians.
+        """Values of the constraints' Jacobian :math:`\\partial(\\text{constraints})/\\partial z` at its structural
+        nonzeros, block after block as :meth:`_blocks` lists them (each row-major): per interval
+        :math:`\\partial/\\partial x_j, \\partial/\\partial x_{j+1}, \\partial/\\partial\\tau_j,
+        \\partial/\\partial\\tau_{j+1}` of the kept defects, then the holonomic rows A_h at each node, then per node
+        the contact rows' :math:`\\partial/\\partial x_j, \\partial/\\partial\\tau_j` (and :math:`\\partial/\\partial s`).
 
         Args:
             z: Decision vector, as for :meth:`defects`.
@@ -283,14 +473,23 @@ class TrajectoryProblem:
         if self._jac_cache[0] == key:  # IPOPT asks again at the same point (e.g. after a function evaluation)
             return self._jac_cache[1]
         X, U = self._split(z)
-        h = self.t_end / (self.nodes - 1)
-        I = np.eye(self.nx)
-        node = [self._jac_node(X[j], U[j]) for j in range(self.nodes)]
+        N = self.nodes
+        h = self.t_end / (N - 1)
+        I = np.eye(self.nx)[self.keep]
+        node = [self._jac_node(X[j], U[j]) for j in range(N)]
         vals = []
-        for j in range(self.nodes - 1):
+        for j in range(N - 1):
             (Fx0, Fu0), (Fx1, Fu1) = node[j], node[j + 1]
-            vals += [(-I - 0.5 * h * Fx0).ravel(), (I - 0.5 * h * Fx1).ravel(), (-0.5 * h * Fu0).ravel(),
-                     (-0.5 * h * Fu1).ravel()]
+            k = self.keep
+            vals += [(-I - 0.5 * h * Fx0[k]).ravel(), (I - 0.5 * h * Fx1[k]).ravel(), (-0.5 * h * Fu0[k]).ravel(),
+                     (-0.5 * h * Fu1[k]).ravel()]
+        for j in range(1, N) if self.mh else ():
+            vals.append(self._holonomic(X[j, :self.n])[1].ravel())
+        if self.limits is not None:
+            s = self._peak(z)
+            for j in range(N):
+                Jx, Ju, Js = self.limits.jacobian(X[j, :self.n], X[j, self.n:], U[j], s)
+                vals += [Jx.ravel(), Ju.ravel()] + ([Js.ravel()] if self.cost_kind == "peak-mu" else [])
         out = np.concatenate(vals)
         if not np.all(np.isfinite(out)):
             raise NonFiniteError("trajectory optimisation: the dynamics' derivatives are not finite at an iterate")
@@ -300,13 +499,23 @@ class TrajectoryProblem:
     # --- the NLP ---------------------------------------------------------------------------------------------------
 
     def _initial(self) -> np.ndarray:
+        z = self._initial_states()
+        if self.cost_kind == "peak-mu":  # s starts at the guess's own peak (squared): a feasible start for its rows
+            X, U = self._split(z)
+            F = np.array([self.limits.forces(X[j, :self.n], X[j, self.n:], U[j]) for j in range(self.nodes)])
+            ratio = (F[..., 0] ** 2 + F[..., 1] ** 2) / np.maximum(F[..., 2], 1e-9 * self.limits.scale) ** 2
+            z[-1] = min(float(np.max(ratio)), 1e6)
+        return z
+
+    def _initial_states(self) -> np.ndarray:
         N = self.nodes
+        extra = [np.ones(1)] if self.cost_kind == "peak-mu" else []
         if self.guess is not None:
             q, nu, tau = (np.asarray(a, float) for a in self.guess)
             if q.shape != (N, self.n) or nu.shape != (N, self.k) or tau.shape != (N, self.m):
                 raise InputError(f"guess shapes {q.shape}, {nu.shape}, {tau.shape}; expected ({N}, {self.n}), "
                                  f"({N}, {self.k}), ({N}, {self.m})")
-            return np.concatenate([np.hstack([q, nu]).ravel(), tau.ravel()])
+            return np.concatenate([np.hstack([q, nu]).ravel(), tau.ravel()] + extra)
         x0 = np.concatenate([self.q0, self.nu0])
         x1 = np.where(np.isfinite(self.x_end), self.x_end, x0)
         t = np.linspace(0.0, self.t_end, N)
@@ -318,7 +527,7 @@ class TrajectoryProblem:
             S = self.robot.reduced(X[j, :self.n], np.zeros(self.k)).S
             X[j, self.n:] = np.linalg.lstsq(S, sdot[j] * dq, rcond=None)[0]
         X[-1] = np.where(np.isfinite(self.x_end), self.x_end, X[-1])
-        return np.concatenate([np.clip(X, self.x_lo, self.x_hi).ravel(), np.zeros(N * self.m)])
+        return np.concatenate([np.clip(X, self.x_lo, self.x_hi).ravel(), np.zeros(N * self.m)] + extra)
 
     def solve(self, tol: float = 1e-9, max_iter: int = 500, verbose: bool = False) -> TrajectorySolution:
         """Solve with IPOPT (CasADi ``nlpsol``, limited-memory Hessian).
@@ -337,96 +546,69 @@ class TrajectoryProblem:
             raise InputError(f"max_iter = {max_iter!r}; expected an integer >= 0")
         ca = _casadi()
         N, nx, m = self.nodes, self.nx, self.m
-        nz, ng = N * (nx + m), (N - 1) * nx
+        nz, ng = self.nz, self.n_constraints
         rows, cols = self._pattern()
-        order = np.lexsort((rows, cols))  # column-major: CasADi's compressed-column storage
-        colind = np.searchsorted(cols[order], np.arange(nz + 1))
-        sparsity = ca.Sparsity(ng, nz, colind.tolist(), rows[order].tolist())
-        problem = self
-
-        class Jac(ca.Callback):
-            def __init__(self, name, opts):
-                ca.Callback.__init__(self)
-                self.construct(name, opts)
-
-            def get_n_in(self):
-                return 2
-
-            def get_n_out(self):
-                return 1
-
-            def get_sparsity_in(self, i):
-                return ca.Sparsity.dense(nz, 1) if i == 0 else ca.Sparsity.dense(ng, 1)
-
-            def get_sparsity_out(self, i):
-                return sparsity
-
-            def eval(self, arg):
-                vals = problem.jacobian_values(np.asarray(arg[0], float).ravel())
-                return [ca.DM(sparsity, vals[order])]
-
-        class Defects(ca.Callback):
-            def __init__(self, name, opts):
-                ca.Callback.__init__(self)
-                self.construct(name, opts)
-
-            def get_n_in(self):
-                return 1
-
-            def get_n_out(self):
-                return 1
-
-            def get_sparsity_in(self, i):
-                return ca.Sparsity.dense(nz, 1)
-
-            def get_sparsity_out(self, i):
-                return ca.Sparsity.dense(ng, 1)
-
-            def eval(self, arg):
-                return [ca.DM(problem.defects(np.asarray(arg[0], float).ravel()))]
-
-            def has_jacobian(self):
-                return True
-
-            def get_jacobian(self, name, inames, onames, opts):
-                problem._callbacks.append(Jac(name, opts))  # CasADi holds no Python reference to it
-                return problem._callbacks[-1]
-
-        self._callbacks = [Defects("defects", {"enable_fd": False})]
-        defects = self._callbacks[0]
+        self._callbacks = []  # CasADi holds no Python reference to them
+        constraints = sparse_callback("constraints", nz, ng, self.constraints, self.jacobian_values, rows, cols,
+                                      self._callbacks)
         z = ca.MX.sym("z", nz)
         h = self.t_end / (N - 1)
         w = np.full(N, h)
         w[[0, -1]] = 0.5 * h
         weights = ca.DM(np.repeat(w, m))
-        u = z[N * nx:]
-        cost = ca.dot(weights * u, u)
+        u = z[N * nx:N * (nx + m)]
+        effort = ca.dot(weights * u, u)
+        cost = effort if self.cost_kind == "effort" else z[nz - 1] + self.effort_weight * effort
+        if self.rate_weight > 0:  # the torques' rate, sum |tau_{j+1} - tau_j|^2 / h (the integral of |dtau/dt|^2)
+            du = u[m:] - u[:-m]
+            cost = cost + self.rate_weight / h * ca.dot(du, du)
         lbx = np.concatenate([np.tile(self.x_lo, N), np.tile(self.tau_lo, N)])
         ubx = np.concatenate([np.tile(self.x_hi, N), np.tile(self.tau_hi, N)])
+        if self.cost_kind == "peak-mu":  # s = (peak required mu)^2, within mu_max^2 if given
+            mu_max = self.limits.mu_max
+            lbx = np.append(lbx, 0.0)
+            ubx = np.append(ubx, np.inf if mu_max is None else mu_max ** 2)
         x0 = np.concatenate([self.q0, self.nu0])
         lbx[:nx] = ubx[:nx] = x0
         fixed = np.flatnonzero(np.isfinite(self.x_end))
         lbx[(N - 1) * nx + fixed] = ubx[(N - 1) * nx + fixed] = self.x_end[fixed]
+        lbg, ubg = np.zeros(ng), np.zeros(ng)
+        if self.limits is not None:
+            lo, hi = self.limits.bounds()
+            c = self.limits.rows_per_node
+            lbg[ng - N * c:], ubg[ng - N * c:] = np.tile(lo, N), np.tile(hi, N)
         opts = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.constr_viol_tol": tol,
                 "ipopt.max_iter": int(max_iter), "ipopt.print_level": 5 if verbose else 0, "print_time": bool(verbose),
                 "ipopt.sb": "yes", "ipopt.honor_original_bounds": "yes"}
-        solver = ca.nlpsol("trajectory", "ipopt", {"x": z, "f": cost, "g": defects(z)}, opts)
+        solver = ca.nlpsol("trajectory", "ipopt", {"x": z, "f": cost, "g": constraints(z)}, opts)
         self.calls = {"dynamics": 0, "derivatives": 0}
+        if self.limits is not None:
+            self.limits.calls = 0
         self._defect_cache = self._jac_cache = (None, None)
         start = time.perf_counter()
-        res = solver(x0=self._initial(), lbx=lbx, ubx=ubx, lbg=0.0, ubg=0.0)
+        res = solver(x0=self._initial(), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
         wall = time.perf_counter() - start
         stats = solver.stats()
         zopt = np.asarray(res["x"], float).ravel()
         X, U = self._split(zopt)
         calls = dict(self.calls)
-        max_defect = float(np.max(np.abs(self.defects(zopt))))
+        if self.limits is not None:
+            calls["forces"] = self.limits.calls
+        g = self.constraints(zopt)
+        nd = (N - 1) * (len(self.keep) + self.mh)
+        max_defect = float(np.max(np.abs(g[:nd])))
         t = np.linspace(0.0, self.t_end, N)
+        forces, wheels = None, []
+        if self.limits is not None:
+            forces = np.array([self.limits.forces(X[j, :self.n], X[j, self.n:], U[j]) for j in range(N)])
+            wheels = list(self.limits.wheels)
+        effort = float(np.sum(np.repeat(w, m) * U.ravel() ** 2))
         return TrajectorySolution(t, X[:, :self.n].copy(), X[:, self.n:].copy(), U.copy(), float(res["f"]),
                                   str(stats["return_status"]), bool(stats["success"]), int(stats["iter_count"]),
                                   wall, calls["dynamics"], calls["derivatives"], max_defect, self.derivatives,
                                   list(self.robot.coordinates), list(self.robot.velocity_names),
-                                  [mo.name for mo in self.robot.motors])
+                                  [mo.name for mo in self.robot.motors], forces=forces, wheels=wheels,
+                                  effort=effort, force_calls=calls.get("forces", 0), cost_kind=self.cost_kind)
 
 
 def _finite(value, what: str) -> float:
@@ -458,4 +640,4 @@ def _fmt(a: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:g}" for v in a) + "]"
 
 
-__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES"]
+__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES", "COSTS", "HOLONOMIC_TOL"]

@@ -345,7 +345,7 @@ def result(robot, pc: Pieces, nudot, dq, dnu, dtau) -> DynamicsDerivatives:
     return out
 
 
-def dynamics_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
+def dynamics_derivatives(robot, q, nu, tau, pc: Pieces | None = None) -> DynamicsDerivatives:
     """:math:`\\dot\\nu` and its derivatives in q, :math:`\\nu` and :math:`\\tau` at one state (Python path).
 
     Args:
@@ -357,6 +357,8 @@ def dynamics_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
             the derivative along it.
         nu: Independent velocities (k,) in the order of ``robot.velocity_names``.
         tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+        pc: The derivative :class:`~robotdyn.reduction.dynamics_derivatives.Pieces` at (q, nu) when the caller
+            has them already (default None: computed here).
 
     Returns:
         A :class:`DynamicsDerivatives`.
@@ -368,7 +370,7 @@ def dynamics_derivatives(robot, q, nu, tau) -> DynamicsDerivatives:
     q, nu, tau = robot.check_q(q), robot.check_nu(nu), robot.check_tau(tau)
     for c in robot.constraints:
         kind(c)
-    pc = pieces(robot, q, nu)
+    pc = pieces(robot, q, nu) if pc is None else pc
     S, M, k, n = pc.S, pc.M, pc.k, pc.n
     model, tree, v, w, B = pc.model, pc.tree, pc.v, pc.w, pc.B
     Mr = S.T @ M @ S

@@ -117,15 +117,18 @@ def state(robot: Robot, **values: float) -> np.ndarray:
 
 # ------------------------------------------------------------------------------------------------- CLI
 def register_cli(subparsers, parents) -> None:
-    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.description.kinematics`).
+    """``robotdyn fk ROBOT --q ... --frame NAME`` (generic forward kinematics, see :mod:`robotdyn.description.kinematics`)
+    and ``robotdyn climbing-posture ROBOT --slope DEG`` (:mod:`robotdyn.robots.mmr12_eod.climbing_posture`).
 
     Args:
         subparsers: The CLI's subparsers (``argparse`` action).
         parents: Parsers whose arguments it inherits (the common and robot arguments).
     """
     from ...cli.fk import register_fk_cli
+    from .climbing_posture import register_cli as register_climbing
 
     register_fk_cli(subparsers, parents)
+    register_climbing(subparsers, parents)
 
 
 # ------------------------------------------------------------------------------------- control scenarios

@@ -1,0 +1,104 @@
+"""Python functions as CasADi constraint functions with a sparse analytic Jacobian (the plumbing of every NLP here).
+
+IPOPT (through CasADi's ``nlpsol``) sees the robot's model as one CasADi ``Callback`` computing all constraint
+values g(z) at once, whose Jacobian is another ``Callback`` with a declared sparsity pattern, filled by the
+caller's own derivatives (analytic, or finite differences for comparison): CasADi's automatic differentiation is
+never used through Pinocchio. Used by :mod:`robotdyn.optimisation.trajectory` (collocation defects) and
+:mod:`robotdyn.optimisation.posture` (contact forces at a posture).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+
+def _casadi():
+    from ..errors import InputError
+
+    try:
+        import casadi
+    except ImportError as exc:  # pragma: no cover - the test extra installs it
+        raise InputError("optimisation needs CasADi (pip install casadi, or the `test` extra)") from exc
+    return casadi
+
+
+def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], np.ndarray],
+                    jacobian_values: Callable[[np.ndarray], np.ndarray], rows: np.ndarray, cols: np.ndarray,
+                    keep: list):
+    """A CasADi function z -> g(z) whose Jacobian is ``jacobian_values`` on the pattern (rows, cols).
+
+    Args:
+        name: The function's name (in CasADi's messages).
+        nz: Number of decision variables.
+        ng: Number of constraint values.
+        values: z (nz,) -> g(z) (ng,).
+        jacobian_values: z (nz,) -> the Jacobian's values (nnz,) at (rows[i], cols[i]), in that order.
+        rows: Row indices (nnz,) of the structural nonzeros.
+        cols: Column indices (nnz,).
+        keep: A list that keeps the callback objects alive while the solver uses them (CasADi holds no Python
+            reference to them): the caller keeps it as long as the solver.
+
+    Returns:
+        The CasADi ``Callback`` (call it on an ``MX`` symbol to build the NLP's constraints).
+    """
+    ca = _casadi()
+    rows, cols = np.asarray(rows, int), np.asarray(cols, int)
+    order = np.lexsort((rows, cols))  # column-major: CasADi's compressed-column storage
+    colind = np.searchsorted(cols[order], np.arange(nz + 1))
+    sparsity = ca.Sparsity(ng, nz, colind.tolist(), rows[order].tolist())
+
+    class Jac(ca.Callback):
+        def __init__(self, name, opts):
+            ca.Callback.__init__(self)
+            self.construct(name, opts)
+
+        def get_n_in(self):
+            return 2
+
+        def get_n_out(self):
+            return 1
+
+        def get_sparsity_in(self, i):
+            return ca.Sparsity.dense(nz, 1) if i == 0 else ca.Sparsity.dense(ng, 1)
+
+        def get_sparsity_out(self, i):
+            return sparsity
+
+        def eval(self, arg):
+            vals = jacobian_values(np.asarray(arg[0], float).ravel())
+            return [ca.DM(sparsity, vals[order])]
+
+    class Values(ca.Callback):
+        def __init__(self, name, opts):
+            ca.Callback.__init__(self)
+            self.construct(name, opts)
+
+        def get_n_in(self):
+            return 1
+
+        def get_n_out(self):
+            return 1
+
+        def get_sparsity_in(self, i):
+            return ca.Sparsity.dense(nz, 1)
+
+        def get_sparsity_out(self, i):
+            return ca.Sparsity.dense(ng, 1)
+
+        def eval(self, arg):
+            return [ca.DM(values(np.asarray(arg[0], float).ravel()))]
+
+        def has_jacobian(self):
+            return True
+
+        def get_jacobian(self, name, inames, onames, opts):
+            keep.append(Jac(name, opts))
+            return keep[-1]
+
+    keep.append(Values(name, {"enable_fd": False}))
+    return keep[-1]
+
+
+__all__ = ["sparse_callback"]

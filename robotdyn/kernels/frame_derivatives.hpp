@@ -26,7 +26,11 @@ using Eigen::MatrixXd;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 using Matrix6x = Eigen::Matrix<double, 6, Eigen::Dynamic>;
-using Matrix3x = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+// 3 x n blocks of the derivative formulas, on the stack (no allocation per temporary) up to kMaxNv coordinates;
+// a larger model takes the Python path (ReducedDerivatives::run refuses it)
+constexpr int kMaxNv = 128;
+using Matrix3x = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxNv>;
+using RowX = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxNv>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 inline Matrix3d skew3(const Vector3d& x) {

@@ -172,6 +172,7 @@ struct ReducedDerivatives {
                             const Eigen::Ref<const VectorXd>& tau) {
     if (ev.operational_) throw std::domain_error("operational-space velocities: derivatives on the Python path");
     if (!ev.slips_.empty()) throw std::domain_error("slipping wheels: derivatives on the Python path");
+    if (ev.nv_ > derivs::kMaxNv) throw std::domain_error("more coordinates than the derivative kernels' blocks hold");
     ev.configure(q);
     ev.dynamics(nu);
     if (tau.size() != ev.Br_.cols()) throw std::invalid_argument("tau has the wrong length");

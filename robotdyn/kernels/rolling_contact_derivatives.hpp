@@ -15,7 +15,7 @@ namespace derivs {
 // dq of a wheel's contact geometry (wheel_geometry_dq): 3 x n each, eR the radius coordinate's unit row
 struct WheelGeometryDq {
   Matrix3x a, u, n, t1, t2, r;
-  Eigen::RowVectorXd eR;
+  RowX eR;
   const Matrix3x& E(int i) const { return i == 0 ? t1 : i == 1 ? t2 : n; }
 };
 
@@ -126,7 +126,7 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   const Vector3d w = V.tail<3>();
   const Matrix3x dw = dV.bottomRows<3>();
   const double Rd = radius_index >= 0 ? v[radius_index] : 0.0;
-  const Eigen::RowVectorXd& eR = gd.eR;
+  const RowX& eR = gd.eR;
   const Vector3d r = -R * u;
   const Matrix3x &dr = gd.r, &du = gd.u, &da = gd.a, &dn = gd.n;
   Matrix3d N = Matrix3d::Zero();
@@ -144,8 +144,8 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   const Matrix3d P = (Matrix3d::Identity() - u * u.transpose()) / nw;
   const Matrix3d Qa = Matrix3d::Identity() - a * a.transpose();
   const double na = n.dot(a);
-  const Eigen::RowVectorXd dna = a.transpose() * dn + n.transpose() * da;
-  const Eigen::RowVectorXd dnw = -na * dna / nw;
+  const RowX dna = a.transpose() * dn + n.transpose() * da;
+  const RowX dnw = -na * dna / nw;
   auto dP_times = [&](const Vector3d& y) -> Matrix3x {  // d(P y)/dq at fixed y, P = (I - u u^T)/nw
     return (-(u * (y.transpose() * du)) - du * u.dot(y)) / nw - (P * y) * dnw / nw;
   };
@@ -184,7 +184,7 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   const Matrix3x& dt1 = gd.t1;
   const Vector3d c1d = adot.cross(n) + a.cross(ndot);
   const Matrix3x dc1d = cross_d(adot, dadot, n, dn) + cross_d(a, da, ndot, dndot);
-  const Eigen::RowVectorXd dnc1 = t1.transpose() * cross_d(a, da, n, dn);
+  const RowX dnc1 = t1.transpose() * cross_d(a, da, n, dn);
   const Vector3d y = c1d - t1 * t1.dot(c1d);
   const Matrix3x dy = dc1d - dt1 * t1.dot(c1d) - t1 * (c1d.transpose() * dt1 + t1.transpose() * dc1d);
   const Vector3d t1d = y / nc1;

@@ -83,4 +83,30 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
     return out
 
 
-__all__ = ["compiled_derivatives"]
+def raw_derivatives(fast, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tuple | None:
+    """The compiled derivative set at one state without the API's checks and wrapping, for a caller that evaluates
+    many states of one robot (a trajectory optimiser's Jacobian): ``(nudot, dq, dnu, dtau, qdot, dqdot_dq, S, A)``
+    as in :func:`compiled_derivatives`, or ``None`` where the Python path must answer (including a non-finite
+    result, whose error that path raises).
+
+    Args:
+        fast: The robot's :class:`~robotdyn.fast.compiled.CompiledModel` (:func:`robotdyn.fast.dispatch.compiled_model`),
+            its projection chosen (``fast.ready``).
+        q: Natural coordinates (n,) [m, rad], valid (unchecked here).
+        nu: Independent velocities (k,) [m/s, rad/s], valid.
+        tau: Motor torques/forces (n_motors,) [N m or N], valid.
+
+    Returns:
+        The tuple of arrays, or ``None``.
+    """
+    if fast.operational is not None or getattr(fast.ev, "slipping", 0) or not hasattr(fast.ev, "derivatives") \
+            or not fast.ready:
+        return None
+    try:
+        out = fast.ev.derivatives(q, nu, tau)
+    except Fallback:
+        return None
+    return out if all(np.all(np.isfinite(x)) for x in out[:6]) else None
+
+
+__all__ = ["compiled_derivatives", "raw_derivatives"]

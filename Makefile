@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test bench venv clean chromium docs
 
-$(STAMP): pyproject.toml setup.py robotdyn/_compiled.cpp robotdyn/_integrator.hpp robotdyn/_torque_profile.hpp robotdyn/_controller.hpp $(wildcard robotdyn/kernels/*.hpp)
+$(STAMP): pyproject.toml setup.py robotdyn/_compiled.cpp robotdyn/_integrator.hpp robotdyn/_torque_profile.hpp robotdyn/_controller.hpp robotdyn/_stiff_integrator.hpp $(wildcard robotdyn/kernels/*.hpp)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet "setuptools>=77" wheel "pybind11>=2.12" "pin>=4.1,<5" "cmeel-eigen>=3.4"  # build requirements (pyproject.toml)

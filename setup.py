@@ -31,6 +31,7 @@ def _extension() -> list[Extension]:
             "robotdyn._compiled",
             ["robotdyn/_compiled.cpp"],
             depends=["robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp", "robotdyn/_controller.hpp",
+                     "robotdyn/_stiff_integrator.hpp",
                      *sorted(p.as_posix() for p in Path("robotdyn/kernels").glob("*.hpp"))],  # the kernels
             include_dirs=[pybind11.get_include(), *pinocchio, *(str(Path(e) / "eigen3") for e in eigen)],
             define_macros=[

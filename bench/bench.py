@@ -145,6 +145,7 @@ def main() -> None:
     side_by_side_bench()
     startup_bench()
     compiled_engine_bench()
+    evaluation_profile_bench()
     controller_bench()
     compiled_forces_bench()
     rigid_limit_bench()
@@ -256,6 +257,35 @@ def compiled_engine_bench() -> None:
               f"{np.max(np.abs(traj.q - ref.q)):>17.2e} {np.max(np.abs(traj.nu - ref.nu)):>19.2e} {drift:>13.2e}")
 
 
+def evaluation_profile_bench() -> None:
+    """Where a compiled evaluation's time goes (Evaluator.profile: each part timed in C++, this thread's CPU time, no
+    Python in the loop), next to Pinocchio's own C++ CRBA + RNEA + frame placements and Jacobians on the same model,
+    at the state a second into each robot's first scenario (the holonomic residuals are then nonzero, so the
+    simulation's right-hand side pays the pull-back). Parts: rows = constraint rows, residuals and B; projection = S
+    (LU of A_d, condition estimate, span check); drift = the rows' drift and w after RNEA; reduce = M_r, h, g_r, B_r;
+    rhs = the whole right-hand side of a compiled simulation with the pull-back at gain 1."""
+    parts = ("crba", "rnea", "frames", "rows", "projection", "drift", "reduce", "pull_back")
+    print("\nwhere a compiled evaluation's time goes [us, C++ CPU time per call] (issue 26: pinocchio = Pinocchio's own "
+          "CRBA + RNEA + frame Jacobians on the same model)")
+    print(f"{'robot':<20} {'evaluation':>10} {'pinocchio':>9} {'ratio':>6} {'rhs':>7} " + " ".join(f"{p:>10}" for p in parts))
+    for name in names():
+        robot = robotdyn.load(name)
+        fast = compiled_model(robot)
+        scenarios = getattr(module(name), "SCENARIOS", {})
+        if fast is None or not scenarios:
+            continue
+        try:
+            traj = next(iter(scenarios.values())).run(robot, t_end=1.0, progress=False)
+            fast.compute(traj.q[-1], traj.nu[-1])
+            t = fast.ev.profile(traj.q[-1], traj.nu[-1], 2000 if robot.nq < 20 else 500, 1.0)
+        except Exception as exc:  # a benchmark reports, it does not stop
+            print(f"{name:<20} skipped: {exc}")
+            continue
+        print(f"{name:<20} {1e6 * t['evaluation']:>10.2f} {1e6 * t['pinocchio']:>9.2f} "
+              f"{t['evaluation'] / t['pinocchio']:>6.2f} {1e6 * t['rhs']:>7.2f} "
+              + " ".join(f"{1e6 * t[p]:>10.2f}" for p in parts))
+
+
 def controller_bench() -> None:
     """The built-in controller scenarios (robotdyn.simulation.feedback: feedback laws as data) on the compiled loop
     against the same law on the scipy loop, at each scenario's tolerances: cost per simulated second (whole
@@ -316,8 +346,10 @@ def controller_bench() -> None:
     dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
     print(f"{'quasimoro / LQR (lqr_law)':<36} {10.0:>8.1f} {1e3 * ws / 10:>11.2f} {1e3 * wc / 10:>14.3f} "
           f"{ws / wc:>8.1f}x {dev:>15.2e} {ref.stats['nfev']:>10d}/{fast.stats['nfev']:<10d}")
-    print("  the linkage's compiled evaluation costs ~110 us (25 coordinates, loop closures) on either loop: its runs "
-          "are bound by the evaluation, not by Python; compiled Adams steps onto each of the scenario's 400 samples "
+    print("  the linkage's compiled right-hand side costs ~35 us of CPU (25 coordinates, loop closures, the pull-back; "
+          "~100 us before the pull-back's SVD gave way to a complete orthogonal decomposition: see 'where a compiled "
+          "evaluation's time goes') on either loop: its runs are bound by the evaluation, not by Python; compiled "
+          "Adams steps onto each of the scenario's 400 samples "
           "per second (3,700 evaluations where DOP853 interpolates with 1,650); with 11 samples it needs half "
           "DOP853's")
     print("  still a Python callable (scipy only): omni_caster ellipse (tangent heading: u'' is not a polynomial or "
@@ -423,7 +455,10 @@ def traction_bench() -> None:
 
 def compliant_bench() -> None:
     """The linkage rover over its 5 cm bump, rigid contacts against compliant tyres (about 1 mm static deflection,
-    robotdyn.robots.linkage_suspension.compliant), the same tolerances and samples: whole simulate() calls."""
+    robotdyn.robots.linkage_suspension.compliant), the same tolerances and samples: whole simulate() calls. Rigid:
+    the scipy loop on the compiled model (the speed held by a Python function) and the compiled engine (the same law
+    as data, adams); compliant: the compiled engine (its default dopri5, and the stiff rosenbrock4) and the Python
+    path (LSODA). Issue 23's target: the compliant compiled run <= 10x the rigid compiled run."""
     from robotdyn.robot import Robot
     from robotdyn.robots.linkage_suspension.compliant import bump_run, compliant_spec
     from robotdyn.robots.linkage_suspension.model import PEAK_SPEED, SPEC
@@ -432,22 +467,35 @@ def compliant_bench() -> None:
     k = soft.constraints[0].normal_law.stiffness
     options = dict(rtol=1e-8, atol=1e-10, n_out=101)
     print(f"\nlinkage rover over the bump (5 cm step), rtol 1e-8, 101 samples; compliant tyres k = {k:.4g} N/m "
-          "(1 mm static deflection) with a linear tyre law, on the Python path (compiled: not available)")
-    print(f"{'run':<44} {'sim [s]':>8} {'wall [s]':>9} {'evals':>7} {'/ rigid':>8} {'/ rigid Py':>11}  flight")
+          "(1 mm static deflection) with a linear tyre law")
+    print(f"{'run':<52} {'sim [s]':>8} {'wall [s]':>9} {'evals':>7} {'/ rigid':>8} {'/ rigid Py':>11}  flight")
+    runs = (("rigid, compiled model (scipy DOP853)", rigid, True, False, None),
+            ("rigid, compiled engine (adams)", rigid, True, True, None),
+            ("rigid, Python path", rigid, False, False, None),
+            ("compliant, compiled engine (dopri5)", soft, True, True, None),
+            ("compliant, compiled engine (rosenbrock4)", soft, True, True, "rosenbrock4"),
+            ("compliant, Python path (LSODA)", soft, False, False, None))
     for speed, t_end in ((PEAK_SPEED, 2.2), (25.0, 0.45)):
-        walls = {}
-        for name, robot, compiled in (("rigid, compiled", rigid, True), ("rigid, Python path", rigid, False),
-                                      ("compliant (LSODA)", soft, False)):
+        walls, trajs = {}, {}
+        for name, robot, compiled, feedback, method in runs:
             with use_compiled(compiled):
                 start = time.perf_counter()
-                traj = bump_run(robot, t_end, rigid, speed=speed, **options)
+                traj = bump_run(robot, t_end, rigid, speed=speed, feedback=feedback, method=method, **options)
                 walls[name] = wall = time.perf_counter() - start
+            trajs[name] = traj
             flight = traj.stats.get("flight")
             flights = "-" if flight is None else (f"{len(flight)} events" if flight else "none")
-            ratio = wall / walls["rigid, compiled"]
-            ratio_py = wall / walls.get("rigid, Python path", wall)
-            print(f"{name + f' at {speed:.3g} rad/s':<44} {t_end:>8.3g} {wall:>9.3f} {traj.stats['nfev']:>7} "
+            ratio = wall / walls[runs[0][0]]
+            ratio_py = wall / walls.get(runs[2][0], wall)
+            print(f"{name + f' at {speed:.3g} rad/s':<52} {t_end:>8.3g} {wall:>9.3f} {traj.stats['nfev']:>7} "
                   f"{ratio:>8.1f} {ratio_py:>11.1f}  {flights}")
+        b = trajs[runs[5][0]]
+        for name in (runs[3][0], runs[4][0]):
+            a = trajs[name]
+            print(f"  {name}: {walls[name] / walls[runs[0][0]]:.1f}x the rigid scipy loop on the compiled model, "
+                  f"{walls[name] / walls[runs[1][0]]:.1f}x the rigid compiled engine (issue 23 target <= 10x); vs "
+                  f"LSODA: max |q| difference {float(np.max(np.abs(a.q - b.q))):.1e}, flight events "
+                  f"{len(a.stats['flight'])} vs {len(b.stats['flight'])}")
 
 
 def simulate_many_bench(runs: int = 10_000) -> None:
@@ -513,5 +561,7 @@ def trajectory_optimisation_bench() -> None:
 if __name__ == "__main__":
     if sys.argv[1:] == ["controllers"]:  # only this section: python bench/bench.py controllers
         controller_bench()
+    elif sys.argv[1:] == ["profile"]:  # only this section: python bench/bench.py profile
+        evaluation_profile_bench()
     else:
         main()

@@ -17,6 +17,8 @@
 //   kernels/contact_forces.hpp     contact/contact_forces.py (lambda on the projection's rows, wheel forces)
 //   kernels/rigid_limit.hpp        contact/rigid_limit.py (the loads rigid-body dynamics leave open)
 //   kernels/sliding.hpp            contact/sliding.py and contact/friction.py (slipping wheels, friction laws)
+//   kernels/joint_springs.hpp      reduction/joint_springs.py (springs and dampers on joints)
+//   kernels/compliant_contact.hpp  contact/compliant_contact.py (wheels that fly and land: normal force laws)
 //   kernels/lu_solve.hpp           LU substitutions and LAPACK's 1-norm condition estimate (used by the above)
 // The rigid-body algorithms are Pinocchio's (header-only use of the installed Pinocchio 4), on a copy of the
 // robot's Pinocchio model rebuilt joint by joint; tests/test_compiled*.py check every output against the Python
@@ -36,6 +38,9 @@
 #include "kernels/rigid_limit.hpp"
 #include "kernels/sliding.hpp"
 #include "_integrator.hpp"
+#include "_stiff_integrator.hpp"
+#include "kernels/compliant_contact.hpp"
+#include "kernels/joint_springs.hpp"
 #include "_torque_profile.hpp"
 #include "_controller.hpp"
 #include "kernels/reduced_dynamics_derivatives.hpp"  // the derivatives (robotdyn/fast/compiled_derivatives.py)
@@ -48,6 +53,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <thread>
 #include <limits>
@@ -147,6 +153,7 @@ class Evaluator {
     dependent_ = dependent;
     operational_ = false;
     selected_ = true;
+    configured_ = false;
   }
   // Operational velocities: nu = J_o v with J_o the selected components of a frame's twist (local or world axes).
   void set_operational(const std::vector<int>& rows, int frame, const std::vector<int>& select, bool local) {
@@ -156,6 +163,7 @@ class Evaluator {
     op_local_ = local;
     operational_ = true;
     selected_ = true;
+    configured_ = false;
   }
 
   int nv() const { return nv_; }
@@ -182,6 +190,7 @@ class Evaluator {
   void configure(const Eigen::Ref<const VectorXd>& q) {
     if (!selected_) throw Fallback("no projection chosen yet");
     if (q.size() != nv_) throw std::invalid_argument("q has the wrong length");
+    configured_ = false;  // (until this configuration is complete)
     q_ = q;
     // one pass: placements, world joint Jacobians, M (upper triangle) and the subtrees' composite inertias, from
     // which g_k = -J_k^T (Y_subtree(k) * gravity): the torque that holds the subtree's weight
@@ -203,6 +212,7 @@ class Evaluator {
       row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
     motor_columns(motors_, model_, data_, Jf_, nv_, B_);
     project();
+    configured_ = true;
   }
 
   // State level: v = S nu, the drift, w and the dynamics.
@@ -265,7 +275,8 @@ class Evaluator {
 
   void rhs_into(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                 const Eigen::Ref<const VectorXd>& tau, double alpha, Eigen::Ref<VectorXd> out) {
-    configure(q);
+    // springs, compliant wheels: the stiff integrator's differences in nu keep q, whose configuration level is kept
+    if (!(applied() && configured_ && q.size() == q_.size() && q == q_)) configure(q);
     dynamics(nu);
     const int k = static_cast<int>(S_.cols());
     if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
@@ -281,6 +292,10 @@ class Evaluator {
       force_.noalias() = Br_ * tau;
     }
     force_ -= hr_;
+    if (applied()) {  // joint springs, compliant wheels: + S^T Q(q, v)
+      applied_forces();
+      force_.noalias() += S_.transpose() * Qa_;
+    }
     llt_.compute(Mr_);
     llt_.solveInPlace(force_);
     out.tail(k) = force_;
@@ -316,6 +331,88 @@ class Evaluator {
     RowMat force(slips_.size(), 2);
     for (size_t i = 0; i < slips_.size(); ++i) force.row(i) = -slip_.normal[i] * slip_.c.row(i);
     return py::make_tuple(out, slip_.normal, RowMat(slip_.s), force);
+  }
+
+  // ------------------------------------------------------------------------------------------ springs, compliant wheels
+  // Applied forces that depend on the state (robotdyn/contact/applied_forces.py): joint springs and dampers
+  // (kernels/joint_springs.hpp) and compliant wheels (kernels/compliant_contact.hpp). Their sum Q(q, v) enters
+  // rhs_into as S^T Q; a simulation carries the friction and the damper work as two extra states; observe adds
+  // their stored energy.
+  void add_spring(int index, double stiffness, double damping, double rest) {
+    if (index < 0 || index >= nv_) throw std::invalid_argument("no such coordinate");
+    springs_.push_back(robotdyn::kernels::JointSpring{index, stiffness, damping, rest});
+  }
+  // A compliant wheel: its contact geometry as a wheel without rows (as add_wheel), its normal law (kind 0 linear,
+  // 1 Hunt-Crossley; k, c, n) and its friction law (code -1 none, 0 regularised Coulomb, 1 linear tyre; p0, p1)
+  // on the tangential directions D (0..2, 2), rows of coefficients of (t1, t2).
+  void add_compliant_wheel(int frame, const Vector3d& axis, double radius, int radius_index, int kind, double k,
+                           double c, double n, int code, double p0, double p1, const MatrixXd& D) {
+    if (kind < 0 || kind > 1 || code < -1 || code > 1) throw std::invalid_argument("unknown contact or friction law");
+    if (D.cols() != 2 || D.rows() > 2) throw std::invalid_argument("tangential directions must be (0..2, 2)");
+    robotdyn::kernels::CompliantContact cc;
+    cc.wheel = static_cast<int>(wheels_.size());
+    cc.normal = robotdyn::kernels::NormalLaw{kind, k, c, n};
+    cc.friction = robotdyn::kernels::FrictionLaw{code, p0, p1};
+    cc.D = D;
+    order_.emplace_back(0, static_cast<int>(wheels_.size()));
+    wheels_.push_back(Wheel{frame, axis, radius, radius_index, Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3>(0, 3)});
+    contacts_.push_back(cc);
+  }
+  bool applied() const { return !springs_.empty() || !contacts_.empty(); }
+  // The compliant wheels' contact mode at the last applied_forces: bits 2i (wheel i pressed in), 2i + 1 (its normal
+  // force positive); the stiff integrator's differences do not cross a switch of it.
+  unsigned long long contact_mode() const {
+    unsigned long long out = 0;
+    for (size_t i = 0; i < contact_states_.size() && i < 32; ++i) {
+      if (contact_states_[i].delta > 0.0) out |= 1ULL << (2 * i);
+      if (contact_states_[i].force[2] > 0.0) out |= 1ULL << (2 * i + 1);
+    }
+    return out;
+  }
+
+  // Q (Qa_), the friction and damper powers and each contact's state, after configure(q) and v_ = S nu.
+  void applied_forces() {
+    Qa_.setZero(nv_);
+    damper_power_ = robotdyn::kernels::add_joint_springs(springs_, q_, v_, Qa_);
+    friction_power_ = 0.0;
+    contact_states_.resize(contacts_.size());
+    Ac_.resize(3, nv_);
+    for (size_t i = 0; i < contacts_.size(); ++i) {
+      const robotdyn::kernels::CompliantContact& cc = contacts_[i];
+      const WheelGeometry& g = geo_[cc.wheel];
+      Ac_.row(0).noalias() = g.t1.transpose() * Aw_[cc.wheel];
+      Ac_.row(1).noalias() = g.t2.transpose() * Aw_[cc.wheel];
+      Ac_.row(2).noalias() = g.n.transpose() * Aw_[cc.wheel];
+      const robotdyn::kernels::ContactState st = robotdyn::kernels::add_compliant_contact(cc, g.phi, Ac_, v_, Qa_);
+      contact_states_[i] = st;
+      friction_power_ += st.friction_power;
+      damper_power_ += st.damper_power;
+    }
+  }
+  // The springs' and contacts' stored energy at the configured q [J].
+  double stored_energy() const {
+    double out = robotdyn::kernels::joint_springs_potential(springs_, q_);
+    for (const auto& cc : contacts_) out += cc.normal.potential(-geo_[cc.wheel].phi);
+    return out;
+  }
+  // The compliant wheels' penetrations [m] at the state y (its q).
+  void penetrations(const double* y, const py::object& rechoose, std::vector<double>& out) {
+    with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
+    out.resize(contacts_.size());
+    for (size_t i = 0; i < contacts_.size(); ++i) out[i] = -geo_[contacts_[i].wheel].phi;
+  }
+  // (Q (nv,), friction power [W], damper power [W], per compliant wheel (delta, rate, F_t1, F_t2, f_n)) at (q, nu):
+  // the compiled robotdyn.contact.applied_forces.applied (tests compare them).
+  py::tuple applied_state(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
+    configure(q);
+    dynamics(nu);
+    applied_forces();
+    RowMat states(contacts_.size(), 5);
+    for (size_t i = 0; i < contacts_.size(); ++i) {
+      const auto& st = contact_states_[i];
+      states.row(i) << st.delta, st.rate, st.force[0], st.force[1], st.force[2];
+    }
+    return py::make_tuple(Qa_, friction_power_, damper_power_, states);
   }
 
   // ------------------------------------------------------------------------------------------ feedback laws
@@ -372,6 +469,7 @@ class Evaluator {
         const int k = mobility();
         VectorXd q(Eigen::Map<const VectorXd>(y, nv_)), nu(Eigen::Map<const VectorXd>(y + nv_, k));
         py::tuple sel = run_ < 0 ? rechoose(q, nu) : rechoose(run_, q, nu);
+        configured_ = false;
         rows_ = sel[0].cast<std::vector<int>>();
         if (!operational_) {
           independent_ = sel[1].cast<std::vector<int>>();
@@ -396,6 +494,10 @@ class Evaluator {
         rhs_into(Eigen::Map<const VectorXd>(y.data(), nv_), Eigen::Map<const VectorXd>(y.data() + nv_, k), tau_,
                  alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k));
       });
+      if (applied()) {  // y = (q, nu, friction work, damper work)
+        dy[nv_ + k] = friction_power_;
+        dy[nv_ + k + 1] = damper_power_;
+      }
       return;
     }
     try {  // y = (q, nu, friction work)
@@ -435,6 +537,7 @@ class Evaluator {
       potential -= Y.mass() * gravity_.linear().dot(data_.oMi[i].act(Y.lever()));
     }
     energy = 0.5 * v_.dot(data_.M.selfadjointView<Eigen::Upper>() * v_) + potential;  // CRBA fills the upper part
+    if (applied()) energy += stored_energy();  // springs' and compliant contacts' elastic energy
     residual = 0.0;
     for (size_t r = 0; r < holonomic_.size(); ++r)
       if (holonomic_[r]) residual = std::max(residual, std::fabs(residual_[r]));
@@ -567,6 +670,7 @@ class Evaluator {
            4 * static_cast<Eigen::Index>(wheels_.size()) + 4 * static_cast<Eigen::Index>(couplings_.size()) + 3;
   }
   void set_model_vector(const double* x) {
+    configured_ = false;
     Eigen::Index i = 0;
     auto get_se3 = [&]() {
       Matrix3d R;
@@ -620,6 +724,7 @@ class Evaluator {
                          const std::string& method, int threads, py::object progress, py::object rechoose,
                          double time_limit) {
     if (!slips_.empty()) throw std::invalid_argument("simulate_many does not run robots with slipping wheels");
+    if (applied()) throw std::invalid_argument("simulate_many does not run robots with joint springs or compliant wheels");
     const long N = static_cast<long>(Q0.rows());
     const int k = mobility(), dim = nv_ + k;
     const long S = static_cast<long>(samples.size());
@@ -783,7 +888,10 @@ class Evaluator {
     if (profile.motors() != static_cast<int>(motors_.size()))
       throw std::invalid_argument("the torque profile is for another number of motors");
     const bool slipping = !slips_.empty();
-    const int dim = nv_ + k + (slipping ? 1 : 0);  // slipping wheels: the friction work as the last component
+    if (slipping && applied()) throw std::invalid_argument("slipping wheels with joint springs or compliant wheels");
+    if (method == "rosenbrock4" && slipping) throw std::invalid_argument("rosenbrock4 does not run slipping wheels");
+    // slipping wheels: the friction work as the last component; springs, compliant wheels: friction and damper work
+    const int dim = nv_ + k + (slipping ? 1 : applied() ? 2 : 0);
     robotdyn::State y0(dim, 0.0);
     Eigen::Map<VectorXd>(y0.data(), nv_) = q0;
     Eigen::Map<VectorXd>(y0.data() + nv_, k) = nu0;
@@ -835,11 +943,37 @@ class Evaluator {
     } lift_off{this, alpha, &profile, &rechoose, slipping};
     int slip_error = -1;
     double slip_value = 0.0;
+    std::vector<std::tuple<double, int, int>> crossings;  // flight phases: (t, compliant wheel, +1 touch-down / -1 lift-off)
     {
       py::gil_scoped_release release;
       try {
-        out = robotdyn::integrate(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol, observer, poll,
-                                  lift_off);
+        if (method == "rosenbrock4") {  // stiff (_stiff_integrator.hpp), with the compliant wheels' flight phases
+          auto depths = [this, &rechoose](double, const robotdyn::State& y, std::vector<double>& d) {
+            penetrations(y.data(), rechoose, d);
+          };
+          robotdyn::Crossings<decltype(depths)> flights(depths);
+          struct Mode {  // the right-hand side's mode, and the Jacobian's differences on or off
+            Evaluator* ev;
+            unsigned long long operator()() const { return ev->contact_mode(); }
+            void differencing(bool on) { ev->differencing_ = on; }
+          } mode{this};
+          out = robotdyn::integrate_stiff(system, y0, t0, t_end, samples, next, breaks, rtol, atol, nv_ + k, observer,
+                                          poll, flights, mode);
+          for (const auto& [te, i, direction] : flights.found)
+            if (te <= out.t) crossings.emplace_back(te, i, direction);
+        } else if (!contacts_.empty()) {  // explicit, with the flight phases on the dense output
+          auto depths = [this, &rechoose](double, const robotdyn::State& y, std::vector<double>& d) {
+            penetrations(y.data(), rechoose, d);
+          };
+          robotdyn::Crossings<decltype(depths)> flights(depths);
+          out = robotdyn::integrate_crossings(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol,
+                                              observer, poll, flights);
+          for (const auto& [te, i, direction] : flights.found)
+            if (te <= out.t) crossings.emplace_back(te, i, direction);
+        } else {
+          out = robotdyn::integrate(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol, observer, poll,
+                                    lift_off);
+        }
       } catch (const SlipError& e) {
         slip_error = e.kind;
         slip_value = e.value;
@@ -869,7 +1003,89 @@ class Evaluator {
     result["event"] = out.event;
     result["slip_error"] = slip_error;
     result["slip_value"] = slip_value;
+    result["flights"] = crossings;
     return result;
+  }
+
+  // Where an evaluation's time goes (make bench): CPU seconds per call, each part timed over `repeat` calls at (q, nu),
+  // next to Pinocchio's own C++ algorithms on the same model: "evaluation" (configure + dynamics, as compute),
+  // "pinocchio" (CRBA + RNEA + the frames' placements and Jacobians, the rigid-body work inside it), "crba", "rnea",
+  // "frames", "rows" (constraint rows, residuals, B), "projection", "drift" (drift and w, after RNEA), "reduce"
+  // (M_r, h, g_r, B_r), "rhs" (the simulation's right-hand side with the pull-back at gain `alpha`) and "pull_back".
+  // The evaluator is left evaluated at (q, nu).
+  py::dict profile(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu, int repeat, double alpha) {
+    if (repeat < 1) throw std::invalid_argument("repeat must be >= 1");
+    configure(q);
+    dynamics(nu);
+    const VectorXd q0 = q, nu0 = nu;
+    const VectorXd tau = VectorXd::Zero(Br_.cols());
+    VectorXd out(nv_ + nu.size());
+    auto seconds = [repeat](auto&& f) {  // this thread's CPU time (the machine may be shared), else wall time
+#ifdef CLOCK_THREAD_CPUTIME_ID
+      timespec a, b;
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+      for (int i = 0; i < repeat; ++i) f();
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+      return ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / repeat;
+#else
+      const auto start = std::chrono::steady_clock::now();
+      for (int i = 0; i < repeat; ++i) f();
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeat;
+#endif
+    };
+    auto frames = [&] {
+      pin::updateFramePlacements(model_, data_);
+      for (size_t f = 0; f < frames_.size(); ++f) {
+        Jf_[f].setZero(6, nv_);
+        pin::getFrameJacobian(model_, data_, frames_[f], pin::LOCAL_WORLD_ALIGNED, Jf_[f]);
+      }
+    };
+    auto rows = [&] {
+      A_.setZero(nrows(), nv_);
+      residual_.setZero(nrows());
+      int row = 0;
+      for (const auto& [kind, i] : order_)
+        row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
+      motor_columns(motors_, model_, data_, Jf_, nv_, B_);
+    };
+    auto drift = [&] {
+      drift_.setZero(nrows());
+      int row = 0;
+      for (const auto& [kind, i] : order_)
+        row = kind == 0 ? wheel_drift(i, row) : kind == 1 ? closure_drift(i, row) : coupling_drift(i, row);
+      w_.setZero(nv_);
+      if (operational_)
+        drift_acceleration_operational(drift_, rows_, op_select_, model_, data_, frames_[op_frame_], op_local_, nv_,
+                                       Kinv_, rhs_, w_);
+      else
+        drift_acceleration_selection(drift_, rows_, dependent_, lu_, lus_, rhs_, wd_, w_);
+    };
+    py::dict t;
+    t["evaluation"] = seconds([&] { configure(q0); dynamics(nu0); });
+    t["pinocchio"] = seconds([&] {
+      pin::crba(model_, data_, q_, pin::Convention::WORLD);
+      pin::rnea(model_, data_, q_, v_, zero_);
+      frames();
+    });
+    t["crba"] = seconds([&] { pin::crba(model_, data_, q_, pin::Convention::WORLD); });
+    t["frames"] = seconds(frames);
+    t["rows"] = seconds(rows);
+    t["projection"] = seconds([&] { project(); });
+    t["rnea"] = seconds([&] {
+      pin::rnea(model_, data_, q_, v_, zero_);
+      for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) data_.a[i] = data_.a_gf[i];
+    });
+    t["drift"] = seconds(drift);
+    const VectorXd Cv = data_.tau;
+    t["reduce"] = seconds([&] {
+      data_.tau = Cv;
+      reduce(data_.M, S_, g_, data_.tau, w_, B_, SM_, Mr_, hr_, gr_, Br_);
+    });
+    t["rhs"] = seconds([&] { rhs_into(q0, nu0, tau, alpha, out); });
+    t["pull_back"] = seconds([&] { pull_back(alpha, out); });
+    configure(q0);
+    dynamics(nu0);
+    return t;
   }
 
   // Many states: stacked M_r (N, k, k), h (N, k), g (N, k), S (N, n, k), w (N, n), B_r (N, k, motors).
@@ -906,6 +1122,7 @@ class Evaluator {
   }
   int wheel_drift(size_t i, int row) {
     const Wheel& wh = wheels_[i];
+    if (wh.D.rows() == 0) return row;  // a compliant wheel: no rows
     return kernels::wheel_drift(wh, geo_[i], terrain_, model_, data_, frames_[wh.frame], Aw_[i], v_, row, drift_);
   }
   int closure_rows(size_t i, int row) {
@@ -926,12 +1143,10 @@ class Evaluator {
                           Kinv_, cond_, S_);
     else if (!project_selection(A_, rows_, independent_, dependent_, nv_, lus_, lu_, sel_, cond_, S_))
       return;
-    check_span(A_, S_, AS_);
+    if (!differencing_) check_span(A_, S_, AS_);  // (a stiff Jacobian's difference leaves the manifold by ~1e-8)
   }
 
-  void pull_back(double alpha, Eigen::Ref<VectorXd> out) {
-    kernels::pull_back(holonomic_, residual_, A_, nv_, alpha, svd_, out);
-  }
+  void pull_back(double alpha, Eigen::Ref<VectorXd> out) { pull_back_.apply(holonomic_, residual_, A_, nv_, alpha, out); }
 
   pin::Model model_;
   pin::Data data_;
@@ -948,7 +1163,8 @@ class Evaluator {
   pin::Motion gravity_;  // the model's gravity (the Pinocchio model itself has none, see the constructor)
   std::vector<int> rows_, independent_, dependent_, op_select_;
   int op_frame_ = -1;
-  bool op_local_ = true, operational_ = false, selected_ = false;
+  bool op_local_ = true, operational_ = false, selected_ = false, configured_ = false;
+  bool differencing_ = false;  // a stiff Jacobian's differences are being taken (project skips its span check)
   // state and work buffers (sized on first use, then reused)
   VectorXd tau_, e_, lambda_, lr_, nudot_, a_;
   RowMat wl_, ww_, wf_, wp_;
@@ -965,10 +1181,17 @@ class Evaluator {
   Matrix6x Jc_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   Eigen::LLT<MatrixXd> llt_;
-  Eigen::JacobiSVD<MatrixXd> svd_;
+  PullBack pull_back_;  // the pull-back's decomposition and buffers
   double cond_ = 1.0;
   RigidLimit rigid_;  // the rigid limit's split (forces) and its buffers
   SlipSystem slip_;   // the slipping wheels' system (slip_rhs_into), its results and buffers
+  // joint springs and compliant wheels (applied_forces)
+  std::vector<robotdyn::kernels::JointSpring> springs_;
+  std::vector<robotdyn::kernels::CompliantContact> contacts_;
+  std::vector<robotdyn::kernels::ContactState> contact_states_;
+  VectorXd Qa_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> Ac_;
+  double friction_power_ = 0.0, damper_power_ = 0.0;
   // the lift-off event's cache and the state of a SlipError
   double event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
 
@@ -1043,6 +1266,9 @@ PYBIND11_MODULE(_compiled, m) {
       .def("add_closure", &Evaluator::add_closure)
       .def("add_motor", &Evaluator::add_motor)
       .def("add_slipping", &Evaluator::add_slipping)
+      .def("add_spring", &Evaluator::add_spring)
+      .def("add_compliant_wheel", &Evaluator::add_compliant_wheel)
+      .def("applied_state", &Evaluator::applied_state)
       .def_property_readonly("slipping", &Evaluator::slipping)
       .def_readonly("last_t", &Evaluator::last_t_, "Time [s] of the last right-hand side a simulation evaluated")
       .def_property_readonly("slip_condition", &Evaluator::slip_condition,
@@ -1101,6 +1327,8 @@ PYBIND11_MODULE(_compiled, m) {
            },
            "(nudot, dnudot/dq, dnudot/dnu, dnudot/dtau, v, dv/dq, S, A) at (q, nu, tau) "
            "(robotdyn.fast.compiled_derivatives)")
+      .def("profile", &Evaluator::profile, py::arg("q"), py::arg("nu"), py::arg("repeat"), py::arg("alpha") = 0.0,
+           "seconds per call of each part of an evaluation, and of Pinocchio's CRBA + RNEA + frame Jacobians")
       .def_property_readonly("condition", &Evaluator::condition,
                              "1-norm condition number of the last projection's block: LAPACK's estimate below 1e8, "
                              "exact above (operational velocities: exact)")

@@ -95,7 +95,8 @@ double locate_root(G&& g, double a, double ga, double b, double gb) {
 template <class Stepper, class System, class Observer, class Poll, class Event = NoEvent>
 Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, double t_end,
                   const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
-                  double dt0, Observer&& observer, Poll&& poll, Event&& event = Event()) {
+                  double dt0, Observer&& observer, Poll&& poll, Event&& event = Event(), double unit = 1.0) {
+  // (a step below 8 eps max(unit, |t|) fails as vanishing: unit 1 by default, 0 for the true spacing of doubles)
   Outcome out;
   out.t = t0;
   out.y = y0;
@@ -122,7 +123,7 @@ Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, 
     if (tc + stepper.current_time_step() > limit)
       stepper.initialize(State(stepper.current_state()), tc, limit - tc);
     const double h = stepper.current_time_step();
-    if (!(h > 8.0 * eps * std::max(1.0, std::fabs(tc)))) {
+    if (!(h > 8.0 * eps * std::max(unit, std::fabs(tc)))) {
       out.status = FAILED;
       out.message = "Required step size is less than spacing between numbers.";
       return out;

@@ -58,13 +58,14 @@ def phases(traj) -> dict[str, list[float]]:
     return out
 
 
+@pytest.mark.parametrize("engine", ["auto", "scipy"])  # the compiled engine where built; the Python path (LSODA)
 @pytest.mark.parametrize("zeta", [0.0, 0.2, 0.5])
-def test_landing_on_a_linear_spring_damper(zeta):
+def test_landing_on_a_linear_spring_damper(zeta, engine):
     k, v_in, gap = 2.0e4, 1.0, 0.01
     c = 2 * zeta * np.sqrt(k * M)
     robot = disc(normal_stiffness=k, normal_damping=c)
     q0, nu0 = state(robot, R + gap, -v_in)
-    traj = simulate(robot, 0.1, q0, nu0, n_out=101, rtol=1e-10, atol=1e-13, progress=False)
+    traj = simulate(robot, 0.1, q0, nu0, n_out=101, rtol=1e-10, atol=1e-13, progress=False, engine=engine)
     wn = np.sqrt(k / M)
     s, wd = zeta * wn, wn * np.sqrt(1 - zeta**2)
     theta = np.pi - np.arctan2(2 * zeta * np.sqrt(1 - zeta**2), 1 - 2 * zeta**2)

@@ -1,7 +1,7 @@
 """The command line with springs and compliant wheels: simulate reports the wheels' flight phases (lift-off and
 touch-down per wheel) instead of stopping at lift-off, and the work of friction and dampers; bad springs and
-compliant-wheel entries are one-line errors with exit status 2; the compiled engine refuses such robots in one
-line (they run on the Python path)."""
+compliant-wheel entries are one-line errors with exit status 2; the compiled engine runs such robots and refuses
+in one line what it cannot run (e.g. torques given as a Python function)."""
 
 from __future__ import annotations
 
@@ -76,19 +76,21 @@ def test_compliant_wheel_with_stick_slip_is_one_line(tmp_path):
         in out.stderr, out.stderr
 
 
-def test_compiled_engine_refuses_springs_in_one_line():
+def test_compiled_engine_runs_springs_and_refuses_a_python_torque_in_one_line():
     from robotdyn.errors import RobotDynError
+    from robotdyn.fast.compiled import available
     from robotdyn.interfaces.constraint_file import read
     from robotdyn.simulation.engine import simulate
 
     cf = read(EXAMPLES / "sprung_car.toml")
     robot = cf.robot()
     q0, nu0 = cf.SCENARIOS["brake"].initial_state(robot)
-    with pytest.raises(RobotDynError, match="^engine = 'compiled' cannot run this simulation: joint springs and "
-                                            "dampers are evaluated on the Python path"):
-        simulate(robot, 0.1, q0, nu0, engine="compiled", progress=False)
-    traj = simulate(robot, 0.1, q0, nu0, progress=False)  # auto: the Python path
-    assert traj.stats["engine"].startswith("scipy") and np.isfinite(traj.q).all()
+    with pytest.raises(RobotDynError, match="^engine = 'compiled' cannot run this simulation: the torques are a "
+                                            "Python function"):
+        simulate(robot, 0.1, q0, nu0, lambda t, q, nu: np.zeros(4), engine="compiled", progress=False)
+    traj = simulate(robot, 0.1, q0, nu0, progress=False)  # auto: the compiled engine where it is built
+    assert traj.stats["engine"] == ("compiled (adams)" if available() else "scipy (DOP853)")
+    assert np.isfinite(traj.q).all() and traj.damper_work is not None
 
 
 def test_dump_applies_the_springs():

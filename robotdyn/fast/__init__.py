@@ -3,7 +3,8 @@ chooses it.
 
 Owns ``compiled`` (:class:`~robotdyn.fast.compiled.CompiledModel`, ``why_not``, ``Fallback``, ``available``) and
 ``dispatch`` (``ROBOTDYN_COMPILED``, ``use_compiled``, ``enabled``, ``compiled_model``, ``reduce``): every
-caller that could take the compiled path asks robotdyn.fast.dispatch. Imports the foundation, description,
+caller that could take the compiled path asks robotdyn.fast.dispatch; ``compiled_applied`` (joint springs and
+compliant wheels encoded for the evaluator) and ``applied_model`` (the compiled simulation's model of such robots). Imports the foundation, description,
 constraints and reduction only.
 
 Import rule (tests/test_layout.py enforces it): the stages are, in order, foundation (robotdyn.errors, robotdyn.inputs,

@@ -93,22 +93,25 @@ def _compiled_formulas(constraint, base: type) -> bool:
     return isinstance(constraint, base) and all(getattr(cls, m) is getattr(base, m) for m in _COMPILED_FORMULAS[base])
 
 
-def why_not(robot) -> str | None:
+def why_not(robot, applied: bool = False) -> str | None:
     """Why ``robot`` cannot use the compiled path (``None``: it can).
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
+        applied: Whether joint springs and compliant wheels are compiled too (the compiled simulation's model,
+            :func:`robotdyn.fast.applied_model.applied_model`); default ``False``: they keep a robot on the
+            Python path.
 
     Returns:
         A one-line reason, or ``None``.
     """
     if _compiled is None:
         return "the compiled extension robotdyn._compiled was not built"
-    if getattr(robot, "springs", None):  # robotdyn.reduction.joint_springs
+    if getattr(robot, "springs", None) and not applied:  # robotdyn.reduction.joint_springs
         return "joint springs and dampers are evaluated on the Python path (not compiled)"
     if any(getattr(c, "rolling", False) for c in robot.constraints):  # robotdyn.contact.compliant_rolling
         return "compliant wheels that roll while in contact (friction = 'rolling') are simulated on the Python path"
-    if any(getattr(c, "compliant", False) for c in robot.constraints):  # robotdyn.contact.compliant_contact
+    if any(getattr(c, "compliant", False) for c in robot.constraints) and not applied:
         return "compliant wheels (normal force laws) are evaluated on the Python path (not compiled)"
     for i in range(1, robot.model.njoints):
         kind = robot.model.joints[i].shortname().replace("JointModel", "")
@@ -116,10 +119,17 @@ def why_not(robot) -> str | None:
             return f"joint {robot.model.names[i]!r} of type {kind} is not compiled"
     terrains = set()
     for c in robot.constraints:
-        if _compiled_formulas(c, RollingWheel):
+        compliant = applied and getattr(c, "compliant", False)  # robotdyn.contact.compliant_contact
+        if _compiled_formulas(c, RollingWheel) or compliant:
             if _terrain_code(c.terrain) is None:
                 return f"wheel {c.name!r} rolls on {c.terrain!r}, whose formulas are not compiled"
             terrains.add(id(c.terrain))
+            if compliant:
+                from .compiled_applied import compliant_refusal
+
+                reason = compliant_refusal(c)
+                if reason is not None:
+                    return reason
         elif isinstance(c, JointCoupling) and type(c).rows is JointCoupling.rows:
             if not (isinstance(c.law, CosineLaw) and c.dlaw == c.law.d and c.ddlaw == c.law.dd):
                 return f"coupling {c.name!r} has a law other than a CosineLaw"
@@ -218,7 +228,12 @@ class CompiledModel:
         self.wheels = [c for c in self.constraints if isinstance(c, RollingWheel)]
         self.couplings = [c for c in self.constraints if isinstance(c, JointCoupling)]
         for c in self.constraints:
-            if isinstance(c, RollingWheel):
+            if getattr(c, "compliant", False):  # a compliant wheel (robotdyn.fast.compiled_applied)
+                from .compiled_applied import add_compliant_wheel
+
+                ev.set_terrain(*_terrain_code(c.terrain))
+                add_compliant_wheel(ev, c, frame(c.fid))
+            elif isinstance(c, RollingWheel):
                 ev.set_terrain(*_terrain_code(c.terrain))
                 ev.add_wheel(frame(c.fid), np.asarray(c.axis, float), float(c.radius),
                              -1 if c.radius_index is None else int(c.radius_index), np.asarray(c._directions, float))
@@ -229,6 +244,10 @@ class CompiledModel:
                 ev.add_closure(frame(c.f1), frame(c.f2), [int(s) for s in c._sel])
         for m in robot.motors:
             ev.add_motor(int(m.index), int(m.jid), -1 if m.rid is None else frame(m.rid))
+        if getattr(robot, "springs", None):  # only where why_not(robot, applied=True) let them in
+            from .compiled_applied import add_springs
+
+            add_springs(ev, robot)
         self.slip_refusal = self._add_slipping(ev, robot)
         if self.wheels and hasattr(ev, "set_normal_stiffness"):  # the rigid limit of :meth:`forces`' open loads
             from ..constraints.wheel_compliance import wheel_stiffness

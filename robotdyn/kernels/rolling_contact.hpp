@@ -33,6 +33,7 @@ struct WheelGeometry {  // configuration-level quantities of one wheel
   Matrix3d N;  // dn/dp on a curved terrain
   double na, nw, nc1, R;
   Vector3d p;  // contact point (world)
+  double phi;  // signed distance above the terrain [m] (a compliant wheel's penetration is -phi)
   int row;     // the wheel's first row
 };
 
@@ -81,6 +82,7 @@ inline int wheel_rows(const Wheel& wh, const Terrain& terrain, const pin::SE3& o
   terrain.eval(p[0], p[1], f, grad, H);
   const double norm = std::sqrt(1.0 + grad.squaredNorm());
   const double phi = (p[2] - f) / norm;
+  g.phi = phi;
   if (!flat) {  // Terrain.normal_derivative
     Matrix3d dm = Matrix3d::Zero();
     dm.block<2, 2>(0, 0) = -H;

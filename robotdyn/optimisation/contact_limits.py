@@ -63,6 +63,7 @@ class ContactLimits:
             min_load = 0.0
         self.min_load, self.mu_max, self.peak = min_load, mu_max, bool(peak)
         self.derivatives = derivatives
+        self.steps = None  # a ManifoldSteps: finite differences in q along the holonomic level set
         from ..contact.sliding import sliding_now
 
         sliding = sliding_now(robot)
@@ -189,6 +190,12 @@ class ContactLimits:
             yp, ym = y.copy(), y.copy()
             yp[i] += step
             ym[i] -= step
+            if self.steps is not None and i < n:
+                pair = self.steps.pair(q, i, step)
+                if pair is None:
+                    dF[:, :, i] = 0.0
+                    continue
+                yp[:n], ym[:n] = pair
             Fp = self.forces(yp[:n], yp[n:n + k], yp[n + k:]).copy()
             Fm = self.forces(ym[:n], ym[n:n + k], ym[n + k:])
             dF[:, :, i] = (Fp - Fm) / (2 * step)

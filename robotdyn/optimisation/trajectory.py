@@ -18,7 +18,8 @@ the control the collocation assumed, and a re-simulation with the exact model ch
 Jacobian is block-sparse (two state blocks and two torque blocks per interval) and built from
 :math:`\\partial f/\\partial x, \\partial f/\\partial\\tau` at each node: analytic
 (:meth:`robotdyn.robot.Robot.dynamics_derivatives`: ``dqdot_dq``, ``S``, ``dq``, ``dnu``, ``dtau``) or, for
-comparison, central finite differences of the forward dynamics (``derivatives="finite-difference"``). The cost is
+comparison, central finite differences of the forward dynamics (``derivatives="finite-difference"``; with holonomic
+rows the coordinates are stepped along their level set, :mod:`robotdyn.optimisation.manifold_steps`). The cost is
 quadratic and its gradient exact in both cases; IPOPT's Hessian is its limited-memory (L-BFGS) approximation, in
 both cases, so that the two differ only in the constraint Jacobian.
 
@@ -231,6 +232,7 @@ class TrajectoryProblem:
             self.limits = ContactLimits(robot, self.q0, None if min_load is None else _finite(min_load, "min_load"),
                                         None if mu_max is None else _finite(mu_max, "mu_max"),
                                         peak=cost == "peak-mu", derivatives=force_derivatives)
+            self.limits.steps = self.steps
         self.force_derivatives = force_derivatives
         names = list(robot.coordinates) + list(robot.velocity_names)
         self.names = names
@@ -288,6 +290,10 @@ class TrajectoryProblem:
         else:
             self.positions = np.arange(self.n)
         self.keep = np.concatenate([self.positions, self.n + np.arange(self.k)])
+        from .manifold_steps import ManifoldSteps
+
+        # finite differences in q step along the holonomic level set (a redundant loop would open otherwise)
+        self.steps = ManifoldSteps(self._holonomic, self.positions, self.n) if self.mh else None
 
     def _holonomic(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The independent holonomic rows' residuals (mh,) [m or rad] at q and their Jacobian (mh, n) (the rows
@@ -378,6 +384,12 @@ class TrajectoryProblem:
             yp, ym = y.copy(), y.copy()
             yp[i] += step
             ym[i] -= step
+            if self.steps is not None and i < n:  # along the holonomic level set; dependent columns zero
+                pair = self.steps.pair(x[:n], i, step)
+                if pair is None:
+                    J[:, i] = 0.0
+                    continue
+                yp[:n], ym[:n] = pair
             J[:, i] = (self._f(yp[:self.nx], yp[self.nx:]) - self._f(ym[:self.nx], ym[self.nx:])) / (2 * step)
         return J[:, :self.nx], J[:, self.nx:]
 

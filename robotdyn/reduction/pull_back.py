@@ -14,7 +14,8 @@ residual ~1e-7 that a plain least-squares solve turns into corrections ~1e16 (an
 :func:`correction` therefore solves by a truncated SVD: singular values below :data:`RANK_TOL` times
 :math:`\\max(\\sigma_{max}, 1)` count as zero (the rule of :func:`robotdyn.reduction.projection.independent_rows`), and
 :func:`offsets` names the residuals left in their directions: constant offsets of the model, reported once rather
-than chased. The compiled path does the same in C++ (``robotdyn/kernels/pull_back.hpp``).
+than chased. The compiled path gives the same minimum-norm solution in C++ (``robotdyn/kernels/pull_back.hpp``, by a complete
+orthogonal decomposition, pivots below the same relative tolerance counting as zero).
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..fast.compiled import Fallback
 from ..fast.dispatch import compiled_model
-from .compiled_engine import METHODS, as_data, at_time, choose_engine, simulate_compiled
+from .compiled_engine import as_data, at_time, choose_engine, default_method, simulate_compiled
 from ..errors import ConstraintError, NonFiniteError, RobotDynError
 from ..reduction.projection import solve
 from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
@@ -87,7 +87,8 @@ def simulate(
         n_out: Number of output samples.
         rtol, atol: Error tolerances (relative, absolute per component) of either engine.
         method: The integrator: a ``scipy.integrate.solve_ivp`` method (default DOP853) or one of
-            :data:`robotdyn.simulation.compiled_engine.METHODS` (default adams); it selects the engine too.
+            :data:`robotdyn.simulation.compiled_engine.METHODS` (default adams; dopri5 for compliant wheels,
+            rosenbrock4 for stiff ones); it selects the engine too.
         stabilisation: Gain [1/s] pulling holonomic residuals back to zero (:mod:`robotdyn.reduction.pull_back`).
         progress: Print progress to stderr on long runs.
         engine: ``auto``, ``compiled`` (an error naming why where it cannot run) or ``scipy``.
@@ -174,7 +175,7 @@ def simulate(
                                             method or "DOP853", stabilisation, progress, time_limit=time_limit),
                         robot, torque)
     if compiled_engine:
-        return _applied(simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or METHODS[0],
+        return _applied(simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or default_method(robot),
                                           stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times),
                         robot, torque)
     compliant = compliant_wheels(robot)

@@ -55,7 +55,30 @@ def _hold_speed(robot: Robot, speed: float = PEAK_SPEED):
     return tau
 
 
-def bump_run(robot: Robot, t_end: float = 1.5, rigid: Robot | None = None, speed: float = PEAK_SPEED, **options):
+def hold_speed_law(robot: Robot, speed: float = PEAK_SPEED):
+    """The torques of :func:`_hold_speed` as a :class:`~robotdyn.simulation.feedback.FeedbackLaw` (data, so the
+    compiled engine evaluates them without Python): tau = K speed - K nu_j with nu_j the side's middle wheel speed,
+    which must be an independent velocity (it is for the rigid rover and for :func:`compliant_spec`).
+
+    Args:
+        robot: The rigid or compliant rover.
+        speed: The wheel speed [rad/s] held (default: the section 3 peak).
+
+    Returns:
+        The :class:`~robotdyn.simulation.feedback.FeedbackLaw`.
+    """
+    from ...simulation.feedback import FeedbackLaw
+    from ...simulation.torque_profile import Constant
+
+    names = list(robot.velocity_names)
+    Knu = np.zeros((6, robot.mobility))
+    Knu[:3, names.index("phi2_dot")] = SPEED_GAIN
+    Knu[3:, names.index("phi5_dot")] = SPEED_GAIN
+    return FeedbackLaw(feedforward=Constant(np.full(6, SPEED_GAIN * speed)), Knu=Knu)
+
+
+def bump_run(robot: Robot, t_end: float = 1.5, rigid: Robot | None = None, speed: float = PEAK_SPEED,
+             feedback: bool = False, **options):
     """Drive ``robot`` over the 5 cm bump of ``TERRAINS["bump"]`` (the rigid rover's ``bump`` scenario: from
     x = -0.6 m at the wheel speed ``speed`` [rad/s], the section 3 peak by default, held by the motors; at about
     25 rad/s, 3.5 m/s, the wheels leave the ground over the bump's crest).
@@ -67,6 +90,8 @@ def bump_run(robot: Robot, t_end: float = 1.5, rigid: Robot | None = None, speed
             lowered by its wheels' static deflection (the weight shared by six wheels on their stiffness).
         speed: The wheel speed [rad/s] the motors hold, also the initial independent wheel speeds (default: the
             section 3 peak ``PEAK_SPEED``).
+        feedback: Hold the speed with :func:`hold_speed_law` (data: the compiled engine can run it) instead of a
+            Python function (default ``False``).
         **options: Passed to :func:`robotdyn.simulation.engine.simulate` (rtol, method, ...).
 
     Returns:
@@ -91,7 +116,8 @@ def bump_run(robot: Robot, t_end: float = 1.5, rigid: Robot | None = None, speed
         nu0 = v0[robot.independent_indices]
     else:
         nu0 = nu_r
-    return simulate(robot, t_end, q0, nu0, _hold_speed(robot, speed), progress=False, **options)
+    torque = hold_speed_law(robot, speed) if feedback else _hold_speed(robot, speed)
+    return simulate(robot, t_end, q0, nu0, torque, progress=False, **options)
 
 
-__all__ = ["compliant_spec", "bump_run", "TYRE_STIFFNESS", "TYRE_MU"]
+__all__ = ["compliant_spec", "bump_run", "hold_speed_law", "TYRE_STIFFNESS", "TYRE_MU"]

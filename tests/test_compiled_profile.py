@@ -1,0 +1,39 @@
+"""Evaluator.profile (robotdyn/_compiled.cpp; make bench's 'where a compiled evaluation's time goes'): every part's
+time is a positive, finite number of seconds, Pinocchio's own CRBA + RNEA + frame Jacobians cost less than the whole
+evaluation that contains them, and profiling leaves the evaluator evaluated at the state it was given (the same
+numbers as compute there)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robotdyn
+from robotdyn.fast import dispatch
+from robotdyn.fast.dispatch import compiled_model
+
+PARTS = ("evaluation", "pinocchio", "crba", "rnea", "frames", "rows", "projection", "drift", "reduce", "rhs",
+         "pull_back")
+
+
+@pytest.mark.parametrize("name", ["quasimoro", "linkage_suspension"])
+def test_profile_times_and_state(name):
+    if not dispatch.enabled():
+        pytest.skip("the compiled fast path is off")
+    robot = robotdyn.load(name)
+    rng = np.random.default_rng(4)
+    q, nu = robot.neutral(), rng.normal(size=robot.mobility)
+    fast = compiled_model(robot)
+    ref = [np.array(x) for x in fast.compute(q, nu)]
+    other = robot.neutral()
+    fast.compute(other, 2.0 * nu)  # something else evaluated before the profile
+    t = fast.ev.profile(q, nu, 50, 1.0)
+    assert set(t) == set(PARTS)
+    assert all(np.isfinite(t[p]) and t[p] > 0.0 for p in PARTS if p != "pull_back")
+    assert np.isfinite(t["pull_back"]) and t["pull_back"] >= 0.0  # (nothing to do where the residuals are zero)
+    assert t["pinocchio"] < t["evaluation"]
+    ev = fast.ev
+    for got, want in zip((ev.M, ev.h, ev.g, ev.B, ev.S, ev.w, ev.v), ref):
+        np.testing.assert_array_equal(got, want)
+    with pytest.raises(ValueError, match="repeat"):
+        fast.ev.profile(q, nu, 0)

@@ -43,6 +43,7 @@
 #include "kernels/joint_springs.hpp"
 #include "_torque_profile.hpp"
 #include "_controller.hpp"
+#include "kernels/reduced_dynamics_derivatives.hpp"  // the derivatives (robotdyn/fast/compiled_derivatives.py)
 
 #include <pybind11/pybind11.h>
 #include <pybind11/eigen.h>
@@ -69,6 +70,8 @@ using namespace robotdyn::kernels;  // pin, the Eigen names, RowMat, Matrix6x an
 namespace {
 
 class Evaluator {
+  template <class> friend struct robotdyn::ReducedDerivatives;  // kernels/reduced_dynamics_derivatives.hpp
+
  public:
   Evaluator(const std::vector<std::string>& kinds, const std::vector<int>& parents,
             const std::vector<MatrixXd>& placements, const std::vector<Vector3d>& axes,
@@ -1201,6 +1204,7 @@ class Evaluator {
   std::vector<WheelGeometry> geo_;
   std::vector<Matrix6x> Jf_;
   std::vector<MatrixXd> Aw_;
+  robotdyn::derivs::Workspace deriv_;  // the derivatives' passes (kernels/reduced_dynamics_derivatives.hpp)
   const double* buffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   int run_ = -1;  // the run a batch thread is on (its rechoice callback gets it), -1 alone
   long generation_ = 0;
@@ -1311,6 +1315,18 @@ PYBIND11_MODULE(_compiled, m) {
         return py::make_tuple(e, r);
       })
       .def("evaluate_many", &Evaluator::evaluate_many)
+      .def("derivatives",
+           [](Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
+             robotdyn::derivs::Result r;
+             try {
+               r = robotdyn::ReducedDerivatives<Evaluator>::run(ev, q, nu, tau);
+             } catch (const std::domain_error& e) {
+               throw Fallback(e.what());
+             }
+             return py::make_tuple(r.nudot, r.dq, r.dnu, r.dtau, r.v, r.Vq, r.S, r.A);
+           },
+           "(nudot, dnudot/dq, dnudot/dnu, dnudot/dtau, v, dv/dq, S, A) at (q, nu, tau) "
+           "(robotdyn.fast.compiled_derivatives)")
       .def("profile", &Evaluator::profile, py::arg("q"), py::arg("nu"), py::arg("repeat"), py::arg("alpha") = 0.0,
            "seconds per call of each part of an evaluation, and of Pinocchio's CRBA + RNEA + frame Jacobians")
       .def_property_readonly("condition", &Evaluator::condition,

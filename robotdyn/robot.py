@@ -767,8 +767,9 @@ class Robot:
     def dynamics_derivatives(self, q, nu, tau):
         """:math:`\\dot\\nu` and its derivatives in q (natural coordinates, and along the holonomic manifold in
         independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
-        :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (Python path; see
-        :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`, and with slipping wheels
+        :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (compiled where the compiled model
+        serves, :mod:`robotdyn.fast.compiled_derivatives`, else the Python reference
+        :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`; with slipping wheels
         :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`).
 
         Args:
@@ -790,9 +791,15 @@ class Robot:
             from .contact.sliding_derivatives import sliding_derivatives
 
             return sliding_derivatives(self, q, nu, tau)
+        from .fast.compiled_derivatives import compiled_derivatives
         from .reduction.dynamics_derivatives import dynamics_derivatives
+        from .constraints.row_derivatives import kind
 
-        return dynamics_derivatives(self, q, nu, tau)
+        q, nu, tau = self.check_q(q), self.check_nu(nu), self.check_tau(tau)
+        for c in self.constraints:
+            kind(c)  # the Python path's one-line refusal of a constraint without derivatives, on either path
+        fast = compiled_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves
+        return fast if fast is not None else dynamics_derivatives(self, q, nu, tau)
 
     def contact_force_derivatives(self, q, nu, tau):
         """The wheel contact forces (normal load, tangential components in the contact frame) and each wheel's

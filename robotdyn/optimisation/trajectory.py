@@ -358,6 +358,13 @@ class TrajectoryProblem:
         n = self.n
         if self.derivatives == "analytic":
             self.calls["derivatives"] += 1
+            if self._fast is not None:  # the compiled derivative set in one call (as _f takes the compiled rhs)
+                from ..fast.compiled_derivatives import raw_derivatives
+
+                raw = raw_derivatives(self._fast, x[:n], x[n:], u)
+                if raw is not None:
+                    _, dq, dnu, dtau, _, Vq, S, _ = raw
+                    return np.block([[Vq, S], [dq, dnu]]), np.vstack([np.zeros((n, self.m)), dtau])
             d = self.robot.dynamics_derivatives(x[:n], x[n:], u)
             Fx = np.block([[d.dqdot_dq, d.S], [d.dq, d.dnu]])
             Fu = np.vstack([np.zeros((n, self.m)), d.dtau])

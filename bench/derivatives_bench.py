@@ -1,0 +1,103 @@
+"""The compiled derivatives of the reduced forward dynamics (robotdyn.fast.compiled_derivatives), per robot, in
+units of one compiled evaluation, and against central finite differences of the compiled model (issue 26:
+targets <= 5 evaluations, and >= 10x faster than finite differences on the six-wheel linkage rover).
+
+One compiled evaluation is one forward-dynamics right-hand side of the compiled model (``Evaluator.rhs``:
+configuration and state passes, the reduced solve): what a finite-difference Jacobian calls 2 (n + k + m) times.
+The derivative set is (nudot, d/dq, d/dnu, d/dtau, dqdot/dq, S) in one C++ call; the API line adds the Python
+wrapper (checks, the independent position coordinates). Run alone: ``python bench/derivatives_bench.py``.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from robotdyn.fast.compiled_derivatives import compiled_derivatives  # noqa: E402
+from robotdyn.fast.dispatch import compiled_model  # noqa: E402
+from robotdyn.reduction.dynamics_derivatives import dynamics_derivatives  # noqa: E402
+from robotdyn.robot import Robot  # noqa: E402
+from robotdyn.robots import module, names  # noqa: E402
+
+
+def _best(fn, number: int, repeat: int = 5) -> float:
+    """Median seconds per call over ``repeat`` batches of ``number`` calls (after one warm-up call)."""
+    fn()
+    runs = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        for _ in range(number):
+            fn()
+        runs.append((time.perf_counter() - t) / number)
+    return statistics.median(runs)
+
+
+def _state(robot, name: str, rng):
+    from test_dynamics_derivatives import START, admissible_state
+
+    return admissible_state(robot, START.get(name), rng)
+
+
+def central_differences(ev, q, nu, tau, T) -> np.ndarray:
+    """The Jacobian of (qdot, nudot) in (q_P, nu, tau) by central differences of the compiled right-hand side, q
+    moved along the holonomic manifold's tangent T (n, p) (off it the redundant closure rows stop spanning)."""
+    n, k, p = len(q), len(nu), T.shape[1]
+    y = np.concatenate([np.zeros(p), nu, tau])
+    cols = []
+    for i in range(y.size):
+        h = np.cbrt(np.finfo(float).eps) * (1.0 + abs(y[i]))
+        yp, ym = y.copy(), y.copy()
+        yp[i] += h
+        ym[i] -= h
+        cols.append((ev.rhs(q + T @ yp[:p], yp[p:p + k], yp[p + k:], 0.0)
+                     - ev.rhs(q + T @ ym[:p], ym[p:p + k], ym[p + k:], 0.0)) / (2 * h))
+    return np.column_stack(cols)
+
+
+def derivatives_bench() -> None:
+    print("\ncompiled derivatives of the reduced dynamics (nudot, d/dq, d/dnu, d/dtau, dqdot/dq, S) per state [us]; "
+          "'evals' = time / one compiled evaluation (rhs)")
+    print(f"{'robot':<20} {'n':>3} {'k':>3} {'eval':>7} {'derivs C++':>11} {'evals':>6} {'API':>8} {'evals':>6} "
+          f"{'Python path':>12} {'/ C++':>7}")
+    rng = np.random.default_rng(0)
+    for name in names():
+        robot = Robot(module(name).SPEC)
+        q, nu, tau = _state(robot, name, rng)
+        fast = compiled_model(robot)
+        if compiled_derivatives(robot, q, nu, tau) is None:
+            print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3}   Python path (operational-space velocities or "
+                  "slipping wheels are not compiled)")
+            continue
+        ev = fast.ev
+        t_ev = _best(lambda: ev.rhs(q, nu, tau, 0.0), 500)
+        t_c = _best(lambda: ev.derivatives(q, nu, tau), 100)
+        t_api = _best(lambda: robot.dynamics_derivatives(q, nu, tau), 50)
+        t_py = _best(lambda: dynamics_derivatives(robot, q, nu, tau), 3, 3)
+        print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3} {t_ev * 1e6:>7.1f} {t_c * 1e6:>11.1f} {t_c / t_ev:>6.1f} "
+              f"{t_api * 1e6:>8.1f} {t_api / t_ev:>6.1f} {t_py * 1e6:>12.0f} {t_py / t_c:>6.0f}x")
+        if name == "linkage_suspension":
+            linkage = (robot, ev, q, nu, tau, t_ev, t_c, t_api)
+    robot, ev, q, nu, tau, t_ev, t_c, t_api = linkage
+    d = robot.dynamics_derivatives(q, nu, tau)
+    T = d.tangent
+    t_fd = _best(lambda: central_differences(ev, q, nu, tau, T), 3, 3)
+    J = central_differences(ev, q, nu, tau, T)
+    n, p = robot.nq, T.shape[1]
+    exact = np.hstack([d.dq_manifold, d.dnu, d.dtau])
+    err = np.abs(J[n:] - exact).max() / max(1.0, np.abs(exact).max())
+    m = len(robot.motors)
+    print(f"linkage rover (n = {n}: {p} independent positions, k = {robot.mobility}, {m} motors): central "
+          f"differences of the compiled model along the manifold, {2 * (p + robot.mobility + m)} evaluations "
+          f"{t_fd * 1e3:.2f} ms; compiled derivatives {t_c * 1e3:.3f} ms "
+          f"({t_fd / t_c:.0f}x faster; API {t_fd / t_api:.0f}x), their largest difference {err:.1e} (relative; the "
+          "differences' own error)")
+
+
+if __name__ == "__main__":
+    derivatives_bench()

@@ -1,0 +1,112 @@
+"""Derivatives of the reduced forward dynamics on the compiled path: the fast twin of
+:func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`.
+
+The C++ kernels (``robotdyn/kernels/*_derivatives.hpp``: one per constraint kind, and
+``reduced_dynamics_derivatives.hpp`` for the projection's chain rule and the reduced solve) evaluate the same
+formulas as the Python reference, in the same order, on Pinocchio's own C++ derivative algorithms
+(``computeForwardKinematicsDerivatives``, ``getFrameVelocityDerivatives``, ``getFrameAccelerationDerivatives``,
+``getFrameJacobianTimeVariation``, ``computeRNEADerivatives``) and on the compiled model's configuration pass
+(:class:`~robotdyn.fast.compiled.CompiledModel`): one call gives :math:`\\dot\\nu`, :math:`\\partial\\dot\\nu/\\partial q`
+(natural coordinates), :math:`\\partial\\dot\\nu/\\partial\\nu`, :math:`\\partial\\dot\\nu/\\partial\\tau`,
+:math:`\\dot q = S\\nu`, :math:`\\partial(S\\nu)/\\partial q`, S and the constraint rows A (from which the independent
+position coordinates and the tangent of the holonomic manifold are chosen here, as the Python path does).
+
+It serves what the compiled model serves (:func:`robotdyn.fast.compiled.why_not`) with independent velocities that
+are a selection of v: rolling wheels on the compiled terrains (whose third derivatives are closed forms, so every
+piece is analytic), loop closures and cosine-law joint couplings. Operational-space velocities and slipping wheels
+are left to the Python path (:func:`compiled_derivatives` returns ``None``), as is any state where the compiled
+evaluation falls back (a projection that must be re-chosen, a wheel lying flat). ``tests/test_compiled_derivatives.py``
+checks every output against the Python path on every built-in robot.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import NonFiniteError
+from ..reduction.dynamics_derivatives import DynamicsDerivatives, position_coordinates
+from .compiled import Fallback
+from .dispatch import compiled_model
+
+
+class _CompiledDerivatives(DynamicsDerivatives):
+    """A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` whose manifold coordinates
+    (``positions``, ``tangent``, ``dq_manifold``: a pivoted QR of the holonomic rows) are chosen on first access, as
+    the Python path chooses them: a trajectory optimiser or a linearisation in natural coordinates never pays for
+    them."""
+
+    def __getattr__(self, name: str):
+        if name in ("positions", "tangent", "dq_manifold") and "_manifold" in self.__dict__:
+            A_h, prefer = self.__dict__.pop("_manifold")
+            positions, T = position_coordinates(A_h, prefer)
+            self.__dict__.update(positions=positions, tangent=T, dq_manifold=self.dq @ T)
+            return self.__dict__[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+
+def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives | None:
+    """:math:`\\dot\\nu` and its derivatives at one state by the robot's compiled model, or ``None`` where the
+    Python path must answer (no compiled model, operational-space velocities, slipping wheels, a compiled fallback).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], already checked (``robot.check_q``).
+        nu: Independent velocities (k,) [m/s, rad/s] in the order of ``robot.velocity_names``, already checked.
+        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``, already checked.
+
+    Returns:
+        The :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (the same contents as the Python
+        path's, ``numerical`` empty), or ``None``.
+
+    Raises:
+        NonFiniteError: A non-finite result (as the Python path).
+    """
+    fast = compiled_model(robot)
+    if fast is None or fast.operational is not None or getattr(fast.ev, "slipping", 0) \
+            or not hasattr(fast.ev, "derivatives"):  # (an extension built before the derivatives)
+        return None
+    if not fast.ready:
+        fast._choose(q, nu)
+    try:
+        nudot, dq, dnu, dtau, v, Vq, S, A = fast.ev.derivatives(q, nu, tau)
+    except Fallback:
+        return None
+    out = _CompiledDerivatives.__new__(_CompiledDerivatives)
+    out.__dict__.update(nudot=nudot, dq=dq, dnu=dnu, dtau=dtau, qdot=v, dqdot_dq=Vq, S=S, numerical=(),
+                        coordinates=list(robot.coordinates), velocities=list(robot.velocity_names),
+                        motors=[m.name for m in robot.motors],
+                        _manifold=(A[np.asarray(fast.holonomic, bool)], fast._hint.dependent))
+    for name in ("nudot", "dq", "dnu", "dtau", "dqdot_dq"):
+        if not np.all(np.isfinite(getattr(out, name))):
+            raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
+                                 f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g})")
+    return out
+
+
+def raw_derivatives(fast, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tuple | None:
+    """The compiled derivative set at one state without the API's checks and wrapping, for a caller that evaluates
+    many states of one robot (a trajectory optimiser's Jacobian): ``(nudot, dq, dnu, dtau, qdot, dqdot_dq, S, A)``
+    as in :func:`compiled_derivatives`, or ``None`` where the Python path must answer (including a non-finite
+    result, whose error that path raises).
+
+    Args:
+        fast: The robot's :class:`~robotdyn.fast.compiled.CompiledModel` (:func:`robotdyn.fast.dispatch.compiled_model`),
+            its projection chosen (``fast.ready``).
+        q: Natural coordinates (n,) [m, rad], valid (unchecked here).
+        nu: Independent velocities (k,) [m/s, rad/s], valid.
+        tau: Motor torques/forces (n_motors,) [N m or N], valid.
+
+    Returns:
+        The tuple of arrays, or ``None``.
+    """
+    if fast.operational is not None or getattr(fast.ev, "slipping", 0) or not hasattr(fast.ev, "derivatives") \
+            or not fast.ready:
+        return None
+    try:
+        out = fast.ev.derivatives(q, nu, tau)
+    except Fallback:
+        return None
+    return out if all(np.all(np.isfinite(x)) for x in out[:6]) else None
+
+
+__all__ = ["compiled_derivatives", "raw_derivatives"]

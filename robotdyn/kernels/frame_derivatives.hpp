@@ -1,0 +1,161 @@
+// robotdyn/kernels/frame_derivatives.hpp: frame velocities and accelerations with their configuration derivatives
+// at one state (q, x), twin of robotdyn/constraints/row_derivatives.py (FramePass, _rot_dq, _cross_d).
+//
+// One computeForwardKinematicsDerivatives per pass, on a Pinocchio data of its own (first order where no
+// acceleration is needed); per joint, Pinocchio's getJointVelocityDerivatives / getJointAccelerationDerivatives in
+// WORLD, carried to each frame's origin (FramePass below). The Python twin rotates the LOCAL frame derivatives to
+// world axes instead; both are the derivatives of the LOCAL_WORLD_ALIGNED J(q) x at fixed x and of its classical
+// acceleration, which is what the constraint rows need. Placements and world Jacobians come from the evaluator's
+// configuration pass (its data and frame Jacobians at q).
+#pragma once
+
+#include <pinocchio/multibody.hpp>
+#include <pinocchio/algorithm/kinematics-derivatives.hpp>
+#include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/frames-derivatives.hpp>
+
+#include <stdexcept>
+#include <vector>
+
+namespace robotdyn {
+namespace derivs {
+
+namespace pin = pinocchio;
+using Eigen::Matrix3d;
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+using Matrix6x = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+// 3 x n blocks of the derivative formulas, on the stack (no allocation per temporary) up to kMaxNv coordinates;
+// a larger model takes the Python path (ReducedDerivatives::run refuses it)
+constexpr int kMaxNv = 128;
+using Matrix3x = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxNv>;
+using RowX = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxNv>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+inline Matrix3d skew3(const Vector3d& x) {
+  Matrix3d m;
+  m << 0.0, -x[2], x[1], x[2], 0.0, -x[0], -x[1], x[0], 0.0;
+  return m;
+}
+
+// d(R(q) y)/dq at fixed y for a frame rotation R with world angular Jacobian Jw: -[R y]x Jw (_rot_dq)
+inline Matrix3x rot_dq(const Vector3d& Ry, const Matrix3x& Jw) { return -skew3(Ry) * Jw; }
+
+// derivative of x cross y from those of x and y (3 x n each) (_cross_d)
+inline Matrix3x cross_d(const Vector3d& x, const Matrix3x& dx, const Vector3d& y, const Matrix3x& dy) {
+  return -skew3(y) * dx + skew3(x) * dy;
+}
+
+// One pass (FramePass): the kinematics derivatives at (q, x) (with accelerations: at (q, x, 0)) and, per frame,
+// cached world-axes results. Pinocchio's joint derivatives are taken in WORLD (the spatial velocity and
+// acceleration at the world origin, whose q-derivatives at fixed x are exact there) and carried to the frame
+// origin p: v_p = v_O + w x p, a_p = a_O + alpha x p + w x v_p (classical acceleration), differentiated with
+// dp/dq = J_p (the frame's LOCAL_WORLD_ALIGNED Jacobian's linear rows). The Python twin rotates the LOCAL
+// derivatives instead; both give the derivative of the LOCAL_WORLD_ALIGNED J(q) x at fixed x (and of its
+// classical acceleration), and the tests hold them equal to 1e-10.
+struct FramePass {
+  pin::Data data;
+  VectorXd x;
+  bool accelerations = false;
+  std::vector<char> has_vel, has_acc, has_jv, has_ja;
+  std::vector<Vector6d> V, Acc;
+  std::vector<Matrix6x> dV, dAcc, jdV, jdA;
+  Matrix6x t1_, t2_, t3_, t4_;  // work
+
+  void run(const pin::Model& model, const VectorXd& q, const VectorXd& x_, bool with_accelerations) {
+    if (data.oMi.size() != static_cast<size_t>(model.njoints) || data.oMf.size() != model.frames.size())
+      data = pin::Data(model);
+    x = x_;
+    accelerations = with_accelerations;
+    if (accelerations)
+      pin::computeForwardKinematicsDerivatives(model, data, q, x, VectorXd::Zero(model.nv));
+    else
+      pin::computeForwardKinematicsDerivatives(model, data, q, x);  // velocities only (first order)
+    const size_t nf = model.frames.size(), nj = static_cast<size_t>(model.njoints);
+    has_vel.assign(nf, 0);
+    has_acc.assign(nf, 0);
+    has_jv.assign(nj, 0);
+    has_ja.assign(nj, 0);
+    if (V.size() != nf) {
+      V.resize(nf);
+      Acc.resize(nf);
+      dV.resize(nf);
+      dAcc.resize(nf);
+    }
+    if (jdV.size() != nj) {
+      jdV.resize(nj);
+      jdA.resize(nj);
+    }
+  }
+
+  // d(ov)/dq of a joint at fixed x, WORLD (6 x n)
+  const Matrix6x& joint_velocity_dq(const pin::Model& model, pin::JointIndex jid) {
+    if (!has_jv[jid]) {
+      jdV[jid].setZero(6, model.nv);
+      t2_.setZero(6, model.nv);
+      pin::getJointVelocityDerivatives(model, data, jid, pin::WORLD, jdV[jid], t2_);
+      has_jv[jid] = 1;
+    }
+    return jdV[jid];
+  }
+
+  // world-axes (LOCAL_WORLD_ALIGNED) frame velocity V = J x and dV/dq at fixed x (FramePass.velocity);
+  // oMf: the frame's placement at q, J: its LOCAL_WORLD_ALIGNED Jacobian at q (6 x n)
+  void velocity(const pin::Model& model, pin::FrameIndex fid, const pin::SE3& oMf, const Matrix6x& J) {
+    if (has_vel[fid]) return;
+    const pin::JointIndex jid = model.frames[fid].parentJoint;
+    const Matrix6x& jd = joint_velocity_dq(model, jid);
+    const pin::Motion& ov = data.ov[jid];
+    const Vector3d p = oMf.translation(), w = ov.angular();
+    const Vector3d vp = ov.linear() + w.cross(p);
+    V[fid] << vp, w;
+    dV[fid].resize(6, model.nv);
+    dV[fid].topRows<3>() = jd.topRows<3>() - skew3(p) * jd.bottomRows<3>() + skew3(w) * J.topRows<3>();
+    dV[fid].bottomRows<3>() = jd.bottomRows<3>();
+    has_vel[fid] = 1;
+  }
+
+  // world-axes classical acceleration at vdot = 0 and its q-derivative at fixed x (FramePass.acceleration)
+  void acceleration(const pin::Model& model, pin::FrameIndex fid, const pin::SE3& oMf, const Matrix6x& J) {
+    if (has_acc[fid]) return;
+    if (!accelerations) throw std::logic_error("frame pass without accelerations");
+    velocity(model, fid, oMf, J);
+    const pin::JointIndex jid = model.frames[fid].parentJoint;
+    if (!has_ja[jid]) {
+      const int n = model.nv;
+      t1_.setZero(6, n);
+      jdA[jid].setZero(6, n);
+      t3_.setZero(6, n);
+      t4_.setZero(6, n);
+      pin::getJointAccelerationDerivatives(model, data, jid, pin::WORLD, t1_, jdA[jid], t3_, t4_);
+      has_ja[jid] = 1;
+    }
+    const Matrix6x& ja = jdA[jid];
+    const pin::Motion& oa = data.oa[jid];
+    const Vector3d p = oMf.translation(), w = data.ov[jid].angular(), al = oa.angular();
+    const Vector3d vp = V[fid].head<3>();
+    Acc[fid] << oa.linear() + al.cross(p) + w.cross(vp), al;
+    dAcc[fid].resize(6, model.nv);
+    dAcc[fid].topRows<3>() = ja.topRows<3>() - skew3(p) * ja.bottomRows<3>() + skew3(al) * J.topRows<3>() +
+                             skew3(w) * dV[fid].topRows<3>() - skew3(vp) * dV[fid].bottomRows<3>();
+    dAcc[fid].bottomRows<3>() = ja.bottomRows<3>();
+    has_acc[fid] = 1;
+  }
+
+  // the frame Jacobian's time variation along x in LOCAL_WORLD_ALIGNED (KinematicState.frame's dJ): the forward
+  // kinematics derivatives leave data.dJ as computeJointJacobiansTimeVariation does
+  void jacobian_dot(const pin::Model& model, pin::FrameIndex fid, Matrix6x& dJ) {
+    dJ.setZero(6, model.nv);
+    pin::getFrameJacobianTimeVariation(model, data, fid, pin::LOCAL_WORLD_ALIGNED, dJ);
+  }
+
+  // world angular velocity of a joint's body and its q-derivative at fixed x (the motors' reaction terms)
+  void joint_angular(const pin::Model& model, pin::JointIndex jid, Vector3d& w, Matrix3x& dw) {
+    w = data.ov[jid].angular();
+    dw = joint_velocity_dq(model, jid).bottomRows<3>();
+  }
+};
+
+}  // namespace derivs
+}  // namespace robotdyn

@@ -1,0 +1,90 @@
+// robotdyn/kernels/loop_closure_derivatives.hpp: configuration derivatives of a loop closure's rows, twin of
+// robotdyn/constraints/row_derivatives.py (closure_velocity_dq, closure_drift_dq) beside the closure's values in
+// loop_closure.hpp (robotdyn/constraints/loop_closure.py, whose LoopClosure.rows gives Adot): d(A x)/dq at fixed x,
+// the drift's dgamma/dq at fixed v, and Adot.
+#pragma once
+
+#include <vector>
+
+#include "frame_derivatives.hpp"
+
+namespace robotdyn {
+namespace derivs {
+
+// The closure's two frames at q: placements (R1, p1, p2) and world Jacobians J1, J2 (6 x n).
+struct ClosureFrames {
+  Matrix3d R1;
+  Vector3d p1, p2;
+  const Matrix6x* J1;
+  const Matrix6x* J2;
+};
+
+// copy the selected components (0..5: x y z rx ry rz in frame 1's axes) of a 6 x n block into out
+template <class Out>
+void select_rows(const Matrix6x& full, const std::vector<int>& select, Out&& out) {
+  for (size_t r = 0; r < select.size(); ++r) out.row(static_cast<Eigen::Index>(r)) = full.row(select[r]);
+}
+
+// closure_velocity_dq: V1/dV1, V2/dV2 the frames' world velocities at x and their q-derivatives
+template <class Out>
+void closure_velocity_dq(const ClosureFrames& f, const std::vector<int>& select, const Vector6d& V1,
+                         const Matrix6x& dV1, const Vector6d& V2, const Matrix6x& dV2, Out&& out) {
+  const Matrix6x &J1 = *f.J1, &J2 = *f.J2;
+  const Matrix3d R1T = f.R1.transpose();
+  const Vector3d d = f.p2 - f.p1;
+  const Matrix3x dd = J2.topRows<3>() - J1.topRows<3>();
+  const Vector3d yt = V2.head<3>() - V1.head<3>() + d.cross(V1.tail<3>());
+  const Vector3d yr = V2.tail<3>() - V1.tail<3>();
+  const Matrix3x dyt = dV2.topRows<3>() - dV1.topRows<3>() + cross_d(d, dd, V1.tail<3>(), dV1.bottomRows<3>());
+  const Matrix3x dyr = dV2.bottomRows<3>() - dV1.bottomRows<3>();
+  Matrix6x full(6, J1.cols());
+  full.topRows<3>() = R1T * (skew3(yt) * J1.bottomRows<3>() + dyt);
+  full.bottomRows<3>() = R1T * (skew3(yr) * J1.bottomRows<3>() + dyr);
+  select_rows(full, select, out);
+}
+
+// closure_drift_dq into drift_out, and Adot (LoopClosure.rows) into adot_out; A1/dA1, A2/dA2 the frames' world
+// classical accelerations at v with q-derivatives, dJ1, dJ2 their Jacobians' time variations along v
+template <class Out1, class Out2>
+void closure_drift_dq(const ClosureFrames& f, const std::vector<int>& select, const Vector6d& V1,
+                      const Matrix6x& dV1, const Vector6d& V2, const Matrix6x& dV2, const Vector6d& A1,
+                      const Matrix6x& dA1, const Vector6d& A2, const Matrix6x& dA2, const Matrix6x& dJ1,
+                      const Matrix6x& dJ2, Out1&& drift_out, Out2&& adot_out) {
+  const Matrix6x &J1 = *f.J1, &J2 = *f.J2;
+  const Matrix3d R1T = f.R1.transpose();
+  const Vector3d d = f.p2 - f.p1;
+  const Matrix3x dd = J2.topRows<3>() - J1.topRows<3>();
+  const Vector3d w1 = V1.tail<3>();
+  const Matrix3x dw1 = dV1.bottomRows<3>();
+  const Vector3d ddot = V2.head<3>() - V1.head<3>();
+  const Matrix3x dddot = dV2.topRows<3>() - dV1.topRows<3>();
+  const Vector3d kt = ddot + d.cross(w1);
+  const Matrix3x dkt_q = dddot + cross_d(d, dd, w1, dw1);
+  const Vector3d jt = A2.head<3>() - A1.head<3>() + ddot.cross(w1) + d.cross(A1.tail<3>());
+  const Matrix3x djt = dA2.topRows<3>() - dA1.topRows<3>() + cross_d(ddot, dddot, w1, dw1) +
+                       cross_d(d, dd, A1.tail<3>(), dA1.bottomRows<3>());
+  const Vector3d kr = V2.tail<3>() - V1.tail<3>();
+  const Matrix3x dkr = dV2.bottomRows<3>() - dV1.bottomRows<3>();
+  const Vector3d jr = A2.tail<3>() - A1.tail<3>();
+  const Matrix3x djr = dA2.bottomRows<3>() - dA1.bottomRows<3>();
+  const Vector3d yt = jt - w1.cross(kt), yr = jr - w1.cross(kr);
+  const Matrix3x dyt = djt - cross_d(w1, dw1, kt, dkt_q);
+  const Matrix3x dyr = djr - cross_d(w1, dw1, kr, dkr);
+  Matrix6x full(6, J1.cols());
+  full.topRows<3>() = R1T * (skew3(yt) * J1.bottomRows<3>() + dyt);
+  full.bottomRows<3>() = R1T * (skew3(yr) * J1.bottomRows<3>() + dyr);
+  select_rows(full, select, drift_out);
+  // Adot: R1^T (dK - [w1]x K) with K = [J2_c - J1_c + [d]x J1_w; J2_w - J1_w]
+  const Matrix3d W = skew3(w1);
+  const Matrix3x Kt = dd + skew3(d) * J1.bottomRows<3>();
+  const Matrix3x dKt = dJ2.topRows<3>() - dJ1.topRows<3>() + skew3(ddot) * J1.bottomRows<3>() +
+                       skew3(d) * dJ1.bottomRows<3>();
+  const Matrix3x Kr = J2.bottomRows<3>() - J1.bottomRows<3>();
+  const Matrix3x dKr = dJ2.bottomRows<3>() - dJ1.bottomRows<3>();
+  full.topRows<3>() = R1T * (dKt - W * Kt);
+  full.bottomRows<3>() = R1T * (dKr - W * Kr);
+  select_rows(full, select, adot_out);
+}
+
+}  // namespace derivs
+}  // namespace robotdyn

@@ -1,0 +1,290 @@
+// robotdyn/kernels/reduced_dynamics_derivatives.hpp: derivatives of the reduced forward dynamics nudot(q, nu, tau),
+// twin of robotdyn/reduction/dynamics_derivatives.py (pieces, Pieces.Aq, motor_rows, dynamics_derivatives), the same
+// formulas in the same order: the projection's chain rule (dS = -K^-1 dK S, dw = -K^-1 (dK w + d gamma)), the
+// multiplier mu = K^-T rho, Pinocchio's computeRNEADerivatives for the tree, the motors' reaction terms and the
+// reduced solve; the per-constraint pieces are the <kind>_derivatives.hpp beside this file.
+//
+// Served here: independent velocities that are a selection of v (operational-space velocities and slipping wheels
+// throw, and the Python side takes its reference path). The evaluator hands over its state after configure(q)
+// and dynamics(nu) (S, v, w, A, M, B, M_r, h_r, B_r, the LU factors of A_d) through the friend ReducedDerivatives.
+#pragma once
+
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
+
+#include <stdexcept>
+#include <vector>
+
+#include "frame_derivatives.hpp"
+#include "joint_coupling_derivatives.hpp"
+#include "loop_closure_derivatives.hpp"
+#include "rolling_contact_derivatives.hpp"
+
+namespace robotdyn {
+namespace derivs {
+
+// Work buffers kept by the evaluator between calls (Pinocchio data of the passes and of the tree derivatives).
+struct Workspace {
+  std::vector<FramePass> passes;  // columns of S, then w, then v
+  pinocchio::Data tree;
+  bool has_tree = false;
+  std::vector<MatrixXd> dA;  // d(A x)/dq per pass (m x n)
+  std::vector<WheelGeometryDq> geo;
+  MatrixXd dgam_q, Adot;
+  Matrix6x dJ1, dJ2;
+};
+
+// The outputs (DynamicsDerivatives' analytic contents, SI units).
+struct Result {
+  VectorXd nudot;  // (k)
+  MatrixXd dq;     // (k, n) natural coordinates
+  MatrixXd dnu;    // (k, k)
+  MatrixXd dtau;   // (k, motors)
+  VectorXd v;      // qdot = S nu (n)
+  MatrixXd Vq;     // d(S nu)/dq (n, n)
+  MatrixXd S;      // (n, k)
+  MatrixXd A;      // all constraint rows at q (m, n)
+};
+
+}  // namespace derivs
+
+template <class Ev>
+struct ReducedDerivatives {
+  using Model = pinocchio::Model;
+  using MatrixXd = Eigen::MatrixXd;
+  using VectorXd = Eigen::VectorXd;
+  using Matrix3d = Eigen::Matrix3d;
+
+  // d(A x)/dq of every row at the pass's x (velocity_dq), stacked in constraint order
+  static void velocity_dq(Ev& ev, derivs::FramePass& fp, MatrixXd& out) {
+    const Model& model = ev.model_;
+    out.setZero(ev.nrows(), ev.nv_);
+    for (const auto& [kind, i] : ev.order_) {
+      if (kind == 0) {
+        const auto& wh = ev.wheels_[i];
+        const auto& g = ev.geo_[i];
+        const int fid = ev.frames_[wh.frame];
+        const auto& J = ev.Jf_[wh.frame];
+        fp.velocity(model, fid, ev.data_.oMf[fid], J);
+        const double xR = wh.radius_index >= 0 ? fp.x[wh.radius_index] : 0.0;
+        const int nd = static_cast<int>(wh.D.rows());
+        derivs::wheel_velocity_dq(g, ev.deriv_.geo[i], MatrixXd(wh.D), fp.V[fid], fp.dV[fid], xR,
+                                  out.middleRows(g.row, nd));
+      } else if (kind == 1) {
+        const auto& c = ev.closures_[i];
+        const int row = closure_row(ev, i);
+        const auto fr = frames_of(ev, c);
+        derivs::closure_velocity_dq(fr, c.select, fp.V[ev.frames_[c.f1]], fp.dV[ev.frames_[c.f1]],
+                                    fp.V[ev.frames_[c.f2]], fp.dV[ev.frames_[c.f2]],
+                                    out.middleRows(row, static_cast<int>(c.select.size())));
+      } else {
+        const auto& c = ev.couplings_[i];
+        const derivs::CosineCoupling cc{c.i, c.j, c.amplitude, c.rate, c.phase};
+        derivs::coupling_velocity_dq(cc, ev.q_[c.j], fp.x[c.j], out.middleRows(coupling_row(ev, i), 1));
+      }
+    }
+  }
+
+  // first row of closure i / coupling i (rows follow order_; wheels record theirs in their geometry)
+  static int closure_row(const Ev& ev, size_t which) { return row_of(ev, 1, which); }
+  static int coupling_row(const Ev& ev, size_t which) { return row_of(ev, 2, which); }
+  static int row_of(const Ev& ev, int kind_, size_t which) {
+    int row = 0;
+    for (const auto& [kind, i] : ev.order_) {
+      if (kind == kind_ && static_cast<size_t>(i) == which) return row;
+      row += kind == 0 ? static_cast<int>(ev.wheels_[i].D.rows())
+                       : kind == 1 ? static_cast<int>(ev.closures_[i].select.size()) : 1;
+    }
+    return row;
+  }
+
+  template <class C>
+  static derivs::ClosureFrames frames_of(Ev& ev, const C& c) {
+    const int f1 = ev.frames_[c.f1], f2 = ev.frames_[c.f2];
+    derivs::ClosureFrames fr;
+    fr.R1 = ev.data_.oMf[f1].rotation();
+    fr.p1 = ev.data_.oMf[f1].translation();
+    fr.p2 = ev.data_.oMf[f2].translation();
+    fr.J1 = &ev.Jf_[c.f1];
+    fr.J2 = &ev.Jf_[c.f2];
+    return fr;
+  }
+
+  // the frames' velocities in a pass (the closures' velocity_dq reads them from the cache)
+  static void prepare(Ev& ev, derivs::FramePass& fp, bool accelerations) {
+    const Model& model = ev.model_;
+    for (const auto& c : ev.closures_)
+      for (int f : {c.f1, c.f2}) {
+        const int fid = ev.frames_[f];
+        fp.velocity(model, fid, ev.data_.oMf[fid], ev.Jf_[f]);
+        if (accelerations) fp.acceleration(model, fid, ev.data_.oMf[fid], ev.Jf_[f]);
+      }
+  }
+
+  // drift_dq and Adot of every row on the pass at v
+  static void drift_dq(Ev& ev, derivs::FramePass& fp, MatrixXd& dgam, MatrixXd& Adot) {
+    const Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    dgam.setZero(ev.nrows(), ev.nv_);
+    Adot.setZero(ev.nrows(), ev.nv_);
+    for (const auto& [kind, i] : ev.order_) {
+      if (kind == 0) {
+        const auto& wh = ev.wheels_[i];
+        const auto& g = ev.geo_[i];
+        const int fid = ev.frames_[wh.frame];
+        const auto& J = ev.Jf_[wh.frame];
+        fp.acceleration(model, fid, ev.data_.oMf[fid], J);
+        fp.jacobian_dot(model, fid, ws.dJ1);
+        const int nd = static_cast<int>(wh.D.rows());
+        derivs::wheel_drift_dq(g, ws.geo[i], MatrixXd(wh.D), ev.terrain_, ev.terrain_.flat(), J, wh.radius_index, fp.x,
+                               fp.V[fid], fp.dV[fid], fp.Acc[fid], fp.dAcc[fid], ws.dJ1, ev.Aw_[i],
+                               dgam.middleRows(g.row, nd), Adot.middleRows(g.row, nd));
+      } else if (kind == 1) {
+        const auto& c = ev.closures_[i];
+        const int row = closure_row(ev, i), nr = static_cast<int>(c.select.size());
+        const int f1 = ev.frames_[c.f1], f2 = ev.frames_[c.f2];
+        fp.jacobian_dot(model, f1, ws.dJ1);
+        fp.jacobian_dot(model, f2, ws.dJ2);
+        derivs::closure_drift_dq(frames_of(ev, c), c.select, fp.V[f1], fp.dV[f1], fp.V[f2], fp.dV[f2], fp.Acc[f1],
+                                 fp.dAcc[f1], fp.Acc[f2], fp.dAcc[f2], ws.dJ1, ws.dJ2, dgam.middleRows(row, nr),
+                                 Adot.middleRows(row, nr));
+      } else {
+        const auto& c = ev.couplings_[i];
+        const derivs::CosineCoupling cc{c.i, c.j, c.amplitude, c.rate, c.phase};
+        const int row = coupling_row(ev, i);
+        derivs::coupling_drift_dq(cc, ev.q_[c.j], fp.x[c.j], dgam.middleRows(row, 1), Adot.middleRows(row, 1));
+      }
+    }
+  }
+
+  // -K^-1 [X_rows] for the selection projection (Projection.solve_neg): zero except the dependent rows
+  static MatrixXd solve_neg(Ev& ev, const MatrixXd& X) {
+    const int nd = static_cast<int>(ev.dependent_.size());
+    MatrixXd out = MatrixXd::Zero(ev.nv_, X.cols());
+    if (nd == 0) return out;
+    MatrixXd Xr(nd, X.cols());
+    for (int r = 0; r < nd; ++r) Xr.row(r) = X.row(ev.rows_[r]);
+    const MatrixXd Y = ev.lu_.solve(Xr);
+    for (int r = 0; r < nd; ++r) out.row(ev.dependent_[r]) = -Y.row(r);
+    return out;
+  }
+
+  static derivs::Result run(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+                            const Eigen::Ref<const VectorXd>& tau) {
+    if (ev.operational_) throw std::domain_error("operational-space velocities: derivatives on the Python path");
+    if (!ev.slips_.empty()) throw std::domain_error("slipping wheels: derivatives on the Python path");
+    if (ev.nv_ > derivs::kMaxNv) throw std::domain_error("more coordinates than the derivative kernels' blocks hold");
+    ev.configure(q);
+    ev.dynamics(nu);
+    if (tau.size() != ev.Br_.cols()) throw std::invalid_argument("tau has the wrong length");
+    const Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    const int n = ev.nv_;
+    const int k = static_cast<int>(ev.S_.cols());
+    const MatrixXd& S = ev.S_;
+    const VectorXd& v = ev.v_;
+    const VectorXd& w = ev.w_;
+    const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
+    derivs::Result out;
+    Eigen::LLT<MatrixXd> llt(ev.Mr_);
+    if (llt.info() != Eigen::Success) throw std::domain_error("reduced mass matrix not positive definite");
+    out.nudot = llt.solve(ev.Br_ * tau - ev.hr_);
+    const VectorXd a = S * out.nudot + w;
+    // the contact geometry's derivatives (configuration level)
+    ws.geo.resize(ev.wheels_.size());
+    for (size_t i = 0; i < ev.wheels_.size(); ++i)
+      derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
+                                ev.terrain_.flat(), ws.geo[i]);
+    // the frame passes at the columns of S, at w and at v, and the rows' derivatives there
+    ws.passes.resize(k + 2);
+    ws.dA.resize(k + 2);
+    for (int l = 0; l < k + 2; ++l) {
+      derivs::FramePass& fp = ws.passes[l];
+      fp.run(model, ev.q_, l < k ? VectorXd(S.col(l)) : l == k ? w : v, l == k + 1);
+      prepare(ev, fp, l == k + 1);
+      velocity_dq(ev, fp, ws.dA[l]);
+    }
+    const MatrixXd& dA_w = ws.dA[k];
+    const MatrixXd& dA_v = ws.dA[k + 1];
+    drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);
+    const int m = ev.nrows();
+    const MatrixXd dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
+    out.Vq = solve_neg(ev, dA_v);            // v = S(q) nu: dv/dq = -K^-1 d(K v)/dq
+    const MatrixXd dgA = ws.dgam_q + dgam_v * out.Vq;
+    const MatrixXd Wnu = solve_neg(ev, dgam_v * S);
+    // the tree: RNEA(q, v, a) and its derivatives, with gravity
+    if (!ws.has_tree) {
+      ws.tree = pinocchio::Data(model);
+      ws.has_tree = true;
+    }
+    MatrixXd dtau_dq = MatrixXd::Zero(n, n), dtau_dv = MatrixXd::Zero(n, n), dtau_da = MatrixXd::Zero(n, n);
+    ev.model_.gravity = ev.gravity_;
+    try {
+      pinocchio::computeRNEADerivatives(model, ws.tree, ev.q_, v, a, dtau_dq, dtau_dv, dtau_da);
+    } catch (...) {
+      ev.model_.gravity.setZero();
+      throw;
+    }
+    ev.model_.gravity.setZero();
+    const VectorXd rho = ws.tree.tau - ev.B_ * tau;
+    // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d
+    MatrixXd L = MatrixXd::Zero(k, n);
+    const int nd = static_cast<int>(ev.dependent_.size());
+    if (nd) {
+      VectorXd rd(nd);
+      for (int r = 0; r < nd; ++r) rd[r] = rho[ev.dependent_[r]];
+      const VectorXd mu = ev.lu_.transpose().solve(rd);
+      for (int l = 0; l < k; ++l)
+        for (int r = 0; r < nd; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
+    }
+    // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot
+    MatrixXd dKa = dA_w + dgA;
+    for (int l = 0; l < k; ++l) dKa += out.nudot[l] * ws.dA[l];
+    const MatrixXd Aq = solve_neg(ev, dKa);
+    const MatrixXd ST = S.transpose();
+    MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * out.Vq + (ST * M) * Aq;
+    motor_rows(ev, tau, G);
+    const MatrixXd Minv = llt.solve(MatrixXd::Identity(k, k));
+    out.dq = -Minv * G;
+    out.dnu = -Minv * (ST * (dtau_dv * S + M * Wnu));
+    out.dtau = Minv * ev.Br_;
+    out.v = v;
+    out.S = S;
+    out.A = ev.A_;
+    (void)m;
+    return out;
+  }
+
+  // G -= S^T d(B(q) tau)/dq at fixed S (motor_rows): motors reacting on a body
+  static void motor_rows(Ev& ev, const Eigen::Ref<const VectorXd>& tau, MatrixXd& G) {
+    const Model& model = ev.model_;
+    const int n = ev.nv_;
+    const int k = static_cast<int>(ev.S_.cols());
+    for (size_t j = 0; j < ev.motors_.size(); ++j) {
+      const auto& mo = ev.motors_[j];
+      if (mo.reaction < 0 || tau[j] == 0.0) continue;
+      const pinocchio::JointIndex jid = static_cast<pinocchio::JointIndex>(mo.joint);
+      // the joint body's world angular Jacobian: CRBA's world columns (data_.J) on its supporting joints
+      derivs::Matrix3x Jw = derivs::Matrix3x::Zero(3, n);
+      for (const pinocchio::JointIndex s : model.supports[jid]) {
+        if (s == 0) continue;
+        const int c0 = model.joints[s].idx_v();
+        for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
+      }
+      const Eigen::Vector3d axis = Jw.col(mo.index);
+      const derivs::Matrix3x daxis = -derivs::skew3(axis) * Jw;
+      const int rf = ev.frames_[mo.reaction];
+      for (int l = 0; l < k; ++l) {
+        derivs::FramePass& fp = ev.deriv_.passes[l];
+        Eigen::Vector3d wc;
+        derivs::Matrix3x dwc;
+        fp.joint_angular(model, jid, wc, dwc);
+        fp.velocity(model, rf, ev.data_.oMf[rf], ev.Jf_[mo.reaction]);
+        const Eigen::Vector3d wr = fp.V[rf].template tail<3>();
+        const derivs::Matrix3x dwr = fp.dV[rf].template bottomRows<3>();
+        G.row(l) -= tau[j] * (axis.transpose() * (dwc - dwr) + (wc - wr).transpose() * daxis);
+      }
+    }
+  }
+};
+
+}  // namespace robotdyn

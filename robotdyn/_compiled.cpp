@@ -207,22 +207,23 @@ class Evaluator {
       pin::getFrameJacobian(model_, data_, frames_[f], pin::LOCAL_WORLD_ALIGNED, Jf_[f]);
     }
     Aw_.resize(wheels_.size());
-    int row = 0;
-    for (const auto& [kind, i] : order_)
-      row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
-    motor_columns(motors_, model_, data_, Jf_, nv_, B_);
+    constraint_rows();
     project();
     configured_ = true;
   }
 
-  // State level: v = S nu, the drift, w and the dynamics.
-  void dynamics(const Eigen::Ref<const VectorXd>& nu) {
-    if (nu.size() != S_.cols()) throw std::invalid_argument("nu has the wrong length");
-    v_.noalias() = S_ * nu;
-    // one pass: RNEA(q, v, 0) without gravity = C v, whose forward sweep leaves the joint velocities and their
-    // accelerations at zero joint acceleration (for the drift terms); RNEA(q, v, w) = C v + g + M w
-    pin::rnea(model_, data_, q_, v_, zero_);
-    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) data_.a[i] = data_.a_gf[i];
+  // Every constraint's rows (A, residual: kernels/rolling_contact, loop_closure, joint_coupling) in the rows'
+  // order, and the motors' columns B (kernels/actuation), at the configured placements and frame Jacobians.
+  void constraint_rows() {
+    int row = 0;
+    for (const auto& [kind, i] : order_)
+      row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
+    motor_columns(motors_, model_, data_, Jf_, nv_, B_);
+  }
+
+  // Every constraint's drift at v (the joint accelerations at zero joint acceleration in data_.a), then w, the
+  // drift's acceleration (kernels/projection, kernels/operational_space).
+  void drift_pass() {
     drift_.setZero(nrows());
     int row = 0;
     for (const auto& [kind, i] : order_)
@@ -233,6 +234,17 @@ class Evaluator {
                                      Kinv_, rhs_, w_);
     else
       drift_acceleration_selection(drift_, rows_, dependent_, lu_, lus_, rhs_, wd_, w_);
+  }
+
+  // State level: v = S nu, the drift, w and the dynamics.
+  void dynamics(const Eigen::Ref<const VectorXd>& nu) {
+    if (nu.size() != S_.cols()) throw std::invalid_argument("nu has the wrong length");
+    v_.noalias() = S_ * nu;
+    // one pass: RNEA(q, v, 0) without gravity = C v, whose forward sweep leaves the joint velocities and their
+    // accelerations at zero joint acceleration (for the drift terms); RNEA(q, v, w) = C v + g + M w
+    pin::rnea(model_, data_, q_, v_, zero_);
+    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) data_.a[i] = data_.a_gf[i];
+    drift_pass();
     reduce(data_.M, S_, g_, data_.tau, w_, B_, SM_, Mr_, hr_, gr_, Br_);
   }
 
@@ -1043,23 +1055,9 @@ class Evaluator {
     auto rows = [&] {
       A_.setZero(nrows(), nv_);
       residual_.setZero(nrows());
-      int row = 0;
-      for (const auto& [kind, i] : order_)
-        row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
-      motor_columns(motors_, model_, data_, Jf_, nv_, B_);
+      constraint_rows();
     };
-    auto drift = [&] {
-      drift_.setZero(nrows());
-      int row = 0;
-      for (const auto& [kind, i] : order_)
-        row = kind == 0 ? wheel_drift(i, row) : kind == 1 ? closure_drift(i, row) : coupling_drift(i, row);
-      w_.setZero(nv_);
-      if (operational_)
-        drift_acceleration_operational(drift_, rows_, op_select_, model_, data_, frames_[op_frame_], op_local_, nv_,
-                                       Kinv_, rhs_, w_);
-      else
-        drift_acceleration_selection(drift_, rows_, dependent_, lu_, lus_, rhs_, wd_, w_);
-    };
+    auto drift = [&] { drift_pass(); };
     py::dict t;
     t["evaluation"] = seconds([&] { configure(q0); dynamics(nu0); });
     t["pinocchio"] = seconds([&] {

@@ -37,3 +37,20 @@ def phases(traj) -> dict[str, list[float]]:
     for e in traj.stats["flight"]:
         out[e["event"]].append(e["t"])
     return out
+
+
+def landing(k: float, zeta: float, v_in: float) -> tuple[float, float]:
+    """The damped landing's closed form (mass M on a linear spring-damper k, c = 2 zeta sqrt(k M), touching down
+    at speed v_in [m/s], no gravity): the contact time [s] until the force k x + c x' returns to zero, plus the
+    flight back up to the undeformed height, and the rebound velocity [m/s] (negative: upward is -v_in's sign).
+
+    x(t) = v_in / w_d exp(-s t) sin(w_d t) (s = zeta w_n, w_d = w_n sqrt(1 - zeta^2)); the force is zero at
+    w_d t* = pi - atan2(2 zeta sqrt(1 - zeta^2), 1 - 2 zeta^2), where the disc is still x* deep and leaves at
+    v_out = x'(t*); it then rises x* at v_out."""
+    wn = np.sqrt(k / M)
+    s, wd = zeta * wn, wn * np.sqrt(1 - zeta**2)
+    theta = np.pi - np.arctan2(2 * zeta * np.sqrt(1 - zeta**2), 1 - 2 * zeta**2)
+    t_star = theta / wd
+    x_star = v_in / wd * np.exp(-s * t_star) * np.sin(theta)
+    v_out = -v_in * np.exp(-s * t_star) * (np.cos(theta) - s / wd * np.sin(theta))
+    return t_star + x_star / v_out, v_out

@@ -71,34 +71,45 @@ def parameters(func) -> list[str]:
     return [p.name for p in sig.parameters.values() if p.name not in ("self", "cls") and not p.name.startswith("_")]
 
 
-def missing_descriptions() -> list[str]:
-    missing = []
+def public_objects():
+    """Every public module-level object defined in its own module: ``(qualified name, object)``."""
     for mod in public_modules():
         for name, obj in vars(mod).items():
             if name.startswith("_") or getattr(obj, "__module__", None) != mod.__name__:
                 continue
-            where = f"{mod.__name__}.{name}"
-            if inspect.isfunction(obj):
-                doc = described(obj.__doc__)
-                missing += [f"{where}({p})" for p in parameters(obj) if p not in doc]
-            elif inspect.isclass(obj):
-                if issubclass(obj, BaseException):
-                    continue  # exceptions: a message, documented by the class
-                init = obj.__dict__.get("__init__")
-                ctor = init if init is not None and inspect.isfunction(init) else None
-                if ctor is not None or "__dataclass_fields__" in obj.__dict__:
-                    doc = described(obj.__doc__, SECTIONS + ("Attributes",)) | described(
-                        getattr(ctor, "__doc__", None))
-                    names = parameters(ctor) if ctor is not None else parameters(obj)
-                    missing += [f"{where}({p})" for p in names if p not in doc]
-                fields = getattr(obj, "__dataclass_fields__", {})
-                for mname, member in obj.__dict__.items():
-                    if mname.startswith("_") or mname in fields:  # a field's default (e.g. a lambda) is data
-                        continue
-                    func = member.__func__ if isinstance(member, (staticmethod, classmethod)) else member
-                    if inspect.isfunction(func):
-                        doc = described(inspect.getdoc(getattr(obj, mname)))  # inherited, as autodoc shows it
-                        missing += [f"{where}.{mname}({p})" for p in parameters(func) if p not in doc]
+            yield f"{mod.__name__}.{name}", obj
+
+
+def public_methods(cls):
+    """A class's own public functions, static and class methods unwrapped, dataclass fields skipped (a field's
+    default, e.g. a lambda, is data; properties are not functions): ``(name, function)``."""
+    fields = getattr(cls, "__dataclass_fields__", {})
+    for mname, member in cls.__dict__.items():
+        if mname.startswith("_") or mname in fields:
+            continue
+        func = member.__func__ if isinstance(member, (staticmethod, classmethod)) else member
+        if inspect.isfunction(func):
+            yield mname, func
+
+
+def missing_descriptions() -> list[str]:
+    missing = []
+    for where, obj in public_objects():
+        if inspect.isfunction(obj):
+            doc = described(obj.__doc__)
+            missing += [f"{where}({p})" for p in parameters(obj) if p not in doc]
+        elif inspect.isclass(obj):
+            if issubclass(obj, BaseException):
+                continue  # exceptions: a message, documented by the class
+            init = obj.__dict__.get("__init__")
+            ctor = init if init is not None and inspect.isfunction(init) else None
+            if ctor is not None or "__dataclass_fields__" in obj.__dict__:
+                doc = described(obj.__doc__, SECTIONS + ("Attributes",)) | described(getattr(ctor, "__doc__", None))
+                names = parameters(ctor) if ctor is not None else parameters(obj)
+                missing += [f"{where}({p})" for p in names if p not in doc]
+            for mname, func in public_methods(obj):
+                doc = described(inspect.getdoc(getattr(obj, mname)))  # inherited, as autodoc shows it
+                missing += [f"{where}.{mname}({p})" for p in parameters(func) if p not in doc]
     return missing
 
 
@@ -210,23 +221,14 @@ def needs_returns(func) -> bool:
 
 def missing_returns() -> list[str]:
     missing = []
-    for mod in public_modules():
-        for name, obj in vars(mod).items():
-            if name.startswith("_") or getattr(obj, "__module__", None) != mod.__name__:
-                continue
-            where = f"{mod.__name__}.{name}"
-            if inspect.isfunction(obj):
-                if needs_returns(obj) and not has_section(obj.__doc__):
-                    missing.append(where)
-            elif inspect.isclass(obj) and not issubclass(obj, BaseException):
-                fields = getattr(obj, "__dataclass_fields__", {})
-                for mname, member in obj.__dict__.items():
-                    if mname.startswith("_") or mname in fields:  # dunders, dataclass-generated methods, fields
-                        continue
-                    func = member.__func__ if isinstance(member, (staticmethod, classmethod)) else member
-                    if inspect.isfunction(func) and needs_returns(func) and not has_section(
-                            inspect.getdoc(getattr(obj, mname))):  # properties are exempt: not functions
-                        missing.append(f"{where}.{mname}")
+    for where, obj in public_objects():
+        if inspect.isfunction(obj):
+            if needs_returns(obj) and not has_section(obj.__doc__):
+                missing.append(where)
+        elif inspect.isclass(obj) and not issubclass(obj, BaseException):
+            for mname, func in public_methods(obj):
+                if needs_returns(func) and not has_section(inspect.getdoc(getattr(obj, mname))):
+                    missing.append(f"{where}.{mname}")
     return missing
 
 

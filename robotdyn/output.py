@@ -109,6 +109,33 @@ PARTIAL_SUFFIX = ".partial"
 """What :func:`visible_output` appends to the target's name for the file being written."""
 
 
+def try_lock(path) -> tuple[int, bool]:
+    """Open ``path`` for reading and writing (created with mode 0666 less the umask, not truncated: another process
+    may hold it) and try to take an exclusive ``flock`` on it without waiting.
+
+    Args:
+        path: The file to lock (``str`` or :class:`~pathlib.Path`); its directory must exist.
+
+    Returns:
+        ``(fd, held)``: the open file descriptor (the caller closes it; closing releases the lock) and whether this
+        process holds the lock. ``held`` is False where another process holds it (fd still open, e.g. to read
+        who); True also on a platform without ``flock`` (no lock is taken there).
+
+    Raises:
+        OSError: The file cannot be opened.
+    """
+    fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666)
+    try:
+        import fcntl
+    except ImportError:  # no flock (Windows): no lock
+        return fd, True
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return fd, False
+    return fd, True
+
+
 @contextlib.contextmanager
 def visible_output(path, what: str = "output file") -> Iterator[tuple[Path, object]]:
     """Yield ``(partial path, binary file open for writing and reading)`` for an output written while it is computed
@@ -134,19 +161,13 @@ def visible_output(path, what: str = "output file") -> Iterator[tuple[Path, obje
     target = check_target(path, what)
     partial = check_target(target.with_name(target.name + PARTIAL_SUFFIX), what)
     try:  # not truncated before it is locked: another run may be writing it
-        fd = os.open(partial, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666)
+        fd, held = try_lock(partial)
     except OSError as exc:
         raise OutputError(f"cannot write {what} {str(partial)!r}: {exc.strerror or exc}") from None
-    try:
-        import fcntl
-
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
+    if not held:
         os.close(fd)
         raise OutputError(f"{what} {str(path)!r}: another process is writing it ({str(partial)!r} is locked); expected "
-                          "one run per output file") from None
-    except ImportError:  # no flock (Windows): no lock
-        pass
+                          "one run per output file")
     ok = False
     try:
         os.ftruncate(fd, 0)  # a leftover of a killed run

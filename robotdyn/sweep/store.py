@@ -26,7 +26,7 @@ import os
 from pathlib import Path
 
 from ..errors import OutputError
-from ..output import atomic_output
+from ..output import atomic_output, try_lock
 
 RUNS = "runs"
 TRAJECTORIES = "trajectories"
@@ -100,18 +100,14 @@ def lock(out: Path) -> Lock:
     Raises:
         OutputError: Another process holds the lock (naming its pid, host and start time).
     """
-    import fcntl
     import socket
     import time
 
-    path = out / LOCK
     try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666)
+        fd, held = try_lock(out / LOCK)
     except OSError as exc:
         raise OutputError(f"cannot lock sweep directory {str(out)!r}: {exc.strerror or exc}") from None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
+    if not held:
         try:
             holder = os.pread(fd, 300, 0).decode(errors="replace").strip() or "another process"
         finally:

@@ -60,11 +60,23 @@ def central_differences(ev, q, nu, tau, T) -> np.ndarray:
     return np.column_stack(cols)
 
 
+def pinocchio_floor(robot, q, v) -> float:
+    """Seconds per call of Pinocchio's own computeABADerivatives on the robot's tree at (q, v, tau = 0), no
+    constraints: the floor of any derivative set of these dynamics on Pinocchio (its Python binding's call included)."""
+    import pinocchio as pin
+
+    model = robot.model
+    data = model.createData()
+    tau = np.zeros(model.nv)
+    return _best(lambda: pin.computeABADerivatives(model, data, q, v, tau), 500)
+
+
 def derivatives_bench() -> None:
     print("\ncompiled derivatives of the reduced dynamics (nudot, d/dq, d/dnu, d/dtau, dqdot/dq, S) per state [us]; "
-          "'evals' = time / one compiled evaluation (rhs)")
+          "'evals' = time / one compiled evaluation (rhs); API: Robot.dynamics_derivatives, checked and with "
+          "check=False; floor: Pinocchio's computeABADerivatives on the unconstrained tree")
     print(f"{'robot':<20} {'n':>3} {'k':>3} {'eval':>7} {'derivs C++':>11} {'evals':>6} {'API':>8} {'evals':>6} "
-          f"{'Python path':>12} {'/ C++':>7}")
+          f"{'unchecked':>10} {'evals':>6} {'floor':>7} {'evals':>6} {'Python path':>12} {'/ C++':>7}")
     rng = np.random.default_rng(0)
     for name in names():
         robot = Robot(module(name).SPEC)
@@ -78,9 +90,12 @@ def derivatives_bench() -> None:
         t_ev = _best(lambda: ev.rhs(q, nu, tau, 0.0), 500)
         t_c = _best(lambda: ev.derivatives(q, nu, tau), 100)
         t_api = _best(lambda: robot.dynamics_derivatives(q, nu, tau), 50)
+        t_fast = _best(lambda: robot.dynamics_derivatives(q, nu, tau, check=False), 50)
+        t_floor = pinocchio_floor(robot, q, fast.ev.derivatives(q, nu, tau)[4])
         t_py = _best(lambda: dynamics_derivatives(robot, q, nu, tau), 3, 3)
         print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3} {t_ev * 1e6:>7.1f} {t_c * 1e6:>11.1f} {t_c / t_ev:>6.1f} "
-              f"{t_api * 1e6:>8.1f} {t_api / t_ev:>6.1f} {t_py * 1e6:>12.0f} {t_py / t_c:>6.0f}x")
+              f"{t_api * 1e6:>8.1f} {t_api / t_ev:>6.1f} {t_fast * 1e6:>10.1f} {t_fast / t_ev:>6.1f} "
+              f"{t_floor * 1e6:>7.1f} {t_floor / t_ev:>6.1f} {t_py * 1e6:>12.0f} {t_py / t_c:>6.0f}x")
         if name == "linkage_suspension":
             linkage = (robot, ev, q, nu, tau, t_ev, t_c, t_api)
     robot, ev, q, nu, tau, t_ev, t_c, t_api = linkage

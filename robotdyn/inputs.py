@@ -58,6 +58,9 @@ def as_vector(values, n: int, what: str, names: Sequence[str] | None = None,
     Raises:
         InputError: Wrong length, non-numeric, non-finite or too large entries.
     """
+    if isinstance(values, np.ndarray) and values.dtype == np.float64 and values.shape == (n,) \
+            and np.isfinite(values).all() and (limit is None or n == 0 or np.abs(values).max() <= limit):
+        return values.copy()  # the common case in one vectorised check; any mistake takes the loop for its message
     if isinstance(values, str):
         values = values.replace(",", " ").split()
     try:

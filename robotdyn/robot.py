@@ -764,7 +764,7 @@ class Robot:
             self.warn_conditioning(red, out)
         return out
 
-    def dynamics_derivatives(self, q, nu, tau):
+    def dynamics_derivatives(self, q, nu, tau, check: bool = True):
         """:math:`\\dot\\nu` and its derivatives in q (natural coordinates, and along the holonomic manifold in
         independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
         :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (compiled where the compiled model
@@ -777,13 +777,16 @@ class Robot:
                 manifold for ``dq_manifold`` to be the derivative along it.
             nu: Independent velocities (k,) [m/s, rad/s] in the order of :attr:`velocity_names`.
             tau: Motor torques/forces (n_motors,) [N m or N] in the order of :attr:`motors`.
+            check: Validate q, nu and tau (lengths, finiteness, joint ranges) and the constraints' derivative
+                rules (default True). ``False`` is the fast entry for a caller that validated them once and
+                evaluates many states (an optimiser, a controller): float arrays of the right lengths expected.
 
         Returns:
             A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`.
 
         Raises:
             InputError: Wrong sizes, or a constraint without derivatives (a stick-slip wheel, exact Coulomb
-                friction, a user's own constraint class).
+                friction, a user's own constraint class); with ``check=False`` wrong sizes may raise another error.
             SingularConstraintError: Slipping wheels whose coupled system is singular (Painlevé).
             NonFiniteError: A non-finite result.
         """
@@ -795,9 +798,12 @@ class Robot:
         from .reduction.dynamics_derivatives import dynamics_derivatives
         from .constraints.row_derivatives import kind
 
-        q, nu, tau = self.check_q(q), self.check_nu(nu), self.check_tau(tau)
-        for c in self.constraints:
-            kind(c)  # the Python path's one-line refusal of a constraint without derivatives, on either path
+        if check:
+            q, nu, tau = self.check_q(q), self.check_nu(nu), self.check_tau(tau)
+            for c in self.constraints:
+                kind(c)  # the Python path's one-line refusal of a constraint without derivatives, on either path
+        else:
+            q, nu, tau = (np.asarray(x, dtype=float) for x in (q, nu, tau))
         fast = compiled_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves
         return fast if fast is not None else dynamics_derivatives(self, q, nu, tau)
 

@@ -37,8 +37,8 @@ class _CompiledDerivatives(DynamicsDerivatives):
 
     def __getattr__(self, name: str):
         if name in ("positions", "tangent", "dq_manifold") and "_manifold" in self.__dict__:
-            A_h, prefer = self.__dict__.pop("_manifold")
-            positions, T = position_coordinates(A_h, prefer)
+            A, holonomic, prefer = self.__dict__.pop("_manifold")  # (the holonomic rows picked here, on demand)
+            positions, T = position_coordinates(A[np.asarray(holonomic, bool)], prefer)
             self.__dict__.update(positions=positions, tangent=T, dq_manifold=self.dq @ T)
             return self.__dict__[name]
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
@@ -71,15 +71,15 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
         nudot, dq, dnu, dtau, v, Vq, S, A = fast.ev.derivatives(q, nu, tau)
     except Fallback:
         return None
+    arrays = (nudot, dq, dnu, dtau, Vq)
+    if not all(np.isfinite(x).all() for x in arrays):
+        name = ("nudot", "dq", "dnu", "dtau", "dqdot_dq")[[np.isfinite(x).all() for x in arrays].index(False)]
+        raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
+                             f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g})")
     out = _CompiledDerivatives.__new__(_CompiledDerivatives)
     out.__dict__.update(nudot=nudot, dq=dq, dnu=dnu, dtau=dtau, qdot=v, dqdot_dq=Vq, S=S, numerical=(),
                         coordinates=list(robot.coordinates), velocities=list(robot.velocity_names),
-                        motors=[m.name for m in robot.motors],
-                        _manifold=(A[np.asarray(fast.holonomic, bool)], fast._hint.dependent))
-    for name in ("nudot", "dq", "dnu", "dtau", "dqdot_dq"):
-        if not np.all(np.isfinite(getattr(out, name))):
-            raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
-                                 f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g})")
+                        motors=[m.name for m in robot.motors], _manifold=(A, fast.holonomic, fast._hint.dependent))
     return out
 
 

@@ -364,7 +364,10 @@ class TrajectoryProblem:
                 raw = raw_derivatives(self._fast, x[:n], x[n:], u)
                 if raw is not None:
                     _, dq, dnu, dtau, _, Vq, S, _ = raw
-                    return np.block([[Vq, S], [dq, dnu]]), np.vstack([np.zeros((n, self.m)), dtau])
+                    Fx, Fu = np.empty((self.nx, self.nx)), np.zeros((self.nx, self.m))
+                    Fx[:n, :n], Fx[:n, n:], Fx[n:, :n], Fx[n:, n:] = Vq, S, dq, dnu
+                    Fu[n:] = dtau
+                    return Fx, Fu
             d = self.robot.dynamics_derivatives(x[:n], x[n:], u)
             Fx = np.block([[d.dqdot_dq, d.S], [d.dq, d.dnu]])
             Fu = np.vstack([np.zeros((n, self.m)), d.dtau])
@@ -384,6 +387,16 @@ class TrajectoryProblem:
                 yp[:n], ym[:n] = pair
             J[:, i] = (self._f(yp[:self.nx], yp[self.nx:]) - self._f(ym[:self.nx], ym[self.nx:])) / (2 * step)
         return J[:, :self.nx], J[:, self.nx:]
+
+    def _jac_nodes(self, X: np.ndarray, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:math:`(\\partial f/\\partial x, \\partial f/\\partial\\tau)` at every node, (N, nx, nx) and (N, nx, m)
+        (:meth:`_jac_node` at each), written into two stacked arrays that :meth:`jacobian_values` slices at once."""
+        N = len(X)
+        Fx = np.empty((N, self.nx, self.nx))
+        Fu = np.empty((N, self.nx, self.m))
+        for j in range(N):
+            Fx[j], Fu[j] = self._jac_node(X[j], U[j])
+        return Fx, Fu
 
     def defects(self, z: np.ndarray) -> np.ndarray:
         """Trapezoidal defects :math:`x_{j+1} - x_j - \\tfrac{h}{2}(f_j + f_{j+1})`, (N-1, nx) flattened.
@@ -487,13 +500,12 @@ class TrajectoryProblem:
         N = self.nodes
         h = self.t_end / (N - 1)
         I = np.eye(self.nx)[self.keep]
-        node = [self._jac_node(X[j], U[j]) for j in range(N)]
-        vals = []
-        for j in range(N - 1):
-            (Fx0, Fu0), (Fx1, Fu1) = node[j], node[j + 1]
-            k = self.keep
-            vals += [(-I - 0.5 * h * Fx0[k]).ravel(), (I - 0.5 * h * Fx1[k]).ravel(), (-0.5 * h * Fu0[k]).ravel(),
-                     (-0.5 * h * Fu1[k]).ravel()]
+        Fx, Fu = self._jac_nodes(X, U)
+        Fx, Fu = Fx[:, self.keep], Fu[:, self.keep]
+        # per interval j the four blocks d/dx_j, d/dx_{j+1}, d/dtau_j, d/dtau_{j+1}, each row-major (_blocks)
+        vals = [np.concatenate([(-I - 0.5 * h * Fx[:-1]).reshape(N - 1, -1), (I - 0.5 * h * Fx[1:]).reshape(N - 1, -1),
+                                (-0.5 * h * Fu[:-1]).reshape(N - 1, -1), (-0.5 * h * Fu[1:]).reshape(N - 1, -1)],
+                               axis=1).ravel()]
         for j in range(1, N) if self.mh else ():
             vals.append(self._holonomic(X[j, :self.n])[1].ravel())
         if self.limits is not None:

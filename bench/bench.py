@@ -468,7 +468,10 @@ def compliant_bench() -> None:
     options = dict(rtol=1e-8, atol=1e-10, n_out=101)
     print(f"\nlinkage rover over the bump (5 cm step), rtol 1e-8, 101 samples; compliant tyres k = {k:.4g} N/m "
           "(1 mm static deflection) with a linear tyre law")
-    print(f"{'run':<52} {'sim [s]':>8} {'wall [s]':>9} {'evals':>7} {'/ rigid':>8} {'/ rigid Py':>11}  flight")
+    print("each run's accuracy: max |q - q_ref| over the samples against the same model run at rtol 1e-11, atol "
+          "1e-13 (compiled engine, dopri5)")
+    print(f"{'run':<52} {'sim [s]':>8} {'wall [s]':>9} {'evals':>7} {'/ rigid':>8} {'/ rigid Py':>11} "
+          f"{'|q - ref|':>9}  flight")
     runs = (("rigid, compiled model (scipy DOP853)", rigid, True, False, None),
             ("rigid, compiled engine (adams)", rigid, True, True, None),
             ("rigid, Python path", rigid, False, False, None),
@@ -476,8 +479,10 @@ def compliant_bench() -> None:
             ("compliant, compiled engine (dopri5)", soft, True, True, None),
             ("compliant, compiled engine (rosenbrock4)", soft, True, True, "rosenbrock4"),
             ("compliant, Python path (LSODA)", soft, False, False, None))
+    tight = dict(options, rtol=1e-11, atol=1e-13, method="dopri5")
     for speed, t_end in ((PEAK_SPEED, 2.2), (25.0, 0.45)):
         walls, trajs = {}, {}
+        refs = {id(robot): bump_run(robot, t_end, rigid, speed=speed, feedback=True, **tight) for robot in (rigid, soft)}
         for name, robot, compiled, feedback, method in runs:
             with use_compiled(compiled):
                 start = time.perf_counter()
@@ -488,8 +493,9 @@ def compliant_bench() -> None:
             flights = "-" if flight is None else (f"{len(flight)} events" if flight else "none")
             ratio = wall / walls[runs[0][0]]
             ratio_py = wall / walls.get(runs[2][0], wall)
+            error = float(np.max(np.abs(traj.q - refs[id(robot)].q)))
             print(f"{name + f' at {speed:.3g} rad/s':<52} {t_end:>8.3g} {wall:>9.3f} {traj.stats['nfev']:>7} "
-                  f"{ratio:>8.1f} {ratio_py:>11.1f}  {flights}")
+                  f"{ratio:>8.1f} {ratio_py:>11.1f} {error:>9.1e}  {flights}")
         b = trajs[runs[6][0]]
         fastest = min(walls[runs[1][0]], walls[runs[3][0]])  # the rigid compiled engine, its better integrator
         for name in (runs[4][0], runs[5][0]):

@@ -394,7 +394,8 @@ class Evaluator {
       const WheelGeometry& g = geo_[cc.wheel];
       Ac_.row(0).noalias() = g.t1.transpose() * Aw_[cc.wheel];
       Ac_.row(1).noalias() = g.t2.transpose() * Aw_[cc.wheel];
-      Ac_.row(2).noalias() = g.n.transpose() * Aw_[cc.wheel];
+      robotdyn::kernels::penetration_gradient(wheels_[cc.wheel], g, terrain_, Jf_[wheels_[cc.wheel].frame],
+                                              Aw_[cc.wheel], Ac_.row(2));  // d phi / dq (n^T A_w on a plane)
       const robotdyn::kernels::ContactState st = robotdyn::kernels::add_compliant_contact(cc, g.phi, Ac_, v_, Qa_);
       contact_states_[i] = st;
       friction_power_ += st.friction_power;
@@ -408,8 +409,10 @@ class Evaluator {
     return out;
   }
   // The compliant wheels' penetrations [m] at the state y (its q).
+  // (An explicit step's last evaluation was at its end, dopri5's first-same-as-last: its configuration is reused.)
   void penetrations(const double* y, const py::object& rechoose, std::vector<double>& out) {
-    with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
+    if (!(configured_ && q_.size() == nv_ && Eigen::Map<const VectorXd>(y, nv_) == q_))
+      with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
     out.resize(contacts_.size());
     for (size_t i = 0; i < contacts_.size(); ++i) out[i] = -geo_[contacts_[i].wheel].phi;
   }

@@ -3,9 +3,11 @@
 A :class:`CompliantWheel` contributes no constraint rows. At every state its contact geometry (the rolling wheel's:
 contact point p, contact frame E = (t1, t2, n), :mod:`robotdyn.constraints.rolling_contact`) gives
 
-- the penetration :math:`\\delta = -\\phi` [m] (:math:`\\phi` the signed distance of the wheel's lowest rim point
-  above the terrain, along its normal) and its rate :math:`\\dot\\delta = -n^T A_w v` [m/s] (the normal velocity
-  of the wheel's material point at p; at the lowest rim point it equals :math:`-\\dot\\phi`);
+- the penetration :math:`\\delta = -\\phi(q)` [m] (:math:`\\phi` the signed distance of the wheel's lowest rim
+  point above the terrain, along its normal) and its rate :math:`\\dot\\delta = -G v` [m/s] with
+  :math:`G = \\partial\\phi/\\partial q` (1, nv), :func:`penetration_gradient`: exactly the time derivative of
+  the same :math:`\\phi(q)` (on a plane :math:`G = n^T A_w`, the normal velocity of the wheel's material point at
+  p; on curved terrain G adds a term of order :math:`\\phi` times the terrain's curvature);
 - the normal force :math:`f_n = N(\\delta, \\dot\\delta) \\ge 0` of its :class:`NormalLaw` (zero while
   :math:`\\delta \\le 0`: the wheel flies; never pulling);
 - the tangential force of its friction law :math:`F_t = -f_n c(s)` (:mod:`robotdyn.contact.friction`) from the slip
@@ -15,10 +17,13 @@ contact point p, contact frame E = (t1, t2, n), :mod:`robotdyn.constraints.rolli
 (a wheel declared with ``friction = "rolling"`` has no friction law: while :math:`f_n > 0` its tangential rows are
 constraints of the motion instead, and its tangential force is their multiplier,
 :mod:`robotdyn.contact.compliant_rolling`; :meth:`CompliantWheel.state` gives its normal force only)
-and applies :math:`Q = A^T (F_{t1}, F_{t2}, f_n)` with :math:`A = E^T A_w` (3, nv) the rolling rows: the contact
-force on the wheel's material point at p. Energy: the law's elastic part stores :math:`U(\\delta)`, the rest of
-the normal force does the work :math:`-\\int (f_n - f_e(\\delta))\\,\\dot\\delta\\,dt \\le 0` (the damper's),
-friction :math:`\\int F_t \\cdot s\\,dt \\le 0`.
+and applies :math:`Q = A^T (F_{t1}, F_{t2}, f_n)` with A (3, nv) the rows :math:`(t_1, t_2)^T A_w` and G: the
+tangential force on the wheel's material point at p, the normal force along :math:`\\partial\\phi/\\partial q`
+(the contact force at p along n, to first order in :math:`\\phi`). Energy: the law's elastic part stores
+:math:`U(\\delta)`, whose rate :math:`f_e(\\delta)\\dot\\delta` is then exactly minus the elastic force's power;
+the rest of the normal force does the work :math:`-\\int (f_n - f_e(\\delta))\\,\\dot\\delta\\,dt \\le 0` (the
+damper's), friction :math:`\\int F_t \\cdot s\\,dt \\le 0`: kinetic + potential + stored energy change by motor
+work + damper work + friction work, on any terrain.
 
 Laws (:math:`\\delta` the penetration [m], :math:`\\dot\\delta` its rate [m/s]):
 
@@ -265,9 +270,8 @@ class CompliantWheel(RollingWheel):
         Returns:
             The indicator [m].
         """
-        Aw, geo = self._world_jacobian(kin)
-        rate = float(geo[9][:, 2] @ (Aw @ kin.v))
-        return self.normal_law.pressing(-float(geo[7]), -rate)
+        rate = float(penetration_gradient(self, kin) @ kin.v)  # d phi / dt
+        return self.normal_law.pressing(self.penetration(kin), -rate)
 
     def __repr__(self) -> str:
         return (f"CompliantWheel(frame={self.frame!r}, radius={self.radius}, normal={self.normal_law!r}, "
@@ -300,8 +304,8 @@ class CompliantWheel(RollingWheel):
 
     def state(self, kin: KinematicState) -> dict:
         """The contact at the state of ``kin``: ``delta``, ``rate`` [m/s], ``normal`` f_n [N], ``slip`` s (2,)
-        [m/s], ``force`` (3,) in the contact frame (t1, t2, n) [N], ``E`` (3, 3), ``point`` p, ``Q`` (nv,) the
-        generalised force, ``friction_power`` :math:`F_t\\cdot s` [W] (<= 0), ``damper_power``
+        [m/s] (:math:`-\\dot\\phi`), ``force`` (3,) in the contact frame (t1, t2, n) [N], ``E`` (3, 3), ``point`` p,
+        ``Q`` (nv,) the generalised force (the normal force along :math:`\\partial\\phi/\\partial q`, see the module), ``friction_power`` :math:`F_t\\cdot s` [W] (<= 0), ``damper_power``
         :math:`-(f_n - f_e)\\dot\\delta` [W] (<= 0).
 
         Args:
@@ -314,6 +318,7 @@ class CompliantWheel(RollingWheel):
         Aw, geo = self._world_jacobian(kin)
         E = geo[9]
         A = E.T @ Aw
+        A[2] = penetration_gradient(self, kin)  # (n^T A_w on a plane)
         u = A @ kin.v
         delta, rate = -float(geo[7]), -float(u[2])
         fn = self.normal_law.force(delta, rate)
@@ -327,6 +332,55 @@ class CompliantWheel(RollingWheel):
         damper = -(fn - self.normal_law.elastic(delta)) * rate if delta > 0.0 else 0.0
         return dict(delta=delta, rate=rate, normal=fn, slip=slip, force=force, E=E, point=geo[5], Q=A.T @ force,
                     friction_power=float(ft @ slip), damper_power=float(damper))
+
+
+def penetration_gradient(wheel: RollingWheel, kin: KinematicState) -> np.ndarray:
+    """:math:`G = \\partial\\phi/\\partial q` (nv,): the gradient of the wheel's signed distance
+    :math:`\\phi(q) = (p_z - f(p_x, p_y))\\,s(p)`, :math:`s = 1/\\|(-f_x, -f_y, 1)\\|`, above the terrain z = f(x, y)
+    (:class:`~robotdyn.constraints.rolling_contact.RollingWheel`'s contact point p, the rim point below the centre
+    along the terrain normal n taken at p itself), so that :math:`\\dot\\phi = G v` exactly.
+
+    With :math:`\\nabla\\phi` at p equal to :math:`n + (\\phi / s)(\\nabla s, 0)` and
+    :math:`\\nabla s = -s^3 H \\nabla f` (H the terrain's Hessian), and the contact point's velocity
+    :math:`\\dot p = A_w v - R(\\dot u - \\omega \\times u)` whose second part is along :math:`a \\times u`, normal to
+    n (u, a the unit vector from p to the centre and the axle):
+
+    :math:`G = n^T A_w + w^T J_p`, :math:`w = (-\\phi s^2 H \\nabla f, 0)`, :math:`J_p = J_c - u\\,\\partial R/\\partial q
+    - R J_u` the contact point's Jacobian, :math:`J_u = K^{-1} P (Q_a N (J_c - u\\,\\partial R/\\partial q) + (a n^T +
+    (n\\cdot a) I)[a]_\\times J_\\omega)` the derivative of u (the implicit solve of
+    :meth:`~robotdyn.constraints.rolling_contact.RollingWheel.contact`: :math:`P = (I - u u^T)/|n - (n\\cdot a) a|`,
+    :math:`Q_a = I - a a^T`, N = dn/dp, :math:`K = I + R P Q_a N`). On a plane (H = 0) :math:`G = n^T A_w`.
+
+    Args:
+        wheel: The wheel (a :class:`CompliantWheel` or any rolling wheel).
+        kin: The :class:`~robotdyn.constraints.constraint.KinematicState` (its q).
+
+    Returns:
+        G (nv,) [m per unit of each coordinate].
+    """
+    Aw, geo = wheel._world_jacobian(kin)
+    c, a, R, n, u, p, nw, phi, N, E, nc1 = geo
+    row = n @ Aw
+    if N is None:
+        return row
+    terrain = wheel.terrain
+    grad = np.asarray(terrain.gradient(p[0], p[1]), float)
+    H = np.asarray(terrain.hessian(p[0], p[1]), float)
+    w = np.zeros(3)
+    w[:2] = -phi / (1.0 + grad @ grad) * (H @ grad)
+    if not np.any(w):
+        return row
+    _, jac = kin.pose(wheel.fid)
+    Jc = jac[:3].copy()
+    if wheel.radius_index is not None:
+        Jc[:, wheel.radius_index] -= u  # the centre's velocity less R-dot u
+    P = (np.eye(3) - np.outer(u, u)) / nw
+    Qa = np.eye(3) - np.outer(a, a)
+    K = np.eye(3) + R * P @ Qa @ N
+    z = P @ np.linalg.solve(K.T, w)  # w^T K^-1 P = z^T
+    skew_a = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    Ju = Qa @ N @ Jc + (np.outer(a, n) + (n @ a) * np.eye(3)) @ skew_a @ jac[3:]  # K P^-1 J_u, on the plane of u
+    return row + w @ Jc - R * (z @ Ju)
 
 
 def compliant_wheels(robot) -> list[CompliantWheel]:
@@ -353,7 +407,7 @@ def _number(value, what: str, unit: str, positive: bool = False) -> float:
 
 
 __all__ = ["NormalLaw", "LinearContact", "HuntCrossley", "CompliantWheel", "make_normal_law", "compliant_wheels", "compliant_wheel",
-           "CONTACT_LAWS"]
+           "penetration_gradient", "CONTACT_LAWS"]
 
 
 def compliant_wheel(robot, w, radius: float, roller_angle: float, **kwargs) -> CompliantWheel:

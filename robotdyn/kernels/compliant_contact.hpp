@@ -3,9 +3,10 @@
 // LinearTyre): the normal force law of penetration and the tangential friction law of a compliant wheel, in their
 // order of operations.
 //
-// With the wheel's rolling rows A = E^T A_w (3, nv; rows t1, t2, n of its contact frame, A_w the world Jacobian of
-// the wheel's material point at the contact point) and its signed distance phi above the terrain:
-//   penetration delta = -phi [m], its rate deltadot = -(A v)_n [m/s], slip s = (A v)_(t1, t2) [m/s];
+// With the wheel's rows A (3, nv): t1^T A_w, t2^T A_w (A_w the world Jacobian of the wheel's material point at the
+// contact point, t1, t2 its contact frame's tangents) and G = d phi / dq (penetration_gradient below), and its signed
+// distance phi above the terrain:
+//   penetration delta = -phi [m], its rate deltadot = -(A v)_n = -dphi/dt [m/s], slip s = (A v)_(t1, t2) [m/s];
 //   normal force f_n = N(delta, deltadot) >= 0 (zero for delta <= 0: the wheel flies; never pulling):
 //     linear         f_n = max(0, k delta + c deltadot)
 //     Hunt-Crossley  f_n = max(0, delta^n (k + lambda deltadot))   (Hunt & Crossley 1975; Marhefka & Orin 1999)
@@ -13,7 +14,15 @@
 //     F_t = -f_n D^T D c(D^T D s), c the friction law's coefficient (F_t = -f_n c(s), robotdyn/contact/friction.py)
 //   generalised force Q = A^T (F_t1, F_t2, f_n); friction power F_t . s (<= 0); damper power
 //   -(f_n - f_e(delta)) deltadot (<= 0), f_e the law's elastic part; stored energy U(delta) = int_0^delta f_e.
+//
+// penetration_gradient (compliant_contact.penetration_gradient): G = n^T A_w + w^T J_p, w = (-phi s^2 H grad f, 0)
+// (s = 1 / |(-f_x, -f_y, 1)|, H the terrain's Hessian, both at p: the gradient of phi(x) = (x_z - f) s at p is
+// n + (phi / s)(grad s, 0)), J_p = J_c - u dR/dq - R J_u the contact point's Jacobian, J_u = K^-1 P (Q_a N (J_c -
+// u dR/dq) + (a n^T + (n.a) I)[a]_x J_omega) (P = (I - u u^T) / nw, Q_a = I - a a^T, N = dn/dp, K = I + R P Q_a N:
+// the implicit solve of rolling_contact.hpp's drift); on a plane (H = 0) G = n^T A_w.
 #pragma once
+
+#include "rolling_contact.hpp"
 
 #include <Eigen/Core>
 
@@ -92,6 +101,32 @@ inline ContactState add_compliant_contact(const CompliantContact& c, double phi,
   out.friction_power = ft.dot(slip);
   Q.noalias() += A.transpose() * out.force;
   return out;
+}
+
+// G = d phi / dq (1, nv) of wheel `wh` with geometry g (wheel_rows at the configured q), its frame's
+// LOCAL_WORLD_ALIGNED Jacobian J (6, nv) and A_w (3, nv), into row (see the top of this file).
+inline void penetration_gradient(const Wheel& wh, const WheelGeometry& g, const Terrain& terrain, const Matrix6x& J,
+                                 const MatrixXd& Aw, Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> row) {
+  row.noalias() = g.n.transpose() * Aw;
+  if (terrain.flat()) return;
+  double f;
+  Eigen::Vector2d grad;
+  Eigen::Matrix2d H;
+  terrain.eval(g.p[0], g.p[1], f, grad, H);
+  Vector3d w = Vector3d::Zero();
+  w.head<2>() = -g.phi / (1.0 + grad.squaredNorm()) * (H * grad);
+  if (w.isZero(0.0)) return;
+  const Matrix3d P = (Matrix3d::Identity() - g.u * g.u.transpose()) / g.nw;
+  const Matrix3d Qa = Matrix3d::Identity() - g.a * g.a.transpose();
+  const Matrix3d K = Matrix3d::Identity() + g.R * (P * Qa * g.N);
+  const Vector3d z = P * K.transpose().partialPivLu().solve(w);  // w^T K^-1 P = z^T
+  // w^T J_c - (w.u) dR/dq - R z^T (Q_a N (J_c - u dR/dq) + (a n^T + (n.a) I)[a]_x J_omega)
+  const Eigen::RowVector3d zn = z.transpose() * (Qa * g.N);
+  const Eigen::RowVector3d cw = w.transpose() - g.R * zn;
+  row.noalias() += cw * J.topRows<3>();
+  const Matrix3d L = (g.a * g.n.transpose() + g.na * Matrix3d::Identity()) * skew(g.a);
+  row.noalias() -= (g.R * (z.transpose() * L)) * J.bottomRows<3>();
+  if (wh.radius_index >= 0) row[wh.radius_index] -= cw.dot(g.u);
 }
 
 }  // namespace kernels

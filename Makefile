@@ -34,16 +34,19 @@ chromium:
 	@[ "$$ROBOTDYN_SKIP_BROWSER" = 1 ] || command -v chromium >/dev/null 2>&1 || { SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y chromium; }
 
-## make test: install, then run the whole test suite, notebooks included
+## make test: install, then run the whole test suite, notebooks included: each notebook executed in a temporary
+## directory outside the repository, its outputs kept in $(NB_CACHE) for make docs (tools/notebook_cache.py)
+NB_CACHE := docs/_build/.jupyter_cache
 test: $(STAMP) chromium
 	$(PY) -m pytest -q tests
-	NB=$$(mktemp -d) && cp notebooks/*.ipynb $$NB/ && cd $$NB && $(CURDIR)/$(PY) -m pytest -q --nbmake -p no:cacheprovider --rootdir=. *.ipynb; status=$$?; rm -rf $$NB; exit $$status  # from a copy outside the repository
+	$(PY) tools/notebook_cache.py execute $(NB_CACHE) notebooks/*.ipynb
 
 ## make docs: the documentation site into docs/_build/html (Sphinx + MyST-NB: the notebooks executed, the API
 ## reference from the docstrings, the errata, the viewer pages), warnings as errors, then checked by
 ## tools/check_site.py (screenshots of four pages in docs/_build/screenshots/). Installs the `docs` group of
-## pyproject.toml without reinstalling robotdyn (no recompilation). SPHINXOPTS="-D nb_execution_mode=cache" reuses
-## notebook outputs whose source did not change.
+## pyproject.toml without reinstalling robotdyn (no recompilation). A notebook whose outputs make test left in
+## $(NB_CACHE) is not executed again, unless it or robotdyn's code changed since; SPHINXOPTS="-D
+## nb_execution_mode=force" executes every notebook.
 DOCS_STAMP := $(VENV)/.docs-installed
 SPHINXOPTS ?=
 $(DOCS_STAMP): $(STAMP) pyproject.toml
@@ -53,6 +56,7 @@ $(DOCS_STAMP): $(STAMP) pyproject.toml
 
 docs: $(DOCS_STAMP) chromium
 	rm -rf docs/api
+	$(PY) tools/notebook_cache.py drop-stale $(NB_CACHE)  # outputs of older code are not reused
 	$(PY) -m sphinx -b html -W --keep-going -c docs $(SPHINXOPTS) . docs/_build/html
 	$(PY) tools/check_site.py docs/_build/html  # local links and anchors, machine paths, alt text; math and figures in Chromium
 	@echo "docs: open docs/_build/html/index.html"

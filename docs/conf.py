@@ -45,7 +45,11 @@ extensions = [
 ]
 
 # ----------------------------------------------------------------------------------------------- notebooks
-nb_execution_mode = "force"  # always run against the current code (SPHINXOPTS="-D nb_execution_mode=cache" to reuse)
+# Outputs of a notebook whose code cells are unchanged are reused from the jupyter-cache that `make test` fills
+# (tools/notebook_cache.py, which `make docs` runs first to drop outputs older than robotdyn's code); any other
+# notebook is executed here, in its own folder, and cached. SPHINXOPTS="-D nb_execution_mode=force" runs them all.
+nb_execution_mode = "cache"
+nb_execution_cache_path = str(DOCS / "_build" / ".jupyter_cache")  # the Makefile's NB_CACHE
 nb_execution_timeout = 900  # per cell [s]
 nb_execution_raise_on_error = True  # a failing notebook fails the build
 nb_execution_show_tb = True

@@ -1,6 +1,7 @@
 """Write notebooks/viewer.ipynb (without outputs): the meshcat viewer in a notebook, for every registered robot.
 
-Usage: .venv/bin/python tools/make_viewer_notebook.py   (check with: pytest --nbmake notebooks/viewer.ipynb)
+Usage: .venv/bin/python tools/make_viewer_notebook.py   (check with: .venv/bin/python tools/notebook_cache.py execute
+/tmp/nb-cache notebooks/viewer.ipynb)
 """
 
 from __future__ import annotations

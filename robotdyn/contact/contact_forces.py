@@ -340,19 +340,35 @@ def cone_minimum(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: i
         d: Number of undetermined combinations.
 
     Returns:
-        The smallest ratio found: exact for d = 0 (or no T_i), a bounded scalar search for d = 1, SLSQP in epigraph
-        form above.
+        The smallest ratio found (:func:`cone_split`'s first value).
+    """
+    return cone_split(maps, fn, d)[0]
+
+
+def cone_split(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: int) -> tuple[float, np.ndarray]:
+    """:func:`cone_minimum` and the combinations z (d,) that reach it (the split the smallest ratio is found at).
+
+    Args:
+        maps: Per wheel ``(b_i, T_i)`` as for :func:`cone_minimum`.
+        fn: (W,) the wheels' normal loads [N] (or any positive scale per wheel, e.g. mu_i f_n,i), all positive.
+        d: Number of undetermined combinations.
+
+    Returns:
+        ``(ratio, z)``: the smallest :math:`\\max_i \\|b_i + T_i z\\| / f_{n,i}` found and its z (d,): exact for
+        d = 0 (or no T_i), a bounded scalar search for d = 1, SLSQP in epigraph form above.
     """
     ratio = lambda z: max(float(np.linalg.norm(b + T @ z)) / f for (b, T), f in zip(maps, fn))  # noqa: E731
+    zero = np.zeros(d)
     if d == 0 or all(not np.any(T) for _, T in maps):
-        return ratio(np.zeros(d))
+        return ratio(zero), zero
     if d == 1:  # one undetermined combination (two wheels on one axle, ...): a bounded scalar search
         from scipy.optimize import minimize_scalar
 
         scale = 10.0 * (1.0 + max(float(np.linalg.norm(b)) for b, _ in maps))
         res = minimize_scalar(lambda z: ratio(np.array([z])), bounds=(-scale, scale), method="bounded",
                               options={"xatol": 1e-12 * scale})
-        return min(float(res.fun), ratio(np.zeros(1)))
+        best = np.array([float(res.x)])
+        return (ratio(best), best) if ratio(best) <= ratio(zero) else (ratio(zero), zero)
     from scipy.optimize import minimize
 
     def cone(x, b, T, f):  # (t f)^2 - |b + T z|^2 >= 0 for x = (z, t)
@@ -363,10 +379,11 @@ def cone_minimum(maps: list[tuple[np.ndarray, np.ndarray]], fn: np.ndarray, d: i
 
     cons = [{"type": "ineq", "fun": cone, "jac": cone_jac, "args": (b, T, f)} for (b, T), f in zip(maps, fn)]
     last = np.append(np.zeros(d), 1.0)
-    x0 = np.append(np.zeros(d), ratio(np.zeros(d)))
+    x0 = np.append(np.zeros(d), ratio(zero))
     res = minimize(lambda x: x[-1], x0, jac=lambda x: last, constraints=cons,
                    bounds=[(None, None)] * d + [(0, None)], method="SLSQP", options={"ftol": 1e-14, "maxiter": 500})
-    return min(ratio(res.x[:-1]), ratio(np.zeros(d)))
+    best = np.asarray(res.x[:-1], float)
+    return (ratio(best), best) if ratio(best) <= ratio(zero) else (ratio(zero), zero)
 
 
 def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, compliance: bool = True

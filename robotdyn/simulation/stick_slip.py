@@ -14,6 +14,11 @@ A :class:`~robotdyn.contact.stick_slip_wheel.StickSlipWheel` is in one of two ph
   (decreasing) tries sticking: the wheel sticks if the sticking solution's force lies inside the cone, else it
   keeps sliding in the direction of that force (the concepts page ``docs/concepts.md``).
 
+On a statically indeterminate chassis (a rigid car or skid steer on four wheels) the normal loads are the rigid
+limit of the wheels' normal compliance (with sliding wheels, from the coupled solve of accelerations, loads and
+friction), and sticking wheels whose tangential forces stay open are decided together: they stick while some
+admissible split keeps each in its cone (:mod:`robotdyn.contact.sticking_cone`, one event for the group).
+
 Lift-off (a normal load reaching zero, decreasing) stops the run with a message naming the wheel, time and load.
 The independent velocities change with the phases, so :func:`simulate` integrates segment by segment and reports
 the full velocities v; the projection is rebuilt at every switch.
@@ -34,6 +39,7 @@ from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import sliding_now
 from ..contact.sliding import tangential as slip
 from ..contact.stick_slip_wheel import StickSlipWheel
+from ..contact.sticking_cone import check as cone_check
 from ..reduction.pull_back import position_rate
 from .progress import Progress
 from .trajectory import Trajectory
@@ -129,20 +135,27 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                 out_w.append(work)
             if moved_at is None:
                 break
-            t, (wheel, direction) = moved_at, _breaking(robot, wheels, q, moved_at, tau_at)
-            wheel.set_phase("slide", direction)
-            switches.append({"t": t, "wheel": wheel.name, "phase": "slide"})
+            t = moved_at
+            for wheel, direction in _breaking(robot, wheels, q, moved_at, tau_at):
+                wheel.set_phase("slide", direction)
+                switches.append({"t": t, "wheel": wheel.name, "phase": "slide"})
             v = np.zeros(n)
             continue
-        unknown = [w.name for w in wheels if w.phase == "stick" and not forces.wheel(w.name).load_determined]
-        if unknown:
-            raise _indeterminate(unknown, t)
+        sticking = [w for w in wheels if w.phase == "stick"]
+        cones = cone_check(forces, sticking)
+        group = [w for w, c in zip(sticking, cones.coupled) if c]  # decided together (open tangential forces)
         moved = False
-        for w in wheels:
-            if w.phase == "stick":
+        for w, c in zip(sticking, cones.coupled):
+            if not c:
                 f = forces.wheel(w.name)
                 if w.mu * f.normal - np.hypot(f.force[0], f.force[1]) < -1e-12 * max(1.0, abs(f.normal)):
                     w.set_phase("slide", -f.force[:2])
+                    switches.append({"t": t, "wheel": w.name, "phase": "slide"})
+                    moved = True
+        if group and cones.group_margin < -1e-12:
+            for w, direction in cones.breaking():
+                if w in group and w.phase == "stick":
+                    w.set_phase("slide", direction)
                     switches.append({"t": t, "wheel": w.name, "phase": "slide"})
                     moved = True
         if moved:
@@ -164,7 +177,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
             red = robot.reduced(qq, nn)
             return np.concatenate([position_rate(red, stabilisation), np.linalg.solve(red.M, red.B @ tau - red.h), [0.0]])
 
-        events = _events(robot, wheels, n, k, tau_at)
+        events = _events(robot, wheels, n, k, tau_at, group)
         seg = grid[(grid > t) | ((grid == 0.0) & (t == 0.0))]
         if len(seg) and seg[-1] < t_end:
             seg = np.append(seg, t_end)
@@ -186,15 +199,22 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         q, nu, work = y[:n], y[n:n + k], float(y[-1])
         v = robot.velocity(q, nu)
         _, wheel, kind = events[i]
-        if kind == "lift-off":
+        if kind == "slide together":  # the group's best split reaches a cone's edge: those wheels slide
+            cones = cone_check(_forces(robot, q, nu, tau_at(t, q, nu)), wheel)
+            worst = int(np.argmax(cones.ratio))
+            for w, direction in cones.breaking() or [(wheel[worst], -cones.force[worst])]:
+                w.set_phase("slide", direction)
+                switches.append({"t": t, "wheel": w.name, "phase": "slide"})
+        elif kind == "lift-off":
             load = _forces(robot, q, nu, tau_at(t, q, nu)).wheel(wheel.name).normal
             stop = (f"lift-off of wheel {wheel.name} at t = {t:.6g} s (normal load {load:.3g} N): the run stops "
                     "there (a wheel in flight is not modelled)")
             print(f"simulate: {stop}", file=sys.stderr, flush=True)
             break
-        if kind == "slide":  # the cone is reached: slide opposite to the sticking force
+        elif kind == "slide":  # the cone is reached: slide opposite to the sticking force
             f = _forces(robot, q, nu, tau_at(t, q, nu)).wheel(wheel.name)
             wheel.set_phase("slide", -f.force[:2])
+            switches.append({"t": t, "wheel": wheel.name, "phase": wheel.phase})
         else:  # the slip along its initial direction reached zero: stick, if the sticking force is in the cone
             wheel.set_phase("stick")
             kin = _kin(robot, q, v)
@@ -205,7 +225,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
             robot._stick_slip_q = q
             _configure(robot)
             v = robot.velocity(q, v[robot.independent_indices])  # the rolling rows hold from here on
-        switches.append({"t": t, "wheel": wheel.name, "phase": wheel.phase})
+            switches.append({"t": t, "wheel": wheel.name, "phase": wheel.phase})
         if len(switches) > max_switches:
             stop = f"more than {max_switches} phase switches by t = {t:.6g} s (Zeno behaviour); the run stops there"
             print(f"simulate: {stop}", file=sys.stderr, flush=True)
@@ -223,30 +243,13 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                       robot.units, np.array(out_w))
 
 
-def _indeterminate(names: list[str], t: float) -> RobotDynError:
-    return RobotDynError(
-        f"the sticking forces of wheels {', '.join(names)} are not determined by rigid-body dynamics at t = {t:.6g} s "
-        "(statically indeterminate contacts), so the friction cone cannot decide sticking; expected determinate "
-        "contacts, or a compliant friction law (friction = 'linear' or 'coulomb')")
-
-
-def _rest_margin(robot, wheels, q, t, tau_at) -> tuple[float, list]:
-    """At rest at q (no velocity left) at time t: the smallest cone margin :math:`\\mu f_n - \\|f_t\\|` [N] of the
-    sticking wheels and those wheels' forces. With statically indeterminate contacts the margin is that of the
-    best admissible split (:meth:`~robotdyn.contact.contact_forces.ConstraintForces.minimum_mu`: some split lies in
-    every cone iff it is at most the smallest mu), scaled by the smallest normal load; ``-inf`` where no normal
-    load is determined (nothing can decide)."""
+def _rest_margin(robot, wheels, q, t, tau_at):
+    """At rest at q (no velocity left) at time t: the smallest cone margin :math:`1 - \\|f_t\\| / (\\mu f_n)` [-] of
+    the sticking wheels and their :class:`~robotdyn.contact.sticking_cone.ConeCheck` (with statically indeterminate
+    contacts, at the admissible split that keeps them furthest inside their cones)."""
     tau = tau_at(t, q, np.zeros(0))
-    forces = _forces(robot, q, np.zeros(0), tau)
-    sticking = [w for w in wheels if w.phase == "stick"]
-    if all(forces.wheel(w.name).load_determined for w in sticking):
-        margins = [w.mu * forces.wheel(w.name).normal - np.hypot(*forces.wheel(w.name).force[:2]) for w in sticking]
-        return (min(margins) if margins else np.inf), [forces.wheel(w.name) for w in sticking]
-    need = forces.minimum_mu()
-    if need is None or not np.isfinite(need):
-        return -np.inf, []
-    load = min(w.normal for w in forces.wheels)
-    return (min(w.mu for w in sticking) - need) * load, []
+    cones = cone_check(_forces(robot, q, np.zeros(0), tau), [w for w in wheels if w.phase == "stick"])
+    return cones.margin, cones
 
 
 def _at_rest(robot, wheels, q, t: float, grid: np.ndarray, tau_at, constant: bool) -> float | None:
@@ -256,8 +259,8 @@ def _at_rest(robot, wheels, q, t: float, grid: np.ndarray, tau_at, constant: boo
     forces at rest, so with torques constant in time (``constant``) the check at t decides the whole run.
 
     Raises:
-        RobotDynError: Statically indeterminate sticking forces that no admissible split keeps in the cones (the
-            one-line error of indeterminate contacts, at the time it happens)."""
+        RobotDynError: A sticking wheel's normal load that nothing determines
+            (:func:`robotdyn.contact.sticking_cone.check`)."""
     from scipy.optimize import brentq
 
     def margin(tt: float) -> float:
@@ -269,8 +272,6 @@ def _at_rest(robot, wheels, q, t: float, grid: np.ndarray, tau_at, constant: boo
     for i, tt in enumerate(times):
         m = margin(tt)
         if m < -tol:
-            if m == -np.inf or not _rest_margin(robot, wheels, q, tt, tau_at)[1]:
-                raise _indeterminate([w.name for w in wheels if w.phase == "stick"], tt)
             return tt if i == 0 else float(brentq(lambda x: margin(x) + tol, last, tt, xtol=1e-12))
         last = tt
         if constant:
@@ -278,13 +279,12 @@ def _at_rest(robot, wheels, q, t: float, grid: np.ndarray, tau_at, constant: boo
     return None
 
 
-def _breaking(robot, wheels, q, t: float, tau_at):
-    """The sticking wheel whose force leaves its cone at time t (determinate forces), and its slip direction
-    (opposite to that force)."""
-    sticking = [w for w in wheels if w.phase == "stick"]
-    forces = _rest_margin(robot, wheels, q, t, tau_at)[1]
-    j = int(np.argmin([w.mu * f.normal - np.hypot(*f.force[:2]) for w, f in zip(sticking, forces)]))
-    return sticking[j], -forces[j].force[:2]
+def _breaking(robot, wheels, q, t: float, tau_at) -> list:
+    """The sticking wheels whose force leaves its cone at time t and their slip directions (opposite to that force,
+    at the split that keeps the wheels furthest inside their cones): ``[(wheel, direction), ...]``."""
+    cones = _rest_margin(robot, wheels, q, t, tau_at)[1]
+    j = int(np.argmax(cones.ratio))
+    return cones.breaking() or [(cones.wheels[j], -cones.force[j])]
 
 
 def _kin(robot, q, v):
@@ -293,23 +293,28 @@ def _kin(robot, q, v):
     return KinematicState(robot.model, robot.data, q, v)
 
 
-def _events(robot, wheels, n, k, tau_at):
-    """Event functions of the current phases: (function, wheel, the phase it leads to or ``lift-off``)."""
+def _events(robot, wheels, n, k, tau_at, group=()):
+    """Event functions of the current phases: (function, wheel, the phase it leads to or ``lift-off``); the sticking
+    wheels of ``group`` (their tangential forces stay open) share one event, (function, group, ``slide together``)."""
     out = []
+    last = {}
 
-    def state(t, y):
-        qq, nn = y[:n], y[n:n + k]
-        return qq, nn, _forces(robot, qq, nn, tau_at(t, qq, nn))
+    def state(t, y):  # every event of a step asks at the same (t, y): the forces are computed once
+        key = (t, y.tobytes())
+        if last.get("key") != key:
+            qq, nn = y[:n], y[n:n + k]
+            last["key"], last["value"] = key, (qq, nn, _forces(robot, qq, nn, tau_at(t, qq, nn)))
+        return last["value"]
 
     for w in wheels:
-        if w.phase == "stick":
+        if w.phase == "stick" and w not in group:
             def cone(t, y, w=w):
                 f = state(t, y)[2].wheel(w.name)
                 return w.mu * f.normal - np.hypot(f.force[0], f.force[1])
 
             cone.terminal, cone.direction = True, -1.0
             out.append((cone, w, "slide"))
-        else:
+        elif w.phase == "slide":
             def stops(t, y, w=w):
                 qq, nn = y[:n], y[n:n + k]
                 return float(slip(w, _kin(robot, qq, robot.velocity(qq, nn)))[1] @ w.direction)
@@ -322,4 +327,10 @@ def _events(robot, wheels, n, k, tau_at):
 
         lift.terminal, lift.direction = True, -1.0
         out.append((lift, w, "lift-off"))
+    if group:
+        def cones(t, y):
+            return cone_check(state(t, y)[2], list(group)).margin
+
+        cones.terminal, cones.direction = True, -1.0
+        out.append((cones, list(group), "slide together"))
     return out

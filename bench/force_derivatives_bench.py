@@ -1,4 +1,4 @@
-"""The compiled contact-force and required-mu derivatives (robotdyn.fast.compiled_force_derivatives) against the
+"""The compiled contact-force and required-mu derivatives (robotdyn.contact.compiled_force_derivatives) against the
 Python path, per call on the robots the compiled path serves, and the linkage rover's traction-limited path
 optimisation (robotdyn.robots.linkage_suspension.traction_path, analytic derivatives) with each, side by side in
 one run. Run alone: ``python bench/force_derivatives_bench.py`` (``--no-optimisation``: the per-call lines only).
@@ -17,7 +17,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from robotdyn.contact import force_derivatives  # noqa: E402
-from robotdyn.fast import compiled_force_derivatives as fast_forces  # noqa: E402
+from robotdyn.contact import compiled_force_derivatives as fast_forces  # noqa: E402
 from robotdyn.robot import Robot  # noqa: E402
 from robotdyn.robots import module  # noqa: E402
 

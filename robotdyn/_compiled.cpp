@@ -1346,7 +1346,7 @@ PYBIND11_MODULE(_compiled, m) {
              return py::make_tuple(r.nudot, r.dq, r.dnu, r.dtau, r.v, r.Vq, r.S, r.A, c.a, c.Aq, c.Wnu);
            },
            "the derivatives' tuple, then (a, da/dq at fixed nudot, dw/dnu) at (q, nu, tau) "
-           "(robotdyn.fast.compiled_force_derivatives)")
+           "(robotdyn.contact.compiled_force_derivatives)")
       .def("force_layer",
            [](Evaluator& ev, const VectorXd& q, const VectorXd& v, const VectorXd& a, const VectorXd& tau,
               const VectorXd& k, const std::vector<int>& unloaded, bool split) {
@@ -1359,7 +1359,7 @@ PYBIND11_MODULE(_compiled, m) {
              return py::make_tuple(l.lam, l.dq, l.dv, l.da, l.dtau, l.residual);
            },
            "(lambda, dlambda/dq, dlambda/dv, dlambda/da, dlambda/dtau, residual) at (q, v, a, tau) with the wheels' "
-           "normal stiffnesses and the unloaded wheels' indices (robotdyn.fast.compiled_force_derivatives)")
+           "normal stiffnesses and the unloaded wheels' indices (robotdyn.contact.compiled_force_derivatives)")
 #endif
       .def("profile", &Evaluator::profile, py::arg("q"), py::arg("nu"), py::arg("repeat"), py::arg("alpha") = 0.0,
            "seconds per call of each part of an evaluation, and of Pinocchio's CRBA + RNEA + frame Jacobians")

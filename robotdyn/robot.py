@@ -806,7 +806,7 @@ class Robot:
         required mu under motor torques ``tau``, with their derivatives in q (natural coordinates, and along the
         holonomic manifold in the independent position coordinates of :meth:`dynamics_derivatives`), nu and tau:
         a :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (compiled where the compiled
-        dynamics derivatives serve, :mod:`robotdyn.fast.compiled_force_derivatives`, else the Python reference
+        dynamics derivatives serve, :mod:`robotdyn.contact.compiled_force_derivatives`, else the Python reference
         :func:`robotdyn.contact.force_derivatives.contact_force_derivatives`).
 
         Args:
@@ -818,7 +818,7 @@ class Robot:
             A :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (forces [N]).
         """
         from .contact.force_derivatives import checked, contact_force_derivatives
-        from .fast.compiled_force_derivatives import compiled_force_derivatives
+        from .contact.compiled_force_derivatives import compiled_force_derivatives
 
         q, nu, tau = checked(self, q, nu, tau)
         fast = compiled_force_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves

@@ -1,4 +1,4 @@
-"""The compiled contact-force and required-mu derivatives (robotdyn.fast.compiled_force_derivatives, C++ kernel
+"""The compiled contact-force and required-mu derivatives (robotdyn.contact.compiled_force_derivatives, C++ kernel
 robotdyn/kernels/contact_forces_derivatives.hpp).
 
 References, independent of the compiled code:
@@ -24,7 +24,7 @@ from robotdyn.constraints.terrain import RampTerrain
 from robotdyn.contact.force_derivatives import contact_force_derivatives
 from robotdyn.fast.compiled import available
 from robotdyn.fast.compiled_derivatives import _CompiledDerivatives
-from robotdyn.fast.compiled_force_derivatives import compiled_force_derivatives
+from robotdyn.contact.compiled_force_derivatives import compiled_force_derivatives
 from robotdyn.robot import Robot
 from robotdyn.robots import module
 

@@ -25,12 +25,9 @@ import weakref
 
 import numpy as np
 
-from ..contact.contact_forces import floating_twin
-from ..contact.force_derivatives import ContactForceDerivatives, _Layer, along_motion, structure
-from ..contact.sliding import sliding_now
-from .compiled import Fallback
-from .compiled_derivatives import _CompiledDerivatives
-from .dispatch import compiled_model
+from ..fast.compiled import Fallback
+from ..fast.compiled_derivatives import _CompiledDerivatives
+from ..fast.dispatch import compiled_model
 
 _LAYOUT: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 """Per robot (or floating twin): its row labels, wheel entries (rows, directions) and normal stiffnesses."""
@@ -51,7 +48,7 @@ def _layout(target, fast, stiffness_robot) -> tuple:
     cached = _LAYOUT.get(target)
     if cached is not None and cached[0] == key:
         return cached[1]
-    from ..contact.compliance import wheel_stiffness
+    from .compliance import wheel_stiffness
 
     labels = list(fast.labels)
     index = {lab: i for i, lab in enumerate(labels)}
@@ -64,7 +61,7 @@ def _layout(target, fast, stiffness_robot) -> tuple:
 
 
 def compiled_force_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray
-                               ) -> ContactForceDerivatives | None:
+                               ) -> object | None:
     """The wheel contact forces, the required mu and their derivatives by the robot's compiled model, or ``None``
     where the Python path must answer (no compiled model, operational-space velocities, slipping wheels, a compiled
     fallback).
@@ -84,6 +81,10 @@ def compiled_force_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.nda
         InputError: The multipliers differentiated are not those of the reported forces (as the Python path).
         NonFiniteError: A non-finite result (as the Python path).
     """
+    from .contact_forces import floating_twin  # (the contact layer above: imported at call time)
+    from .force_derivatives import _Layer, along_motion, structure
+    from .sliding import sliding_now
+
     fast = compiled_model(robot)
     if not _serves(fast) or sliding_now(robot):
         return None

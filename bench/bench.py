@@ -155,6 +155,9 @@ def main() -> None:
     from derivatives_bench import derivatives_bench  # bench/derivatives_bench.py
 
     derivatives_bench()
+    from force_derivatives_bench import force_derivatives_bench  # bench/force_derivatives_bench.py
+
+    force_derivatives_bench()
     trajectory_optimisation_bench()
 
 

@@ -811,7 +811,8 @@ class Robot:
         """The wheel contact forces (normal load, tangential components in the contact frame) and each wheel's
         required mu under motor torques ``tau``, with their derivatives in q (natural coordinates, and along the
         holonomic manifold in the independent position coordinates of :meth:`dynamics_derivatives`), nu and tau:
-        a :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (Python path; see
+        a :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (compiled where the compiled
+        dynamics derivatives serve, :mod:`robotdyn.contact.compiled_force_derivatives`, else the Python reference
         :func:`robotdyn.contact.force_derivatives.contact_force_derivatives`).
 
         Args:
@@ -822,9 +823,12 @@ class Robot:
         Returns:
             A :class:`~robotdyn.contact.force_derivatives.ContactForceDerivatives` (forces [N]).
         """
-        from .contact.force_derivatives import contact_force_derivatives
+        from .contact.force_derivatives import checked, contact_force_derivatives
+        from .contact.compiled_force_derivatives import compiled_force_derivatives
 
-        return contact_force_derivatives(self, q, nu, tau)
+        q, nu, tau = checked(self, q, nu, tau)
+        fast = compiled_force_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves
+        return fast if fast is not None else contact_force_derivatives(self, q, nu, tau)
 
     def conditioning(self, q, nu, tau=None) -> list:
         """The ill-conditioned parts of the reduced solve at (q, nu) (the projection's :math:`A_d`, the reduced

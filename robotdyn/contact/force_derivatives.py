@@ -357,6 +357,52 @@ def _wheel_forces(lay: _Layer, Vq: np.ndarray, S: np.ndarray, Dq: np.ndarray, Dn
     return F, FQ, FV, FT
 
 
+def checked(robot, q, nu, tau) -> tuple:
+    """The state's arrays checked for :func:`contact_force_derivatives` (and its compiled twin), with its one-line
+    refusal of applied forces.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad].
+        nu: Independent velocities (k,) [m/s, rad/s].
+        tau: Motor torques/forces (n_motors,) [N m or N].
+
+    Returns:
+        ``(q, nu, tau)`` as float arrays.
+
+    Raises:
+        InputError: Wrong sizes; joint springs or compliant wheels.
+    """
+    q, nu, tau = robot.check_q(q), robot.check_nu(nu), robot.check_tau(tau)
+    if has_applied(robot):
+        raise InputError(f"contact force derivatives: robot {robot.spec.name!r} has joint springs or compliant "
+                         "wheels, whose forces have no derivatives here; expected rigid and slipping wheels, loop "
+                         "closures and joint couplings")
+    return q, nu, tau
+
+
+def structure(robot, q, nu, tau) -> tuple:
+    """The reported forces at the state and the structure the derivatives follow: ``(forces, unloaded, twin)``,
+    the :class:`~robotdyn.contact.contact_forces.ConstraintForces`, the names of the wheels the rigid limit holds
+    unloaded (its active set; none where no split avoids pulling) and whether the loads come from the floating
+    twin.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], checked.
+        nu: Independent velocities (k,) [m/s, rad/s], checked.
+        tau: Motor torques/forces (n_motors,) [N m or N], checked.
+
+    Returns:
+        ``(forces, unloaded (tuple of names), twin (bool))``.
+    """
+    forces = constraint_forces(robot, q, nu, tau=tau)
+    infeasible = any(note.startswith("no split of the loads pulls") for note in forces.notes)
+    unloaded = () if infeasible else tuple(forces.unloaded)
+    twin = any(note.startswith(TWIN_NOTE) for note in forces.notes)
+    return forces, unloaded, twin
+
+
 def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
     """The wheel contact forces and required mu at (q, nu) under motor torques tau, with their derivatives.
 
@@ -376,12 +422,8 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
             :meth:`robotdyn.robot.Robot.dynamics_derivatives`).
         NonFiniteError: A non-finite result.
     """
-    q, nu, tau = robot.check_q(q), robot.check_nu(nu), robot.check_tau(tau)
-    if has_applied(robot):
-        raise InputError(f"contact force derivatives: robot {robot.spec.name!r} has joint springs or compliant "
-                         "wheels, whose forces have no derivatives here; expected rigid and slipping wheels, loop "
-                         "closures and joint couplings")
-    forces = constraint_forces(robot, q, nu, tau=tau)
+    q, nu, tau = checked(robot, q, nu, tau)
+    forces, unloaded, twin = structure(robot, q, nu, tau)
     pc = pieces(robot, q, nu)  # shared with the dynamics derivatives (Robot.dynamics_derivatives' choice)
     if sliding_now(robot):
         from .sliding_derivatives import sliding_derivatives
@@ -396,9 +438,6 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
     a_q = pc.Aq(D.nudot) + S @ D.dq  # total da/dq
     a_nu = pc.Wnu + S @ D.dnu
     a_tau = S @ D.dtau
-    infeasible = any(note.startswith("no split of the loads pulls") for note in forces.notes)
-    unloaded = () if infeasible else tuple(forces.unloaded)
-    twin = any(note.startswith(TWIN_NOTE) for note in forces.notes)
     if twin:
         target, index = floating_twin(robot)
         nt = target.nq
@@ -409,14 +448,47 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
             return out
 
         lay = layer(target, lift(q), lift(v), lift(a), tau, robot, unloaded)
-        Lq, Lv, La = lay.dq[:, index], lay.dv[:, index], lay.da[:, index]
     else:
         lay = layer(robot, q, v, a, tau, robot, unloaded)
+    return along_motion(robot, q, nu, tau, forces, unloaded, twin, lay, D, pc.Vq, S, a_q, a_nu, a_tau)
+
+
+def along_motion(robot, q, nu, tau, forces, unloaded: tuple, twin: bool, lay: _Layer, D, Vq: np.ndarray,
+                 S: np.ndarray, a_q: np.ndarray, a_nu: np.ndarray, a_tau: np.ndarray) -> ContactForceDerivatives:
+    """Layer 2 of the module: the multipliers' partial derivatives ``lay`` chained along the motion, the wheel
+    forces, the required mu and their derivatives (shared by the Python path and its compiled twin,
+    :mod:`robotdyn.fast.compiled_force_derivatives`).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        q: Natural coordinates (n,) [m, rad], checked.
+        nu: Independent velocities (k,) [m/s, rad/s], checked.
+        tau: Motor torques/forces (n_motors,) [N m or N], checked.
+        forces: The reported forces (:func:`structure`).
+        unloaded: Names of the wheels the rigid limit holds unloaded.
+        twin: Whether ``lay`` is the floating twin's (its coordinates are mapped back).
+        lay: Layer 1 at (q, v, a, tau) (:func:`layer` or the compiled twin's).
+        D: The :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` at the state.
+        Vq: (n, n) :math:`\\partial v/\\partial q`, v = S(q) nu.
+        S: (n, k) the projection.
+        a_q, a_nu, a_tau: (n, n), (n, k), (n, n_motors) total derivatives of the accelerations a.
+
+    Returns:
+        A :class:`ContactForceDerivatives`.
+
+    Raises:
+        InputError: The multipliers differentiated are not those of the reported forces.
+        NonFiniteError: A non-finite result.
+    """
+    if twin:
+        _, index = floating_twin(robot)
+        Lq, Lv, La = lay.dq[:, index], lay.dv[:, index], lay.da[:, index]
+    else:
         Lq, Lv, La = lay.dq, lay.dv, lay.da
-    dlam_dq = Lq + Lv @ pc.Vq + La @ a_q
+    dlam_dq = Lq + Lv @ Vq + La @ a_q
     dlam_dnu = Lv @ S + La @ a_nu
     dlam_dtau = lay.dtau + La @ a_tau
-    F, FQ, FV, FT = _wheel_forces(lay, pc.Vq, S, dlam_dq, dlam_dnu, dlam_dtau)
+    F, FQ, FV, FT = _wheel_forces(lay, Vq, S, dlam_dq, dlam_dnu, dlam_dtau)
     # one story: the multipliers differentiated are those of the forces reported (else a structure not mirrored)
     reported = np.array([w.force for w in forces.wheels]).reshape(-1, 3)
     scale = max(1.0, float(np.abs(reported).max(initial=0.0)))
@@ -463,4 +535,4 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
     return out
 
 
-__all__ = ["ContactForceDerivatives", "contact_force_derivatives", "layer"]
+__all__ = ["ContactForceDerivatives", "along_motion", "checked", "contact_force_derivatives", "layer", "structure"]

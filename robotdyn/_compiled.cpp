@@ -44,9 +44,7 @@
 #include "_torque_profile.hpp"
 #include "_controller.hpp"
 #include "kernels/reduced_dynamics_derivatives.hpp"  // the derivatives (robotdyn/fast/compiled_derivatives.py)
-#ifdef ROBOTDYN_FORCE_DERIVATIVES  // (not yet built on this branch: define it once the build is checked)
-#include "kernels/contact_forces_derivatives.hpp"  // (robotdyn/fast/compiled_force_derivatives.py)
-#endif
+#include "kernels/contact_forces_derivatives.hpp"  // (robotdyn/contact/compiled_force_derivatives.py)
 
 #include <pybind11/pybind11.h>
 #include <pybind11/eigen.h>
@@ -74,9 +72,7 @@ namespace {
 
 class Evaluator {
   template <class> friend struct robotdyn::ReducedDerivatives;  // kernels/reduced_dynamics_derivatives.hpp
-#ifdef ROBOTDYN_FORCE_DERIVATIVES
   template <class> friend struct robotdyn::ContactForcesDerivatives;  // kernels/contact_forces_derivatives.hpp
-#endif
 
  public:
   Evaluator(const std::vector<std::string>& kinds, const std::vector<int>& parents,
@@ -1334,7 +1330,6 @@ PYBIND11_MODULE(_compiled, m) {
            },
            "(nudot, dnudot/dq, dnudot/dnu, dnudot/dtau, v, dv/dq, S, A) at (q, nu, tau) "
            "(robotdyn.fast.compiled_derivatives)")
-#ifdef ROBOTDYN_FORCE_DERIVATIVES
       .def("force_chain",
            [](Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
              using CFD = robotdyn::ContactForcesDerivatives<Evaluator>;
@@ -1363,7 +1358,6 @@ PYBIND11_MODULE(_compiled, m) {
            },
            "(lambda, dlambda/dq, dlambda/dv, dlambda/da, dlambda/dtau, residual) at (q, v, a, tau) with the wheels' "
            "normal stiffnesses and the unloaded wheels' indices (robotdyn.contact.compiled_force_derivatives)")
-#endif
       .def("profile", &Evaluator::profile, py::arg("q"), py::arg("nu"), py::arg("repeat"), py::arg("alpha") = 0.0,
            "seconds per call of each part of an evaluation, and of Pinocchio's CRBA + RNEA + frame Jacobians")
       .def_property_readonly("condition", &Evaluator::condition,

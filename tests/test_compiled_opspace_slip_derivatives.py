@@ -99,7 +99,8 @@ def test_operational_derivatives_equal_python_and_differences(which):
         C = compiled_derivatives(robot, q, nu, tau)
         assert C is not None
         assert_same(C, dynamics_derivatives(robot, q, nu, tau))
-        assert np.abs(C.dq).max() > 1e-6 and np.abs(C.dnu).max() > 1e-6  # not a vacuous comparison
+        # not a vacuous comparison (in body axes the twist dynamics do not depend on x, y, psi: dq is small there)
+        assert np.abs(C.dq).max() > 1e-8 and np.abs(C.dnu).max() > 1e-6
     check_against_compiled_differences(robot, *states[0])
 
 

@@ -83,8 +83,7 @@ def derivatives_bench() -> None:
         q, nu, tau = _state(robot, name, rng)
         fast = compiled_model(robot)
         if compiled_derivatives(robot, q, nu, tau) is None:
-            print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3}   Python path (operational-space velocities or "
-                  "slipping wheels are not compiled)")
+            print(f"{name:<20} {robot.nq:>3} {robot.mobility:>3}   Python path (the compiled model does not serve)")
             continue
         ev = fast.ev
         t_ev = _best(lambda: ev.rhs(q, nu, tau, 0.0), 500)
@@ -112,6 +111,45 @@ def derivatives_bench() -> None:
           f"{t_fd * 1e3:.2f} ms; compiled derivatives {t_c * 1e3:.3f} ms "
           f"({t_fd / t_c:.0f}x faster; API {t_fd / t_api:.0f}x), their largest difference {err:.1e} (relative; the "
           "differences' own error)")
+
+    operational_and_slipping_bench()
+
+
+def operational_and_slipping_bench() -> None:
+    """The compiled derivatives with operational-space velocities (TIAGo driven by its base twist) and with slipping
+    wheels (the skid-steer example, linear tyre law), against their Python path, per state."""
+    from dataclasses import replace
+
+    from robotdyn.contact.sliding_derivatives import sliding_derivatives
+    from robotdyn.interfaces.constraint_file import read
+    from robotdyn.reduction.operational_space import OperationalVelocities
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    spec = read(examples / "tiago.toml").SPEC
+    tiago = Robot(replace(spec, independent=None, operational=OperationalVelocities(
+        "base_footprint", ("vx", "wz"), "local", ["vx", "wz"])))
+    skid = read(examples / "skid_steer.toml").robot()
+    rng = np.random.default_rng(0)
+    q = tiago.neutral()
+    q[:5] = rng.uniform(-2, 2, 5)
+    cases = [("tiago (twist)", tiago, (q, rng.normal(size=2), rng.normal(size=2)), dynamics_derivatives)]
+    q = skid.neutral()
+    for c in ("x", "y", "yaw", "front_left_spin", "rear_right_spin"):
+        q[skid.coordinate_index(c)] = rng.uniform(-1, 1)
+    cases.append(("skid_steer (slipping)", skid, (q, rng.normal(size=skid.mobility) * 0.5, rng.normal(size=4)),
+                  sliding_derivatives))
+    print(f"{'robot':<22} {'n':>3} {'k':>3} {'eval':>7} {'derivs C++':>11} {'evals':>6} {'API':>8} "
+          f"{'Python path':>12} {'/ C++':>7}")
+    for name, robot, (q, nu, tau), python_path in cases:
+        ev = compiled_model(robot).ev
+        assert compiled_derivatives(robot, q, nu, tau) is not None, name
+        rhs = (lambda: ev.slip_rhs(q, nu, tau, 0.0)) if ev.slipping else (lambda: ev.rhs(q, nu, tau, 0.0))
+        t_ev = _best(rhs, 500)
+        t_c = _best(lambda: ev.derivatives(q, nu, tau), 100)
+        t_api = _best(lambda: robot.dynamics_derivatives(q, nu, tau), 50)
+        t_py = _best(lambda: python_path(robot, q, nu, tau), 3, 3)
+        print(f"{name:<22} {robot.nq:>3} {robot.mobility:>3} {t_ev * 1e6:>7.1f} {t_c * 1e6:>11.1f} "
+              f"{t_c / t_ev:>6.1f} {t_api * 1e6:>8.1f} {t_py * 1e6:>12.0f} {t_py / t_c:>6.0f}x")
 
 
 if __name__ == "__main__":

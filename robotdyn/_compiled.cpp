@@ -45,6 +45,8 @@
 #include "_controller.hpp"
 #include "kernels/reduced_dynamics_derivatives.hpp"  // the derivatives (robotdyn/fast/compiled_derivatives.py)
 #include "kernels/contact_forces_derivatives.hpp"  // (robotdyn/contact/compiled_force_derivatives.py)
+#include "kernels/operational_space_derivatives.hpp"  // ... with operational-space velocities
+#include "kernels/sliding_derivatives.hpp"            // ... with slipping wheels
 
 #include <pybind11/pybind11.h>
 #include <pybind11/eigen.h>
@@ -73,6 +75,9 @@ namespace {
 class Evaluator {
   template <class> friend struct robotdyn::ReducedDerivatives;  // kernels/reduced_dynamics_derivatives.hpp
   template <class> friend struct robotdyn::ContactForcesDerivatives;  // kernels/contact_forces_derivatives.hpp
+  template <class> friend struct robotdyn::ProjectedPieces;         // kernels/operational_space_derivatives.hpp
+  template <class> friend struct robotdyn::OperationalDerivatives;  // (the same)
+  template <class> friend struct robotdyn::SlidingDerivatives;      // kernels/sliding_derivatives.hpp
 
  public:
   Evaluator(const std::vector<std::string>& kinds, const std::vector<int>& parents,
@@ -1322,7 +1327,12 @@ PYBIND11_MODULE(_compiled, m) {
            [](Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
              robotdyn::derivs::Result r;
              try {
-               r = robotdyn::ReducedDerivatives<Evaluator>::run(ev, q, nu, tau);
+               if (ev.slipping())
+                 r = robotdyn::SlidingDerivatives<Evaluator>::run(ev, q, nu, tau);
+               else if (robotdyn::OperationalDerivatives<Evaluator>::serves(ev))
+                 r = robotdyn::OperationalDerivatives<Evaluator>::run(ev, q, nu, tau);
+               else
+                 r = robotdyn::ReducedDerivatives<Evaluator>::run(ev, q, nu, tau);
              } catch (const std::domain_error& e) {
                throw Fallback(e.what());
              }

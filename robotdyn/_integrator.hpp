@@ -3,9 +3,11 @@
 //
 // Two drivers:
 //  - run_sampled, for odeint's variable-step, variable-order Adams-Bashforth-Moulton (controlled_adams_bashforth_
-//    moulton, orders 1..8, PECE with a PI step-size controller; the default): it steps exactly onto every sample
-//    time (no interpolation) and every breakpoint, where it restarts the multistep history (a kink of the torque
-//    profile must not lie inside the interpolation that Adams formulas rest on);
+//    moulton, orders 1..8, PECE with a PI step-size controller; the default): it steps exactly onto every
+//    breakpoint, where it restarts the multistep history (a kink of the torque profile must not lie inside the
+//    interpolation that Adams formulas rest on), and takes the samples between its steps from the Hermite
+//    interpolant of its last accepted points (states and derivatives: HermiteHistory), so that dense sampling
+//    does not shorten its steps;
 //  - run_dense, for dense-output steppers (bulirsch_stoer_dense_out: Bulirsch-Stoer extrapolation; dopri5:
 //    Dormand-Prince 5(4)): the samples inside each accepted step are interpolated (the steps do not depend on the
 //    sampling); the stepper is restarted at breakpoints too.
@@ -193,28 +195,114 @@ Outcome run_dense(Stepper& stepper, System& system, const State& y0, double t0, 
   return out;
 }
 
-// A controlled multistep stepper (Adams) stepping exactly onto every sample (no interpolation) and breakpoint, and
-// restarted (reset) at breakpoints. A step that would end within 1 % of a target is stretched onto it.
+// The accepted points of a multistep run since its last restart (the newest `capacity`), each with its state and
+// its derivative, and the Hermite interpolant through them: the polynomial of degree 2 m - 1 that takes the m
+// states and derivatives at the m times (Newton's divided differences on the doubled nodes), evaluated at times
+// inside the newest interval. With m = 4 (degree 7) its error is O(h^8), below the Adams formulas' own at the
+// orders they reach at the run's tolerances.
+class HermiteHistory {
+ public:
+  explicit HermiteHistory(size_t capacity) : cap_(capacity) {}
+  void clear() { t_.clear(), x_.clear(), f_.clear(); }
+  size_t size() const { return t_.size(); }
+  double back() const { return t_.back(); }
+  void push(double t, const State& x, const State& f) {
+    if (t_.size() == cap_) {
+      t_.erase(t_.begin()), x_.erase(x_.begin()), f_.erase(f_.begin());
+    }
+    t_.push_back(t), x_.push_back(x), f_.push_back(f);
+  }
+  // The interpolant at s into out (size of a state).
+  void at(double s, State& out) {
+    const size_t m = t_.size(), N = 2 * m, d = x_.back().size();
+    c_.resize(N);
+    for (size_t j = 0; j < N; ++j) c_[j] = x_[j / 2];
+    for (size_t k = 1; k < N; ++k)
+      for (size_t j = N - 1; j >= k; --j) {
+        if (k == 1 && j % 2 == 1) {  // a doubled node: the derivative there
+          c_[j] = f_[j / 2];
+          continue;
+        }
+        const double dz = t_[j / 2] - t_[(j - k) / 2];
+        for (size_t i = 0; i < d; ++i) c_[j][i] = (c_[j][i] - c_[j - 1][i]) / dz;
+      }
+    out = c_[N - 1];
+    for (size_t j = N - 1; j-- > 0;) {
+      const double w = s - t_[j / 2];
+      for (size_t i = 0; i < d; ++i) out[i] = c_[j][i] + w * out[i];
+    }
+  }
+
+ private:
+  size_t cap_;
+  std::vector<double> t_;
+  std::vector<State> x_, f_, c_;
+};
+
+// A controlled multistep stepper (Adams) restarted (reset) at breakpoints and stepping exactly onto each of them
+// and onto t_end (a step that would end within 1 % of a target is stretched onto it). With `interpolate` the
+// samples between steps come from the Hermite interpolant of the accepted points (HermiteHistory: states and the
+// derivatives the stepper evaluated there), so the steps do not depend on the sampling; without, the stepper
+// steps exactly onto every sample too.
 template <class Stepper, class System, class Observer, class Poll, class Event = NoEvent>
 Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0, double t_end,
                     const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
                     double dt0, Observer&& observer, Poll&& poll, Event&& event = Event(), double rtol = 0.0,
-                    double atol = 0.0) {
+                    double atol = 0.0, bool interpolate = true) {
   Outcome out;
   const double eps = std::numeric_limits<double>::epsilon();
   auto reached = [&](double t, double target) { return target - t <= 8.0 * eps * std::max(1.0, std::fabs(target)); };
   size_t b = 0;
   while (b < breaks.size() && breaks[b] <= t0) ++b;
   while (next < samples.size() && samples[next] <= t0) observer(samples[next++], y0);
-  auto sys = [&system](const State& x, State& dxdt, double t) { system(x, dxdt, t); };
-  State x = y0, x_prev;
+  // the last evaluation (the stepper ends every accepted step with one at the accepted state) and the first one of
+  // each restarted segment (at its start state)
+  double call_t = 0.0, seg_t = t0;
+  State call_x, call_f, seg_x = y0, seg_f;
+  bool seg_open = true;
+  auto sys = [&](const State& x, State& dxdt, double t) {
+    system(x, dxdt, t);
+    if (!interpolate) return;
+    call_t = t, call_x = x, call_f = dxdt;
+    if (seg_open && t == seg_t && x == seg_x) seg_f = dxdt, seg_open = false;
+  };
+  HermiteHistory history(4);
+  State x = y0, x_prev, y_s(y0.size());
+  // the derivative at the accepted state (t, x): the stepper's last evaluation, else one more
+  auto accepted = [&](double t) {
+    if (history.size() == 0) {
+      if (seg_open) {
+        seg_f.resize(seg_x.size());
+        system(seg_x, seg_f, seg_t);
+        seg_open = false;
+      }
+      history.push(seg_t, seg_x, seg_f);
+    }
+    if (!(call_x == x && std::fabs(call_t - t) <= 8.0 * eps * std::max(1.0, std::fabs(t)))) {
+      call_f.resize(x.size());
+      system(x, call_f, t);
+    }
+    history.push(t, x, call_f);
+  };
+  auto emit_to = [&](double t_to, bool at_end) {  // the samples up to t_to, on the interpolant (t_to: accepted)
+    while (next < samples.size() && (samples[next] <= t_to || reached(t_to, samples[next]))) {
+      const double ts = samples[next++];
+      if (reached(ts, history.back()) || ts >= history.back()) {
+        observer(ts, x);
+      } else {
+        history.at(ts, y_s);
+        observer(ts, y_s);
+      }
+    }
+    (void)at_end;
+  };
   double t = t0, dt_nat = dt0;
   double g_prev = event.active() ? event(t0, y0) : 0.0;
   int rejected = 0;
   auto clock = std::chrono::steady_clock::now();
   while (!reached(t, t_end)) {
     double target = t_end;
-    if (next < samples.size()) target = std::min(target, samples[next]);
+    if (!interpolate && next < samples.size()) target = std::min(target, samples[next]);
     if (b < breaks.size()) target = std::min(target, breaks[b]);
     const bool truncated = t + 1.01 * dt_nat >= target;
     double dt = truncated ? target - t : dt_nat;
@@ -238,10 +326,13 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
     dt_nat = truncated ? std::max(dt, dt_nat) : dt;
     ++out.steps;
     if (truncated) t = target;  // land exactly
+    if (interpolate) accepted(t);
+    bool restart = false;
     if (b < breaks.size() && reached(t, breaks[b])) {  // a kink: the multistep history must not span it
       while (b < breaks.size() && reached(t, breaks[b])) ++b;
       stepper.reset();
       dt_nat = std::min(dt_nat, dt0);
+      restart = true;
     }
     if (event.active()) {
       const double g1 = event(t, x);
@@ -258,6 +349,7 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
               return event(tc, y);
             },
             t_prev, g_prev, t, g1);
+        if (interpolate) emit_to(te, false);
         if (reached(te, t)) {  // the root is the step's end
           while (next < samples.size() && reached(t, samples[next])) observer(samples[next++], x);
           y = x;
@@ -271,7 +363,13 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
       }
       g_prev = g1;
     }
-    while (next < samples.size() && reached(t, samples[next])) observer(samples[next++], x);
+    if (interpolate) emit_to(t, false);
+    else
+      while (next < samples.size() && reached(t, samples[next])) observer(samples[next++], x);
+    if (restart && interpolate) {  // a new segment starts here
+      history.clear();
+      seg_t = t, seg_x = x, seg_open = true;
+    }
     if ((out.steps & 15) == 0) {
       const auto now = std::chrono::steady_clock::now();
       if (now - clock > std::chrono::milliseconds(50)) {

@@ -768,9 +768,9 @@ class Robot:
         """:math:`\\dot\\nu` and its derivatives in q (natural coordinates, and along the holonomic manifold in
         independent position coordinates), :math:`\\nu` and :math:`\\tau`: a
         :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` (compiled where the compiled model
-        serves, :mod:`robotdyn.fast.compiled_derivatives`, else the Python reference
-        :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`; with slipping wheels
-        :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`).
+        serves, :mod:`robotdyn.fast.compiled_derivatives`, operational-space velocities and slipping wheels included,
+        else the Python reference :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`; with
+        slipping wheels :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`).
 
         Args:
             q: Natural coordinates (n,) [m, rad] in the order of :attr:`coordinates`, on the holonomic constraint
@@ -790,22 +790,26 @@ class Robot:
             SingularConstraintError: Slipping wheels whose coupled system is singular (Painlevé).
             NonFiniteError: A non-finite result.
         """
-        if sliding_now(self):
-            from .contact.sliding_derivatives import sliding_derivatives
-
-            return sliding_derivatives(self, q, nu, tau)
         from .fast.compiled_derivatives import compiled_derivatives
         from .reduction.dynamics_derivatives import dynamics_derivatives
         from .constraints.row_derivatives import kind
 
+        sliding = bool(sliding_now(self))
+        python_path = dynamics_derivatives
+        if sliding:
+            from .contact.sliding_derivatives import sliding_derivatives, smooth_sliding
+
+            python_path = sliding_derivatives
         if check:
             q, nu, tau = self.check_q(q), self.check_nu(nu), self.check_tau(tau)
+            if sliding:
+                smooth_sliding(self)  # the one-line refusal of stick-slip and exact Coulomb friction, on either path
             for c in self.constraints:
-                kind(c)  # the Python path's one-line refusal of a constraint without derivatives, on either path
+                kind(c, sliding=sliding)  # the one-line refusal of a constraint without derivatives, on either path
         else:
             q, nu, tau = (np.asarray(x, dtype=float) for x in (q, nu, tau))
         fast = compiled_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves
-        return fast if fast is not None else dynamics_derivatives(self, q, nu, tau)
+        return fast if fast is not None else python_path(self, q, nu, tau)
 
     def contact_force_derivatives(self, q, nu, tau):
         """The wheel contact forces (normal load, tangential components in the contact frame) and each wheel's

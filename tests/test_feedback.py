@@ -55,6 +55,41 @@ def test_circle_law_acceleration_is_the_path_acceleration():
     assert np.allclose(law.acceleration.at(t), oc.path_state("circle", t)["nudot"], rtol=0, atol=1e-15)
 
 
+def test_ellipse_law_acceleration_is_the_path_acceleration():
+    """The ellipse's reference acceleration as a piecewise polynomial (a fit: u'' is a function of beta(t), not a
+    polynomial of t) equals path_state's u'' to 1e-13 (max |u''| = 0.84) on [0, T], zero outside, for both headings;
+    its only breakpoints are the ends of the motion."""
+    oc = module("omni_caster")
+    robot = robotdyn.load("omni_caster")
+    t = np.linspace(-1.0, oc.ELLIPSE["T"] + 1.0, 4001)
+    for params in (None, {"heading": "fixed"}):
+        law = oc.ellipse_law(robot, params)
+        assert np.abs(law.acceleration.at(t) - oc.path_state("ellipse", t, params)["nudot"]).max() < 1e-13
+        assert law.acceleration.breakpoints().tolist() == [0.0, oc.ELLIPSE["T"]]
+
+
+def test_ellipse_runs_compiled_and_ends_where_the_closed_form_law_ends_on_scipy():
+    """The ellipse scenario (its law as data, compiled) against the same feed-forward written with path_state's
+    closed-form u''(t) as a Python callable on scipy's LSODA, both at rtol = atol = 1e-9, over 6 s: the final states
+    agree to 1e-6 (the circle's tolerance), and the platform twist follows the plan to 1e-7 at every sample."""
+    oc = module("omni_caster")
+    robot = robotdyn.load("omni_caster")
+    sc = oc.SCENARIOS["ellipse"]
+    fast = sc.run(robot, t_end=6.0, n_out=13, progress=False)
+    q0, nu0 = sc.initial_state(robot)
+
+    def closed_form(t, q, nu):
+        red = robot.reduced(q, nu)
+        return np.linalg.lstsq(red.B, red.M @ oc.path_state("ellipse", t)["nudot"] + red.h, rcond=None)[0]
+
+    ref = simulate(robot, 6.0, q0, nu0, closed_form, n_out=13, method="LSODA", rtol=1e-9, atol=1e-9,
+                   progress=False)
+    assert fast.stats["engine"].startswith("compiled") and ref.stats["engine"].startswith("scipy")
+    assert np.abs(fast.q[-1] - ref.q[-1]).max() <= 1e-6 and np.abs(fast.nu[-1] - ref.nu[-1]).max() <= 1e-6
+    assert np.abs(fast.nu - oc.path_state("ellipse", fast.t)["nu"]).max() < 1e-7
+    assert np.abs(fast.q[-1] - fast.q[0]).max() > 1e-2
+
+
 def _random_states(robot, qs, rng):
     """The configurations ``qs`` (on the constraint manifold) with random independent velocities."""
     return [(q, rng.normal(size=robot.mobility)) for q in qs]

@@ -12,7 +12,7 @@ import pytest
 from robotdyn.fast.dispatch import available
 from robotdyn.errors import InputError
 from robotdyn.robots import quasimoro
-from robotdyn.simulation.torque_profile import Constant, Sine, Sum, Table, as_profile
+from robotdyn.simulation.torque_profile import Constant, PiecewisePolynomial, Sine, Sum, Table, as_profile
 
 
 def profiles():
@@ -22,6 +22,9 @@ def profiles():
         "sine": Sine([1.0, -2.0], 3.7, phase=0.3),
         "table": Table([0.0, 0.5, 2.0, 2.5], [[0.0, 1.0], [1.0, 1.0], [-1.0, 0.5], [0.0, 0.0]]),
         "sum": Constant([0.1, 0.2]) + Sine([0.3, 0.0], 2.0, start=0.5, stop=1.5) + Table([1.0, 2.0], [[0, 0], [1, 2]]),
+        "piecewise": PiecewisePolynomial([0.0, 0.5, 2.0, 2.5], [[[1.0, -2.0], [0.5, 0.25], [-3.0, 1.5]],
+                                                                 [[0.0, 1.0], [2.0, -1.0], [0.0, 0.0]],
+                                                                 [[-1.0, 0.5], [0.125, 4.0], [2.0, -0.5]]]),
     }
 
 
@@ -94,3 +97,33 @@ def test_values_at_many_times_are_the_scalar_ones(name):
     assert many.shape == (t.size, 2)
     assert np.max(np.abs(many - one)) <= 4e-16 * max(1.0, np.max(np.abs(one)))
     assert np.array_equal(many == 0.0, one == 0.0)
+
+
+def test_piecewise_polynomial_closed_form_breakpoints_and_fit():
+    """Piece j is sum_i c_ji (t - x_j)^i on [x_j, x_j+1] (a shared knot belongs to the later piece), zero outside;
+    every knot is a breakpoint unless the pieces are smooth. The fit of f(t) = (exp(-t/2) sin 3t, cos 2t) on [0, 4]
+    s (its closed form) is within 1e-13 everywhere and states its error; a fit too coarse for the tolerance is refused
+    in one line."""
+    p = profiles()["piecewise"]
+    c = p.coefficients
+    for t, j in ((0.25, 0), (0.5, 1), (1.2, 1), (2.0, 2), (2.5, 2)):
+        s = t - p.knots[j]
+        assert np.allclose(p(t), c[j, 0] + c[j, 1] * s + c[j, 2] * s**2, rtol=0, atol=1e-15), t
+    assert np.array_equal(p(-1e-12), [0.0, 0.0]) and np.array_equal(p(2.5 + 1e-12), [0.0, 0.0])
+    assert p.breakpoints().tolist() == [0.0, 0.5, 2.0, 2.5]
+
+    def f(t):
+        return np.stack([np.exp(-t / 2) * np.sin(3 * t), np.cos(2 * t)], axis=-1)
+
+    fit = PiecewisePolynomial.fit(f, 0.0, 4.0, pieces=16, degree=12)
+    assert fit.breakpoints().tolist() == [0.0, 4.0]
+    t = np.linspace(0.0, 4.0, 3001)
+    assert np.abs(fit.at(t) - f(t)).max() < 1e-13 and fit.fit_error < 1e-13
+    with pytest.raises(InputError, match="more pieces or a higher degree") as err:
+        PiecewisePolynomial.fit(f, 0.0, 4.0, pieces=2, degree=3)
+    assert "\n" not in str(err.value)
+    for make, words in ((lambda: PiecewisePolynomial([0.0, 0.0], [[[1.0]]]), "increasing"),
+                        (lambda: PiecewisePolynomial([0.0, 1.0, 2.0], [[[1.0]]]), "2 pieces"),
+                        (lambda: PiecewisePolynomial.fit(f, 1.0, 0.0, 4), "start < stop")):
+        with pytest.raises(InputError, match=words):
+            make()

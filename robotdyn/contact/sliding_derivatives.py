@@ -17,8 +17,10 @@ frame pass per velocity (:class:`~robotdyn.constraints.row_derivatives.FramePass
 :math:`c'(s)` is analytic for :class:`~robotdyn.contact.friction.RegularisedCoulomb` and
 :class:`~robotdyn.contact.friction.LinearTyre` (in its linear and in its saturated range; at the kink it has none
 and the linear side is taken); another smooth law's by central differences, reported as numerical. Exact
-(set-valued) Coulomb friction and stick-slip wheels have no derivative and are refused in one line. The rest is
-:mod:`robotdyn.reduction.dynamics_derivatives`.
+(set-valued) Coulomb friction and stick-slip wheels have no derivative and are refused in one line
+(:func:`smooth_sliding`). The rest is :mod:`robotdyn.reduction.dynamics_derivatives`. The compiled twin is
+``robotdyn/kernels/sliding_derivatives.hpp`` (:mod:`robotdyn.fast.compiled_derivatives`), which
+:meth:`robotdyn.robot.Robot.dynamics_derivatives` takes where the compiled model simulates the slipping wheels.
 """
 
 from __future__ import annotations
@@ -71,6 +73,30 @@ def law_jacobian(wheel: SlippingWheel, s: np.ndarray, numerical: set[str]) -> np
     return f[:, None] * J * f[None, :]
 
 
+def smooth_sliding(robot) -> list:
+    """The wheels sliding now (:func:`~robotdyn.contact.sliding.sliding_now`), each checked to have a derivative:
+    the one-line refusal of stick-slip wheels and exact Coulomb friction, on the Python and the compiled path.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The sliding wheels (:class:`~robotdyn.contact.sliding.SlippingWheel`), in the robot's order.
+
+    Raises:
+        InputError: A stick-slip wheel, or a law without a derivative (exact Coulomb friction).
+    """
+    wheels = sliding_now(robot)
+    for wheel in wheels:
+        if not isinstance(wheel, SlippingWheel):
+            raise InputError(f"dynamics derivatives: wheel {wheel.name!r} switches between sticking and slipping "
+                             "(stick-slip), which has no derivative; expected rolling or smoothly slipping wheels")
+        if isinstance(wheel.law, ExactCoulomb):
+            raise InputError(f"dynamics derivatives: wheel {wheel.name!r} has exact (set-valued) Coulomb friction, "
+                             "which has no derivative; expected friction = 'coulomb' (regularised) or 'linear'")
+    return wheels
+
+
 def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
     """:math:`\\dot\\nu` and its derivatives in q, :math:`\\nu`, :math:`\\tau` for a robot with slipping wheels
     (Python path; the same contents as :func:`robotdyn.reduction.dynamics_derivatives.dynamics_derivatives`).
@@ -94,14 +120,7 @@ def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
         NonFiniteError: A non-finite result.
     """
     q, nu, tau = robot.check_q(q), robot.check_nu(nu), robot.check_tau(tau)
-    wheels = sliding_now(robot)
-    for wheel in wheels:
-        if not isinstance(wheel, SlippingWheel):
-            raise InputError(f"dynamics derivatives: wheel {wheel.name!r} switches between sticking and slipping "
-                             "(stick-slip), which has no derivative; expected rolling or smoothly slipping wheels")
-        if isinstance(wheel.law, ExactCoulomb):
-            raise InputError(f"dynamics derivatives: wheel {wheel.name!r} has exact (set-valued) Coulomb friction, "
-                             "which has no derivative; expected friction = 'coulomb' (regularised) or 'linear'")
+    wheels = smooth_sliding(robot)
     pc = pieces(robot, q, nu) if pc is None else pc
     model, tree, n, k = pc.model, pc.tree, pc.n, pc.k
     S, M, v, w, B, kin0 = pc.S, pc.M, pc.v, pc.w, pc.B, pc.kin0
@@ -150,4 +169,4 @@ def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
     return result(robot, pc, nudot, X[:, :n], X[:, n:n + k], X[:, n + k:])
 
 
-__all__ = ["sliding_derivatives", "law_jacobian"]
+__all__ = ["sliding_derivatives", "law_jacobian", "smooth_sliding"]

@@ -11,12 +11,17 @@ formulas as the Python reference, in the same order, on Pinocchio's own C++ deri
 :math:`\\dot q = S\\nu`, :math:`\\partial(S\\nu)/\\partial q`, S and the constraint rows A (from which the independent
 position coordinates and the tangent of the holonomic manifold are chosen here, as the Python path does).
 
-It serves what the compiled model serves (:func:`robotdyn.fast.compiled.why_not`) with independent velocities that
-are a selection of v: rolling wheels on the compiled terrains (whose third derivatives are closed forms, so every
-piece is analytic), loop closures and cosine-law joint couplings. Operational-space velocities and slipping wheels
-are left to the Python path (:func:`compiled_derivatives` returns ``None``), as is any state where the compiled
-evaluation falls back (a projection that must be re-chosen, a wheel lying flat). ``tests/test_compiled_derivatives.py``
-checks every output against the Python path on every built-in robot.
+It serves what the compiled model serves (:func:`robotdyn.fast.compiled.why_not`): rolling wheels on the compiled
+terrains (whose third derivatives are closed forms, so every piece is analytic), loop closures and cosine-law joint
+couplings, with independent velocities that are a selection of v or a frame's twist (operational-space velocities,
+``kernels/operational_space_derivatives.hpp``), and wheels slipping under the compiled friction laws (regularised
+Coulomb, the linear tyre: ``kernels/sliding_derivatives.hpp``, the twin of
+:func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`). The Python path answers (:func:`compiled_derivatives`
+returns ``None``) where the compiled model does not serve, where it simulates the slipping wheels on the Python path
+(its ``slip_refusal``: e.g. statically indeterminate loads), and at any state where the compiled evaluation falls
+back (a projection that must be re-chosen, a wheel lying flat, a singular slipping contact problem: the Python path
+raises its error there). ``tests/test_compiled_derivatives.py`` checks every output against the Python path on every
+built-in robot, ``tests/test_compiled_opspace_slip_derivatives.py`` the operational and slipping ones.
 """
 
 from __future__ import annotations
@@ -46,7 +51,7 @@ class _CompiledDerivatives(DynamicsDerivatives):
 
 def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives | None:
     """:math:`\\dot\\nu` and its derivatives at one state by the robot's compiled model, or ``None`` where the
-    Python path must answer (no compiled model, operational-space velocities, slipping wheels, a compiled fallback).
+    Python path must answer (no compiled model, slipping wheels it does not simulate, a compiled fallback).
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
@@ -62,7 +67,7 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
         NonFiniteError: A non-finite result (as the Python path).
     """
     fast = compiled_model(robot)
-    if fast is None or fast.operational is not None or getattr(fast.ev, "slipping", 0) \
+    if fast is None or fast.slip_refusal is not None \
             or not hasattr(fast.ev, "derivatives"):  # (an extension built before the derivatives)
         return None
     if not fast.ready:
@@ -79,7 +84,9 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
     out = _CompiledDerivatives.__new__(_CompiledDerivatives)
     out.__dict__.update(nudot=nudot, dq=dq, dnu=dnu, dtau=dtau, qdot=v, dqdot_dq=Vq, S=S, numerical=(),
                         coordinates=list(robot.coordinates), velocities=list(robot.velocity_names),
-                        motors=[m.name for m in robot.motors], _manifold=(A, fast.holonomic, fast._hint.dependent))
+                        motors=[m.name for m in robot.motors],
+                        _manifold=(A, fast.holonomic,
+                                   None if fast.operational is not None else fast._hint.dependent))
     return out
 
 
@@ -99,8 +106,7 @@ def raw_derivatives(fast, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tup
     Returns:
         The tuple of arrays, or ``None``.
     """
-    if fast.operational is not None or getattr(fast.ev, "slipping", 0) or not hasattr(fast.ev, "derivatives") \
-            or not fast.ready:
+    if fast.slip_refusal is not None or not hasattr(fast.ev, "derivatives") or not fast.ready:
         return None
     try:
         out = fast.ev.derivatives(q, nu, tau)

@@ -25,6 +25,7 @@ namespace derivs {
 // Work buffers kept by the evaluator between calls (Pinocchio data of the passes and of the tree derivatives).
 struct Workspace {
   std::vector<FramePass> passes;  // columns of S, then w, then v
+  std::vector<FramePass> units;   // at the unit vectors (sliding_derivatives.hpp: every column of dA/dq)
   pinocchio::Data tree;
   bool has_tree = false;
   std::vector<MatrixXd> dA;  // d(A x)/dq per pass (m x n)
@@ -254,11 +255,14 @@ struct ReducedDerivatives {
     return out;
   }
 
-  // G -= S^T d(B(q) tau)/dq at fixed S (motor_rows): motors reacting on a body
-  static void motor_rows(Ev& ev, const Eigen::Ref<const VectorXd>& tau, MatrixXd& G) {
+  // G -= S^T d(B(q) tau)/dq at fixed S (motor_rows): motors reacting on a body; with `passes` (default: the columns
+  // of S) G -= X^T d(B tau)/dq for the passes' velocities X (at the unit vectors: d(B tau)/dq itself)
+  static void motor_rows(Ev& ev, const Eigen::Ref<const VectorXd>& tau, MatrixXd& G,
+                         std::vector<derivs::FramePass>* passes = nullptr) {
     const Model& model = ev.model_;
     const int n = ev.nv_;
-    const int k = static_cast<int>(ev.S_.cols());
+    std::vector<derivs::FramePass>& ps = passes ? *passes : ev.deriv_.passes;
+    const int k = passes ? static_cast<int>(passes->size()) : static_cast<int>(ev.S_.cols());
     for (size_t j = 0; j < ev.motors_.size(); ++j) {
       const auto& mo = ev.motors_[j];
       if (mo.reaction < 0 || tau[j] == 0.0) continue;
@@ -274,7 +278,7 @@ struct ReducedDerivatives {
       const derivs::Matrix3x daxis = -derivs::skew3(axis) * Jw;
       const int rf = ev.frames_[mo.reaction];
       for (int l = 0; l < k; ++l) {
-        derivs::FramePass& fp = ev.deriv_.passes[l];
+        derivs::FramePass& fp = ps[l];
         Eigen::Vector3d wc;
         derivs::Matrix3x dwc;
         fp.joint_angular(model, jid, wc, dwc);

@@ -11,6 +11,9 @@ motors [N m or N] times a scalar function of time:
 - :class:`Table`: piecewise-linear interpolation of values at increasing times, held constant outside them;
 - :class:`Polynomial`: :math:`\\tau = c_0 + c_1 t + \\dots + c_d t^d` inside a window, zero outside (Horner's
   scheme on both sides);
+- :class:`PiecewisePolynomial`: a polynomial in :math:`t - x_j` on each piece :math:`[x_j, x_{j+1}]` of a set of
+  knots, zero outside them; :meth:`PiecewisePolynomial.fit` interpolates a smooth function of time (Chebyshev
+  interpolation on each piece) to a stated error;
 - sums of these (``a + b``, or :class:`Sum`).
 
 A profile is callable with the scipy path's signature ``profile(t, q, nu)`` (q and nu are ignored), and
@@ -29,7 +32,7 @@ import numpy as np
 
 from ..errors import InputError
 
-CONSTANT, SINE, TABLE, POLYNOMIAL = 0, 1, 2, 3
+CONSTANT, SINE, TABLE, POLYNOMIAL, PIECEWISE = 0, 1, 2, 3, 4
 """Term kinds in :meth:`TorqueProfile.encode` (the C++ side's codes)."""
 
 
@@ -73,6 +76,10 @@ class TorqueProfile:
             elif kind == POLYNOMIAL:
                 if par[0] <= t <= par[1]:
                     out = out + _horner(coef, t)
+            elif kind == PIECEWISE:
+                if par[1] <= t <= par[-1]:
+                    j, s = _piece(par[1:], np.array([t]))
+                    out = out + _horner(_blocks(coef, par)[j[0]], s[0])
             else:  # coef: (points, motors) values, par: the times
                 out = out + _interpolate(par, coef, t)
         return out
@@ -98,6 +105,11 @@ class TorqueProfile:
             elif kind == POLYNOMIAL:
                 inside = (par[0] <= t) & (t <= par[1])
                 out = out + np.where(inside[:, None], _horner(coef, t[:, None]), 0.0)
+            elif kind == PIECEWISE:
+                inside = (par[1] <= t) & (t <= par[-1])
+                j, s = _piece(par[1:], t)
+                blocks = np.moveaxis(_blocks(coef, par)[j], 0, 1)  # (degree + 1, T, motors)
+                out = out + np.where(inside[:, None], _horner(blocks, s[:, None]), 0.0)
             else:
                 i = np.clip(np.searchsorted(par, t, side="right") - 1, 0, len(par) - 2)
                 s = (t - par[i]) / (par[i + 1] - par[i])
@@ -118,6 +130,8 @@ class TorqueProfile:
                 points += [x for x in par[2:4] if math.isfinite(x)]
             elif kind == POLYNOMIAL:
                 points += [x for x in par[0:2] if math.isfinite(x)]
+            elif kind == PIECEWISE:  # par[0]: whether the pieces join smoothly (only the ends are breakpoints)
+                points += [par[1], par[-1]] if par[0] else list(par[1:])
             elif kind == TABLE:
                 points += list(par)
         return np.array(sorted(set(map(float, points))), float)  # np.unique would import numpy.ma (~20 ms) on first use
@@ -165,6 +179,18 @@ def _horner(coef: np.ndarray, t):
     for i in range(coef.shape[0] - 2, -1, -1):
         p = coef[i] + t * p
     return p
+
+
+def _blocks(coef: np.ndarray, par: np.ndarray) -> np.ndarray:
+    """A piecewise term's coefficients (pieces (degree + 1), motors) as (pieces, degree + 1, motors)."""
+    return coef.reshape(len(par) - 2, -1, coef.shape[-1])
+
+
+def _piece(knots: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The piece j of each time (the last knot belongs to the last piece) and s = t - knots[j] (the C++ side's
+    choice)."""
+    j = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2)
+    return j, t - knots[j]
 
 
 def _interpolate(times: np.ndarray, values: np.ndarray, t: float) -> np.ndarray:
@@ -298,6 +324,116 @@ class Polynomial(TorqueProfile):
                 f"window=[{self.start:g}, {self.stop:g}] s)")
 
 
+class PiecewisePolynomial(TorqueProfile):
+    """:math:`\\tau = c_{j0} + c_{j1} s + \\dots + c_{jd} s^d`, :math:`s = t - x_j`, on the piece
+    :math:`x_j \\le t \\le x_{j+1}` of the knots :math:`x_0 < \\dots < x_m` [s], zero outside :math:`[x_0, x_m]`
+    (a knot between two pieces belongs to the later one). Where the pieces are a fit of one smooth function
+    (:meth:`fit`, ``smooth=True``) only :math:`x_0` and :math:`x_m` are breakpoints (:meth:`breakpoints`: the
+    compiled integrator restarts there); else every knot is.
+
+    Args:
+        knots: (m + 1,) increasing times [s].
+        coefficients: (m, degree + 1, motors), piece by piece, lowest power of s first [N m / s^i or N / s^i].
+        smooth: Whether the pieces join smoothly (to rounding), so that the inner knots are not breakpoints
+            (default False).
+
+    Raises:
+        InputError: Knots not finite and increasing, or coefficients not a finite (m, degree + 1, motors) array.
+
+    Example:
+        >>> from robotdyn.simulation.torque_profile import PiecewisePolynomial
+        >>> PiecewisePolynomial([0.0, 1.0, 2.0], [[[0.0], [1.0]], [[1.0], [-1.0]]]).at([0.5, 1.5, 3.0]).tolist()
+        [[0.5], [0.5], [0.0]]
+    """
+
+    def __init__(self, knots, coefficients, smooth: bool = False) -> None:
+        self.knots = np.asarray(knots, dtype=float)
+        self.coefficients = np.asarray(coefficients, dtype=float)
+        if self.knots.ndim != 1 or self.knots.size < 2 or not np.all(np.isfinite(self.knots)) \
+                or not np.all(np.diff(self.knots) > 0):
+            raise InputError(f"piecewise polynomial: knots of shape {self.knots.shape}; expected at least two "
+                             "finite, increasing times [s]")
+        shape = self.coefficients.shape
+        if (self.coefficients.ndim != 3 or shape[0] != self.knots.size - 1 or 0 in shape
+                or not np.all(np.isfinite(self.coefficients))):
+            raise InputError(f"piecewise polynomial: coefficients of shape {shape}; expected finite "
+                             f"({self.knots.size - 1} pieces, degree + 1, motors)")
+        self.smooth = bool(smooth)
+
+    @classmethod
+    def fit(cls, function, start: float, stop: float, pieces: int, degree: int = 13,
+            tolerance: float = 1e-12) -> PiecewisePolynomial:
+        """A smooth function of time on [start, stop] as a piecewise polynomial: on each of ``pieces`` equal pieces
+        its Chebyshev interpolant of ``degree`` (at the Chebyshev points of the first kind), in powers of the
+        piece's local time. Checked against ``function`` at 4 (degree + 1) points of every piece: the largest
+        difference is kept as ``fit_error`` (in the function's units) and must not exceed
+        ``tolerance * max(1, max |function|)``. The fit is smooth (only ``start`` and ``stop`` are breakpoints).
+
+        Args:
+            function: f(t) for an array of times (T,) [s], returning (T, motors) (or (T,) for one value).
+            start, stop: The interval [s] (start < stop).
+            pieces: Number of equal pieces (>= 1).
+            degree: Degree of each piece's polynomial (>= 1; default 13).
+            tolerance: Largest difference allowed, relative to max(1, max |f|) (default 1e-12).
+
+        Returns:
+            The :class:`PiecewisePolynomial` (``smooth``), with ``fit_error``.
+
+        Raises:
+            InputError: A bad interval, number of pieces or degree, a non-finite value of f, or a fit worse than
+                ``tolerance`` (naming the error reached: more pieces or a higher degree would be needed).
+        """
+        from numpy.polynomial import Chebyshev, Polynomial as Power
+
+        if not (math.isfinite(start) and math.isfinite(stop) and start < stop) or int(pieces) < 1 \
+                or int(degree) < 1:
+            raise InputError(f"piecewise polynomial fit on [{start!r}, {stop!r}] s with {pieces!r} pieces of degree "
+                             f"{degree!r}; expected start < stop (finite), pieces >= 1 and degree >= 1")
+
+        def values(t):
+            v = np.asarray(function(t), dtype=float)
+            v = v.reshape(len(t), -1)
+            if not np.all(np.isfinite(v)):
+                raise InputError("piecewise polynomial fit: the function returned a non-finite value")
+            return v
+
+        knots = np.linspace(float(start), float(stop), int(pieces) + 1)
+        h, n = knots[1] - knots[0], int(degree) + 1
+        x = -np.cos(np.pi * (np.arange(n) + 0.5) / n)  # Chebyshev points of the first kind on [-1, 1], increasing
+        nodes = 0.5 * h * (1.0 + x)
+        # values at the nodes -> Chebyshev coefficients on [0, h] -> coefficients of powers of s
+        to_power = np.zeros((n, n))
+        for k in range(n):
+            power = Chebyshev(np.eye(n)[k], domain=[0.0, h]).convert(kind=Power, domain=[0.0, h],
+                                                                      window=[0.0, h]).coef
+            to_power[:len(power), k] = power
+        v = values((knots[:-1, None] + nodes).ravel()).reshape(int(pieces), n, -1)
+        cheb = np.einsum("ij,pjm->pim", np.linalg.inv(np.polynomial.chebyshev.chebvander(x, n - 1)), v)
+        coef = np.einsum("ij,pjm->pim", to_power, cheb)  # (in two steps: the Chebyshev coefficients decay)
+        check = np.linspace(0.0, h, 4 * n)
+        ref = values((knots[:-1, None] + check).ravel()).reshape(int(pieces), len(check), -1)
+        got = _horner(np.moveaxis(coef[:, :, None, :], 1, 0), check[None, :, None])
+        scale = max(1.0, float(np.abs(ref).max()))
+        error = float(np.abs(got - ref).max())
+        if error > tolerance * scale:
+            raise InputError(f"piecewise polynomial fit: error {error:.3g} on [{start:g}, {stop:g}] s with {pieces} "
+                             f"pieces of degree {degree}; expected at most {tolerance:g} x {scale:.3g} (more pieces "
+                             "or a higher degree)")
+        out = cls(knots, np.array(coef), smooth=True)
+        out.fit_error = error
+        return out
+
+    def _terms(self):
+        m, d, motors = self.coefficients.shape
+        return [(PIECEWISE, self.coefficients.reshape(m * d, motors),
+                 np.concatenate([[1.0 if self.smooth else 0.0], self.knots]))]
+
+    def __repr__(self) -> str:
+        m, d, motors = self.coefficients.shape
+        return (f"PiecewisePolynomial({m} pieces of degree {d - 1}, {motors} values, on [{self.knots[0]:g}, "
+                f"{self.knots[-1]:g}] s{', smooth' if self.smooth else ''})")
+
+
 class Sum(TorqueProfile):
     """The sum of profiles (all with the same number of motors).
 
@@ -370,4 +506,4 @@ def as_profile(torque, motors: int) -> TorqueProfile | None:
     return None
 
 
-__all__ = ["TorqueProfile", "Constant", "Sine", "Table", "Polynomial", "Sum", "Scaled", "as_profile"]
+__all__ = ["TorqueProfile", "Constant", "Sine", "Table", "Polynomial", "PiecewisePolynomial", "Sum", "Scaled", "as_profile"]

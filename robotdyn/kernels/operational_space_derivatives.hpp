@@ -1,0 +1,236 @@
+// robotdyn/kernels/operational_space_derivatives.hpp: derivatives of the reduced forward dynamics with operational-
+// space velocities nu = J_o v (operational_space.hpp), twin of robotdyn/reduction/dynamics_derivatives.py (the twist
+// parts of _Projection: solve_neg, multiplier, twist_velocity_dq, twist_drift_dq; pieces, Pieces.Aq and
+// dynamics_derivatives) for the projection of robotdyn/reduction/operational_space.py, the same formulas in the
+// same order. With K = [A_r; J_o] (K S = [0; I], K w = -[gamma_r; Jdot_o v]):
+//
+//   dS = -K^-1 dK S,  dw = -K^-1 (dK w + d[gamma_r; Jdot_o v]),  dS^T rho = -S^T dK^T mu,  mu = K^-T rho,
+//
+// where dK enters only as d(K x)/dq at fixed x: the constraint rows' (the <kind>_derivatives.hpp, through
+// ReducedDerivatives) and the twist rows' d(J_o x)/dq = the frame velocity's q-derivative at fixed x (LOCAL: Pinocchio's
+// getFrameVelocityDerivatives; world axes: FramePass.velocity); d(Jdot_o v)/dq likewise from the frame's LOCAL
+// spatial acceleration (getFrameAccelerationDerivatives) or its world classical acceleration (FramePass), and
+// d(Jdot_o v)/dv = Jdot_o + d(J_o v)/dq.
+//
+// ProjectedPieces below are the Python `pieces` for either projection (a selection of v through ReducedDerivatives'
+// LU of A_d, or K^-1 here): the operational derivatives and the slipping wheels' (sliding_derivatives.hpp) finish
+// from them. A selection of v without slipping wheels keeps ReducedDerivatives::run.
+#pragma once
+
+#include "reduced_dynamics_derivatives.hpp"
+
+#include <pinocchio/algorithm/frames-derivatives.hpp>
+
+namespace robotdyn {
+namespace derivs {
+
+// The operational frame: Pinocchio frame id, its placement and LOCAL_WORLD_ALIGNED Jacobian at q, the axes and
+// the selected twist components (0..5: vx vy vz wx wy wz).
+struct TwistFrame {
+  int fid;
+  const pin::SE3* oMf;
+  const Matrix6x* J;
+  bool local;
+  const std::vector<int>* select;
+};
+
+// d(J_o x)/dq at fixed x = fp.x (k x n) (_Projection.twist_velocity_dq); w1, w2 work
+inline void twist_velocity_dq(const pin::Model& model, FramePass& fp, const TwistFrame& tf, MatrixXd& out,
+                              Matrix6x& w1, Matrix6x& w2) {
+  const Matrix6x* dV;
+  if (tf.local) {
+    w1.setZero(6, model.nv);
+    w2.setZero(6, model.nv);
+    pin::getFrameVelocityDerivatives(model, fp.data, static_cast<pin::FrameIndex>(tf.fid), pin::LOCAL, w1, w2);
+    dV = &w1;
+  } else {
+    fp.velocity(model, tf.fid, *tf.oMf, *tf.J);
+    dV = &fp.dV[tf.fid];
+  }
+  const std::vector<int>& sel = *tf.select;
+  out.resize(static_cast<int>(sel.size()), model.nv);
+  for (size_t r = 0; r < sel.size(); ++r) out.row(static_cast<int>(r)) = dV->row(sel[r]);
+}
+
+// d(Jdot_o v)/dq at fixed v = fp.x (a pass with accelerations) and Jdot_o (k x n each) (_Projection.twist_drift_dq,
+// FrameTwist.rows): LOCAL, the body-axes spatial acceleration; world axes, the classical acceleration
+inline void twist_drift_dq(const pin::Model& model, FramePass& fp, const TwistFrame& tf, MatrixXd& drift,
+                           MatrixXd& Jdot, Matrix6x& w1, Matrix6x& w2, Matrix6x& w3, Matrix6x& w4) {
+  const Matrix6x* dA;
+  if (tf.local) {
+    w1.setZero(6, model.nv);
+    w2.setZero(6, model.nv);
+    w3.setZero(6, model.nv);
+    w4.setZero(6, model.nv);
+    pin::getFrameAccelerationDerivatives(model, fp.data, static_cast<pin::FrameIndex>(tf.fid), pin::LOCAL, w1, w2,
+                                         w3, w4);
+    dA = &w2;
+  } else {
+    fp.acceleration(model, tf.fid, *tf.oMf, *tf.J);
+    dA = &fp.dAcc[tf.fid];
+  }
+  const std::vector<int>& sel = *tf.select;
+  const int k = static_cast<int>(sel.size());
+  drift.resize(k, model.nv);
+  for (int r = 0; r < k; ++r) drift.row(r) = dA->row(sel[r]);
+  w1.setZero(6, model.nv);
+  pin::getFrameJacobianTimeVariation(model, fp.data, static_cast<pin::FrameIndex>(tf.fid),
+                                     tf.local ? pin::LOCAL : pin::LOCAL_WORLD_ALIGNED, w1);
+  Jdot.resize(k, model.nv);
+  for (int r = 0; r < k; ++r) Jdot.row(r) = w1.row(sel[r]);
+}
+
+}  // namespace derivs
+
+// The derivative pieces at (q, nu) for either projection (Python `pieces`); the passes, the rows' derivatives, the
+// geometry and the tree data are the evaluator's derivative workspace (ev.deriv_: columns of S, then w, then v).
+template <class Ev>
+struct ProjectedPieces {
+  using RD = ReducedDerivatives<Ev>;
+  using MatrixXd = Eigen::MatrixXd;
+  using VectorXd = Eigen::VectorXd;
+
+  bool op = false;
+  int n = 0, k = 0;
+  derivs::TwistFrame tf{};
+  std::vector<MatrixXd> dJ;  // d(J_o x)/dq per pass (k x n; operational only)
+  MatrixXd Jodot, dJd_q, dJd_v, dgam_v, Vq, dgA, dgJ, Wnu;
+  derivs::Matrix6x w1, w2, w3, w4;
+
+  // -K^-1 [XA_rows; XJ] (n x cols); XA holds all constraint rows (Projection.solve_neg)
+  MatrixXd solve_neg(Ev& ev, const MatrixXd& XA, const MatrixXd& XJ) const {
+    if (!op) return RD::solve_neg(ev, XA);
+    const int nr = static_cast<int>(ev.rows_.size());
+    MatrixXd X(nr + k, XA.cols());
+    for (int r = 0; r < nr; ++r) X.row(r) = XA.row(ev.rows_[r]);
+    X.bottomRows(k) = XJ;
+    return -ev.Kinv_ * X;
+  }
+
+  // configure(q), dynamics(nu), then every piece (pieces)
+  void build(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
+    if (ev.nv_ > derivs::kMaxNv) throw std::domain_error("more coordinates than the derivative kernels' blocks hold");
+    ev.configure(q);
+    ev.dynamics(nu);
+    const pinocchio::Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    n = ev.nv_;
+    k = static_cast<int>(ev.S_.cols());
+    op = ev.operational_;
+    if (op) {
+      const int f = ev.op_frame_;
+      tf = derivs::TwistFrame{ev.frames_[f], &ev.data_.oMf[ev.frames_[f]], &ev.Jf_[f], ev.op_local_, &ev.op_select_};
+    }
+    const MatrixXd& S = ev.S_;
+    ws.geo.resize(ev.wheels_.size());
+    for (size_t i = 0; i < ev.wheels_.size(); ++i)
+      derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
+                                ev.terrain_.flat(), ws.geo[i]);
+    ws.passes.resize(k + 2);
+    ws.dA.resize(k + 2);
+    dJ.resize(op ? k + 2 : 0);
+    for (int l = 0; l < k + 2; ++l) {
+      derivs::FramePass& fp = ws.passes[l];
+      fp.run(model, ev.q_, l < k ? VectorXd(S.col(l)) : l == k ? ev.w_ : ev.v_, l == k + 1);
+      RD::prepare(ev, fp, l == k + 1);
+      RD::velocity_dq(ev, fp, ws.dA[l]);
+      if (op) derivs::twist_velocity_dq(model, fp, tf, dJ[l], w1, w2);
+    }
+    RD::drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);
+    const MatrixXd& dA_v = ws.dA[k + 1];
+    dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
+    MatrixXd none(0, n);
+    if (op) {
+      derivs::twist_drift_dq(model, ws.passes[k + 1], tf, dJd_q, Jodot, w1, w2, w3, w4);
+      dJd_v = Jodot + dJ[k + 1];
+    }
+    Vq = solve_neg(ev, dA_v, op ? dJ[k + 1] : none);  // v = S(q) nu: dv/dq = -K^-1 d(K v)/dq
+    dgA = ws.dgam_q + dgam_v * Vq;
+    if (op) dgJ = dJd_q + dJd_v * Vq;
+    Wnu = op ? solve_neg(ev, dgam_v * S, dJd_v * S) : solve_neg(ev, dgam_v * S, none);
+  }
+
+  // da/dq at fixed nudot, a = S nudot + w: -K^-1 (d(K a)/dq + dg) (Pieces.Aq)
+  MatrixXd Aq(Ev& ev, const VectorXd& nudot) const {
+    const auto& ws = ev.deriv_;
+    MatrixXd dKa = ws.dA[k];
+    for (int l = 0; l < k; ++l) dKa += nudot[l] * ws.dA[l];
+    if (!op) return solve_neg(ev, dKa + dgA, MatrixXd(0, n));
+    MatrixXd dKaJ = dJ[k];
+    for (int l = 0; l < k; ++l) dKaJ += nudot[l] * dJ[l];
+    return solve_neg(ev, dKa + dgA, dKaJ + dgJ);
+  }
+
+  // RNEA(q, v, a) with gravity and its q-, v-derivatives on the workspace's tree data (ws.tree.tau: RNEA)
+  static void tree(Ev& ev, const VectorXd& a, MatrixXd& dtau_dq, MatrixXd& dtau_dv) {
+    auto& ws = ev.deriv_;
+    const int n = ev.nv_;
+    if (!ws.has_tree) {
+      ws.tree = pinocchio::Data(ev.model_);
+      ws.has_tree = true;
+    }
+    dtau_dq.setZero(n, n);
+    dtau_dv.setZero(n, n);
+    MatrixXd dtau_da = MatrixXd::Zero(n, n);
+    ev.model_.gravity = ev.gravity_;
+    try {
+      pinocchio::computeRNEADerivatives(ev.model_, ws.tree, ev.q_, ev.v_, a, dtau_dq, dtau_dv, dtau_da);
+    } catch (...) {
+      ev.model_.gravity.setZero();
+      throw;
+    }
+    ev.model_.gravity.setZero();
+  }
+};
+
+// The reduced forward dynamics' derivatives with operational-space velocities (dynamics_derivatives with a twist).
+template <class Ev>
+struct OperationalDerivatives {
+  using MatrixXd = Eigen::MatrixXd;
+  using VectorXd = Eigen::VectorXd;
+
+  static bool serves(const Ev& ev) { return ev.operational_; }
+
+  static derivs::Result run(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+                            const Eigen::Ref<const VectorXd>& tau) {
+    if (!ev.slips_.empty()) throw std::domain_error("slipping wheels: sliding_derivatives.hpp");
+    ProjectedPieces<Ev> pc;
+    pc.build(ev, q, nu);
+    if (tau.size() != ev.Br_.cols()) throw std::invalid_argument("tau has the wrong length");
+    const int n = pc.n, k = pc.k;
+    const auto& ws = ev.deriv_;
+    const MatrixXd& S = ev.S_;
+    const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
+    derivs::Result out;
+    Eigen::LLT<MatrixXd> llt(ev.Mr_);
+    if (llt.info() != Eigen::Success) throw std::domain_error("reduced mass matrix not positive definite");
+    out.nudot = llt.solve(ev.Br_ * tau - ev.hr_);
+    const VectorXd a = S * out.nudot + ev.w_;
+    MatrixXd dtau_dq, dtau_dv;
+    ProjectedPieces<Ev>::tree(ev, a, dtau_dq, dtau_dv);
+    const VectorXd rho = ws.tree.tau - ev.B_ * tau;
+    // dS^T rho = -S^T dK^T mu, mu = K^-T rho split into the rows' and the twist's parts
+    const int nr = static_cast<int>(ev.rows_.size());
+    const VectorXd mu = ev.Kinv_.transpose() * rho;
+    MatrixXd L = MatrixXd::Zero(k, n);
+    for (int l = 0; l < k; ++l) {
+      for (int r = 0; r < nr; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
+      L.row(l) += mu.tail(k).transpose() * pc.dJ[l];
+    }
+    const MatrixXd Aq = pc.Aq(ev, out.nudot);
+    const MatrixXd ST = S.transpose();
+    MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * pc.Vq + (ST * M) * Aq;
+    ReducedDerivatives<Ev>::motor_rows(ev, tau, G);
+    const MatrixXd Minv = llt.solve(MatrixXd::Identity(k, k));
+    out.dq = -Minv * G;
+    out.dnu = -Minv * (ST * (dtau_dv * S + M * pc.Wnu));
+    out.dtau = Minv * ev.Br_;
+    out.v = ev.v_;
+    out.Vq = pc.Vq;
+    out.S = S;
+    out.A = ev.A_;
+    return out;
+  }
+};
+
+}  // namespace robotdyn

@@ -281,3 +281,18 @@ def test_cone_minimum_with_two_open_combinations_equals_its_closed_form():
         assert cone_minimum([(b, T @ R) for b, T in base], fn, 2) == pytest.approx(2.0, abs=1e-7)
     base[2] = (np.array([0.0, 9.0]), e2)  # pair 2 now max(|9 + z2|, |z2 - 1|) / 2: at z2 = -4, 2.5 > 2
     assert cone_minimum(base, fn, 2) == pytest.approx(2.5, abs=1e-7)
+
+
+def test_events_at_one_instant_come_in_a_fixed_order():
+    """A wheel's slip and the any-split slip it sets, 1e-16 s apart either way (crossings interpolated in one sample
+    interval), come in the same order: lift-offs, named wheels in the robot's order, then the any-split slip; events
+    apart by more than 1e-12 s keep their time order."""
+    from robotdyn.contact.traction import ANY_SPLIT, TractionEvent, _in_time_order
+
+    wheels = ["w1", "w2"]
+    t = 0.3247878101591285
+    for dt in (1e-16, -1e-16):
+        events = [TractionEvent("slip", ANY_SPLIT, t, 0.04), TractionEvent("slip", "w2", t + dt, 0.04),
+                  TractionEvent("lift-off", "w1", t - dt, 0.0), TractionEvent("slip", "w1", t - 1e-9, 0.03)]
+        order = [(e.kind, e.wheel) for e in _in_time_order(events, wheels)]
+        assert order == [("slip", "w1"), ("lift-off", "w1"), ("slip", "w2"), ("slip", ANY_SPLIT)]

@@ -123,7 +123,7 @@ def compiled_force_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.nda
     D.__dict__.update(nudot=nudot, dq=dq, dnu=dnu, dtau=dtau, qdot=v, dqdot_dq=Vq, S=S, numerical=(),
                       coordinates=list(robot.coordinates), velocities=list(robot.velocity_names),
                       motors=[m.name for m in robot.motors],
-                      _manifold=(A[np.asarray(fast.holonomic, bool)], fast._hint.dependent))
+                      _manifold=(A, fast.holonomic, fast._hint.dependent))
     lay = _Layer(labels, lam, Lq, Lv, La, Lt, wheels, float(residual), set())
     return along_motion(robot, q, nu, tau, forces, unloaded, twin, lay, D, Vq, S, Aq + S @ dq, Wnu + S @ dnu,
                         S @ dtau)

@@ -335,7 +335,21 @@ def _events(tr: Traction) -> list[TractionEvent]:
         level = float(np.max(tr.mu))
         events.append(TractionEvent("slip", ANY_SPLIT, _crossing(tr.t, np.asarray(tr.minimum_mu, float), k, level),
                                     float(tr.minimum_mu[k])))
-    return sorted(events, key=lambda e: e.t)
+    return _in_time_order(events, tr.wheels)
+
+
+def _in_time_order(events: list[TractionEvent], wheels: list[str]) -> list[TractionEvent]:
+    """Events sorted by time; those at the same instant (1e-12 s apart or less: crossings interpolated in the same
+    sample interval differ only in their last bits) in a fixed order, lift-offs before slips, named wheels in the
+    robot's order before the any-split slip, so that the summary's first event does not depend on rounding."""
+    rank = {name: j for j, name in enumerate(wheels)}
+    groups: list[list[TractionEvent]] = []
+    for e in sorted(events, key=lambda e: e.t):
+        if groups and abs(e.t - groups[-1][0].t) <= 1e-12:
+            groups[-1].append(e)
+        else:
+            groups.append([e])
+    return [e for g in groups for e in sorted(g, key=lambda e: (e.kind != "lift-off", rank.get(e.wheel, len(rank))))]
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, k: int, level: float) -> float:

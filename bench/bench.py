@@ -151,6 +151,9 @@ def main() -> None:
     rigid_limit_bench()
     traction_bench()
     compliant_bench()
+    from compliant_rolling_bench import compliant_rolling_bench  # bench/compliant_rolling_bench.py
+
+    compliant_rolling_bench()
     simulate_many_bench()
     from derivatives_bench import derivatives_bench  # bench/derivatives_bench.py
 
@@ -575,5 +578,8 @@ if __name__ == "__main__":
         evaluation_profile_bench()
     elif sys.argv[1:] == ["compliant"]:  # only this section: python bench/bench.py compliant
         compliant_bench()
+        from compliant_rolling_bench import compliant_rolling_bench
+
+        compliant_rolling_bench()
     else:
         main()

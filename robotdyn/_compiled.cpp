@@ -19,6 +19,7 @@
 //   kernels/sliding.hpp            contact/sliding.py and contact/friction.py (slipping wheels, friction laws)
 //   kernels/joint_springs.hpp      reduction/joint_springs.py (springs and dampers on joints)
 //   kernels/compliant_contact.hpp  contact/compliant_contact.py (wheels that fly and land: normal force laws)
+//   kernels/compliant_rolling.hpp  contact/compliant_rolling.py (compliant wheels rolling while in contact)
 //   kernels/lu_solve.hpp           LU substitutions and LAPACK's 1-norm condition estimate (used by the above)
 // The rigid-body algorithms are Pinocchio's (header-only use of the installed Pinocchio 4), on a copy of the
 // robot's Pinocchio model rebuilt joint by joint; tests/test_compiled*.py check every output against the Python
@@ -41,6 +42,7 @@
 #include "_stiff_integrator.hpp"
 #include "kernels/compliant_contact.hpp"
 #include "kernels/joint_springs.hpp"
+#include "kernels/compliant_rolling.hpp"
 #include "_torque_profile.hpp"
 #include "_controller.hpp"
 #include "kernels/reduced_dynamics_derivatives.hpp"  // the derivatives (robotdyn/fast/compiled_derivatives.py)
@@ -316,7 +318,8 @@ class Evaluator {
       force_.noalias() += S_.transpose() * Qa_;
     }
     llt_.compute(Mr_);
-    llt_.solveInPlace(force_);
+    if (rolling_active()) rolling_solve(nu, alpha);  // the rows of the rolling wheels in the run's contact set
+    else llt_.solveInPlace(force_);
     out.tail(k) = force_;
   }
 
@@ -437,6 +440,87 @@ class Evaluator {
     return py::make_tuple(Qa_, friction_power_, damper_power_, states);
   }
 
+  // ------------------------------------------------------------------------------------------ rolling compliant wheels
+  // Compliant wheels that roll while in contact (robotdyn/contact/compliant_rolling.py, kernels/compliant_rolling.hpp):
+  // the run's contact set (set_rolling_mode, data of the run) says whose tangential rows are constraints; the event
+  // min_i s_i pressing_i (s_i = +1 in the set: lift-off, -1 out of it: touch-down) ends the run at a switch, where
+  // robotdyn/simulation/compiled_rolling.py applies the touch-down impact and starts the next run.
+  // The last compliant wheel added rolls on its directions D (1..2, 2), rows of coefficients of (t1, t2).
+  void add_rolling_rows(const MatrixXd& D) {
+    if (contacts_.empty() || D.cols() != 2 || D.rows() < 1 || D.rows() > 2)
+      throw std::invalid_argument("rolling rows need a compliant wheel and directions (1..2, 2)");
+    Wheel wh = wheels_[contacts_.back().wheel];
+    wh.D.setZero(D.rows(), 3);
+    wh.D.leftCols(2) = D;
+    rolling_contact_.push_back(static_cast<int>(contacts_.size()) - 1);
+    rolling_wheels_.push_back(wh);
+    rolling_on_.push_back(0);
+  }
+  // The contact set: on[i] != 0 where rolling wheel i's rows hold.
+  void set_rolling_mode(const std::vector<int>& on) {
+    if (on.size() != rolling_on_.size()) throw std::invalid_argument("one flag per rolling compliant wheel expected");
+    for (size_t i = 0; i < on.size(); ++i) rolling_on_[i] = on[i] != 0;
+  }
+  bool rolling_active() const {
+    return std::any_of(rolling_on_.begin(), rolling_on_.end(), [](char c) { return c != 0; });
+  }
+  // Rows G (m, nv) and drift Gdot v (m,) of the rolling wheels with on[i] set, after configure and dynamics.
+  void rolling_rows_into(const std::vector<char>& on, MatrixXd& G, VectorXd& drift) {
+    int m = 0;
+    for (size_t i = 0; i < on.size(); ++i)
+      if (on[i]) m += static_cast<int>(rolling_wheels_[i].D.rows());
+    G.resize(m, nv_);
+    drift.resize(m);
+    int row = 0;
+    for (size_t i = 0; i < on.size(); ++i) {
+      if (!on[i]) continue;
+      const Wheel& wh = rolling_wheels_[i];
+      const int w = contacts_[rolling_contact_[i]].wheel;
+      const WheelGeometry& g = geo_[w];
+      Matrix3d ET;
+      ET.row(0) = g.t1.transpose();
+      ET.row(1) = g.t2.transpose();
+      ET.row(2) = g.n.transpose();
+      const int nd = static_cast<int>(wh.D.rows());
+      G.middleRows(row, nd).noalias() = (wh.D * ET) * Aw_[w];
+      row = kernels::wheel_drift(wh, g, terrain_, model_, data_, frames_[wh.frame], Aw_[w], v_, row, drift);
+    }
+  }
+  // nudot into force_ (M_r nudot = force_ + G_r^T lambda, G_r nudot = -(G w + Gdot v) - beta G_r nu), llt_ factored.
+  void rolling_solve(const Eigen::Ref<const VectorXd>& nu, double beta) {
+    rolling_rows_into(rolling_on_, rollG_, rollDrift_);
+    rollGr_.noalias() = rollG_ * S_;
+    rollTarget_ = -(rollG_ * w_ + rollDrift_);
+    if (beta != 0.0) rollTarget_.noalias() -= beta * (rollGr_ * nu);
+    kernels::rolling_accelerations(llt_, rollGr_, rollTarget_, force_, rollLambda_, rollMinvGT_);
+  }
+  // The event's value after applied_forces: min_i s_i pressing_i [m] (>= 0 until the contact set must change).
+  double rolling_event() const {
+    double g = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < rolling_contact_.size(); ++i) {
+      const int c = rolling_contact_[i];
+      const auto& st = contact_states_[c];
+      const double p = kernels::pressing(contacts_[c].normal, st.delta, st.rate);
+      g = std::min(g, rolling_on_[i] ? p : -p);
+    }
+    return g;
+  }
+  // (indicators (R,) [m], G (m, nv) of every rolling wheel in order, M_r, S, v) at (q, nu): the switch's data.
+  py::tuple rolling_state(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
+    configure(q);
+    dynamics(nu);
+    applied_forces();
+    VectorXd p(rolling_contact_.size());
+    for (size_t i = 0; i < rolling_contact_.size(); ++i) {
+      const int c = rolling_contact_[i];
+      p[i] = kernels::pressing(contacts_[c].normal, contact_states_[c].delta, contact_states_[c].rate);
+    }
+    MatrixXd G;
+    VectorXd drift;
+    rolling_rows_into(std::vector<char>(rolling_contact_.size(), 1), G, drift);
+    return py::make_tuple(p, G, Mr_, S_, v_);
+  }
+
   // ------------------------------------------------------------------------------------------ feedback laws
   // A feedback law (robotdyn/_controller.hpp) replacing the torque profile in rhs_into (simulate), or none.
   void set_controller(const robotdyn::Controller* c) {
@@ -519,6 +603,11 @@ class Evaluator {
       if (applied()) {  // y = (q, nu, friction work, damper work)
         dy[nv_ + k] = friction_power_;
         dy[nv_ + k + 1] = damper_power_;
+      }
+      if (!rolling_contact_.empty()) {  // the contact-switch event's value at this state (lift_off reuses it)
+        event_t_ = t;
+        event_y_ = y;
+        event_g_ = rolling_event();
       }
       return;
     }
@@ -962,7 +1051,7 @@ class Evaluator {
       bool on;
       bool active() const { return on; }
       double operator()(double t, const robotdyn::State& y) { return ev->lift_off(t, y, alpha, *profile, *rechoose); }
-    } lift_off{this, alpha, &profile, &rechoose, slipping};
+    } lift_off{this, alpha, &profile, &rechoose, slipping || !rolling_contact_.empty()};
     int slip_error = -1;
     double slip_value = 0.0;
     std::vector<std::tuple<double, int, int>> crossings;  // flight phases: (t, compliant wheel, +1 touch-down / -1 lift-off)
@@ -980,7 +1069,7 @@ class Evaluator {
             void differencing(bool on) { ev->differencing_ = on; }
           } mode{this};
           out = robotdyn::integrate_stiff(system, y0, t0, t_end, samples, next, breaks, rtol, atol, nv_ + k, observer,
-                                          poll, flights, mode);
+                                          poll, flights, mode, lift_off);
           for (const auto& [te, i, direction] : flights.found)
             if (te <= out.t) crossings.emplace_back(te, i, direction);
         } else if (!contacts_.empty()) {  // explicit, with the flight phases on the dense output
@@ -989,7 +1078,7 @@ class Evaluator {
           };
           robotdyn::Crossings<decltype(depths)> flights(depths);
           out = robotdyn::integrate_crossings(method, system, y0, t0, t_end, samples, next, breaks, rtol, atol,
-                                              observer, poll, flights);
+                                              observer, poll, flights, lift_off);
           for (const auto& [te, i, direction] : flights.found)
             if (te <= out.t) crossings.emplace_back(te, i, direction);
         } else {
@@ -1200,6 +1289,12 @@ class Evaluator {
   VectorXd Qa_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> Ac_;
   double friction_power_ = 0.0, damper_power_ = 0.0;
+  // rolling compliant wheels (add_rolling_rows): their contact index, their rows' wheel, the run's contact set, buffers
+  std::vector<int> rolling_contact_;
+  std::vector<Wheel> rolling_wheels_;
+  std::vector<char> rolling_on_;
+  MatrixXd rollG_, rollGr_, rollMinvGT_;
+  VectorXd rollDrift_, rollTarget_, rollLambda_;
   // the lift-off event's cache and the state of a SlipError
   double event_t_ = std::numeric_limits<double>::quiet_NaN(), event_g_ = 0.0;
 
@@ -1277,6 +1372,9 @@ PYBIND11_MODULE(_compiled, m) {
       .def("add_spring", &Evaluator::add_spring)
       .def("add_compliant_wheel", &Evaluator::add_compliant_wheel)
       .def("applied_state", &Evaluator::applied_state)
+      .def("add_rolling_rows", &Evaluator::add_rolling_rows)
+      .def("set_rolling_mode", &Evaluator::set_rolling_mode)
+      .def("rolling_state", &Evaluator::rolling_state)
       .def_property_readonly("slipping", &Evaluator::slipping)
       .def_readonly("last_t", &Evaluator::last_t_, "Time [s] of the last right-hand side a simulation evaluated")
       .def_property_readonly("slip_condition", &Evaluator::slip_condition,

@@ -207,15 +207,15 @@ struct NoCrossings {
 // The stiff run from (t0, y0) to t_end (see the top of this file): rtol, atol on every component; columns of the
 // Jacobian from `active` on are zero; on_step as Crossings (or NoCrossings); mode() the right-hand side's mode at
 // its last evaluation.
-template <class System, class Observer, class Poll, class OnStep, class Mode>
+template <class System, class Observer, class Poll, class OnStep, class Mode, class Event = NoEvent>
 Outcome integrate_stiff(System& system, const State& y0, double t0, double t_end, const std::vector<double>& samples,
                         size_t& next, const std::vector<double>& breaks, double rtol, double atol, int active,
-                        Observer&& observer, Poll&& poll, OnStep& on_step, Mode& mode) {
+                        Observer&& observer, Poll&& poll, OnStep& on_step, Mode& mode, Event&& event = Event()) {
   const double dt0 = std::min(1e-4, 1e-3 * (t_end - t0));
   StiffStepper<OnStep, Mode> stepper(atol, rtol, active, on_step, mode);
   // a step across a compliant wheel's touch-down (its damper force jumps) is accepted only once it is about
   // tolerance / jump long: steps down to the spacing of doubles at t are allowed (unit 0), not only 8 eps
-  return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, NoEvent(), 0.0);
+  return run_dense(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, event, 0.0);
 }
 
 }  // namespace robotdyn
@@ -257,20 +257,21 @@ class WithCrossings {
 
 // dopri5 or bulirsch_stoer (as integrate of _integrator.hpp) with crossing events; steps down to the spacing of
 // doubles at t, as integrate_stiff (a touch-down's damper force jumps).
-template <class System, class Observer, class Poll, class OnStep>
+template <class System, class Observer, class Poll, class OnStep, class Event = NoEvent>
 Outcome integrate_crossings(const std::string& method, System& system, const State& y0, double t0, double t_end,
                             const std::vector<double>& samples, size_t& next, const std::vector<double>& breaks,
-                            double rtol, double atol, Observer&& observer, Poll&& poll, OnStep& on_step) {
+                            double rtol, double atol, Observer&& observer, Poll&& poll, OnStep& on_step,
+                            Event&& event = Event()) {
   const double dt0 = std::min(1e-3, 1e-3 * (t_end - t0));
   if (method == "bulirsch_stoer") {
     odeint::bulirsch_stoer_dense_out<State> stepper(atol, rtol, 1.0, 0.0);
     WithCrossings<decltype(stepper), OnStep> with(stepper, on_step);
-    return run_dense(with, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, NoEvent(), 0.0);
+    return run_dense(with, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, event, 0.0);
   }
   if (method == "dopri5") {
     auto stepper = odeint::make_dense_output(atol, rtol, odeint::runge_kutta_dopri5<State>());
     WithCrossings<decltype(stepper), OnStep> with(stepper, on_step);
-    return run_dense(with, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, NoEvent(), 0.0);
+    return run_dense(with, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, event, 0.0);
   }
   throw std::invalid_argument("flight phases need a dense-output integrator (dopri5, bulirsch_stoer, rosenbrock4), not " +
                               method);

@@ -178,17 +178,6 @@ def test_plastic_impact_is_the_one_row_impact_with_e_0_and_splits_redundant_rows
     assert twice.impulse == pytest.approx([one.magnitude / 2] * 2, rel=1e-10)
 
 
-def test_compiled_engine_refuses_rolling_compliant_wheels_in_one_line():
-    from robotdyn.errors import RobotDynError
-
-    robot = disc(normal_stiffness=2e4)
-    q0, nu0 = state(robot, R + 0.01, -1.0, 1.0)
-    with pytest.raises(RobotDynError, match="^engine = 'compiled' cannot run this simulation: compliant wheels that "
-                                            "roll while in contact .friction = 'rolling'. are simulated on the "
-                                            "Python path"):
-        simulate(robot, 0.01, q0, nu0, engine="compiled", progress=False)
-
-
 def test_example_base_on_rolling_tyres_from_simulate(capsys):
     """examples/bump_base_rolling.toml through `robotdyn simulate` (in-process): both front wheels leave the bump's
     crest together (the base is symmetric) with their rows dropped, the rear ones still rolling; the JSON report

@@ -109,8 +109,8 @@ def why_not(robot, applied: bool = False) -> str | None:
         return "the compiled extension robotdyn._compiled was not built"
     if getattr(robot, "springs", None) and not applied:  # robotdyn.reduction.joint_springs
         return "joint springs and dampers are evaluated on the Python path (not compiled)"
-    if any(getattr(c, "rolling", False) for c in robot.constraints):  # robotdyn.contact.compliant_rolling
-        return "compliant wheels that roll while in contact (friction = 'rolling') are simulated on the Python path"
+    if any(getattr(c, "rolling", False) for c in robot.constraints) and not applied:  # contact.compliant_rolling
+        return "compliant wheels that roll while in contact (friction = 'rolling') are evaluated on the Python path"
     if any(getattr(c, "compliant", False) for c in robot.constraints) and not applied:
         return "compliant wheels (normal force laws) are evaluated on the Python path (not compiled)"
     for i in range(1, robot.model.njoints):

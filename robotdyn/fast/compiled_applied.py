@@ -38,7 +38,8 @@ def compliant_refusal(wheel) -> str | None:
 
 def add_compliant_wheel(ev, wheel, frame: int) -> None:
     """Give the evaluator ``ev`` a compliant wheel: its contact geometry (as a wheel without rows), its normal law
-    and its friction law on its tangential directions.
+    and its friction law on its tangential directions, or, for a wheel that rolls while in contact
+    (:mod:`robotdyn.contact.compliant_rolling`), its rolling rows on those directions.
 
     Args:
         ev: The ``robotdyn._compiled.Evaluator`` under construction.
@@ -55,6 +56,8 @@ def add_compliant_wheel(ev, wheel, frame: int) -> None:
     ev.add_compliant_wheel(frame, np.asarray(wheel.axis, float), float(wheel.radius),
                            -1 if wheel.radius_index is None else int(wheel.radius_index), kind,
                            float(law.stiffness), float(law.damping), exponent, int(code), float(p0), float(p1), D)
+    if getattr(wheel, "rolling", False):  # rolls while in contact (kernels/compliant_rolling.hpp)
+        ev.add_rolling_rows(np.asarray(wheel.tangent_directions, float).reshape(-1, 2))
 
 
 def add_springs(ev, robot) -> None:

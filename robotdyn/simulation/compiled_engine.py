@@ -34,7 +34,8 @@ stored elastic energy. Robots with compliant wheels are integrated by a stepper 
 wheel's lift-off and touch-down are located (``stats["flight"]``, as :mod:`robotdyn.simulation.flight` reports them
 on the scipy path's LSODA): :data:`COMPLIANT_DEFAULT` by default, :data:`STIFF` (Boost.Odeint's ``rosenbrock4``, a
 finite-difference Jacobian: ``robotdyn/_stiff_integrator.hpp``) for stiff contacts; springs alone run on the
-default Adams stepper. Slipping wheels and model-based controllers on such
+default Adams stepper. Compliant wheels that roll while in contact run segment by segment between their contact
+switches (:mod:`robotdyn.simulation.compiled_rolling`). Slipping wheels and model-based controllers on such
 robots, and :func:`robotdyn.simulation.many_runs.simulate_many`, stay on the Python path (refused in one line).
 
 The scipy path (DOP853) stays the reference; ``tests/test_compiled_simulation.py`` checks the compiled trajectories

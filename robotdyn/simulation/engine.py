@@ -175,8 +175,11 @@ def simulate(
                                             method or "DOP853", stabilisation, progress, time_limit=time_limit),
                         robot, torque)
     if compiled_engine:
-        return _applied(simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or default_method(robot),
-                                          stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times),
+        fast_run = simulate_compiled
+        if any(w.rolling for w in compliant_wheels(robot)):  # rolling compliant wheels: a switching compiled run
+            from .compiled_rolling import simulate_rolling_compiled as fast_run
+        return _applied(fast_run(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method or default_method(robot),
+                                 stabilisation, Progress(t_end, progress, time_limit), offsets, t0, times),
                         robot, torque)
     compliant = compliant_wheels(robot)
     if any(w.rolling for w in compliant):  # compliant wheels rolling while in contact: a hybrid run

@@ -374,7 +374,7 @@ class PiecewisePolynomial(TorqueProfile):
             start, stop: The interval [s] (start < stop).
             pieces: Number of equal pieces (>= 1).
             degree: Degree of each piece's polynomial (>= 1; default 13).
-            tolerance: Largest difference allowed, relative to max(1, max |f|) (default 1e-12).
+            tolerance: Largest difference allowed, relative to max(1, max abs(f)) (default 1e-12).
 
         Returns:
             The :class:`PiecewisePolynomial` (``smooth``), with ``fit_error``.

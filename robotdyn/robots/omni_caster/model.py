@@ -415,7 +415,7 @@ def circle_law(robot: Robot, params: dict | None = None):
 
 ELLIPSE_FIT = {"pieces": 120, "degree": 13}
 """Pieces and degree of :func:`ellipse_law`'s fit of u''(t): 120 pieces of 0.25 s, degree 13, reach 2e-14 rad/s^2
-(about 3e-14 of max |u''| = 0.84 m/s^2)."""
+(about 3e-14 of max abs(u'') = 0.84 m/s^2)."""
 
 
 def ellipse_law(robot: Robot, params: dict | None = None):
@@ -423,7 +423,7 @@ def ellipse_law(robot: Robot, params: dict | None = None):
     :class:`~robotdyn.simulation.feedback.FeedbackLaw` (it runs compiled): u''(t) of :func:`path_state` (a smooth
     function of beta(t) of eq 61, neither a polynomial nor a sine of t) on [0, T] as a
     :class:`~robotdyn.simulation.torque_profile.PiecewisePolynomial` fit (:data:`ELLIPSE_FIT`), checked to 1e-12 of
-    max |u''| against :func:`path_state` (``fit_error`` on the profile: about 2e-14).
+    max abs(u'') against :func:`path_state` (``fit_error`` on the profile: about 2e-14).
 
     Args:
         robot: The omni caster :class:`~robotdyn.robot.Robot`.

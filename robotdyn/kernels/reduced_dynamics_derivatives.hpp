@@ -157,19 +157,6 @@ struct ReducedDerivatives {
     }
   }
 
-  // -K^-1 [X_rows] for the selection projection (Projection.solve_neg): zero except the dependent rows (the
-  // operational-space, sliding and contact-force derivative kernels use it; run() makes its three solves in one)
-  static MatrixXd solve_neg(Ev& ev, const MatrixXd& X) {
-    const int nd = static_cast<int>(ev.dependent_.size());
-    MatrixXd out = MatrixXd::Zero(ev.nv_, X.cols());
-    if (nd == 0) return out;
-    MatrixXd Xr(nd, X.cols());
-    for (int r = 0; r < nd; ++r) Xr.row(r) = X.row(ev.rows_[r]);
-    const MatrixXd Y = ev.lu_.solve(Xr);
-    for (int r = 0; r < nd; ++r) out.row(ev.dependent_[r]) = -Y.row(r);
-    return out;
-  }
-
   static derivs::Result run(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                             const Eigen::Ref<const VectorXd>& tau) {
     if (ev.operational_) throw std::domain_error("operational-space velocities: derivatives on the Python path");

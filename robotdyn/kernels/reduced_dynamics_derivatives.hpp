@@ -157,6 +157,18 @@ struct ReducedDerivatives {
     }
   }
 
+  // -K^-1 [X_rows] for the selection projection (Projection.solve_neg): zero except the dependent rows
+  static MatrixXd solve_neg(Ev& ev, const MatrixXd& X) {
+    const int nd = static_cast<int>(ev.dependent_.size());
+    MatrixXd out = MatrixXd::Zero(ev.nv_, X.cols());
+    if (nd == 0) return out;
+    MatrixXd Xr(nd, X.cols());
+    for (int r = 0; r < nd; ++r) Xr.row(r) = X.row(ev.rows_[r]);
+    const MatrixXd Y = ev.lu_.solve(Xr);
+    for (int r = 0; r < nd; ++r) out.row(ev.dependent_[r]) = -Y.row(r);
+    return out;
+  }
+
   static derivs::Result run(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                             const Eigen::Ref<const VectorXd>& tau) {
     if (ev.operational_) throw std::domain_error("operational-space velocities: derivatives on the Python path");
@@ -183,56 +195,23 @@ struct ReducedDerivatives {
     for (size_t i = 0; i < ev.wheels_.size(); ++i)
       derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
                                 ev.terrain_.flat(), ws.geo[i]);
-    // the frame passes at the columns of S and at w (velocities only, on the configuration pass at q) and at v
-    // (with accelerations), and the rows' derivatives there; d(A v)/dq = sum_l nu_l d(A S_l)/dq (A x is linear in x)
+    // the frame passes at the columns of S, at w and at v, and the rows' derivatives there
     ws.passes.resize(k + 2);
     ws.dA.resize(k + 2);
-    for (int l = 0; l < k + 1; ++l) {
+    for (int l = 0; l < k + 2; ++l) {
       derivs::FramePass& fp = ws.passes[l];
-      if (l < k)
-        fp.run_velocities(model, ev.data_, S.col(l));
-      else
-        fp.run_velocities(model, ev.data_, w);
-      prepare(ev, fp, false);
+      fp.run(model, ev.q_, l < k ? VectorXd(S.col(l)) : l == k ? w : v, l == k + 1);
+      prepare(ev, fp, l == k + 1);
       velocity_dq(ev, fp, ws.dA[l]);
     }
-    ws.passes[k + 1].run(model, ev.q_, v, true);
-    prepare(ev, ws.passes[k + 1], true);
-    MatrixXd& dA_v = ws.dA[k + 1];
-    dA_v.setZero(ev.nrows(), n);
-    for (int l = 0; l < k; ++l) dA_v += nu[l] * ws.dA[l];
     const MatrixXd& dA_w = ws.dA[k];
+    const MatrixXd& dA_v = ws.dA[k + 1];
     drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);
+    const int m = ev.nrows();
     const MatrixXd dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
-    // the projection's three solves in one: with Y = K^-1 [d(K v)/dq, d(K gamma)/dv, d(K a)/dq + dgamma/dq at fixed
-    // v] (dependent rows), dv/dq = -Y_v (v = S(q) nu), W_nu = -Y_g S, and Aq = -(Y_a + Y_g dv/dq) (Aq below)
-    const int nd = static_cast<int>(ev.dependent_.size());
-    out.Vq = MatrixXd::Zero(n, n);
-    MatrixXd Wnu = MatrixXd::Zero(n, k), Aq = MatrixXd::Zero(n, n);
-    if (nd) {
-      MatrixXd X(nd, 3 * n);
-      for (int r = 0; r < nd; ++r) {
-        const int row = ev.rows_[r];
-        X.row(r).segment(0, n) = dA_v.row(row);
-        X.row(r).segment(n, n) = dgam_v.row(row);
-        auto xa = X.row(r).segment(2 * n, n);
-        xa = dA_w.row(row) + ws.dgam_q.row(row);
-        for (int l = 0; l < k; ++l) xa += out.nudot[l] * ws.dA[l].row(row);
-      }
-      const MatrixXd Y = ev.lu_.solve(X);
-      MatrixXd Vd = -Y.leftCols(n);  // dependent rows of dv/dq
-      const MatrixXd Wd = -Y.middleCols(n, n) * S;
-      MatrixXd Ygd(nd, nd);  // Y_g's dependent columns: Vq is zero off the dependent rows
-      for (int r = 0; r < nd; ++r) Ygd.col(r) = Y.col(n + ev.dependent_[r]);
-      MatrixXd Ad = -Y.rightCols(n);
-      Ad.noalias() -= Ygd * Vd;  // -(Y_a + Y_g Vq)
-      for (int r = 0; r < nd; ++r) {
-        const int i = ev.dependent_[r];
-        out.Vq.row(i) = Vd.row(r);
-        Wnu.row(i) = Wd.row(r);
-        Aq.row(i) = Ad.row(r);
-      }
-    }
+    out.Vq = solve_neg(ev, dA_v);            // v = S(q) nu: dv/dq = -K^-1 d(K v)/dq
+    const MatrixXd dgA = ws.dgam_q + dgam_v * out.Vq;
+    const MatrixXd Wnu = solve_neg(ev, dgam_v * S);
     // the tree: RNEA(q, v, a) and its derivatives, with gravity
     if (!ws.has_tree) {
       ws.tree = pinocchio::Data(model);
@@ -250,6 +229,7 @@ struct ReducedDerivatives {
     const VectorXd rho = ws.tree.tau - ev.B_ * tau;
     // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d
     MatrixXd L = MatrixXd::Zero(k, n);
+    const int nd = static_cast<int>(ev.dependent_.size());
     if (nd) {
       VectorXd rd(nd);
       for (int r = 0; r < nd; ++r) rd[r] = rho[ev.dependent_[r]];
@@ -257,7 +237,10 @@ struct ReducedDerivatives {
       for (int l = 0; l < k; ++l)
         for (int r = 0; r < nd; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
     }
-    // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot: from the one solve above
+    // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot
+    MatrixXd dKa = dA_w + dgA;
+    for (int l = 0; l < k; ++l) dKa += out.nudot[l] * ws.dA[l];
+    const MatrixXd Aq = solve_neg(ev, dKa);
     const MatrixXd ST = S.transpose();
     MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * out.Vq + (ST * M) * Aq;
     motor_rows(ev, tau, G);
@@ -268,6 +251,7 @@ struct ReducedDerivatives {
     out.v = v;
     out.S = S;
     out.A = ev.A_;
+    (void)m;
     return out;
   }
 

@@ -6,9 +6,7 @@ one run. Run alone: ``python bench/force_derivatives_bench.py`` (``--no-optimisa
 
 from __future__ import annotations
 
-import statistics
 import sys
-import time
 from pathlib import Path
 from unittest import mock
 
@@ -22,16 +20,7 @@ from robotdyn.robot import Robot  # noqa: E402
 from robotdyn.robots import module  # noqa: E402
 
 
-def _median(fn, number: int, repeat: int = 5) -> float:
-    """Median seconds per call over ``repeat`` batches of ``number`` calls (after one warm-up call)."""
-    fn()
-    runs = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        for _ in range(number):
-            fn()
-        runs.append((time.perf_counter() - t) / number)
-    return statistics.median(runs)
+from derivatives_bench import _best as _median  # noqa: E402 (bench/: the same median-of-batches timer)
 
 
 def per_call() -> None:

@@ -111,22 +111,22 @@ def configure(robot, q: np.ndarray) -> None:
     robot.velocity_names = [robot.velocity_labels[i] for i in robot.independent_indices]
 
 
-def unloaded_message(wheel: str, t: float, load: float, phase: str) -> str:
-    """``stats["event"]`` of a stick-slip run stopped where a wheel's normal load reached zero: what happened and
-    how to model it (one line).
+def unloaded_message(wheel: str, t: float, load: float, state: str) -> str:
+    """``stats["event"]`` of a run stopped where a rigid wheel's normal load reached zero (a stick-slip wheel, or
+    one slipping under a friction law): what happened and how to model it (one line).
 
     Args:
         wheel: The wheel's name.
         t: Time [s] at which its load reaches zero.
         load: Its normal load there [N] (zero to the event's accuracy).
-        phase: Its phase there, ``stick`` or ``slide``.
+        state: What its tangential side was doing: ``sticking``, ``sliding`` or ``slipping``.
 
     Returns:
         The message: the rigid normal row would have to pull to keep the wheel on the ground, so the rigid model
         cannot continue; ``contact = "compliant"`` (with a ``coulomb`` or ``linear`` friction law: a compliant wheel
         takes no stick_slip law) lets it fly and land.
     """
-    return (f"wheel {wheel} unloads at t = {t:.6g} s (normal load {load:.3g} N, {'sliding' if phase == 'slide' else 'sticking'}): the rigid contact "
+    return (f"wheel {wheel} unloads at t = {t:.6g} s (normal load {load:.3g} N, {state}): the rigid contact "
             "cannot leave the ground, so the run stops there; to let it fly and land give it contact = "
             "\"compliant\" in its [[wheels]] entry (a normal force law of the penetration, with friction = "
             "\"coulomb\" or \"linear\": a compliant wheel takes no stick_slip law)")

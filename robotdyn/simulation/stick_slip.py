@@ -208,7 +208,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                 switches.append({"t": t, "wheel": w.name, "phase": "slide"})
         elif kind == "lift-off":
             load = _forces(robot, q, nu, tau_at(t, q, nu)).wheel(wheel.name).normal
-            stop = unloaded_message(wheel.name, t, load, wheel.phase)
+            stop = unloaded_message(wheel.name, t, load, "sliding" if wheel.phase == "slide" else "sticking")
             lift = {"t": t, "wheel": wheel.name, "load": float(load)}
             print(f"simulate: {stop}", file=sys.stderr, flush=True)
             break

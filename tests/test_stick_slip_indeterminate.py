@@ -34,6 +34,7 @@ import numpy as np
 import pytest
 
 from robotdyn.contact.sticking_cone import check
+from robotdyn.contact.traction import traction
 from robotdyn.interfaces.constraint_file import read
 from robotdyn.robot import Robot
 from robotdyn.simulation.engine import simulate
@@ -97,3 +98,14 @@ def test_driven_car_starts_to_slip_at_the_closed_form():
     assert robot.forward_dynamics(traj.q[-1], nu, np.array([0.0, 0.0, tau, tau]))[
         robot.velocity_names.index("rear_left_wheel_dot")] == pytest.approx(alpha_r, rel=1e-9)
     assert alpha_r > a / R  # the driven wheels spin up faster than the car: they slip
+    # the traction report of the run (robotdyn.contact.traction): the same slip onset, the phases, the loads
+    tr = traction(robot, traj, torque)
+    assert [(e.kind, e.wheel) for e in tr.events] == [("slide", "rear_left"), ("slide", "rear_right")]
+    assert all(e.t == pytest.approx(t_star, rel=1e-8) for e in tr.events)
+    rear = [tr.wheels.index(w) for w in ("rear_left", "rear_right")]
+    assert not tr.phases[:-1].any() and tr.phases[-1, rear].all() and tr.phases[-1].sum() == 2
+    for j in rear:  # rolling: N_r / 2, linear in the torque
+        np.testing.assert_allclose(tr.normal[:-1, j], N0 + kN * c * t, rtol=1e-9)
+    np.testing.assert_allclose(tr.normal[-1, rear], Nr / 2, rtol=1e-9)  # sliding: the three-equation closed form
+    np.testing.assert_allclose(tr.tangential[-1, rear], MU * Nr / 2, rtol=1e-9)
+    assert "holds" not in tr.summary()

@@ -337,16 +337,15 @@ def _simulate(args, limit) -> int:
     if args.csv and not (args.plot or args.traction_plot) and sc.span(args.t_end, None, streamed=True)[1] > SEGMENT \
             and not stick_slip_wheels(robot):
         return _simulate_streamed(args, robot, sc, extra, limit)  # more samples than a segment: to disk as they come
+    from ..contact.stick_slip_traction import check_mu
+
+    check_mu(robot, args.mu)  # a stick-slip wheel's mu is its law's: another --mu refused before the run
     limit.start()
     traj = sc.run(robot, t_end=args.t_end, progress=not args.quiet, **extra)
     partial = traj.stats.get("partial")
     tr = None
-    switches = traj.stats.get("switches")
-    if switches is not None:  # exact stick-slip: the phases' switches stand for the traction summary
-        if args.mu is not None or args.traction_plot:
-            raise RobotDynError("--mu/--traction-plot: this robot's wheels switch between sticking and sliding "
-                                "(friction = 'stick_slip'); their phases are reported instead")
-    elif any(isinstance(c, RollingWheel) for c in robot.constraints):
+    switches = traj.stats.get("switches")  # exact stick-slip: the phases' switches, beside the traction summary
+    if any(isinstance(c, RollingWheel) for c in robot.constraints):
         from ..interfaces.plotting import plot_traction
         from ..contact.traction import traction
 
@@ -380,9 +379,8 @@ def _simulate(args, limit) -> int:
     if tr is not None:
         out["traction"] = {"summary": tr.summary(), "wheels": tr.wheels, "undetermined": list(tr.undetermined),
                            "events": [vars(e) for e in tr.events],
-                           "max_required_mu": {w: float(np.max(tr.required_mu[:, j])) for j, w in enumerate(tr.wheels)
-                                               if tr.friction_determined[j]},  # (as the streamed run: no
-                                                                                # arbitrary split's value)
+                           "max_required_mu": tr.max_required_mu(),  # (as the streamed run: no arbitrary
+                                                                     # split's value; stick-slip: while sticking)
                            "min_normal_load": {w: float(np.min(tr.normal[:, j])) for j, w in enumerate(tr.wheels)}}
     text = [f"{args.robot} / {sc.name}: {sc.description}",
             f"simulated {traj.t[-1]:g} s in {traj.stats['wall']:.2f} s wall ({traj.stats['nfev']} evaluations, "

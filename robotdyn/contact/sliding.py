@@ -430,8 +430,9 @@ def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.nda
     st = forward(robot, q, nu, tau)
     load = np.array([np.inf if w.name in st.unloaded else f for w, f in zip(wheels, st.normal)])
     i = int(np.argmin(load)) if np.isfinite(load).any() else int(np.argmin(st.normal))
-    return (f"lift-off of wheel {wheels[i].name} at t = {t:.6g} s (normal load {st.normal[i]:.3g} N): "
-            "the run stops there (a wheel in flight is not modelled)")
+    from .stick_slip_wheel import unloaded_message
+
+    return unloaded_message(wheels[i].name, t, float(st.normal[i]), "slipping")
 
 
 @dataclass

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..constraints.rolling_contact import RollingWheel
+from ..reduction.projection import auto_independent
 
 _STICK = (np.eye(3), ("longitudinal", "lateral", "normal"))
 _SLIDE = (np.array([[0.0, 0.0, 1.0]]), ("normal",))
@@ -88,3 +89,44 @@ def stick_slip_wheels(robot) -> list[StickSlipWheel]:
         The :class:`StickSlipWheel` constraints of the robot.
     """
     return [c for c in robot.constraints if isinstance(c, StickSlipWheel)]
+
+
+def configure(robot, q: np.ndarray) -> None:
+    """Choose the independent velocities for the wheels' current phases at configuration q: the spec's choice where
+    it still fits the mobility, else :func:`~robotdyn.reduction.projection.auto_independent`'s (the projection is
+    rebuilt at every phase switch; sets ``robot.independent_indices`` and ``robot.velocity_names``).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` with stick-slip wheels in the phases wanted.
+        q: Natural coordinates (n,) [m, rad].
+    """
+    robot._projection_hint = None
+    A = robot.rows_at(q).A
+    mobility = robot.nq - np.linalg.matrix_rank(A) if A.size else robot.nq
+    spec = robot.spec.independent
+    if spec is not None and len(spec) == mobility:
+        robot.independent_indices = np.array([robot.coordinate_index(c) for c in spec], dtype=int)
+    else:
+        robot.independent_indices = auto_independent(A)
+    robot.velocity_names = [robot.velocity_labels[i] for i in robot.independent_indices]
+
+
+def unloaded_message(wheel: str, t: float, load: float, state: str) -> str:
+    """``stats["event"]`` of a run stopped where a rigid wheel's normal load reached zero (a stick-slip wheel, or
+    one slipping under a friction law): what happened and how to model it (one line).
+
+    Args:
+        wheel: The wheel's name.
+        t: Time [s] at which its load reaches zero.
+        load: Its normal load there [N] (zero to the event's accuracy).
+        state: What its tangential side was doing: ``sticking``, ``sliding`` or ``slipping``.
+
+    Returns:
+        The message: the rigid normal row would have to pull to keep the wheel on the ground, so the rigid model
+        cannot continue; ``contact = "compliant"`` (with a ``coulomb`` or ``linear`` friction law: a compliant wheel
+        takes no stick_slip law) lets it fly and land.
+    """
+    return (f"wheel {wheel} unloads at t = {t:.6g} s (normal load {load:.3g} N, {state}): the rigid contact "
+            "cannot leave the ground, so the run stops there; to let it fly and land give it contact = "
+            "\"compliant\" in its [[wheels]] entry (a normal force law of the penetration, with friction = "
+            "\"coulomb\" or \"linear\": a compliant wheel takes no stick_slip law)")

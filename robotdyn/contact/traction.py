@@ -13,6 +13,11 @@ no force object per sample: ~40 us a sample on Quasimoro against ~1.5 ms) wherev
   to pull) and, where the wheel's friction coefficient :math:`\\mu` is known, the first time
   :math:`\\mu_{req} > \\mu` (the wheel would slip). Event times are interpolated linearly between samples.
 
+An exact stick-slip run (``friction = "stick_slip"``, :mod:`robotdyn.simulation.stick_slip`) is reported through the
+same pass, each sample in the phases the run had there (:mod:`robotdyn.contact.stick_slip_traction`): a sticking
+wheel's required friction is what it needs (at most its law's mu), a sliding wheel's friction force is
+:math:`\\mu f_n`; its events are the exact times at which wheels start to slide and the load at which one unloads.
+
 A wheel whose load rigid-body dynamics do not determine (a planar root, a statically indeterminate wheel set: see
 :mod:`robotdyn.contact.contact_forces`) is reported as such; its columns are left out rather than filled with an arbitrary
 split.
@@ -26,6 +31,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .contact_forces import constraint_forces
+from .stick_slip_traction import check_mu, phase_states, phases_of
+from .stick_slip_wheel import StickSlipWheel
 from .traction_fast import WheelLoads, sample_loads, wheel_loads
 from ..errors import InputError
 
@@ -35,10 +42,12 @@ class TractionEvent:
     """The first sample where a wheel's no-slip assumption breaks.
 
     Attributes:
-        kind: ``lift-off`` (normal load <= 0) or ``slip`` (required friction > mu).
+        kind: ``lift-off`` (normal load <= 0), ``slip`` (required friction > mu) or ``slide`` (a stick-slip wheel
+            starts to slide: its friction reaches mu times its load).
         wheel: The wheel's name.
         t: Time [s], interpolated between the two samples around the crossing.
-        value: The normal load [N] (lift-off) or the required friction (slip) at the first sample past it.
+        value: The normal load [N] (lift-off), the required friction (slip) at the first sample past it, or the
+            wheel's mu (slide).
     """
 
     kind: str
@@ -48,6 +57,9 @@ class TractionEvent:
 
     def __str__(self) -> str:
         what = f"load {self.value:.4g} N" if self.kind == "lift-off" else f"required mu {self.value:.4g}"
+        if self.kind == "slide":
+            return (f"wheel {self.wheel} starts to slide at t = {self.t:.6g} s (its friction reaches mu N, "
+                    f"mu = {self.value:.4g})")
         if self.wheel == ANY_SPLIT:
             return (f"slip at t = {self.t:.4g} s: no admissible split of the open forces stays within mu (the "
                     f"smallest mu that holds is {self.value:.4g})")
@@ -84,6 +96,12 @@ class Traction:
         compliant: Wheels whose normal contact is a force law of the penetration (``contact = "compliant"``,
             :mod:`robotdyn.contact.compliant_contact`): their zero load is flight (:meth:`in_air`), not a broken
             assumption.
+        stick_slip: Wheels that switch between sticking and sliding (``friction = "stick_slip"``): their slip is
+            the run's own, decided by their law's mu (no no-slip check).
+        phases: (N, W) ``True`` where a stick-slip wheel slides at that sample (``None``: no stick-slip wheel);
+            there its friction force is :math:`\\mu f_n` and its ``required_mu`` equals its mu.
+        known: (N, W) whether each wheel's friction force is determined at each sample (``None``: not recorded; a
+            stick-slip run records it: a sliding wheel's is, a sticking one's may be left open at rest).
         method: Which pass computed the loads: ``fast`` (:mod:`robotdyn.contact.traction_fast`, a few samples
             possibly by the reference) or ``reference`` (:func:`~robotdyn.contact.contact_forces.constraint_forces`
             at every sample).
@@ -103,6 +121,40 @@ class Traction:
     sliding: list[str] = field(default_factory=list)
     compliance: list[str] = field(default_factory=list)
     compliant: list[str] = field(default_factory=list)
+    stick_slip: list[str] = field(default_factory=list)
+    phases: np.ndarray | None = None
+    known: np.ndarray | None = None
+
+    def needs(self) -> np.ndarray:
+        """(N, W) where ``required_mu`` is a need: a wheel that rolls without slipping there (not a friction law's
+        wheel, not a stick-slip wheel while it slides) and whose friction force is determined.
+
+        Returns:
+            A boolean array (N, W), samples by wheels in wheel order.
+        """
+        out = np.tile(np.array([w not in self.sliding for w in self.wheels], bool) & self.friction_determined,
+                      (len(self.t), 1))
+        if self.phases is not None:
+            out &= ~self.phases
+        return out
+
+    def max_required_mu(self) -> dict[str, float]:
+        """Each wheel's largest required friction over the samples where it is a need (:meth:`needs`; for a
+        stick-slip wheel, while it sticks), by name; wheels where it never is one are left out.
+
+        Returns:
+            A dict wheel name -> largest :math:`\\|f_t\\|/f_n` (``inf`` where the load reached zero).
+        """
+        needs = self.needs()
+        out = {}
+        for j, w in enumerate(self.wheels):
+            if not self.friction_determined[j]:
+                continue
+            if w not in self.stick_slip:
+                out[w] = float(np.max(self.required_mu[:, j]))
+            elif needs[:, j].any():
+                out[w] = float(np.max(self.required_mu[needs[:, j], j]))
+        return out
 
     def in_air(self) -> np.ndarray:
         """(N, W) where a compliant wheel (:attr:`compliant`) is in the air: its load is zero (a force law that
@@ -124,7 +176,7 @@ class Traction:
         """
         air = self.in_air()
         out = (self.normal <= 0) & ~air
-        rolling = np.array([w not in self.sliding for w in self.wheels], bool)
+        rolling = np.array([w not in self.sliding and w not in self.stick_slip for w in self.wheels], bool)
         known = np.isfinite(self.mu) & self.friction_determined & rolling
         out[:, known] |= (self.required_mu[:, known] > self.mu[known]) & ~air[:, known]
         over = self._split_over()
@@ -134,12 +186,15 @@ class Traction:
 
     def _split_over(self) -> np.ndarray | None:
         """(N,) where the minimum-mu column exceeds every wheel's mu (``None``: no such column or no mu)."""
-        if self.minimum_mu is None or not self.wheels or not np.isfinite(self.mu).all():
-            return None
+        if self.minimum_mu is None or not self.wheels or not np.isfinite(self.mu).all() or self.stick_slip:
+            return None  # (a stick-slip run's sticking wheels are switched by the same cone check: sticking_cone)
         return np.asarray(self.minimum_mu, float) > np.max(self.mu)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """CSV columns by name: ``<wheel>.normal`` [N] and ``<wheel>.mu_required`` for each determined wheel.
+        """CSV columns by name: ``<wheel>.normal`` [N] and ``<wheel>.mu_required`` for each determined wheel; for a
+        stick-slip wheel also ``<wheel>.sliding`` (1 while it slides, 0 while it sticks) and ``<wheel>.friction``
+        (its friction force's magnitude [N]: the force it needs while sticking, mu times its load while sliding,
+        where ``mu_required`` equals its mu).
 
         Returns:
             A dict of column name to a (N,) float array, wheels in wheel order, then ``mu_required_min`` (the smallest
@@ -150,6 +205,10 @@ class Traction:
             out[f"{name}.normal"] = self.normal[:, j]
             if self.friction_determined[j]:
                 out[f"{name}.mu_required"] = self.required_mu[:, j]
+            if name in self.stick_slip:
+                out[f"{name}.sliding"] = self.phases[:, j].astype(float)
+                if self.friction_determined[j]:
+                    out[f"{name}.friction"] = self.tangential[:, j]
         if self.minimum_mu is not None:
             out["mu_required_min"] = self.minimum_mu
         return out
@@ -161,25 +220,29 @@ class Traction:
             The one-line summary.
         """
         parts = []
+        slid = [w for j, w in enumerate(self.wheels) if self.phases is not None and self.phases[:, j].any()]
         if self.wheels:
-            rolling = np.array([w not in self.sliding for w in self.wheels], bool)
-            mus = self.required_mu[:, self.friction_determined & rolling]
+            needs = self.needs()
+            mus = self.required_mu[needs]
             finite = mus[np.isfinite(mus)]
             peak = finite.max() if finite.size else float("inf")
             if self.minimum_mu is not None:  # every wheel's need, the open forces split at best
                 peak = max(peak if finite.size else 0.0, float(np.max(self.minimum_mu)))
             parts.append(f"loads {self.normal.min():.4g}..{self.normal.max():.4g} N"
-                         + (f", required mu up to {peak:.3g}" if (self.friction_determined & rolling).any()
-                            or self.minimum_mu is not None else ""))
+                         + (f", required mu up to {peak:.3g}" + (" while sticking" if self.stick_slip else "")
+                            if needs.any() or self.minimum_mu is not None else ""))
             if self.compliance:
                 parts.append(f"loads of {', '.join(self.compliance)}: rigid limit of compliance")
             if self.minimum_mu is not None:
                 parts.append(f"with the best split of undetermined forces mu >= {np.max(self.minimum_mu):.3g} suffices")
+        if slid:
+            share = ", ".join(f"{w} {100 * self.phases[:, self.wheels.index(w)].mean():.3g} %" for w in slid)
+            parts.append(f"stick-slip wheels slide (friction mu N) on part of the run: {share} of the samples")
         if self.events:
             parts.append("first: " + str(self.events[0]))
         elif self.sliding:
             parts.append(f"wheels {', '.join(self.sliding)} slide under their friction law (no no-slip check)")
-        elif self.wheels:
+        elif self.wheels and not slid:  # (never "holds" where a wheel slides)
             checked = "within every wheel's mu" if np.isfinite(self.mu).all() else "loads stay positive"
             if not self.friction_determined.all():
                 checked += ", friction of " + ", ".join(
@@ -234,8 +297,15 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
     """
     if method not in METHODS:
         raise InputError(f"method = {method!r}; expected one of {', '.join(METHODS)}")
-    loads = wheel_loads(robot, traj.t, traj.q, traj.nu, torque) if method == "auto" else None
-    used = "reference" if loads is None else "fast"
+    table = phases_of(traj)
+    if table is not None:  # exact stick-slip: each sample in its phases, by the reference
+        check_mu(robot, mu)
+        with phase_states(robot, traj, table) as state:
+            loads = _reference_loads(robot, traj, torque, state)
+        used = "reference"
+    else:
+        loads = wheel_loads(robot, traj.t, traj.q, traj.nu, torque) if method == "auto" else None
+        used = "reference" if loads is None else "fast"
     if loads is None:
         loads = _reference_loads(robot, traj, torque)
     names = loads.names
@@ -254,29 +324,39 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
                    _friction_coefficients(robot, wheels, mu), friction_known, undetermined)
     out.minimum_mu = loads.minimum_mu
     out.method = used
-    by_law = {c.name for c in robot.constraints if getattr(c, "sliding", False)
-              or (hasattr(c, "law") and not getattr(c, "rolling", False))}  # rolling compliant: no law, no slip
+    by_law = {c.name for c in robot.constraints if not isinstance(c, StickSlipWheel) and (getattr(c, "sliding", False)
+              or (hasattr(c, "law") and not getattr(c, "rolling", False)))}  # rolling compliant: no law, no slip
     out.sliding = [w for w in wheels if w in by_law]  # (they slip by design: their friction is their law's)
     compliant = {(w.name or w.frame) for w in robot.spec.wheels if getattr(w, "contact", "rigid") == "compliant"}
     out.compliant = [w for w in wheels if w in compliant]  # (a zero load is flight)
     if loads.compliance is not None:
         out.compliance = [names[j] for j in keep if loads.compliance[:, j].any()]
-    out.events = _events(out)
+    if table is not None:
+        out.stick_slip = [w for w in wheels if w in table.wheels]
+        out.known = loads.load_determined[:, keep]
+        out.phases = np.zeros((len(out.t), len(wheels)), bool)
+        for j, w in enumerate(wheels):
+            if w in table.wheels:
+                out.phases[:, j] = table.sliding[:, table.wheels.index(w)]
+    out.events = _events(out, traj.stats if table is not None else None)
     return out
 
 
-def _reference_loads(robot, traj, torque) -> WheelLoads:
+def _reference_loads(robot, traj, torque, state: Callable[[int], np.ndarray] | None = None) -> WheelLoads:
     """The :class:`~robotdyn.contact.traction_fast.WheelLoads` of a trajectory by
     :func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample (only the loads are kept), with
-    ``minimum_mu`` where every sample has a wheel whose load is not all determined and it is never ``None``."""
+    ``minimum_mu`` where every sample has a wheel whose load is not all determined and it is never ``None``;
+    ``state(i)``, where given, sets the robot to sample i's state and returns its independent velocities
+    (:func:`robotdyn.contact.stick_slip_traction.phase_states`)."""
     zero = np.zeros(len(robot.motors))
     N = len(traj.t)
     names: list[str] = []
     normal = tangential = determined = None
     minimum = []
     for i, t in enumerate(traj.t):
-        tau = zero if torque is None else np.asarray(torque(t, traj.q[i], traj.nu[i]), float)
-        forces = constraint_forces(robot, traj.q[i], traj.nu[i], tau=tau)
+        nu = traj.nu[i] if state is None else state(i)
+        tau = zero if torque is None else np.asarray(torque(t, traj.q[i], nu), float)
+        forces = constraint_forces(robot, traj.q[i], nu, tau=tau)
         names_i, fn, ft, det = sample_loads(forces)
         if normal is None:
             names = names_i
@@ -315,15 +395,28 @@ def _friction_coefficients(robot, wheels: list[str], mu) -> np.ndarray:
     return out
 
 
-def _events(tr: Traction) -> list[TractionEvent]:
-    """The first lift-off and the first slip of each wheel, interpolated between samples, in time order."""
+def _events(tr: Traction, stats: dict | None = None) -> list[TractionEvent]:
+    """The first lift-off and the first slip of each wheel, interpolated between samples, in time order; for a
+    stick-slip run (its ``stats``) the exact time each wheel first slides and where one unloaded."""
     events = []
+    if stats is not None:
+        first = {}
+        for j, w in enumerate(tr.wheels):  # sliding from the start (launched with slip, or beyond its cone at t = 0)
+            if w in tr.stick_slip and tr.phases[0, j]:
+                first[w] = float(tr.t[0])
+        for s in stats.get("switches", []):
+            if s["phase"] == "slide" and s["wheel"] in tr.wheels:
+                first.setdefault(s["wheel"], float(s["t"]))
+        events += [TractionEvent("slide", w, t, float(tr.mu[tr.wheels.index(w)])) for w, t in first.items()]
+        lift = stats.get("lift_off")
+        if lift is not None and lift["wheel"] in tr.wheels:
+            events.append(TractionEvent("lift-off", lift["wheel"], float(lift["t"]), float(lift["load"])))
     for j, name in enumerate(tr.wheels):
         fn = tr.normal[:, j]
         idx = np.flatnonzero(fn <= 0)
-        if idx.size:
+        if idx.size and not any(e.kind == "lift-off" and e.wheel == name for e in events):
             events.append(TractionEvent("lift-off", name, _crossing(tr.t, fn, idx[0], 0.0), float(fn[idx[0]])))
-        if np.isfinite(tr.mu[j]) and tr.friction_determined[j] and name not in tr.sliding:
+        if np.isfinite(tr.mu[j]) and tr.friction_determined[j] and name not in tr.sliding + tr.stick_slip:
             over = np.flatnonzero((fn > 0) & (tr.required_mu[:, j] > tr.mu[j]))
             if over.size:
                 k = over[0]

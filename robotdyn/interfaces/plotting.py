@@ -182,12 +182,35 @@ def wheel_order(robot, wheels: Sequence[str]) -> tuple[list[str], set[str]]:
     return drive + rest, supports
 
 
+def _stick_slip_lines(ax, tr, j: int, color) -> None:
+    """A stick-slip wheel's phases on the friction panel ``ax``: its required friction where it sticks and its
+    friction force is determined (thin), its friction ratio mu where it slides (thick), its mu (dashed) and its
+    sliding samples shaded in its colour."""
+    name = tr.wheels[j]
+    slides = tr.phases[:, j]
+    known = tr.known[:, j] if tr.known is not None else np.full(len(tr.t), bool(tr.friction_determined[j]))
+    mu = np.where(known & np.isfinite(tr.required_mu[:, j]), tr.required_mu[:, j], np.nan)
+    sticks = ~slides & known
+    ax.plot(tr.t, np.where(slides, np.nan, mu), lw=1.2, color=color,
+            label=f"{name} sticking" + ("" if sticks.any() else ": friction not determined" if (~slides).any() else
+                                         " (never)"))
+    if slides.any():
+        ax.plot(tr.t, np.where(slides, mu, np.nan), lw=3.0, alpha=0.5, color=color,
+                label=f"{name} sliding (friction mu N), {100 * slides.mean():.3g} % of the samples")
+        ax.fill_between(tr.t, 0, 1, where=slides, transform=ax.get_xaxis_transform(), color=color, alpha=0.08)
+    if np.isfinite(tr.mu[j]):
+        ax.axhline(tr.mu[j], color=color, ls="--", lw=1.0)
+
+
 def plot_traction(tr, path=None, title: str = "", robot=None):
     """Plot a :class:`~robotdyn.contact.traction.Traction`: normal loads (top) and required friction (bottom)
     per wheel against time, shaded where a rigid wheel is unloaded (load <= 0: lifting off) or a rolling wheel needs
     more friction than its mu (drawn dashed): where the no-slip assumption breaks; and, in a band of its own, where
     a compliant wheel is in the air (:meth:`~robotdyn.contact.traction.Traction.in_air`: flight, which its model
     allows).
+
+    A stick-slip wheel (:attr:`~robotdyn.contact.traction.Traction.phases`) shows its phases: its required friction
+    drawn thin while it sticks, its friction ratio (mu) drawn thick and the band shaded in its colour while it slides.
 
     Drive wheels come first. Every wheel that can slip has its required friction ``|f_t|/f_n`` drawn where it is
     determined; where rigid-body dynamics split a force between wheels only as a sum (e.g. two wheels on one
@@ -215,6 +238,9 @@ def plot_traction(tr, path=None, title: str = "", robot=None):
         (line,) = ax_n.plot(tr.t, tr.normal[:, j], lw=1.2,
                             label=f"{name} (support, frictionless)" if name in supports else name)
         if name in supports:
+            continue
+        if name in getattr(tr, "stick_slip", ()):  # its phases: thin while it sticks, thick and shaded while it slides
+            _stick_slip_lines(ax_mu, tr, j, line.get_color())
             continue
         if not tr.friction_determined[j]:
             pending.append(name)

@@ -305,8 +305,10 @@ def project(
     independent = np.asarray(independent, dtype=int)
     dependent = _others(n, independent)
     if dependent.size != rows.size:
-        raise SingularConstraintError(
+        exc = SingularConstraintError(
             f"{independent.size} independent velocities chosen ({', '.join(names[i] for i in independent)}) but the "
             f"constraints leave {n - rows.size} (n = {n}, rank A = {rows.size}); expected exactly the mobility"
         )
+        exc.mobility = n - rows.size  # (a run that reaches here has changed mobility: simulation.compiled_engine.at_time)
+        raise exc
     return _build(A, independent, dependent, rows, names)

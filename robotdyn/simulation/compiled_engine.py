@@ -355,8 +355,17 @@ def at_time(exc: RobotDynError, t: float) -> RobotDynError:
     import copy
 
     out = copy.copy(exc)
-    out.args = (f"at t = {t:.6g} s: {exc}",)
+    advice = MOBILITY_DROP if t > 0 and getattr(exc, "mobility", None) is not None else ""
+    out.args = (f"at t = {t:.6g} s: {exc}{advice}",)
     return out
+
+
+MOBILITY_DROP = ("; the motion has left the configuration it started in, where some constraint rows were dependent (as "
+                 "rolling wheels' sideways rows can be at one configuration only), and rigid rows cannot follow it "
+                 "without an impulse; give those wheels a friction law so that their rows become forces (friction = "
+                 "'linear' or 'coulomb', with slip = 'lateral' to slide only sideways), or keep the motion in that "
+                 "configuration")
+"""The end of the one-line error of a run whose mobility drops on the way (:func:`at_time`, :func:`stuck`)."""
 
 
 def stuck(robot, state, t: float, reason: str) -> RobotDynError:
@@ -398,7 +407,7 @@ def stuck(robot, state, t: float, reason: str) -> RobotDynError:
             return SingularConstraintError(
                 f"at t = {t:.6g} s: {len(independent)} independent velocities chosen "
                 f"({', '.join(names[i] for i in independent)}) but the constraints leave {robot.nq - rank} "
-                f"(n = {robot.nq}, rank A = {rank}); expected exactly the mobility")
+                f"(n = {robot.nq}, rank A = {rank}); expected exactly the mobility" + (MOBILITY_DROP if t > 0 else ""))
     return RobotDynError(f"at t = {t:.6g} s: the projection cannot be continued ({reason}): the constraints changed "
                          "rank here (e.g. steerable wheels leaving a parallel configuration); expected a motion that "
                          "keeps the mobility, or start away from this configuration")

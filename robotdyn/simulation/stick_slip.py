@@ -19,7 +19,9 @@ limit of the wheels' normal compliance (with sliding wheels, from the coupled so
 friction), and sticking wheels whose tangential forces stay open are decided together: they stick while some
 admissible split keeps each in its cone (:mod:`robotdyn.contact.sticking_cone`, one event for the group).
 
-Lift-off (a normal load reaching zero, decreasing) stops the run with a message naming the wheel, time and load.
+Lift-off (a normal load reaching zero, decreasing) stops the run: the rigid normal row would have to pull. The
+message names the wheel, time and load and the TOML key that lets a wheel fly and land
+(:func:`robotdyn.contact.stick_slip_wheel.unloaded_message`).
 The independent velocities change with the phases, so :func:`simulate` integrates segment by segment and reports
 the full velocities v; the projection is rebuilt at every switch.
 """
@@ -31,30 +33,23 @@ import time
 
 import numpy as np
 
+from ..contact.compliance import weight
 from ..contact.contact_forces import constraint_forces
 from ..errors import RobotDynError
-from ..reduction.projection import auto_independent
 from ..reduction.pull_back import STABILISATION
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import sliding_now
 from ..contact.sliding import tangential as slip
-from ..contact.stick_slip_wheel import StickSlipWheel
+from ..contact.stick_slip_wheel import StickSlipWheel, configure, unloaded_message
+from ..contact.stick_slip_traction import phase_table, recorded_phases
 from ..contact.sticking_cone import check as cone_check
 from ..reduction.pull_back import position_rate
 from .progress import Progress
 from .trajectory import Trajectory
 
 def _configure(robot) -> None:
-    """Choose the independent velocities for the wheels' current phases (the spec's choice where it still fits)."""
-    robot._projection_hint = None
-    A = robot.rows_at(robot._stick_slip_q).A
-    mobility = robot.nq - np.linalg.matrix_rank(A) if A.size else robot.nq
-    spec = robot.spec.independent
-    if spec is not None and len(spec) == mobility:
-        robot.independent_indices = np.array([robot.coordinate_index(c) for c in spec], dtype=int)
-    else:
-        robot.independent_indices = auto_independent(A)
-    robot.velocity_names = [robot.velocity_labels[i] for i in robot.independent_indices]
+    """Choose the independent velocities for the wheels' current phases at ``robot._stick_slip_q``."""
+    configure(robot, robot._stick_slip_q)
 
 
 def _phases(robot) -> list[StickSlipWheel]:
@@ -89,8 +84,10 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
 
     Returns:
         A :class:`~robotdyn.simulation.trajectory.Trajectory` whose velocity columns are the full velocities v (named
-        ``<coordinate>_dot``), with ``friction_work`` and ``stats["switches"]`` (time, wheel, phase) and, where the
-        run stopped early, ``stats["event"]``.
+        ``<coordinate>_dot``), with ``friction_work``, ``stats["switches"]`` (time, wheel, phase), ``stats["phases"]``
+        (each sample's phases: :func:`robotdyn.contact.stick_slip_traction.phase_table`, from which
+        :func:`robotdyn.contact.traction.traction` reports the run's loads and friction) and, where the run stopped
+        early, ``stats["event"]`` (and ``stats["lift_off"]``: time, wheel and load where a wheel unloaded).
     """
     from scipy.integrate import solve_ivp
 
@@ -110,8 +107,8 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         s = slip(w, kin)[1]
         w.set_phase("slide", s) if np.linalg.norm(s) > 1e-9 else w.set_phase("stick")
     grid = np.linspace(0.0, t_end, n_out)
-    out_t, out_q, out_v, out_w = [], [], [], []
-    switches, stop, work, t = [], None, 0.0, 0.0
+    out_t, out_q, out_v, out_w, out_p = [], [], [], [], []  # out_p: each sample's phases (recorded_phases)
+    switches, stop, lift, work, t = [], None, None, 0.0, 0.0
     start = time.perf_counter()
     nfev = 0
     last_report = start
@@ -133,6 +130,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                 out_q.append(q.copy())
                 out_v.append(np.zeros(n))
                 out_w.append(work)
+                out_p.append(recorded_phases(wheels))
             if moved_at is None:
                 break
             t = moved_at
@@ -191,6 +189,7 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                 out_q.append(sol.y[:n, i])
                 out_v.append(robot.velocity(sol.y[:n, i], sol.y[n:n + k, i]))
                 out_w.append(sol.y[-1, i])
+                out_p.append(recorded_phases(wheels))
         if sol.status != 1:
             break
         fired = [i for i, te in enumerate(sol.t_events) if len(te)]
@@ -199,6 +198,8 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
         q, nu, work = y[:n], y[n:n + k], float(y[-1])
         v = robot.velocity(q, nu)
         _, wheel, kind = events[i]
+        if kind == "slide" and _forces(robot, q, nu, tau_at(t, q, nu)).wheel(wheel.name).normal <= 1e-9 * weight(robot):
+            kind = "lift-off"  # its cone's edge reached by its load going to zero (friction zero there): no slide
         if kind == "slide together":  # the group's best split reaches a cone's edge: those wheels slide
             cones = cone_check(_forces(robot, q, nu, tau_at(t, q, nu)), wheel)
             worst = int(np.argmax(cones.ratio))
@@ -207,8 +208,8 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
                 switches.append({"t": t, "wheel": w.name, "phase": "slide"})
         elif kind == "lift-off":
             load = _forces(robot, q, nu, tau_at(t, q, nu)).wheel(wheel.name).normal
-            stop = (f"lift-off of wheel {wheel.name} at t = {t:.6g} s (normal load {load:.3g} N): the run stops "
-                    "there (a wheel in flight is not modelled)")
+            stop = unloaded_message(wheel.name, t, load, "sliding" if wheel.phase == "slide" else "sticking")
+            lift = {"t": t, "wheel": wheel.name, "load": float(load)}
             print(f"simulate: {stop}", file=sys.stderr, flush=True)
             break
         elif kind == "slide":  # the cone is reached: slide opposite to the sticking force
@@ -236,9 +237,12 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     V = np.array(out_v).reshape(len(T), n)
     energy = np.array([robot.energy(qq, vv) for qq, vv in zip(Q, V)])
     residual = np.array([np.max(np.abs(robot.constraint_residual(qq)), initial=0.0) for qq in Q])
-    stats = {"nfev": nfev, "wall": wall, "method": method, "rtol": rtol, "switches": switches}
+    stats = {"nfev": nfev, "wall": wall, "method": method, "rtol": rtol, "switches": switches,
+             "phases": phase_table([w.name for w in wheels], out_p, len(T))}
     if stop:
         stats["event"] = stop
+    if lift:
+        stats["lift_off"] = lift
     return Trajectory(T, Q, V, energy, residual, list(robot.coordinates), list(robot.velocity_labels), stats,
                       robot.units, np.array(out_w))
 

@@ -30,6 +30,11 @@ Laws (:math:`\\delta` the penetration [m], :math:`\\dot\\delta` its rate [m/s]):
 - :class:`LinearContact`: :math:`f_n = \\max(0, k\\delta + c\\dot\\delta)` for :math:`\\delta > 0`.
 - :class:`HuntCrossley`: :math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` (Hunt & Crossley 1975, in the
   form of Marhefka & Orin 1999: :math:`\\lambda = \\tfrac32 \\alpha k`), whose force is continuous at touch-down.
+
+References (the site's bibliography, ``docs/bibliography.md``): K. H. Hunt, F. R. E. Crossley, *Coefficient of
+restitution interpreted as damping in vibroimpact*, Journal of Applied Mechanics (ASME), 1975; D. W. Marhefka,
+D. E. Orin, *A compliant contact model with nonlinear damping for simulation of robotic systems*, IEEE Transactions
+on Systems, Man, and Cybernetics, Part A: Systems and Humans, 1999.
 """
 
 from __future__ import annotations

@@ -141,12 +141,13 @@ class LinearContact(NormalLaw):
 
 
 class HuntCrossley(NormalLaw):
-    """:math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` for :math:`\\delta > 0`, else 0.
+    """:math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` for :math:`\\delta > 0`, else 0 [N], with the
+    penetration :math:`\\delta` [m] and its rate [m/s] (Hunt & Crossley 1975, full reference in the module docstring).
 
     Args:
         stiffness: k [N/m^n] (> 0).
         damping: :math:`\\lambda` [N s/m^(n+1)] (>= 0).
-        exponent: n (>= 1).
+        exponent: n (dimensionless, >= 1; default 1.5, Hertz's for a sphere or a crowned tyre on a plane).
     """
 
     name = "hunt_crossley"

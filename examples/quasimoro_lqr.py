@@ -8,7 +8,8 @@ an unstable equilibrium (one eigenvalue of A near +6.3 1/s). The steps:
 2. keep the states the wheel motors can reach (the body angle and the three velocities; the base's x, y, heading and
    the wheel angles do not enter the dynamics and are not stabilisable by this input);
 3. LQR gain from scipy's Riccati solver;
-4. simulate the nonlinear robot from 0.2 rad off upright with tau = -K (x - x0) as a Python torque callback.
+4. simulate the nonlinear robot from 0.2 rad off upright with tau = -K (x - x0), given as data (lqr_law: a
+   FeedbackLaw, so the closed loop runs on the compiled integrator).
 
 Run: ``python examples/quasimoro_lqr.py`` (add ``--plot FILE.png`` for a figure). Same model from the command line:
 ``robotdyn linearize quasimoro --set theta3=3.14159 --states theta3 theta1_dot theta2_dot theta3_dot

@@ -30,6 +30,11 @@ Laws (:math:`\\delta` the penetration [m], :math:`\\dot\\delta` its rate [m/s]):
 - :class:`LinearContact`: :math:`f_n = \\max(0, k\\delta + c\\dot\\delta)` for :math:`\\delta > 0`.
 - :class:`HuntCrossley`: :math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` (Hunt & Crossley 1975, in the
   form of Marhefka & Orin 1999: :math:`\\lambda = \\tfrac32 \\alpha k`), whose force is continuous at touch-down.
+
+References (the site's bibliography, ``docs/bibliography.md``): K. H. Hunt, F. R. E. Crossley, *Coefficient of
+restitution interpreted as damping in vibroimpact*, Journal of Applied Mechanics (ASME), 1975; D. W. Marhefka,
+D. E. Orin, *A compliant contact model with nonlinear damping for simulation of robotic systems*, IEEE Transactions
+on Systems, Man, and Cybernetics, Part A: Systems and Humans, 1999.
 """
 
 from __future__ import annotations
@@ -136,12 +141,13 @@ class LinearContact(NormalLaw):
 
 
 class HuntCrossley(NormalLaw):
-    """:math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` for :math:`\\delta > 0`, else 0.
+    """:math:`f_n = \\max(0, \\delta^n (k + \\lambda\\dot\\delta))` for :math:`\\delta > 0`, else 0 [N], with the
+    penetration :math:`\\delta` [m] and its rate [m/s] (Hunt & Crossley 1975, full reference in the module docstring).
 
     Args:
         stiffness: k [N/m^n] (> 0).
         damping: :math:`\\lambda` [N s/m^(n+1)] (>= 0).
-        exponent: n (>= 1).
+        exponent: n (dimensionless, >= 1; default 1.5, Hertz's for a sphere or a crowned tyre on a plane).
     """
 
     name = "hunt_crossley"

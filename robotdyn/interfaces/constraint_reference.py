@@ -66,8 +66,8 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "parameters[].xacro": ("pass it to the description as a xacro argument (so a sweep can vary a URDF mass, "
                            "length, inertia)", "true when the Xacro declares an argument of that name",
                            "xacro = true"),
-    "parameters[].minimum": ("the smallest physical value (masses and inertias: 0 by default)", "none",
-                             "minimum = 0.0"),
+    "parameters[].minimum": ("the smallest physical value, in the parameter's unit (masses and inertias: 0 by "
+                             "default)", "none", "minimum = 0.0"),
     "wheels": ("the wheels touching the ground, one table each", "[]", '[[wheels]]\nname = "left"\n'
                'joint = "left_wheel_joint"\nradius = 0.1'),
     "wheels[].name": ("the wheel's name (CSV columns <name>.normal, forces tables)", "the frame name", 'name = "left"'),
@@ -76,35 +76,48 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "wheels[].frame": ("the wheel centre's frame (a ball or a fixed caster: no spin joint)", "one of joint or frame",
                        'frame = "ball_link"'),
     "wheels[].radius": ("the radius, a number or a parameter name", "required", 'radius = "r"'),
-    "wheels[].axis": ("the axle in the wheel frame", "the spin joint's axis", "axis = [0, 1, 0]"),
+    "wheels[].axis": ("the axle's direction in the wheel frame (dimensionless, normalised)", "the spin joint's axis",
+                      "axis = [0, 1, 0]"),
     "wheels[].kind": ("standard (rolls without slipping) | omni (with roller_angle) | caster (a wheel on a steering "
                       "joint of the URDF) | support (touches the ground only: normal row, frictionless, e.g. a ball "
                       "caster or a skid)", "standard", 'kind = "support"'),
     "wheels[].roller_angle": ("omni: angle of the rollers' axes", "0", 'roller_angle = "45 deg"'),
     "wheels[].radius_joint": ("a prismatic joint that sets the radius (adaptable wheels)", "none",
                               'radius_joint = "leg_joint"'),
-    "wheels[].mu": ("friction coefficient (traction checks; the limit of the coulomb and linear laws)", "none (not "
-                    "checked)", "mu = 0.8"),
-    "wheels[].friction": ("rolling (no slip) | coulomb (regularised) | linear (brush tyre) | stick_slip",
+    "wheels[].mu": ("friction coefficient (dimensionless): the traction check's limit; the coulomb law's limit and "
+                    "stick_slip's cone (required by both); saturates the linear law", "none (not checked; linear: "
+                    "unsaturated)", "mu = 0.8"),
+    "wheels[].friction": ("rolling (rolls without slipping) | coulomb (regularised Coulomb, mu and slip_velocity) | "
+                          "linear (brush tyre, stiffness, saturated at mu) | stick_slip (exact Coulomb with mu: sticks "
+                          "while its force is inside the cone mu f_n, slides at mu f_n outside it; rigid contact only)",
                           "rolling", 'friction = "coulomb"'),
-    "wheels[].slip_velocity": ("coulomb: regularisation velocity", "1e-3", "slip_velocity = 0.001"),
-    "wheels[].stiffness": ("linear: force per unit load per m/s of slip", "required by linear", "stiffness = 5.0"),
-    "wheels[].normal_stiffness": ("normal (radial) stiffness k [N/m]: the rigid limit of normal compliance splits the loads "
-                                  "rigid-body dynamics leave open in the ratios of k", "m g / (n * 1 mm): the robot's "
-                                  "weight over its n wheels at 1 mm static deflection", "normal_stiffness = 2.0e5"),
-    "wheels[].normal_damping": ("normal (radial) damping c [N s/m]", "2 * 0.3 * sqrt(k m / n): damping ratio 0.3 on "
-                                "the wheel's share of the mass", "normal_damping = 400.0"),
+    "wheels[].slip_velocity": ("coulomb only: regularisation velocity v_s [m/s], c(s) = mu s / sqrt(s^2 + v_s^2)",
+                               "1e-3 m/s", "slip_velocity = 0.001"),
+    "wheels[].stiffness": ("linear only: slip stiffness k [s/m], the tangential force per unit load per m/s of slip, "
+                           "min(k s, mu) f_n", "required by linear", "stiffness = 5.0"),
+    "wheels[].normal_stiffness": ("normal (radial) stiffness k: N/m (linear law; on rigid wheels the rigid limit of "
+                                  "normal compliance splits the loads rigid-body dynamics leave open in the ratios "
+                                  "of k), N/m^n with contact_law = hunt_crossley",
+                                  "m g / (n * 1 mm) [N/m]: the robot's weight over its n wheels at 1 mm static "
+                                  "deflection, the same for every wheel; hunt_crossley: (m g / n) / (1 mm)^n [N/m^n], "
+                                  "the same deflection", "normal_stiffness = 2.0e5"),
+    "wheels[].normal_damping": ("normal (radial) damping: c [N s/m] of the linear law; lambda [N s/m^(n+1)] of "
+                                "hunt_crossley (used by compliant wheels only)",
+                                "linear: 2 * 0.3 * sqrt(k m / n) [N s/m], damping ratio 0.3 on the wheel's share of "
+                                "the mass; hunt_crossley: 1.5 * 0.2 s/m * k (alpha = 0.2 s/m of Marhefka and Orin "
+                                "1999)", "normal_damping = 400.0"),
     "wheels[].contact": ("rigid (the normal row is a constraint) | compliant (a force law of the penetration "
                          "[m]: the wheel can fly and land; with friction = rolling it rolls without slipping while "
                          "its normal force is > 0, a plastic tangential impact at each touch-down, or it follows "
-                         "friction = coulomb or linear with slip = both; a support is frictionless)", "rigid",
-                         'contact = "compliant"'),
+                         "friction = coulomb or linear with slip = both; a support is frictionless; not with "
+                         "stick_slip)", "rigid", 'contact = "compliant"'),
     "wheels[].contact_law": ("a compliant wheel's normal force law: linear, f = k d + c d' [N] (k in N/m, c in "
                              "N s/m) | hunt_crossley, f = d^n (k + lambda d') [N] (normal_stiffness k in N/m^n, "
-                             "normal_damping lambda in N s/m^(n+1)); only with contact = compliant", "linear",
-                             'contact_law = "hunt_crossley"'),
-    "wheels[].contact_exponent": ("hunt_crossley's exponent n (dimensionless); only with contact_law = "
-                                  "hunt_crossley", "1.5", "contact_exponent = 1.5"),
+                             "normal_damping lambda in N s/m^(n+1)); d the penetration [m], never pulling (f >= 0); "
+                             "only with contact = compliant", "linear", 'contact_law = "hunt_crossley"'),
+    "wheels[].contact_exponent": ("hunt_crossley's exponent n (dimensionless; 1.5 is Hertz's for a sphere or a "
+                                  "crowned tyre on a plane); only with contact_law = hunt_crossley", "1.5",
+                                  "contact_exponent = 1.5"),
     "wheels[].slip": ("with a friction law: both directions, or lateral only (rolls along its rolling direction)",
                       "both", 'slip = "lateral"'),
     "closures": ("loop closures: two frames held together", "[]",

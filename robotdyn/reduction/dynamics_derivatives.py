@@ -35,6 +35,10 @@ them) and for a coupling law that is not a :class:`~robotdyn.constraints.joint_c
 computed at each call. Slipping wheels (friction laws) are refused here in one line: their derivatives are
 :mod:`robotdyn.contact.sliding_derivatives` (a later stage), which reuses :func:`pieces`;
 :meth:`robotdyn.robot.Robot.dynamics_derivatives` chooses.
+
+Reference for the tree's derivatives (``computeRNEADerivatives``, the frame velocity and acceleration derivatives):
+J. Carpentier, N. Mansard, *Analytical derivatives of rigid body dynamics algorithms*, Robotics: Science and
+Systems (RSS), 2018.
 """
 
 from __future__ import annotations
@@ -353,9 +357,9 @@ def dynamics_derivatives(robot, q, nu, tau, pc: Pieces | None = None) -> Dynamic
             loop closures and joint couplings; operational-space velocities are supported (slipping wheels:
             :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`, which
             :meth:`robotdyn.robot.Robot.dynamics_derivatives` chooses).
-        q: Natural coordinates (n,) [m, rad], on the holonomic constraint manifold for ``dq_manifold`` to be
-            the derivative along it.
-        nu: Independent velocities (k,) in the order of ``robot.velocity_names``.
+        q: Natural coordinates (n,) [m, rad] in the order of ``robot.coordinates``, on the holonomic constraint
+            manifold for ``dq_manifold`` to be the derivative along it.
+        nu: Independent velocities (k,) [m/s, rad/s] in the order of ``robot.velocity_names``.
         tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
         pc: The derivative :class:`~robotdyn.reduction.dynamics_derivatives.Pieces` at (q, nu) when the caller
             has them already (default None: computed here).

@@ -114,7 +114,7 @@ def linearize(robot, q, nu, tau) -> LinearModel:
     Args:
         robot: A :class:`~robotdyn.robot.Robot` (rolling and slipping wheels, loop closures, couplings, operational
             velocities): its :meth:`~robotdyn.robot.Robot.dynamics_derivatives`.
-        q: Natural coordinates (n,) on the holonomic manifold [m, rad].
+        q: Natural coordinates (n,) [m, rad] in the order of ``robot.coordinates``, on the holonomic manifold.
         nu: Independent velocities (k,) [m/s, rad/s] in the order of ``robot.velocity_names``.
         tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
 

@@ -150,3 +150,32 @@ def test_front_axle_slides_then_lifts_at_the_closed_forms():
         w = f.wheel(name)
         assert w.normal == pytest.approx(sliding(tau)[1] / 2, rel=1e-9)
         assert -w.force[0] == pytest.approx(MU_F * w.normal, rel=1e-9)
+
+
+def test_shipped_coulomb_car_lifts_its_front_axle_instead_of_a_painleve_error():
+    """The same bug on examples/husky_like.toml as shipped (a regularised Coulomb law, mu = 0.6, on all four
+    wheels, so all slip): under a rear torque 20000 t per wheel it raised "Painleve ... condition 6e18". Now it stops
+    at the front axle's lift-off, and at every sample before it the front axle's load is the moment balance about
+    the front contact line, N_f = M g - (W_0 + a c_1 + I_w sum_i alpha_i) / L, with the model's accelerations."""
+    from robotdyn.simulation.torque_profile import Polynomial
+
+    robot = Robot(read(EXAMPLES / "husky_like.toml").SPEC)
+    c = 20000.0
+    torque = Polynomial([[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, c, c]])
+    traj = simulate(robot, 0.005, robot.neutral(), np.zeros(robot.mobility), torque, n_out=11, progress=False,
+                    engine="scipy")
+    assert traj.stats["event"].startswith("wheel front_left unloads at t = 0.0031") and "Painleve" not in \
+        traj.stats["event"]
+    assert traj.t[-1] < traj.stats["t_event"] < traj.t[-1] + 5e-4
+    names = robot.velocity_names
+    spins = [names.index(f"{w}_wheel_dot") for w in ("front_left", "front_right", "rear_left", "rear_right")]
+    last = None
+    for t, q, nu in zip(traj.t[1:], traj.q[1:], traj.nu[1:]):
+        tau = torque(t, q, nu)
+        acc = robot.forward_dynamics(q, nu, tau)
+        f = robot.contact_forces(q, nu, tau=tau)
+        front = f.wheel("front_left").normal + f.wheel("front_right").normal
+        closed = M * G - (W0 + acc[names.index("x_dot")] * C1 + IW * np.sum(acc[spins])) / L
+        assert front == pytest.approx(closed, rel=1e-8)
+        last = front
+    assert 0 < last < 0.3 * M * G

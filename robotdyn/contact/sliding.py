@@ -269,6 +269,11 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
     U of unloaded wheels is found by an active-set loop (with friction the problem is no longer a QP, so not
     :func:`robotdyn.contact.rigid_limit.split`'s solver): a loaded wheel whose load comes out negative is unloaded,
     an unloaded one whose multiplier :math:`\\mu` comes out negative is loaded again (at most 2W + 2 solves).
+    Where a wheel to unload cannot be held at zero by the load-moving directions left (its row of
+    :math:`C N V_n` depends on those of U: a whole axle of a rigid car would pull, it lifts off), no split avoids
+    pulling: the compatible loads are returned, some negative (as :func:`robotdyn.contact.rigid_limit.split` does),
+    for a lift-off event to locate the zero; holding that wheel as well would make the system singular, which is no
+    Painleve paradox.
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
@@ -329,6 +334,7 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
     compat = PV.T @ (kinv[:, None] * C)  # (p, m)
     opened = (N @ Vo).T  # (d - p, m)
     unloaded: list[int] = []
+    compatible = None  # the solution holding no wheel at zero load (returned where no split avoids pulling)
     for _ in range(2 * len(every) + 2):
         u = len(unloaded)
         top = np.hstack([MS, -G, np.zeros((n, u))])
@@ -346,7 +352,15 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
         scale = max(float(np.max(np.abs(loads), initial=0.0)), 1e-300)
         free = [j for j in range(len(every)) if j not in unloaded]
         worst = min(free, key=lambda j: loads[j]) if free else None
+        if u == 0:
+            compatible = sol, lam, loads
         if worst is not None and loads[worst] < -PULL_TOL * scale:
+            if np.linalg.matrix_rank(PV[unloaded + [worst]], tol=RANK_TOL) <= u:
+                # the open loads cannot hold this wheel at zero too (a whole axle would pull: it lifts off), so no
+                # split pulls on no wheel: the compatible loads, some negative, as rigid_limit.split gives them (the
+                # lift-off event then finds where the load reaches zero; holding both wheels was singular)
+                (sol, lam, loads), unloaded = compatible, []
+                break
             unloaded.append(worst)
             continue
         if u and np.min(mu) < -PULL_TOL * float(np.max(np.abs(mu))):

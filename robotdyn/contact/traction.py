@@ -35,7 +35,9 @@ class TractionEvent:
     """The first sample where a wheel's no-slip assumption breaks.
 
     Attributes:
-        kind: ``lift-off`` (normal load <= 0) or ``slip`` (required friction > mu).
+        kind: ``lift-off`` (a rigid contact's normal load <= 0), ``unloaded`` (a compliant contact's load reaches 0:
+            its spring-damper stops pushing while the tyre still touches; it leaves the ground later, at the lift-off
+            of the run's flight phases) or ``slip`` (required friction > mu).
         wheel: The wheel's name.
         t: Time [s], interpolated between the two samples around the crossing.
         value: The normal load [N] (lift-off) or the required friction (slip) at the first sample past it.
@@ -47,10 +49,13 @@ class TractionEvent:
     value: float
 
     def __str__(self) -> str:
-        what = f"load {self.value:.4g} N" if self.kind == "lift-off" else f"required mu {self.value:.4g}"
+        what = f"load {self.value:.4g} N" if self.kind != "slip" else f"required mu {self.value:.4g}"
         if self.wheel == ANY_SPLIT:
             return (f"slip at t = {self.t:.4g} s: no admissible split of the open forces stays within mu (the "
                     f"smallest mu that holds is {self.value:.4g})")
+        if self.kind == "unloaded":
+            return (f"zero load of compliant wheel {self.wheel} at t = {self.t:.4g} s (its contact stops pushing "
+                    "while the tyre still touches; it leaves the ground at its flight-phase lift-off)")
         return f"{self.kind} of wheel {self.wheel} at t = {self.t:.4g} s ({what})"
 
 
@@ -322,7 +327,8 @@ def _events(tr: Traction) -> list[TractionEvent]:
         fn = tr.normal[:, j]
         idx = np.flatnonzero(fn <= 0)
         if idx.size:
-            events.append(TractionEvent("lift-off", name, _crossing(tr.t, fn, idx[0], 0.0), float(fn[idx[0]])))
+            kind = "unloaded" if name in tr.compliant else "lift-off"  # (a compliant tyre's geometric lift-off
+            events.append(TractionEvent(kind, name, _crossing(tr.t, fn, idx[0], 0.0), float(fn[idx[0]])))  # is later)
         if np.isfinite(tr.mu[j]) and tr.friction_determined[j] and name not in tr.sliding:
             over = np.flatnonzero((fn > 0) & (tr.required_mu[:, j] > tr.mu[j]))
             if over.size:
@@ -349,7 +355,7 @@ def _in_time_order(events: list[TractionEvent], wheels: list[str]) -> list[Tract
             groups[-1].append(e)
         else:
             groups.append([e])
-    return [e for g in groups for e in sorted(g, key=lambda e: (e.kind != "lift-off", rank.get(e.wheel, len(rank))))]
+    return [e for g in groups for e in sorted(g, key=lambda e: (e.kind == "slip", rank.get(e.wheel, len(rank))))]
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, k: int, level: float) -> float:

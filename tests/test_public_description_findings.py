@@ -1,0 +1,40 @@
+"""What a new user met running robotdyn on public ROS descriptions (Clearpath's Husky and Jackal, as shipped,
+session 30), reproduced on our own fixtures (examples/bump_base.toml: a rigid four-wheel base on compliant tyres).
+
+- Over a bump, the run's summary said ``first: lift-off of wheel front_left at t = 0.06722 s`` while its flight
+  phases said ``lift-off 0.0720508 s`` for the same wheel (Husky: 0.0664 against 0.0728 s). Both are right about
+  different things: a spring-damper tyre's force k d + c d' reaches zero (it never pulls) while the tyre still
+  touches (d > 0, d' < 0); it leaves the ground when d = 0. The traction event of a compliant wheel is now called
+  what it is, a zero load, and the word lift-off is kept for the instant the wheel leaves the ground.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from robotdyn.contact.traction import traction
+from robotdyn.interfaces.constraint_file import read
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def test_a_compliant_wheel_unloads_before_it_lifts_off_and_the_summary_says_so():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the example chooses its independent velocities automatically)
+        cf = read(EXAMPLES / "bump_base.toml")
+        robot = cf.robot()
+    scenario = cf.SCENARIOS["bump"]
+    traj = scenario.run(robot, t_end=0.1, n_out=201, progress=False)
+    tr = traction(robot, traj, scenario.torque)
+    lift = {e["wheel"]: e["t"] for e in traj.stats["flight"] if e["event"] == "lift-off"}
+    first = tr.events[0]
+    assert first.kind == "unloaded" and first.wheel in lift
+    j = tr.wheels.index(first.wheel)
+    k0, k1 = np.searchsorted(tr.t, first.t), np.searchsorted(tr.t, lift[first.wheel])
+    assert k1 - k0 >= 5  # several samples apart (0.0668 against 0.0721 s) ...
+    assert np.all(tr.normal[k0:k1, j] == 0.0)  # ... with zero load in between: unloaded, still touching
+    text = tr.summary()
+    assert "zero load of compliant wheel" in text and "lift-off of wheel" not in text, text

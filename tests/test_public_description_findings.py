@@ -6,15 +6,20 @@ session 30), reproduced on our own fixtures (examples/bump_base.toml: a rigid fo
   different things: a spring-damper tyre's force k d + c d' reaches zero (it never pulls) while the tyre still
   touches (d > 0, d' < 0); it leaves the ground when d = 0. The traction event of a compliant wheel is now called
   what it is, a zero load, and the word lift-off is kept for the instant the wheel leaves the ground.
+- Turning the Husky in place under a Coulomb law took 78 s for 1 s simulated, on the scipy engine, and nothing
+  said why (its loads are statically indeterminate: the rigid limit of compliance with friction has no compiled
+  twin). The summary now says why a run is not on the compiled engine (examples/husky_like.toml).
 """
 
 from __future__ import annotations
 
+import json
 import warnings
 from pathlib import Path
 
 import numpy as np
 
+from robotdyn.cli import main
 from robotdyn.contact.traction import traction
 from robotdyn.interfaces.constraint_file import read
 
@@ -38,3 +43,17 @@ def test_a_compliant_wheel_unloads_before_it_lifts_off_and_the_summary_says_so()
     assert np.all(tr.normal[k0:k1, j] == 0.0)  # ... with zero load in between: unloaded, still touching
     text = tr.summary()
     assert "zero load of compliant wheel" in text and "lift-off of wheel" not in text, text
+
+
+def test_a_run_off_the_compiled_engine_says_why(capsys):
+    argv = ["simulate", "--constraints", str(EXAMPLES / "husky_like.toml"), "--scenario", "turn_in_place",
+            "--t-end", "0.005", "--quiet"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "scipy" in out and "(not on the compiled engine: the wheels' normal loads are statically " \
+        "indeterminate" in out, out
+    assert main([*argv, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["engine"].startswith("scipy") and "rigid limit" in data["engine_reason"]
+    assert main(["simulate", "quasimoro", "--scenario", "rectilinear", "--t-end", "0.01", "--quiet"]) == 0
+    assert "not on the compiled engine" not in capsys.readouterr().out  # (a compiled run: nothing to explain)

@@ -557,6 +557,9 @@ case("optimise-nodes-huge", ["optimise", "quasimoro", "--t-end", "1", "--nodes",
 case("optimise-end-unknown", [*OPT, "--end", "nosuchcoord=1"], "nosuchcoord")
 case("optimise-bound-inverted", [*OPT, "--end", "x=0.1", "--bound", "theta3=0.1:-0.1"], "theta3")
 case("optimise-final-outside-bounds", [*OPT, "--end", "x=0.1", "--bound", "x=-1:0.05"], "x")
+case("optimise-compliant-wheels", ["optimise", "--constraints", str(EXAMPLES / "bump_base.toml"), "--t-end", "1",
+                                   "--nodes", "3", "--end", "x=0.1"], "compliant")  # was a failed IPOPT solve
+case("linearize-state-twice", [*LIN, "--states", "theta3", "theta3"], "theta3")  # was accepted as one state
 
 
 def _bump(**changes) -> dict:

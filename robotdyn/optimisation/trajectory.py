@@ -203,6 +203,8 @@ class TrajectoryProblem:
         if derivatives not in DERIVATIVES:
             raise InputError(f"derivatives = {derivatives!r}; expected one of {', '.join(DERIVATIVES)}")
         self.derivatives = derivatives
+        if derivatives == "analytic":  # a constraint without a derivative rule: one line now, not at IPOPT's points
+            _derivative_rules(robot)
         self.n, self.k, self.m = len(robot.coordinates), len(robot.velocity_names), len(robot.motors)
         if self.m == 0:
             raise InputError(f"robot {robot.spec.name!r} has no motors: nothing to optimise")
@@ -641,6 +643,23 @@ class TrajectoryProblem:
                                   list(self.robot.coordinates), list(self.robot.velocity_names),
                                   [mo.name for mo in self.robot.motors], forces=forces, wheels=wheels,
                                   effort=effort, force_calls=calls.get("forces", 0), cost_kind=self.cost_kind)
+
+
+def _derivative_rules(robot) -> None:
+    """Refuse, in one line, a robot some of whose constraints have no analytic derivative rule (a compliant wheel,
+    exact Coulomb or stick-slip friction, a user's own constraint class): the checks of
+    :meth:`robotdyn.robot.Robot.dynamics_derivatives`, made once before the solve (a robot without holonomic rows
+    met them only at IPOPT's first point, as a failed solve)."""
+    from ..constraints.row_derivatives import kind
+    from ..contact.sliding import sliding_now
+
+    sliding = bool(sliding_now(robot))
+    if sliding:
+        from ..contact.sliding_derivatives import smooth_sliding
+
+        smooth_sliding(robot)
+    for c in robot.constraints:
+        kind(c, sliding=sliding)
 
 
 def _finite(value, what: str) -> float:

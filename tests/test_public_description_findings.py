@@ -9,6 +9,8 @@ session 30), reproduced on our own fixtures (examples/bump_base.toml: a rigid fo
 - Turning the Husky in place under a Coulomb law took 78 s for 1 s simulated, on the scipy engine, and nothing
   said why (its loads are statically indeterminate: the rigid limit of compliance with friction has no compiled
   twin). The summary now says why a run is not on the compiled engine (examples/husky_like.toml).
+- On Clearpath's Ridgeback (a mecanum base), ``info`` listed the four omni wheels without their roller angles,
+  so a user could not check the handedness (+45/-45 deg) that decides whether the base moves sideways.
 """
 
 from __future__ import annotations
@@ -57,3 +59,23 @@ def test_a_run_off_the_compiled_engine_says_why(capsys):
     assert data["engine"].startswith("scipy") and "rigid limit" in data["engine_reason"]
     assert main(["simulate", "quasimoro", "--scenario", "rectilinear", "--t-end", "0.01", "--quiet"]) == 0
     assert "not on the compiled engine" not in capsys.readouterr().out  # (a compiled run: nothing to explain)
+
+
+def test_info_shows_each_omni_wheel_roller_angle(tmp_path, capsys):
+    import tomllib
+
+    import tomli_w
+
+    data = tomllib.loads((EXAMPLES / "skid_steer.toml").read_text())
+    data["urdf"] = str(EXAMPLES / "skid_steer.urdf.xacro")
+    data.pop("independent")
+    for w, angle in zip(data["wheels"], ["45 deg", "-45 deg", "-45 deg", "45 deg"]):
+        for key in ("friction", "stiffness", "mu"):
+            w.pop(key, None)
+        w["kind"], w["roller_angle"] = "omni", angle
+    (tmp_path / "mecanum.toml").write_text(tomli_w.dumps(data))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["info", "--constraints", str(tmp_path / "mecanum.toml")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("roller_angle=45 deg") == 2 and out.count("roller_angle=-45 deg") == 2, out

@@ -63,6 +63,8 @@ def as_vector(values, n: int, what: str, names: Sequence[str] | None = None,
         return values.copy()  # the common case in one vectorised check; any mistake takes the loop for its message
     if isinstance(values, str):
         values = values.replace(",", " ").split()
+    if values is None:
+        raise InputError(f"{what} is None; expected {n} values" + (f" ({', '.join(names)})" if names else ""))
     try:
         seq = list(values) if isinstance(values, Iterable) else [values]
     except TypeError:

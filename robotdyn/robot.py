@@ -542,14 +542,20 @@ class Robot:
         """``q``, ``nu`` (and ``tau``) as float arrays, their lengths checked (a wrong length is a one-line
         :class:`~robotdyn.errors.InputError` from :meth:`check_q`/:meth:`check_nu`/:meth:`check_tau`, never
         numpy's shape error deep inside); values are not range-checked here (the API's hot path)."""
-        q_, nu_ = np.asarray(q, float), np.asarray(nu, float)
+        try:
+            q_, nu_ = np.asarray(q, float), np.asarray(nu, float)
+        except (TypeError, ValueError):  # not numbers: the checks name the entry
+            q_, nu_ = self.check_q(q), self.check_nu(nu, what)
         if q_.shape != (self.nq,):
             self.check_q(q)
         if nu_.shape != (self.mobility,):
             self.check_nu(nu, what)
         if tau is None:
             return q_, nu_
-        tau_ = np.asarray(tau, float)
+        try:
+            tau_ = np.asarray(tau, float)
+        except (TypeError, ValueError):
+            tau_ = self.check_tau(tau)
         if tau_.shape != (len(self.motors),):
             self.check_tau(tau)
         return q_, nu_, tau_
@@ -747,7 +753,7 @@ class Robot:
             >>> bool(abs(nudot[0] - nudot[1]) < 1e-12)  # equal torques: the wheels accelerate alike
             True
         """
-        q, nu, tau = self._state(q, nu, tau)
+        q, nu, tau = self._state(q, nu, self.check_tau(tau) if tau is None else tau)
         if sliding_now(self):
             return forward_sliding(self, q, nu, tau).nudot
         red = self.reduced(q, nu)
@@ -785,8 +791,8 @@ class Robot:
             A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives`.
 
         Raises:
-            InputError: Wrong sizes, or a constraint without derivatives (a stick-slip wheel, exact Coulomb
-                friction, a user's own constraint class); with ``check=False`` wrong sizes may raise another error.
+            InputError: Wrong sizes (with ``check=False`` too), or a constraint without derivatives (a stick-slip
+                wheel, exact Coulomb friction, a user's own constraint class).
             SingularConstraintError: Slipping wheels whose coupled system is singular (Painlevé).
             NonFiniteError: A non-finite result.
         """
@@ -806,8 +812,8 @@ class Robot:
                 smooth_sliding(self)  # the one-line refusal of stick-slip and exact Coulomb friction, on either path
             for c in self.constraints:
                 kind(c, sliding=sliding)  # the one-line refusal of a constraint without derivatives, on either path
-        else:
-            q, nu, tau = (np.asarray(x, dtype=float) for x in (q, nu, tau))
+        else:  # lengths only (a one-line InputError, never the binding's TypeError); values are the caller's
+            q, nu, tau = self._state(q, nu, self.check_tau(tau) if tau is None else tau)
         fast = compiled_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves
         return fast if fast is not None else python_path(self, q, nu, tau)
 

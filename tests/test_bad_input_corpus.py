@@ -549,6 +549,52 @@ case("linearize-lqr-q-nan", [*LIN, *UPRIGHT, "--lqr-q", "nan", "1", "1", "1", "-
 case("linearize-lqr-r-zero", [*LIN, *UPRIGHT, "--lqr-q", "1", "1", "1", "1", "--lqr-r", "0", "1"], "--lqr-r")
 case("linearize-lqr-unstabilisable", [*LIN, "--lqr-q", *["1"] * 9, "--lqr-r", "1", "1"], "stabilisable")
 
+# ------------------------------------------------------------ optimise, compliant wheels, joint springs
+OPT = ["optimise", "quasimoro", "--t-end", "1", "--nodes", "5"]
+case("optimise-end-beyond-reach", [*OPT, "--end", "x=1e9"], "q_end")  # was IPOPT tracebacks at trial points
+case("optimise-nodes-huge", ["optimise", "quasimoro", "--t-end", "1", "--nodes", "20000", "--end", "x=0.1"],
+     "nodes")  # was a collocation of 20,000 nodes started (10^8: memory exhausted)
+case("optimise-end-unknown", [*OPT, "--end", "nosuchcoord=1"], "nosuchcoord")
+case("optimise-bound-inverted", [*OPT, "--end", "x=0.1", "--bound", "theta3=0.1:-0.1"], "theta3")
+case("optimise-final-outside-bounds", [*OPT, "--end", "x=0.1", "--bound", "x=-1:0.05"], "x")
+case("optimise-compliant-wheels", ["optimise", "--constraints", str(EXAMPLES / "bump_base.toml"), "--t-end", "1",
+                                   "--nodes", "3", "--end", "x=0.1"], "compliant")  # was a failed IPOPT solve
+case("linearize-state-twice", [*LIN, "--states", "theta3", "theta3"], "theta3")  # was accepted as one state
+
+
+def _bump(**changes) -> dict:
+    """examples/bump_base.toml (compliant wheels) as data with an absolute urdf, then ``changes`` (as _skid)."""
+    data = tomllib.loads((EXAMPLES / "bump_base.toml").read_text())
+    data["urdf"] = str(EXAMPLES / data["urdf"])
+    for dotted, value in changes.items():
+        keys = dotted.split(".")
+        node = data
+        for k in keys[:-1]:
+            node = node[int(k)] if isinstance(node, list) else node[k]
+        node[keys[-1]] = value
+    return data
+
+
+toml_case("compliant-stiffness-zero", "normal_stiffness", _bump(**{"wheels.0.normal_stiffness": 0.0}))
+toml_case("compliant-stiffness-inf", "normal_stiffness", _bump(**{"wheels.0.normal_stiffness": float("inf")}))
+toml_case("compliant-damping-negative", "normal_damping", _bump(**{"wheels.0.normal_damping": -1.0}))
+toml_case("compliant-damping-text", "normal_damping", _bump(**{"wheels.0.normal_damping": "soft"}))
+toml_case("compliant-law-unknown", "contact_law", _bump(**{"wheels.0.contact_law": "hertz"}))
+toml_case("compliant-exponent-below-one", "contact_exponent",
+          _bump(**{"wheels.0.contact_law": "hunt_crossley", "wheels.0.contact_exponent": 0.5}))
+toml_case("compliant-key-misspelt", "normal_stiffnes", _bump(**{"wheels.0.normal_stiffnes": 1e5}))
+toml_case("compliant-wheel-missing-joint", "nosuch_spin",
+          {**_bump(), "wheels": [*_bump()["wheels"], {"name": "ghost", "joint": "nosuch_spin", "radius": 0.1,
+                                                      "contact": "compliant"}]})
+_SPRING = {"joint": "axle_roll", "stiffness": 100.0, "damping": 1.0}
+toml_case("spring-neither-stiffness-nor-damping", "stiffness",
+          {**_skid(), "springs": [{"joint": "axle_roll"}]})  # was accepted: a spring that does nothing
+toml_case("spring-stiffness-negative", "stiffness", {**_skid(), "springs": [{**_SPRING, "stiffness": -1.0}]})
+toml_case("spring-damping-nan", "damping", {**_skid(), "springs": [{**_SPRING, "damping": float("nan")}]})
+toml_case("spring-unknown-joint", "nosuchjoint", {**_skid(), "springs": [{**_SPRING, "joint": "nosuchjoint"}]})
+toml_case("spring-twice-on-a-joint", "axle_roll", {**_skid(), "springs": [_SPRING, _SPRING]})
+toml_case("spring-unknown-key", "preload", {**_skid(), "springs": [{**_SPRING, "preload": 3.0}]})
+
 # --------------------------------------------------------------------------------------------- descriptions
 dd_case("valid-control", "", urdf_text())  # (replaced below: the control must pass; see test_control_is_valid)
 CASES.pop()

@@ -109,3 +109,19 @@ def test_the_makefile_and_the_docs_configuration_name_the_same_cache():
     assert re.search(r'^nb_execution_mode = "cache"', conf, re.MULTILINE)
     path = re.search(r"^nb_execution_cache_path = str\(DOCS / (.+)\)", conf, re.MULTILINE).group(1)
     assert "docs/" + "/".join(re.findall(r'"([^"]+)"', path)) == cache
+
+
+@pytest.mark.parametrize("text", ["not json", "{}"])
+def test_a_missing_or_unreadable_notebook_is_one_line_before_any_kernel(tmp_path, capsys, text):
+    """A missing file, and a file that is not a version-4 notebook: exit status 2 and one line naming it, before
+    the cache is touched (an unreadable one used to run into jupyter-cache's 40-line traceback, exit 1)."""
+    tool = _tool()
+    cache = tmp_path / "cache"
+    assert tool.main(["execute", str(cache), str(tmp_path / "nosuch.ipynb")]) == 2
+    bad = tmp_path / "bad.ipynb"
+    bad.write_text(text)
+    assert tool.main(["execute", str(cache), str(bad)]) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert len(lines) == 2 and "nosuch.ipynb" in lines[0] and "bad.ipynb is not a notebook" in lines[1], err
+    assert "expected" in lines[1] and not out and not cache.exists()

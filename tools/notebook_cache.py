@@ -86,6 +86,26 @@ def drop_stale(cache: Path, repo: Path = REPO) -> bool:
     return dropped
 
 
+def unreadable(path: Path) -> str | None:
+    """Why ``path`` cannot be read as a version-4 notebook (its reader's message, first line), or None.
+
+    Args:
+        path: A notebook file.
+
+    Returns:
+        The reason, or None for a readable notebook.
+    """
+    import nbformat
+
+    try:
+        nb = nbformat.read(str(path), as_version=4)
+        if not isinstance(nb.get("cells"), list):
+            return "no cells"
+    except Exception as exc:  # noqa: BLE001 - any reader error (JSON, schema, encoding) is the same answer
+        return (str(exc).strip().splitlines() or [type(exc).__name__])[0][:200]
+    return None
+
+
 def execute(cache: Path, notebooks: list[Path]) -> int:
     """Run ``notebooks`` into an emptied ``cache`` and print one line per notebook.
 
@@ -99,6 +119,12 @@ def execute(cache: Path, notebooks: list[Path]) -> int:
     if missing or not notebooks:
         print(f"notebook cache: expected notebook files, got {' '.join(missing) or 'none'}", file=sys.stderr)
         return 2
+    for nb in notebooks:  # before any kernel starts: an unreadable file was jupyter-cache's 40-line traceback
+        problem = unreadable(nb)
+        if problem:
+            print(f"notebook cache: {nb} is not a notebook ({problem}); expected a Jupyter notebook (nbformat 4)",
+                  file=sys.stderr)
+            return 2
     if cache.exists():
         shutil.rmtree(cache)
     cache.mkdir(parents=True)

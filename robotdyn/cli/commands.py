@@ -387,6 +387,12 @@ def _simulate(args, limit) -> int:
             f"{traj.stats.get('engine', 'scipy')} engine)",
             "final state:", *(f"  {k:<14} {v: .8g}" for k, v in final.items()),
             f"energy: {traj.energy[0]:.10g} J -> {traj.energy[-1]:.10g} J; max holonomic residual {drift:.2e}"]
+    if str(out["engine"] or "scipy").startswith("scipy"):  # the Python path: say why (it can take 100x longer)
+        from ..simulation.engine_reason import python_path_reason
+
+        out["engine_reason"] = python_path_reason(traj.robot or robot, traj.torque)
+        if out["engine_reason"]:
+            text.insert(2, f"  (not on the compiled engine: {out['engine_reason']})")
     if tr is not None:
         text.append(tr.summary())
     if "flight" in traj.stats:  # compliant wheels: lift-off and touch-down times (robotdyn.simulation.flight)

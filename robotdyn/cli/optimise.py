@@ -51,7 +51,8 @@ def cmd_optimise(args) -> int:
     if not s.success:  # nothing printed or written: an unconverged iterate is not a result
         raise RobotDynError(f"the optimisation did not converge: IPOPT {s.status} after {s.iterations} iterations "
                             f"(largest defect {s.max_defect:.2g}; looser bounds, more time or more nodes may make "
-                            "the problem feasible)")
+                            "the problem feasible)" + (f"; the model refused a point IPOPT tried: {problem.refused}"
+                                                       if getattr(problem, "refused", None) else ""))
     if args.csv:
         header = ["t"] + s.coordinates + s.velocity_names + [f"tau_{m}" for m in s.motors]
         with atomic_output(args.csv, "CSV file") as tmp:

@@ -275,6 +275,10 @@ class OmniWheel(RollingWheel):
         ca, sa = np.cos(self.roller_angle), np.sin(self.roller_angle)
         self._directions = np.array([[ca, sa, 0.0], [0.0, 0.0, 1.0]])
 
+    def __repr__(self) -> str:  # (the roller angle too: a mecanum base's info shows each wheel's handedness)
+        return (f"{type(self).__name__}(frame={self.frame!r}, radius={self.radius}, roller_angle="
+                f"{np.degrees(self.roller_angle):.6g} deg, terrain={self.terrain!r})")
+
 
 class SupportWheel(RollingWheel):
     """A wheel that only touches the ground: the holonomic normal row, no tangential rows (a frictionless

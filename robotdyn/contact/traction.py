@@ -42,8 +42,10 @@ class TractionEvent:
     """The first sample where a wheel's no-slip assumption breaks.
 
     Attributes:
-        kind: ``lift-off`` (normal load <= 0), ``slip`` (required friction > mu) or ``slide`` (a stick-slip wheel
-            starts to slide: its friction reaches mu times its load).
+        kind: ``lift-off`` (a rigid contact's normal load <= 0), ``unloaded`` (a compliant contact's load reaches 0:
+            its spring-damper stops pushing while the tyre still touches; it leaves the ground later, at the lift-off
+            of the run's flight phases), ``slip`` (required friction > mu) or ``slide`` (a stick-slip wheel starts
+            to slide: its friction reaches mu times its load).
         wheel: The wheel's name.
         t: Time [s], interpolated between the two samples around the crossing.
         value: The normal load [N] (lift-off), the required friction (slip) at the first sample past it, or the
@@ -56,13 +58,17 @@ class TractionEvent:
     value: float
 
     def __str__(self) -> str:
-        what = f"load {self.value:.4g} N" if self.kind == "lift-off" else f"required mu {self.value:.4g}"
+        loaded = self.kind in ("lift-off", "unloaded")
+        what = f"load {self.value:.4g} N" if loaded else f"required mu {self.value:.4g}"
         if self.kind == "slide":
             return (f"wheel {self.wheel} starts to slide at t = {self.t:.6g} s (its friction reaches mu N, "
                     f"mu = {self.value:.4g})")
         if self.wheel == ANY_SPLIT:
             return (f"slip at t = {self.t:.4g} s: no admissible split of the open forces stays within mu (the "
                     f"smallest mu that holds is {self.value:.4g})")
+        if self.kind == "unloaded":
+            return (f"zero load of compliant wheel {self.wheel} at t = {self.t:.4g} s (its contact stops pushing "
+                    "while the tyre still touches; it leaves the ground at its flight-phase lift-off)")
         return f"{self.kind} of wheel {self.wheel} at t = {self.t:.4g} s ({what})"
 
 
@@ -415,7 +421,8 @@ def _events(tr: Traction, stats: dict | None = None) -> list[TractionEvent]:
         fn = tr.normal[:, j]
         idx = np.flatnonzero(fn <= 0)
         if idx.size and not any(e.kind == "lift-off" and e.wheel == name for e in events):
-            events.append(TractionEvent("lift-off", name, _crossing(tr.t, fn, idx[0], 0.0), float(fn[idx[0]])))
+            kind = "unloaded" if name in tr.compliant else "lift-off"  # (a compliant tyre's geometric lift-off
+            events.append(TractionEvent(kind, name, _crossing(tr.t, fn, idx[0], 0.0), float(fn[idx[0]])))  # is later)
         if np.isfinite(tr.mu[j]) and tr.friction_determined[j] and name not in tr.sliding + tr.stick_slip:
             over = np.flatnonzero((fn > 0) & (tr.required_mu[:, j] > tr.mu[j]))
             if over.size:
@@ -442,7 +449,7 @@ def _in_time_order(events: list[TractionEvent], wheels: list[str]) -> list[Tract
             groups[-1].append(e)
         else:
             groups.append([e])
-    return [e for g in groups for e in sorted(g, key=lambda e: (e.kind != "lift-off", rank.get(e.wheel, len(rank))))]
+    return [e for g in groups for e in sorted(g, key=lambda e: (e.kind == "slip", rank.get(e.wheel, len(rank))))]
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, k: int, level: float) -> float:

@@ -916,6 +916,8 @@ def _springs(cx: _Context) -> list:
         for key in ("stiffness", "damping"):
             if numbers.get(key, 0.0) < 0:
                 r.fail(where, f"{key} = {numbers[key]}; expected a number >= 0")
+        if "stiffness" not in numbers and "damping" not in numbers:  # a spring that does nothing: a slip of the pen
+            r.fail(where, "neither stiffness nor damping given; expected stiffness (N/m or N m/rad) and/or damping")
         out.append(JointSpring(j, name=sp.get("name", j), **numbers))
     return out
 

@@ -67,7 +67,10 @@ def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], 
             return sparsity
 
         def eval(self, arg):
-            vals = jacobian_values(np.asarray(arg[0], float).ravel())
+            try:
+                vals = jacobian_values(np.asarray(arg[0], float).ravel())
+            except Exception as exc:  # noqa: BLE001 - see _refused
+                vals = _refused(keep, exc, len(order))
             return [ca.DM(sparsity, vals[order])]
 
     class Values(ca.Callback):
@@ -88,7 +91,10 @@ def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], 
             return ca.Sparsity.dense(ng, 1)
 
         def eval(self, arg):
-            return [ca.DM(values(np.asarray(arg[0], float).ravel()))]
+            try:
+                return [ca.DM(values(np.asarray(arg[0], float).ravel()))]
+            except Exception as exc:  # noqa: BLE001 - see _refused
+                return [ca.DM(_refused(keep, exc, ng))]
 
         def has_jacobian(self):
             return True
@@ -101,4 +107,40 @@ def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], 
     return keep[-1]
 
 
-__all__ = ["sparse_callback"]
+class Refusal:
+    """The first error a callback raised at a point IPOPT tried (kept in the callbacks' ``keep`` list).
+
+    Args:
+        exc: The exception the model raised.
+    """
+
+    def __init__(self, exc: Exception):
+        self.exc = exc
+
+
+def _refused(keep: list, exc: Exception, size: int) -> np.ndarray:
+    """NaN values for a point where the model raised (e.g. a trial point beyond the joint ranges, or where the
+    constraints are singular): IPOPT backtracks from NaN constraint values, or stops with Invalid_Number_Detected,
+    instead of CasADi printing the Python traceback and its own dump of the point. The first error is kept in
+    ``keep`` (see :func:`refusal`)."""
+    if refusal(keep) is None:
+        keep.append(Refusal(exc))
+    return np.full(size, np.nan)
+
+
+def refusal(keep: list) -> str | None:
+    """The first error a callback of ``keep`` raised during the solve, as one line (None: none raised).
+
+    Args:
+        keep: The list given to :func:`sparse_callback`.
+
+    Returns:
+        ``"ErrorType: message"`` (its first line), or None.
+    """
+    for item in keep:
+        if isinstance(item, Refusal):
+            return f"{type(item.exc).__name__}: {str(item.exc).splitlines()[0] if str(item.exc) else ''}"
+    return None
+
+
+__all__ = ["Refusal", "refusal", "sparse_callback"]

@@ -342,7 +342,8 @@ class PostureProblem:
         ubx = np.concatenate([self.x_hi, self.tau_hi, [np.inf]])
         opts = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.constr_viol_tol": tol,
                 "ipopt.max_iter": int(max_iter), "ipopt.print_level": 5 if verbose else 0, "print_time": bool(verbose),
-                "ipopt.sb": "yes", "ipopt.honor_original_bounds": "yes"}
+                "ipopt.sb": "yes", "ipopt.honor_original_bounds": "yes",
+                "show_eval_warnings": False}  # a refused trial point: robotdyn.optimisation.callbacks._refused
         solver = ca.nlpsol("posture", "ipopt", {"x": z, "f": z[-1], "g": g(z)}, opts)
         self.calls = {"evaluations": 0, "derivatives": 0}
         start = time.perf_counter()

@@ -56,11 +56,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, NonFiniteError
-from .callbacks import _casadi, sparse_callback
+from ..inputs import MAX_POSITION
+from .callbacks import _casadi, refusal, sparse_callback
 
 DERIVATIVES = ("analytic", "finite-difference")
 """How the dynamics' Jacobian is computed (``derivatives`` of :class:`TrajectoryProblem`)."""
 COSTS = ("effort", "peak-mu")
+MAX_NODES = 10_000
+"""Most collocation nodes of one problem (its Jacobian pattern and IPOPT's work grow with them; 10^8 exhausts
+memory)."""
 """What :class:`TrajectoryProblem` minimises: ``effort`` :math:`\\int\\lVert\\tau\\rVert^2 dt`, or ``peak-mu`` the
 square of the largest required friction coefficient over wheels and nodes plus ``effort_weight`` times the effort."""
 HOLONOMIC_TOL = 1e-8
@@ -152,7 +156,7 @@ class TrajectoryProblem:
     Args:
         robot: A :class:`~robotdyn.robot.Robot` (holonomic rows are kept at every node).
         t_end: Duration T [s] (> 0).
-        nodes: Number of collocation nodes N (>= 3).
+        nodes: Number of collocation nodes N (3 to :data:`MAX_NODES`).
         q0: Initial natural coordinates (n,) [m, rad].
         nu0: Initial independent velocities (k,) [m/s, rad/s] (default: at rest).
         q_end: Final values of some coordinates, by name {coordinate: value} [m or rad]; the others are free.
@@ -193,12 +197,14 @@ class TrajectoryProblem:
         self.t_end = _finite(t_end, "t_end")
         if not self.t_end > 0:
             raise InputError(f"t_end = {t_end!r}; expected a finite duration > 0 [s]")
-        if not (isinstance(nodes, (int, np.integer)) and nodes >= 3):
-            raise InputError(f"nodes = {nodes!r}; expected an integer >= 3")
+        if not (isinstance(nodes, (int, np.integer)) and 3 <= nodes <= MAX_NODES):
+            raise InputError(f"nodes = {nodes!r}; expected an integer from 3 to {MAX_NODES:,}")
         self.nodes = int(nodes)
         if derivatives not in DERIVATIVES:
             raise InputError(f"derivatives = {derivatives!r}; expected one of {', '.join(DERIVATIVES)}")
         self.derivatives = derivatives
+        if derivatives == "analytic":  # a constraint without a derivative rule: one line now, not at IPOPT's points
+            _derivative_rules(robot)
         self.n, self.k, self.m = len(robot.coordinates), len(robot.velocity_names), len(robot.motors)
         if self.m == 0:
             raise InputError(f"robot {robot.spec.name!r} has no motors: nothing to optimise")
@@ -234,6 +240,9 @@ class TrajectoryProblem:
             if name not in robot.coordinates:
                 raise InputError(f"q_end names {name!r}; expected one of the coordinates {robot.coordinates}")
             self.x_end[robot.coordinates.index(name)] = _finite(value, f"q_end[{name!r}]")
+            if abs(self.x_end[robot.coordinates.index(name)]) > MAX_POSITION:
+                raise InputError(f"q_end[{name!r}] = {value!r}; expected abs(value) <= {MAX_POSITION:g} m or rad "
+                                 "(what a robot reaches)")
         nu_end = [0.0] * self.k if nu_end is None else list(nu_end)
         if len(nu_end) != self.k:
             raise InputError(f"nu_end has {len(nu_end)} entries; expected {self.k} ({robot.velocity_names})")
@@ -602,7 +611,8 @@ class TrajectoryProblem:
             lbg[ng - N * c:], ubg[ng - N * c:] = np.tile(lo, N), np.tile(hi, N)
         opts = {"ipopt.hessian_approximation": "limited-memory", "ipopt.tol": tol, "ipopt.constr_viol_tol": tol,
                 "ipopt.max_iter": int(max_iter), "ipopt.print_level": 5 if verbose else 0, "print_time": bool(verbose),
-                "ipopt.sb": "yes", "ipopt.honor_original_bounds": "yes"}
+                "ipopt.sb": "yes", "ipopt.honor_original_bounds": "yes",
+                "show_eval_warnings": False}  # a refused trial point: robotdyn.optimisation.callbacks._refused
         solver = ca.nlpsol("trajectory", "ipopt", {"x": z, "f": cost, "g": constraints(z)}, opts)
         self.calls = {"dynamics": 0, "derivatives": 0}
         if self.limits is not None:
@@ -612,6 +622,7 @@ class TrajectoryProblem:
         res = solver(x0=self._initial(), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
         wall = time.perf_counter() - start
         stats = solver.stats()
+        self.refused = refusal(self._callbacks)  # the model's first error at a trial point (None: none)
         zopt = np.asarray(res["x"], float).ravel()
         X, U = self._split(zopt)
         calls = dict(self.calls)
@@ -632,6 +643,23 @@ class TrajectoryProblem:
                                   list(self.robot.coordinates), list(self.robot.velocity_names),
                                   [mo.name for mo in self.robot.motors], forces=forces, wheels=wheels,
                                   effort=effort, force_calls=calls.get("forces", 0), cost_kind=self.cost_kind)
+
+
+def _derivative_rules(robot) -> None:
+    """Refuse, in one line, a robot some of whose constraints have no analytic derivative rule (a compliant wheel,
+    exact Coulomb or stick-slip friction, a user's own constraint class): the checks of
+    :meth:`robotdyn.robot.Robot.dynamics_derivatives`, made once before the solve (a robot without holonomic rows
+    met them only at IPOPT's first point, as a failed solve)."""
+    from ..constraints.row_derivatives import kind
+    from ..contact.sliding import sliding_now
+
+    sliding = bool(sliding_now(robot))
+    if sliding:
+        from ..contact.sliding_derivatives import smooth_sliding
+
+        smooth_sliding(robot)
+    for c in robot.constraints:
+        kind(c, sliding=sliding)
 
 
 def _finite(value, what: str) -> float:

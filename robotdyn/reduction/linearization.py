@@ -78,11 +78,14 @@ class LinearModel:
             A new :class:`LinearModel` (the inputs, ``tau0`` and ``q0`` unchanged).
 
         Raises:
-            InputError: An unknown state name.
+            InputError: An unknown state name, or one listed twice.
         """
         bad = [s for s in keep if s not in self.states]
         if bad:
             raise InputError(f"unknown state {bad[0]!r}; expected some of {', '.join(self.states)}")
+        twice = [s for s in dict.fromkeys(keep) if list(keep).count(s) > 1]
+        if twice:
+            raise InputError(f"state {twice[0]!r} listed twice; expected distinct states of {', '.join(self.states)}")
         idx = np.array([i for i, s in enumerate(self.states) if s in keep], dtype=int)
         npos = len(self.position_index)
         pos = [i for i in idx if i < npos]

@@ -34,6 +34,7 @@ from ..contact.compliant_contact import compliant_wheels
 from ..contact.applied_forces import applied, has_applied
 from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .progress import Progress
+from .run_options import check_run_options
 from .feedback import FeedbackLaw
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
@@ -141,6 +142,7 @@ def simulate(
         raise RobotDynError(f"t_end = {t_end:g} s; expected a duration of at least {MIN_DURATION:g} s")
     if time_limit is not None and not (np.isfinite(time_limit) and time_limit > 0):
         raise RobotDynError(f"time_limit = {time_limit} s; expected a positive wall-clock duration or None")
+    n_out = check_run_options(n_out, rtol, atol, method)  # robotdyn.simulation.run_options
     if not 2 <= n_out <= MAX_SAMPLES:
         width = 2 * robot.nq + 3
         raise RobotDynError(f"{n_out:.3g} output samples for t_end = {t_end:g} s ({8 * width * n_out / 1e9:.3g} GB); "

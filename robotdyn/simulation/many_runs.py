@@ -197,7 +197,7 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
         from ..fast.compiled import why_not
 
         raise RobotDynError(f"simulate_many needs the compiled model: {why_not(robot)}")
-    if fast.ev.slipping:
+    if fast.ev.slipping or fast.slip_refusal is not None:  # (refused: slipping wheels whose friction is not
         raise RobotDynError("simulate_many does not run robots with slipping wheels (their friction and lift-off "
                             "are on robotdyn.simulation.simulate); expected wheels that roll without slipping")
     robot.reduced(Q0[0], NU0[0])  # the projection's rows (the Python path chooses them)

@@ -140,7 +140,8 @@ def model_vectors(ctx: RunContext, runs: list[RunInput], mode: str = "auto") -> 
             except RobotDynError as exc:  # each run meets it again when built alone, and says so in its row
                 reasons.append(f"runs{where} built one at a time: {error_message(exc)}")
                 continue
-            if fast is None or fast.ev.slipping:
+            if fast is None or fast.ev.slipping or fast.slip_refusal is not None:  # (friction not compiled: the
+                # model's slipping wheels would have none, e.g. on a statically indeterminate chassis)
                 reasons.append(f"runs{where} built one at a time: "
                                + ("slipping wheels" if fast is not None else why_not(base)))
                 continue

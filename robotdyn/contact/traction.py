@@ -34,6 +34,8 @@ from .contact_forces import constraint_forces
 from .stick_slip_traction import check_mu, phase_states, phases_of
 from .stick_slip_wheel import StickSlipWheel
 from .traction_fast import WheelLoads, sample_loads, wheel_loads
+from .traction_memo import once_per_sample
+from .traction_minimum import cone_problem, minimum_mu_many
 from ..errors import InputError
 
 
@@ -353,26 +355,28 @@ def _reference_loads(robot, traj, torque, state: Callable[[int], np.ndarray] | N
     names: list[str] = []
     normal = tangential = determined = None
     minimum = []
-    for i, t in enumerate(traj.t):
-        nu = traj.nu[i] if state is None else state(i)
-        tau = zero if torque is None else np.asarray(torque(t, traj.q[i], nu), float)
-        forces = constraint_forces(robot, traj.q[i], nu, tau=tau)
-        names_i, fn, ft, det = sample_loads(forces)
-        if normal is None:
-            names = names_i
-            normal, tangential = np.zeros((N, len(names))), np.zeros((N, len(names)))
-            determined = np.zeros((N, len(names), 3), bool)
-            compliance = np.zeros((N, len(names)), bool)
-        normal[i], tangential[i], determined[i] = fn, ft, det
-        compliance[i] = [w.compliance[2] for w in forces.wheels]
-        if not det.all():
-            minimum.append(forces.minimum_mu())
+    with once_per_sample(robot) as next_sample:  # (what one sample's call evaluated twice: once)
+        for i, t in enumerate(traj.t):
+            next_sample()
+            nu = traj.nu[i] if state is None else state(i)
+            tau = zero if torque is None else np.asarray(torque(t, traj.q[i], nu), float)
+            forces = constraint_forces(robot, traj.q[i], nu, tau=tau)
+            names_i, fn, ft, det = sample_loads(forces)
+            if normal is None:
+                names = names_i
+                normal, tangential = np.zeros((N, len(names))), np.zeros((N, len(names)))
+                determined = np.zeros((N, len(names), 3), bool)
+                compliance = np.zeros((N, len(names)), bool)
+            normal[i], tangential[i], determined[i] = fn, ft, det
+            compliance[i] = [w.compliance[2] for w in forces.wheels]
+            if not det.all():
+                minimum.append(cone_problem(forces))  # (solved for all samples at once below)
     if normal is None:
         normal, tangential, determined = np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0, 3), bool)
         compliance = np.zeros((0, 0), bool)
     out = WheelLoads(names, normal, tangential, determined[:, :, 2], determined.all(axis=2), compliance=compliance)
     if minimum and len(minimum) == N and all(m is not None for m in minimum):
-        out.minimum_mu = np.array(minimum, float)
+        out.minimum_mu = np.array(minimum_mu_many(minimum), float)
     return out
 
 

@@ -25,6 +25,8 @@ split.
 
 from __future__ import annotations
 
+import sys
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -32,6 +34,7 @@ import numpy as np
 
 from .contact_forces import constraint_forces
 from .stick_slip_traction import check_mu, phase_states, phases_of
+from .sliding import sliding_now
 from .stick_slip_wheel import StickSlipWheel
 from .traction_fast import WheelLoads, sample_loads, wheel_loads
 from .traction_memo import once_per_sample
@@ -267,7 +270,7 @@ wheel_loads`) where it serves the robot, else sample by sample; ``reference`` sa
 
 
 def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, float] | None = None,
-             method: str = "auto") -> Traction:
+             method: str = "auto", progress: bool = False) -> Traction:
     """Wheel loads, required friction and no-slip events along a trajectory.
 
     Args:
@@ -280,6 +283,8 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
             stacked linear algebra over blocks of samples, the same numbers) where it serves the robot, the
             per-sample reference elsewhere (slipping wheels, no compiled model) and at the samples it cannot
             serve; ``reference``: :func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample.
+        progress: Report on stderr, once the pass has taken more than a second, the samples done (at most once a
+            second) and at its end how long it took, by which pass and why (:class:`PassReport`).
 
     Returns:
         The :class:`Traction` (``method`` says which pass computed it: ``fast`` or ``reference``).
@@ -300,16 +305,20 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
     if method not in METHODS:
         raise InputError(f"method = {method!r}; expected one of {', '.join(METHODS)}")
     table = phases_of(traj)
+    report = PassReport(len(traj.t), progress)
     if table is not None:  # exact stick-slip: each sample in its phases, by the reference
         check_mu(robot, mu)
+        report.why = "the fast pass does not serve exact stick-slip phases"
         with phase_states(robot, traj, table) as state:
-            loads = _reference_loads(robot, traj, torque, state)
+            loads = _reference_loads(robot, traj, torque, state, report)
         used = "reference"
     else:
         loads = wheel_loads(robot, traj.t, traj.q, traj.nu, torque) if method == "auto" else None
         used = "reference" if loads is None else "fast"
+        report.why = _why_reference(robot) if method == "auto" else "method = 'reference'"
     if loads is None:
-        loads = _reference_loads(robot, traj, torque)
+        loads = _reference_loads(robot, traj, torque, report=report)
+    report.done(used)
     names = loads.names
     undetermined = {}
     for j, name in enumerate(names):
@@ -344,12 +353,67 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
     return out
 
 
-def _reference_loads(robot, traj, torque, state: Callable[[int], np.ndarray] | None = None) -> WheelLoads:
+class PassReport:
+    """Progress of a traction pass on stderr (``simulate`` without ``--quiet``): nothing during its first second,
+    then the samples done at most once a second, and at the end the time it took, by which pass and why the fast
+    one did not serve (a per-sample reference pass costs milliseconds a sample).
+
+    Args:
+        n: Number of samples.
+        enabled: Whether to print.
+        interval: Seconds between two lines (and before the first) [s].
+    """
+
+    def __init__(self, n: int, enabled: bool, interval: float = 1.0) -> None:
+        self.n, self.enabled, self.interval = n, enabled, interval
+        self.start = self.last = time.perf_counter()
+        self.why = ""
+        self.printed = False
+
+    def __call__(self, i: int) -> None:
+        """Report that sample ``i`` is next (a line if a second has passed since the last).
+
+        Args:
+            i: The sample's index (0-based).
+        """
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if now - self.last >= self.interval:
+            self.last, self.printed = now, True
+            print(f"traction: sample {i} / {self.n} ({100 * i / max(self.n, 1):.0f}%), per-sample reference pass",
+                  file=sys.stderr, flush=True)
+
+    def done(self, used: str) -> None:
+        """Report the end of the pass (a line if it took a second or more, or printed progress).
+
+        Args:
+            used: Which pass computed the loads (:attr:`Traction.method`: ``fast`` or ``reference``).
+        """
+        took = time.perf_counter() - self.start
+        if self.enabled and (self.printed or took >= self.interval):
+            why = f" ({self.why})" if used == "reference" and self.why else ""
+            print(f"traction: {self.n} samples in {took:.3g} s by the {used} pass{why}", file=sys.stderr, flush=True)
+
+
+def _why_reference(robot) -> str:
+    """Why the fast pass (:func:`~robotdyn.contact.traction_fast.wheel_loads`) may not serve ``robot``: the reason
+    its compiled model gives (:func:`robotdyn.fast.dispatch.why_not`), or its slipping wheels."""
+    from ..fast.dispatch import why_not
+
+    if sliding_now(robot):
+        return "slipping wheels are evaluated on the Python path"
+    return why_not(robot) or ""
+
+
+def _reference_loads(robot, traj, torque, state: Callable[[int], np.ndarray] | None = None,
+                     report: Callable[[int], None] | None = None) -> WheelLoads:
     """The :class:`~robotdyn.contact.traction_fast.WheelLoads` of a trajectory by
     :func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample (only the loads are kept), with
     ``minimum_mu`` where every sample has a wheel whose load is not all determined and it is never ``None``;
     ``state(i)``, where given, sets the robot to sample i's state and returns its independent velocities
-    (:func:`robotdyn.contact.stick_slip_traction.phase_states`)."""
+    (:func:`robotdyn.contact.stick_slip_traction.phase_states`); ``report(i)``, where given, is told each sample's
+    index (:class:`PassReport`)."""
     zero = np.zeros(len(robot.motors))
     N = len(traj.t)
     names: list[str] = []
@@ -358,6 +422,8 @@ def _reference_loads(robot, traj, torque, state: Callable[[int], np.ndarray] | N
     with once_per_sample(robot) as next_sample:  # (what one sample's call evaluated twice: once)
         for i, t in enumerate(traj.t):
             next_sample()
+            if report is not None:
+                report(i)
             nu = traj.nu[i] if state is None else state(i)
             tau = zero if torque is None else np.asarray(torque(t, traj.q[i], nu), float)
             forces = constraint_forces(robot, traj.q[i], nu, tau=tau)

@@ -133,3 +133,29 @@ def test_pass_report_prints_progress_and_which_pass_took_the_time(capsys):
     assert lines[0] == "traction: sample 1 / 3 (33%), per-sample reference pass"
     assert lines[1].startswith("traction: 3 samples in ") and lines[1].endswith(
         " s by the reference pass (compliant wheels are evaluated on the Python path)")
+
+
+def test_memories_serve_only_their_own_pass_and_thread():
+    import threading
+
+    from test_compliant_rolling import R, disc, state
+
+    robot = disc(g=9.81)
+    q0, nu = state(robot, R, vx=1.0, w=1.0 / R)
+    with once_per_sample(robot) as outer:
+        with once_per_sample(robot) as inner:
+            assert inner.memos == []  # a pass inside another leaves the other's memory alone ...
+        assert robot.__dict__["reduced"] is outer.memos[-1]  # ... and its exit does not remove it
+        assert robot.constraints[-1].__dict__["state"] is outer.memos[0]
+        outer()
+        first = robot.reduced(q0, nu)
+        assert robot.reduced(q0, nu) is first and outer.memos[-1].hits == 1
+        other = []
+        thread = threading.Thread(target=lambda: other.append(robot.reduced(q0, nu)))
+        thread.start()
+        thread.join()
+        assert other[0] is not first and outer.memos[-1].hits == 1  # another thread's call: computed, not shared
+        np.testing.assert_array_equal(other[0].M, first.M)
+        outer()
+        assert robot.reduced(q0, nu) is not first  # forgotten at the next sample
+    assert "reduced" not in robot.__dict__

@@ -14,10 +14,14 @@ Where :func:`robotdyn.contact.traction.traction` computes the loads sample by sa
 :func:`once_per_sample` keeps the last value of each and hands it back (wheel states as copies) when the next call is
 at the same arguments bit for bit; the reduced model only within one sample (the pass calls ``next_sample()`` before
 each, since a stick-slip run's phases change the projection between samples). On exit the robot is as before.
+
+A memory serves only the thread whose pass installed it (another thread's calls go straight to the method), and a
+pass leaves alone what another pass (in any thread) has already wrapped: that pass then runs without it.
 """
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
@@ -25,14 +29,19 @@ import numpy as np
 
 from .compliant_contact import compliant_wheels
 
+_LOCK = threading.Lock()  # (installing and removing the memories)
+
 
 class _StateMemo:
     """One wheel's ``state(kin)`` with a one-entry memory keyed by the state's (q, v) bytes; ``hits`` counts reuses."""
 
     def __init__(self, method) -> None:
         self.method, self.key, self.value, self.hits = method, None, None, 0
+        self.thread = threading.get_ident()
 
     def __call__(self, kin) -> dict:
+        if threading.get_ident() != self.thread:  # (another thread's call: not this pass's)
+            return self.method(kin)
         key = (np.asarray(kin.q, float).tobytes(), np.asarray(kin.v, float).tobytes())
         if key != self.key:
             self.key = None  # (a raise leaves no stale entry)
@@ -49,8 +58,11 @@ class _ReducedMemo:
 
     def __init__(self, method) -> None:
         self.method, self.key, self.value, self.hits = method, None, None, 0
+        self.thread = threading.get_ident()
 
     def __call__(self, q, nu, coriolis: bool = False):
+        if threading.get_ident() != self.thread:
+            return self.method(q, nu, coriolis)
         try:
             key = (np.asarray(q, float).tobytes(), np.asarray(nu, float).tobytes(), bool(coriolis))
         except (TypeError, ValueError):  # (not numbers: the method's own one-line error)
@@ -77,27 +89,32 @@ def once_per_sample(robot) -> Iterator[Callable[[], None]]:
 
     Yields:
         ``next_sample()``: forget the reduced model (call it before each sample). Its attribute ``memos`` lists the
-        memories (their ``hits``: evaluations saved).
+        memories installed (the wheels' in constraint order, then the robot's; their ``hits``: evaluations saved).
     """
     owners = [*compliant_wheels(robot), robot]
     names = ["state"] * (len(owners) - 1) + ["reduced"]
-    saved = [o.__dict__.get(n) for o, n in zip(owners, names)]  # (an instance's own attribute: restored on exit)
-    memos = [_StateMemo(o.state) for o in owners[:-1]] + [_ReducedMemo(robot.reduced)]
-    for o, n, memo in zip(owners, names, memos):
-        setattr(o, n, memo)  # (an instance attribute over the class's method)
+    installed = []  # (owner, name, memory)
+    with _LOCK:
+        for o, n in zip(owners, names):
+            if n in o.__dict__:  # (another pass's memory, or the owner's own attribute: left alone)
+                continue
+            memo = _StateMemo(o.state) if n == "state" else _ReducedMemo(o.reduced)
+            setattr(o, n, memo)  # (an instance attribute over the class's method)
+            installed.append((o, n, memo))
+    reduced = [m for o, n, m in installed if n == "reduced"]
 
     def next_sample() -> None:
-        memos[-1].clear()
+        for memo in reduced:
+            memo.clear()
 
-    next_sample.memos = memos
+    next_sample.memos = [m for _, _, m in installed]
     try:
         yield next_sample
     finally:
-        for o, n, old in zip(owners, names, saved):
-            if old is None:
-                o.__dict__.pop(n, None)
-            else:
-                setattr(o, n, old)
+        with _LOCK:
+            for o, n, memo in installed:
+                if o.__dict__.get(n) is memo:
+                    del o.__dict__[n]
 
 
 __all__ = ["once_per_sample"]

@@ -5,7 +5,10 @@ The forces are those of :func:`robotdyn.contact.contact_forces.constraint_forces
 :class:`~robotdyn.simulation.trajectory.Trajectory` (a post-pass: the integrator is not slowed down), computed by the
 fast pass of :mod:`robotdyn.contact.traction_fast` (compiled calls and stacked linear algebra over blocks of samples,
 no force object per sample: ~40 us a sample on Quasimoro against ~1.5 ms) wherever it serves the robot, else by
-``constraint_forces`` itself sample by sample (``method="reference"`` forces that). Per wheel:
+``constraint_forces`` itself sample by sample (``method="reference"`` forces that: compliant wheels and exact
+stick-slip runs, a few milliseconds a sample), with what one sample's call evaluated twice done once
+(:mod:`robotdyn.contact.traction_memo`) and the minimum-mu column solved for all samples at once, only where the run
+reports it (:mod:`robotdyn.contact.traction_minimum`); ``progress`` reports that pass on stderr. Per wheel:
 
 - the normal load :math:`f_n` [N] (positive: pressed on the ground);
 - the required friction coefficient :math:`\\mu_{req} = \\|f_t\\| / f_n` (``inf`` where :math:`f_n \\le 0`);

@@ -350,7 +350,8 @@ def _simulate(args, limit) -> int:
         from ..contact.traction import traction
 
         try:
-            tr = traction(traj.robot or robot, traj, traj.torque, args.mu)  # the robot and torques simulated
+            tr = traction(traj.robot or robot, traj, traj.torque, args.mu,  # the robot and torques simulated
+                          progress=not args.quiet)
         except KeyboardInterrupt:  # the trajectory is kept; only its traction columns are lost
             partial = traj.stats["partial"] = (partial + "; " if partial else "") + "traction not computed (interrupted)"
             tr = None

@@ -5,7 +5,10 @@ The forces are those of :func:`robotdyn.contact.contact_forces.constraint_forces
 :class:`~robotdyn.simulation.trajectory.Trajectory` (a post-pass: the integrator is not slowed down), computed by the
 fast pass of :mod:`robotdyn.contact.traction_fast` (compiled calls and stacked linear algebra over blocks of samples,
 no force object per sample: ~40 us a sample on Quasimoro against ~1.5 ms) wherever it serves the robot, else by
-``constraint_forces`` itself sample by sample (``method="reference"`` forces that). Per wheel:
+``constraint_forces`` itself sample by sample (``method="reference"`` forces that: compliant wheels and exact
+stick-slip runs, a few milliseconds a sample), with what one sample's call evaluated twice done once
+(:mod:`robotdyn.contact.traction_memo`) and the minimum-mu column solved for all samples at once, only where the run
+reports it (:mod:`robotdyn.contact.traction_minimum`); ``progress`` reports that pass on stderr. Per wheel:
 
 - the normal load :math:`f_n` [N] (positive: pressed on the ground);
 - the required friction coefficient :math:`\\mu_{req} = \\|f_t\\| / f_n` (``inf`` where :math:`f_n \\le 0`);
@@ -25,6 +28,8 @@ split.
 
 from __future__ import annotations
 
+import sys
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -32,8 +37,11 @@ import numpy as np
 
 from .contact_forces import constraint_forces
 from .stick_slip_traction import check_mu, phase_states, phases_of
+from .sliding import sliding_now
 from .stick_slip_wheel import StickSlipWheel
 from .traction_fast import WheelLoads, sample_loads, wheel_loads
+from .traction_memo import once_per_sample
+from .traction_minimum import cone_problem, minimum_mu_many
 from ..errors import InputError
 
 
@@ -271,7 +279,7 @@ wheel_loads`) where it serves the robot, else sample by sample; ``reference`` sa
 
 
 def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, float] | None = None,
-             method: str = "auto") -> Traction:
+             method: str = "auto", progress: bool = False) -> Traction:
     """Wheel loads, required friction and no-slip events along a trajectory.
 
     Args:
@@ -284,6 +292,8 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
             stacked linear algebra over blocks of samples, the same numbers) where it serves the robot, the
             per-sample reference elsewhere (slipping wheels, no compiled model) and at the samples it cannot
             serve; ``reference``: :func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample.
+        progress: Report on stderr, once the pass has taken more than a second, the samples done (at most once a
+            second) and at its end how long it took, by which pass and why (:class:`PassReport`).
 
     Returns:
         The :class:`Traction` (``method`` says which pass computed it: ``fast`` or ``reference``).
@@ -304,16 +314,20 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
     if method not in METHODS:
         raise InputError(f"method = {method!r}; expected one of {', '.join(METHODS)}")
     table = phases_of(traj)
+    report = PassReport(len(traj.t), progress)
     if table is not None:  # exact stick-slip: each sample in its phases, by the reference
         check_mu(robot, mu)
+        report.why = "the fast pass does not serve exact stick-slip phases"
         with phase_states(robot, traj, table) as state:
-            loads = _reference_loads(robot, traj, torque, state)
+            loads = _reference_loads(robot, traj, torque, state, report)
         used = "reference"
     else:
         loads = wheel_loads(robot, traj.t, traj.q, traj.nu, torque) if method == "auto" else None
         used = "reference" if loads is None else "fast"
+        report.why = _why_reference(robot) if method == "auto" else "method = 'reference'"
     if loads is None:
-        loads = _reference_loads(robot, traj, torque)
+        loads = _reference_loads(robot, traj, torque, report=report)
+    report.done(used)
     names = loads.names
     undetermined = {}
     for j, name in enumerate(names):
@@ -348,37 +362,96 @@ def traction(robot, traj, torque: Callable | None = None, mu: float | dict[str, 
     return out
 
 
-def _reference_loads(robot, traj, torque, state: Callable[[int], np.ndarray] | None = None) -> WheelLoads:
+class PassReport:
+    """Progress of a traction pass on stderr (``simulate`` without ``--quiet``): nothing during its first second,
+    then the samples done at most once a second, and at the end the time it took, by which pass and why the fast
+    one did not serve (a per-sample reference pass costs milliseconds a sample).
+
+    Args:
+        n: Number of samples.
+        enabled: Whether to print.
+        interval: Seconds between two lines (and before the first) [s].
+    """
+
+    def __init__(self, n: int, enabled: bool, interval: float = 1.0) -> None:
+        self.n, self.enabled, self.interval = n, enabled, interval
+        self.start = self.last = time.perf_counter()
+        self.why = ""
+        self.printed = False
+
+    def __call__(self, i: int) -> None:
+        """Report that sample ``i`` is next (a line if a second has passed since the last).
+
+        Args:
+            i: The sample's index (0-based).
+        """
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if now - self.last >= self.interval:
+            self.last, self.printed = now, True
+            print(f"traction: sample {i} / {self.n} ({100 * i / max(self.n, 1):.0f}%), per-sample reference pass",
+                  file=sys.stderr, flush=True)
+
+    def done(self, used: str) -> None:
+        """Report the end of the pass (a line if it took a second or more, or printed progress).
+
+        Args:
+            used: Which pass computed the loads (:attr:`Traction.method`: ``fast`` or ``reference``).
+        """
+        took = time.perf_counter() - self.start
+        if self.enabled and (self.printed or took >= self.interval):
+            why = f" ({self.why})" if used == "reference" and self.why else ""
+            print(f"traction: {self.n} samples in {took:.3g} s by the {used} pass{why}", file=sys.stderr, flush=True)
+
+
+def _why_reference(robot) -> str:
+    """Why the fast pass (:func:`~robotdyn.contact.traction_fast.wheel_loads`) may not serve ``robot``: the reason
+    its compiled model gives (:func:`robotdyn.fast.dispatch.why_not`), or its slipping wheels."""
+    from ..fast.dispatch import why_not
+
+    if sliding_now(robot):
+        return "slipping wheels are evaluated on the Python path"
+    return why_not(robot) or ""
+
+
+def _reference_loads(robot, traj, torque, state: Callable[[int], np.ndarray] | None = None,
+                     report: Callable[[int], None] | None = None) -> WheelLoads:
     """The :class:`~robotdyn.contact.traction_fast.WheelLoads` of a trajectory by
     :func:`~robotdyn.contact.contact_forces.constraint_forces` at every sample (only the loads are kept), with
     ``minimum_mu`` where every sample has a wheel whose load is not all determined and it is never ``None``;
     ``state(i)``, where given, sets the robot to sample i's state and returns its independent velocities
-    (:func:`robotdyn.contact.stick_slip_traction.phase_states`)."""
+    (:func:`robotdyn.contact.stick_slip_traction.phase_states`); ``report(i)``, where given, is told each sample's
+    index (:class:`PassReport`)."""
     zero = np.zeros(len(robot.motors))
     N = len(traj.t)
     names: list[str] = []
     normal = tangential = determined = None
     minimum = []
-    for i, t in enumerate(traj.t):
-        nu = traj.nu[i] if state is None else state(i)
-        tau = zero if torque is None else np.asarray(torque(t, traj.q[i], nu), float)
-        forces = constraint_forces(robot, traj.q[i], nu, tau=tau)
-        names_i, fn, ft, det = sample_loads(forces)
-        if normal is None:
-            names = names_i
-            normal, tangential = np.zeros((N, len(names))), np.zeros((N, len(names)))
-            determined = np.zeros((N, len(names), 3), bool)
-            compliance = np.zeros((N, len(names)), bool)
-        normal[i], tangential[i], determined[i] = fn, ft, det
-        compliance[i] = [w.compliance[2] for w in forces.wheels]
-        if not det.all():
-            minimum.append(forces.minimum_mu())
+    with once_per_sample(robot) as next_sample:  # (what one sample's call evaluated twice: once)
+        for i, t in enumerate(traj.t):
+            next_sample()
+            if report is not None:
+                report(i)
+            nu = traj.nu[i] if state is None else state(i)
+            tau = zero if torque is None else np.asarray(torque(t, traj.q[i], nu), float)
+            forces = constraint_forces(robot, traj.q[i], nu, tau=tau)
+            names_i, fn, ft, det = sample_loads(forces)
+            if normal is None:
+                names = names_i
+                normal, tangential = np.zeros((N, len(names))), np.zeros((N, len(names)))
+                determined = np.zeros((N, len(names), 3), bool)
+                compliance = np.zeros((N, len(names)), bool)
+            normal[i], tangential[i], determined[i] = fn, ft, det
+            compliance[i] = [w.compliance[2] for w in forces.wheels]
+            if not det.all():
+                minimum.append(cone_problem(forces))  # (solved for all samples at once below)
     if normal is None:
         normal, tangential, determined = np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0, 3), bool)
         compliance = np.zeros((0, 0), bool)
     out = WheelLoads(names, normal, tangential, determined[:, :, 2], determined.all(axis=2), compliance=compliance)
     if minimum and len(minimum) == N and all(m is not None for m in minimum):
-        out.minimum_mu = np.array(minimum, float)
+        out.minimum_mu = np.array(minimum_mu_many(minimum), float)
     return out
 
 

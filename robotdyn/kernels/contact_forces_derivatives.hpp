@@ -119,15 +119,9 @@ struct ContactForcesDerivatives {
     for (size_t j = 0; j < ev.motors_.size(); ++j) {
       const auto& mo = ev.motors_[j];
       if (mo.reaction < 0 || tau[j] == 0.0) continue;
-      const pinocchio::JointIndex jid = static_cast<pinocchio::JointIndex>(mo.joint);
-      derivs::Matrix3x Jw = derivs::Matrix3x::Zero(3, n);
-      for (const pinocchio::JointIndex s : model.supports[jid]) {
-        if (s == 0) continue;
-        const int c0 = model.joints[s].idx_v();
-        for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
-      }
-      const Eigen::Vector3d axis = Jw.col(mo.index);
-      axes.push_back({j, jid, ev.frames_[mo.reaction], mo.reaction, axis, -derivs::skew3(axis) * Jw});
+      Axis ax{j, static_cast<pinocchio::JointIndex>(mo.joint), ev.frames_[mo.reaction], mo.reaction, {}, {}};
+      RD::motor_axis(ev, mo, ax.axis, ax.daxis);
+      axes.push_back(ax);
     }
     // one frame pass per unit velocity e_j: d(A e_j)/dq (column j of A differentiated, m x n) and row j of
     // d(B tau)/dq

@@ -122,21 +122,10 @@ struct ProjectedPieces {
       tf = derivs::TwistFrame{ev.frames_[f], &ev.data_.oMf[ev.frames_[f]], &ev.Jf_[f], ev.op_local_, &ev.op_select_};
     }
     const MatrixXd& S = ev.S_;
-    ws.geo.resize(ev.wheels_.size());
-    for (size_t i = 0; i < ev.wheels_.size(); ++i)
-      derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
-                                ev.terrain_.flat(), ws.geo[i]);
-    ws.passes.resize(k + 2);
-    ws.dA.resize(k + 2);
     dJ.resize(op ? k + 2 : 0);
-    for (int l = 0; l < k + 2; ++l) {
-      derivs::FramePass& fp = ws.passes[l];
-      fp.run(model, ev.q_, l < k ? VectorXd(S.col(l)) : l == k ? ev.w_ : ev.v_, l == k + 1);
-      RD::prepare(ev, fp, l == k + 1);
-      RD::velocity_dq(ev, fp, ws.dA[l]);
+    RD::frame_passes(ev, [&](int l, derivs::FramePass& fp) {
       if (op) derivs::twist_velocity_dq(model, fp, tf, dJ[l], w1, w2);
-    }
-    RD::drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);
+    });
     const MatrixXd& dA_v = ws.dA[k + 1];
     dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
     MatrixXd none(0, n);
@@ -160,27 +149,6 @@ struct ProjectedPieces {
     for (int l = 0; l < k; ++l) dKaJ += nudot[l] * dJ[l];
     return solve_neg(ev, dKa + dgA, dKaJ + dgJ);
   }
-
-  // RNEA(q, v, a) with gravity and its q-, v-derivatives on the workspace's tree data (ws.tree.tau: RNEA)
-  static void tree(Ev& ev, const VectorXd& a, MatrixXd& dtau_dq, MatrixXd& dtau_dv) {
-    auto& ws = ev.deriv_;
-    const int n = ev.nv_;
-    if (!ws.has_tree) {
-      ws.tree = pinocchio::Data(ev.model_);
-      ws.has_tree = true;
-    }
-    dtau_dq.setZero(n, n);
-    dtau_dv.setZero(n, n);
-    MatrixXd dtau_da = MatrixXd::Zero(n, n);
-    ev.model_.gravity = ev.gravity_;
-    try {
-      pinocchio::computeRNEADerivatives(ev.model_, ws.tree, ev.q_, ev.v_, a, dtau_dq, dtau_dv, dtau_da);
-    } catch (...) {
-      ev.model_.gravity.setZero();
-      throw;
-    }
-    ev.model_.gravity.setZero();
-  }
 };
 
 // The reduced forward dynamics' derivatives with operational-space velocities (dynamics_derivatives with a twist).
@@ -202,12 +170,10 @@ struct OperationalDerivatives {
     const MatrixXd& S = ev.S_;
     const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
     derivs::Result out;
-    Eigen::LLT<MatrixXd> llt(ev.Mr_);
-    if (llt.info() != Eigen::Success) throw std::domain_error("reduced mass matrix not positive definite");
-    out.nudot = llt.solve(ev.Br_ * tau - ev.hr_);
+    const Eigen::LLT<MatrixXd> llt = ReducedDerivatives<Ev>::reduced_mass(ev, tau, out);
     const VectorXd a = S * out.nudot + ev.w_;
     MatrixXd dtau_dq, dtau_dv;
-    ProjectedPieces<Ev>::tree(ev, a, dtau_dq, dtau_dv);
+    ReducedDerivatives<Ev>::tree(ev, a, dtau_dq, dtau_dv);
     const VectorXd rho = ws.tree.tau - ev.B_ * tau;
     // dS^T rho = -S^T dK^T mu, mu = K^-T rho split into the rows' and the twist's parts
     const int nr = static_cast<int>(ev.rows_.size());
@@ -221,14 +187,8 @@ struct OperationalDerivatives {
     const MatrixXd ST = S.transpose();
     MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * pc.Vq + (ST * M) * Aq;
     ReducedDerivatives<Ev>::motor_rows(ev, tau, G);
-    const MatrixXd Minv = llt.solve(MatrixXd::Identity(k, k));
-    out.dq = -Minv * G;
-    out.dnu = -Minv * (ST * (dtau_dv * S + M * pc.Wnu));
-    out.dtau = Minv * ev.Br_;
-    out.v = ev.v_;
+    ReducedDerivatives<Ev>::solve_reduced(ev, llt, G, dtau_dv, pc.Wnu, out);
     out.Vq = pc.Vq;
-    out.S = S;
-    out.A = ev.A_;
     return out;
   }
 };

@@ -177,55 +177,25 @@ struct ReducedDerivatives {
     ev.configure(q);
     ev.dynamics(nu);
     if (tau.size() != ev.Br_.cols()) throw std::invalid_argument("tau has the wrong length");
-    const Model& model = ev.model_;
     auto& ws = ev.deriv_;
     const int n = ev.nv_;
     const int k = static_cast<int>(ev.S_.cols());
     const MatrixXd& S = ev.S_;
-    const VectorXd& v = ev.v_;
     const VectorXd& w = ev.w_;
     const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
     derivs::Result out;
-    Eigen::LLT<MatrixXd> llt(ev.Mr_);
-    if (llt.info() != Eigen::Success) throw std::domain_error("reduced mass matrix not positive definite");
-    out.nudot = llt.solve(ev.Br_ * tau - ev.hr_);
+    const Eigen::LLT<MatrixXd> llt = reduced_mass(ev, tau, out);
     const VectorXd a = S * out.nudot + w;
-    // the contact geometry's derivatives (configuration level)
-    ws.geo.resize(ev.wheels_.size());
-    for (size_t i = 0; i < ev.wheels_.size(); ++i)
-      derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
-                                ev.terrain_.flat(), ws.geo[i]);
-    // the frame passes at the columns of S, at w and at v, and the rows' derivatives there
-    ws.passes.resize(k + 2);
-    ws.dA.resize(k + 2);
-    for (int l = 0; l < k + 2; ++l) {
-      derivs::FramePass& fp = ws.passes[l];
-      fp.run(model, ev.q_, l < k ? VectorXd(S.col(l)) : l == k ? w : v, l == k + 1);
-      prepare(ev, fp, l == k + 1);
-      velocity_dq(ev, fp, ws.dA[l]);
-    }
+    frame_passes(ev, [](int, derivs::FramePass&) {});
     const MatrixXd& dA_w = ws.dA[k];
     const MatrixXd& dA_v = ws.dA[k + 1];
-    drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);
-    const int m = ev.nrows();
     const MatrixXd dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
     out.Vq = solve_neg(ev, dA_v);            // v = S(q) nu: dv/dq = -K^-1 d(K v)/dq
     const MatrixXd dgA = ws.dgam_q + dgam_v * out.Vq;
     const MatrixXd Wnu = solve_neg(ev, dgam_v * S);
     // the tree: RNEA(q, v, a) and its derivatives, with gravity
-    if (!ws.has_tree) {
-      ws.tree = pinocchio::Data(model);
-      ws.has_tree = true;
-    }
-    MatrixXd dtau_dq = MatrixXd::Zero(n, n), dtau_dv = MatrixXd::Zero(n, n), dtau_da = MatrixXd::Zero(n, n);
-    ev.model_.gravity = ev.gravity_;
-    try {
-      pinocchio::computeRNEADerivatives(model, ws.tree, ev.q_, v, a, dtau_dq, dtau_dv, dtau_da);
-    } catch (...) {
-      ev.model_.gravity.setZero();
-      throw;
-    }
-    ev.model_.gravity.setZero();
+    MatrixXd dtau_dq, dtau_dv;
+    tree(ev, a, dtau_dq, dtau_dv);
     const VectorXd rho = ws.tree.tau - ev.B_ * tau;
     // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d
     MatrixXd L = MatrixXd::Zero(k, n);
@@ -244,15 +214,95 @@ struct ReducedDerivatives {
     const MatrixXd ST = S.transpose();
     MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * out.Vq + (ST * M) * Aq;
     motor_rows(ev, tau, G);
+    solve_reduced(ev, llt, G, dtau_dv, Wnu, out);
+    return out;
+  }
+
+  // the shared set-up of the derivative kernels at the evaluator's state (configure(q), dynamics(nu) done): the
+  // contact geometry's derivatives (ws.geo), the frame passes at the columns of S, at w and at v (ws.passes, the
+  // last with accelerations) with every row's d(A x)/dq there (ws.dA), then per_pass(l, pass) (the
+  // operational-space rows' own), and the drift's derivatives on the pass at v (ws.dgam_q, ws.Adot)
+  template <class PerPass>
+  static void frame_passes(Ev& ev, PerPass&& per_pass) {
+    const Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    const int k = static_cast<int>(ev.S_.cols());
+    ws.geo.resize(ev.wheels_.size());
+    for (size_t i = 0; i < ev.wheels_.size(); ++i)
+      derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
+                                ev.terrain_.flat(), ws.geo[i]);
+    ws.passes.resize(k + 2);
+    ws.dA.resize(k + 2);
+    for (int l = 0; l < k + 2; ++l) {
+      derivs::FramePass& fp = ws.passes[l];
+      fp.run(model, ev.q_, l < k ? VectorXd(ev.S_.col(l)) : l == k ? ev.w_ : ev.v_, l == k + 1);
+      prepare(ev, fp, l == k + 1);
+      velocity_dq(ev, fp, ws.dA[l]);
+      per_pass(l, fp);
+    }
+    drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);
+  }
+
+  // the reduced mass matrix's factors and nudot = M_r^-1 (B_r tau - h_r) into out.nudot
+  static Eigen::LLT<MatrixXd> reduced_mass(Ev& ev, const Eigen::Ref<const VectorXd>& tau, derivs::Result& out) {
+    Eigen::LLT<MatrixXd> llt(ev.Mr_);
+    if (llt.info() != Eigen::Success) throw std::domain_error("reduced mass matrix not positive definite");
+    out.nudot = llt.solve(ev.Br_ * tau - ev.hr_);
+    return llt;
+  }
+
+  // the reduced solve (dynamics_derivatives' last step): dq = -M_r^-1 G, dnu = -M_r^-1 S^T (dtau/dv S + M W_nu),
+  // dtau = M_r^-1 B_r, with v, S and A (out.Vq is the caller's)
+  static void solve_reduced(Ev& ev, const Eigen::LLT<MatrixXd>& llt, const MatrixXd& G, const MatrixXd& dtau_dv,
+                            const MatrixXd& Wnu, derivs::Result& out) {
+    const MatrixXd& S = ev.S_;
+    const MatrixXd& M = ev.data_.M;
+    const int k = static_cast<int>(S.cols());
+    const MatrixXd ST = S.transpose();
     const MatrixXd Minv = llt.solve(MatrixXd::Identity(k, k));
     out.dq = -Minv * G;
     out.dnu = -Minv * (ST * (dtau_dv * S + M * Wnu));
     out.dtau = Minv * ev.Br_;
-    out.v = v;
+    out.v = ev.v_;
     out.S = S;
     out.A = ev.A_;
-    (void)m;
-    return out;
+  }
+
+  // RNEA(q, v, a) with gravity and its q-, v-derivatives on the workspace's tree data (ws.tree.tau: RNEA)
+  static void tree(Ev& ev, const VectorXd& a, MatrixXd& dtau_dq, MatrixXd& dtau_dv) {
+    auto& ws = ev.deriv_;
+    const int n = ev.nv_;
+    if (!ws.has_tree) {
+      ws.tree = pinocchio::Data(ev.model_);
+      ws.has_tree = true;
+    }
+    dtau_dq.setZero(n, n);
+    dtau_dv.setZero(n, n);
+    MatrixXd dtau_da = MatrixXd::Zero(n, n);
+    ev.model_.gravity = ev.gravity_;
+    try {
+      pinocchio::computeRNEADerivatives(ev.model_, ws.tree, ev.q_, ev.v_, a, dtau_dq, dtau_dv, dtau_da);
+    } catch (...) {
+      ev.model_.gravity.setZero();
+      throw;
+    }
+    ev.model_.gravity.setZero();
+  }
+
+  // a motor's joint axis in world axes and its q-derivative at fixed S: the joint body's world angular Jacobian
+  // from CRBA's world columns (data_.J) on its supporting joints, axis = its column `index`, daxis = -[axis]x Jw
+  template <class Motor>
+  static void motor_axis(const Ev& ev, const Motor& mo, Eigen::Vector3d& axis, derivs::Matrix3x& daxis) {
+    const Model& model = ev.model_;
+    const pinocchio::JointIndex jid = static_cast<pinocchio::JointIndex>(mo.joint);
+    derivs::Matrix3x Jw = derivs::Matrix3x::Zero(3, ev.nv_);
+    for (const pinocchio::JointIndex s : model.supports[jid]) {
+      if (s == 0) continue;
+      const int c0 = model.joints[s].idx_v();
+      for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
+    }
+    axis = Jw.col(mo.index);
+    daxis = -derivs::skew3(axis) * Jw;
   }
 
   // G -= S^T d(B(q) tau)/dq at fixed S (motor_rows): motors reacting on a body; with `passes` (default: the columns
@@ -260,22 +310,15 @@ struct ReducedDerivatives {
   static void motor_rows(Ev& ev, const Eigen::Ref<const VectorXd>& tau, MatrixXd& G,
                          std::vector<derivs::FramePass>* passes = nullptr) {
     const Model& model = ev.model_;
-    const int n = ev.nv_;
     std::vector<derivs::FramePass>& ps = passes ? *passes : ev.deriv_.passes;
     const int k = passes ? static_cast<int>(passes->size()) : static_cast<int>(ev.S_.cols());
     for (size_t j = 0; j < ev.motors_.size(); ++j) {
       const auto& mo = ev.motors_[j];
       if (mo.reaction < 0 || tau[j] == 0.0) continue;
       const pinocchio::JointIndex jid = static_cast<pinocchio::JointIndex>(mo.joint);
-      // the joint body's world angular Jacobian: CRBA's world columns (data_.J) on its supporting joints
-      derivs::Matrix3x Jw = derivs::Matrix3x::Zero(3, n);
-      for (const pinocchio::JointIndex s : model.supports[jid]) {
-        if (s == 0) continue;
-        const int c0 = model.joints[s].idx_v();
-        for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
-      }
-      const Eigen::Vector3d axis = Jw.col(mo.index);
-      const derivs::Matrix3x daxis = -derivs::skew3(axis) * Jw;
+      Eigen::Vector3d axis;
+      derivs::Matrix3x daxis;
+      motor_axis(ev, mo, axis, daxis);
       const int rf = ev.frames_[mo.reaction];
       for (int l = 0; l < k; ++l) {
         derivs::FramePass& fp = ps[l];

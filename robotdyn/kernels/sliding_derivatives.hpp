@@ -87,7 +87,7 @@ struct SlidingDerivatives {
     const MatrixXd& M = ev.data_.M;
     const VectorXd a = S * nudot + ev.w_;
     MatrixXd dtau_dq, dtau_dv;
-    ProjectedPieces<Ev>::tree(ev, a, dtau_dq, dtau_dv);
+    RD::tree(ev, a, dtau_dq, dtau_dv);
     // every column of dA/dq: passes at the unit vectors, T_j = d(A e_j)/dq (m x n)
     auto& ws = ev.deriv_;
     std::vector<derivs::FramePass>& units = ws.units;

@@ -488,6 +488,8 @@ def compliant_bench() -> None:
             ("compliant, compiled engine (cvode, rtol 1e-10)", soft, True, True, "cvode"))
     tighter = {runs[8][0]: dict(rtol=1e-10, atol=1e-12)}
     tight = dict(options, rtol=1e-11, atol=1e-13, method="dopri5")
+    import sksundae.cvode  # noqa: F401 (cvode's import, once per process, is not timed: the models are warm too)
+
     for speed, t_end in ((PEAK_SPEED, 2.2), (25.0, 0.45)):
         walls, trajs = {}, {}
         refs = {id(robot): bump_run(robot, t_end, rigid, speed=speed, feedback=True, **tight) for robot in (rigid, soft)}

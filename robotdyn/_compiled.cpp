@@ -656,6 +656,9 @@ class Evaluator {
     penetrations(y.data(), rechoose, step_depths_);
     out = Eigen::Map<const VectorXd>(step_depths_.data(), static_cast<Eigen::Index>(step_depths_.size()));
   }
+  // A Jacobian's differences are being taken (on: the projection skips its span check, as for rosenbrock4: a
+  // difference leaves the constraint manifold by ~1e-8)
+  void set_differencing(bool on) { differencing_ = on; }
   double event_value(double t, const Eigen::Ref<const VectorXd>& y, double alpha,
                      const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
     if (y.size() != state_size()) throw std::invalid_argument("y: expected the state's length");
@@ -1429,6 +1432,7 @@ PYBIND11_MODULE(_compiled, m) {
       .def("event_value", &Evaluator::event_value, "the terminal event's value at (t, y, alpha, profile, rechoose): the "
            "slipping wheels' smallest load [N] or the rolling compliant wheels' switch value")
       .def_property_readonly("state_size", &Evaluator::state_size)
+      .def("set_differencing", &Evaluator::set_differencing, "a Jacobian's differences are being taken (on/off)")
       .def("set_controller", &Evaluator::set_controller, py::arg("controller").none(true),
            "a feedback law replacing the torque profile in simulate (None: none)")
       .def("control_torque", &Evaluator::control_torque)

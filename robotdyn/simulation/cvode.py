@@ -7,9 +7,10 @@ integrates the same ODE as the compiled engine (:mod:`robotdyn.simulation.compil
    \\quad \\dot W_f = P_f,\\quad \\dot W_d = P_d,
 
 with its variable-order (1 to 5), variable-step BDF formulas, a modified Newton iteration on a dense Jacobian
-formed by CVODE's own difference quotients and kept over many steps (CVODE refreshes it when the Newton iteration
-slows, or every 50 steps), and its own local error control (weights :math:`1/(rtol |y_i| + atol)`, the compiled
-engine's). Every evaluation of the right-hand side is one call of the compiled model (``Evaluator.deriv_into``,
+kept over many steps (CVODE asks for a new one when the Newton iteration slows, or every 50 steps; it is formed here
+by forward differences of the compiled model, one evaluation per column of q and nu, the compiled projection told
+so that a difference ~1e-8 off the constraints passes its span check), and its own local error control (weights
+:math:`1/(rtol |y_i| + atol)`, the compiled engine's). Every evaluation of the right-hand side is one call of the compiled model (``Evaluator.deriv_into``,
 the C++ ``deriv`` the compiled steppers use: the torque profile or feedback law, joint springs, compliant contacts
 and the work rates in C++, written into CVODE's own array); no other Python runs per step.
 
@@ -26,9 +27,9 @@ contact switch, :mod:`robotdyn.simulation.compiled_rolling`) is one more root fu
 times (``CV_NORMAL`` mode: the steps do not depend on the sampling); the solver is restarted at the breakpoints of
 the torque profile (``tstop``), as the other integrators are.
 
-:func:`run` has the signature and result of :func:`robotdyn.simulation.compiled_engine.run`, which hands
+:func:`run` returns the result of :func:`robotdyn.simulation.compiled_engine.run`, which hands
 ``method="cvode"`` to it. ``steps`` is not known to it (CVODE counts its steps, scikit-sundae does not return the
-count); ``nfev`` counts every evaluation, those of the difference-quotient Jacobians included, and ``jacobians``
+count); ``nfev`` counts every evaluation, those of the Jacobians' differences included, and ``jacobians``
 the Jacobians formed.
 """
 
@@ -51,6 +52,8 @@ POLL = 512
 poll about every 50 ms."""
 ROOT_RETURN = 2
 """CVODE's return flag at a root of the event functions (``CV_ROOT_RETURN``)."""
+ROOT_EPS = float(np.sqrt(np.finfo(float).eps))
+"""Relative step of the Jacobian's forward differences (times max(1, abs(y_j)))."""
 
 
 def missing() -> str | None:
@@ -121,6 +124,27 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, native, brea
             progress(t)
         deriv(t, x, dx, alpha, native, rechoose)
 
+    active = n + k  # the Jacobian's columns of the work states are zero: nothing depends on them
+    shifted, column = np.empty(len(y)), np.empty(len(y))
+
+    def jacobian(t: float, x: np.ndarray, fx: np.ndarray, J: np.ndarray) -> None:
+        # forward differences, step sqrt(eps) max(1, abs(y_j)) as rosenbrock4's; the compiled model is told, so
+        # that its projection's span check lets a state ~1e-8 off the constraints pass (CVODE's own difference
+        # quotients would stop the run there on a robot with redundant rows, e.g. a sprung car's rolling wheels)
+        count[0] += active
+        shifted[:] = x
+        ev.set_differencing(True)
+        try:
+            for j in range(active):
+                h = ROOT_EPS * max(1.0, abs(x[j]))
+                shifted[j] = x[j] + h
+                deriv(t, shifted, column, alpha, native, rechoose)
+                J[:, j] = (column - fx) / h
+                shifted[j] = x[j]
+        finally:
+            ev.set_differencing(False)
+        J[:, active:] = 0.0
+
     def roots(t: float, x: np.ndarray, g: np.ndarray) -> None:
         if wheels:
             depths(x, g[:wheels], rechoose)
@@ -128,7 +152,7 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, native, brea
             g[wheels] = event_value(t, x, alpha, native, rechoose)
 
     m = wheels + terminal
-    options = dict(method="BDF", rtol=float(rtol), atol=float(atol), max_num_steps=MAX_STEPS)
+    options = dict(method="BDF", rtol=float(rtol), atol=float(atol), max_num_steps=MAX_STEPS, jacfn=jacobian)
     if m:
         roots.terminal = [False] * m
         roots.direction = [0] * wheels + [-1] * terminal

@@ -461,8 +461,9 @@ def compliant_bench() -> None:
     """The linkage rover over its 5 cm bump, rigid contacts against compliant tyres (about 1 mm static deflection,
     robotdyn.robots.linkage_suspension.compliant), the same tolerances and samples: whole simulate() calls. Rigid:
     the scipy loop on the compiled model (the speed held by a Python function) and the compiled engine (the same law
-    as data, adams); compliant: the compiled engine (its default dopri5, and the stiff rosenbrock4) and the Python
-    path (LSODA). Issue 23's target: the compliant compiled run <= 10x the rigid compiled run."""
+    as data, adams); compliant: the compiled engine (its default dopri5, the stiff rosenbrock4, SUNDIALS CVODE's BDF
+    at the same tolerance and at a 100x tighter one) and the Python path (LSODA). Issue 23's target: the compliant
+    compiled run <= 10x the rigid compiled run."""
     from robotdyn.robot import Robot
     from robotdyn.robots.linkage_suspension.compliant import bump_run, compliant_spec
     from robotdyn.robots.linkage_suspension.model import PEAK_SPEED, SPEC
@@ -482,15 +483,21 @@ def compliant_bench() -> None:
             ("rigid, compiled engine (dopri5)", rigid, True, True, "dopri5"),
             ("compliant, compiled engine (dopri5)", soft, True, True, None),
             ("compliant, compiled engine (rosenbrock4)", soft, True, True, "rosenbrock4"),
-            ("compliant, Python path (LSODA)", soft, False, False, None))
+            ("compliant, Python path (LSODA)", soft, False, False, None),
+            ("compliant, compiled engine (cvode)", soft, True, True, "cvode"),
+            ("compliant, compiled engine (cvode, rtol 1e-10)", soft, True, True, "cvode"))
+    tighter = {runs[8][0]: dict(rtol=1e-10, atol=1e-12)}
     tight = dict(options, rtol=1e-11, atol=1e-13, method="dopri5")
+    import sksundae.cvode  # noqa: F401 (cvode's import, once per process, is not timed: the models are warm too)
+
     for speed, t_end in ((PEAK_SPEED, 2.2), (25.0, 0.45)):
         walls, trajs = {}, {}
         refs = {id(robot): bump_run(robot, t_end, rigid, speed=speed, feedback=True, **tight) for robot in (rigid, soft)}
         for name, robot, compiled, feedback, method in runs:
             with use_compiled(compiled):
                 start = time.perf_counter()
-                traj = bump_run(robot, t_end, rigid, speed=speed, feedback=feedback, method=method, **options)
+                traj = bump_run(robot, t_end, rigid, speed=speed, feedback=feedback, method=method,
+                                **{**options, **tighter.get(name, {})})
                 walls[name] = wall = time.perf_counter() - start
             trajs[name] = traj
             flight = traj.stats.get("flight")
@@ -502,7 +509,7 @@ def compliant_bench() -> None:
                   f"{ratio:>8.1f} {ratio_py:>11.1f} {error:>9.1e}  {flights}")
         b = trajs[runs[6][0]]
         fastest = min(walls[runs[1][0]], walls[runs[3][0]])  # the rigid compiled engine, its better integrator
-        for name in (runs[4][0], runs[5][0]):
+        for name in (runs[4][0], runs[5][0], runs[7][0], runs[8][0]):
             a = trajs[name]
             print(f"  {name}: {walls[name] / walls[runs[0][0]]:.1f}x the rigid scipy loop on the compiled model, "
                   f"{walls[name] / fastest:.1f}x the fastest rigid compiled engine run (issue 23 target <= 10x; "

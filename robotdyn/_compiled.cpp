@@ -637,6 +637,35 @@ class Evaluator {
     return event_g_;
   }
 
+  // ------------------------------------------------------------------------------------------ stepped from Python
+  // One call per evaluation for an integrator driven from Python (robotdyn/simulation/cvode.py: SUNDIALS CVODE):
+  // dy = d/dt y of simulate()'s ODE at (t, y), y = (q, nu[, works]) as in simulate, written into dy (no allocation);
+  // the compliant wheels' penetrations [m] at y into `out`; the terminal event's value (lift_off) at (t, y).
+  int state_size() const { return nv_ + mobility() + (!slips_.empty() ? 1 : applied() ? 2 : 0); }
+  void deriv_into(double t, const Eigen::Ref<const VectorXd>& y, Eigen::Ref<VectorXd> dy, double alpha,
+                  const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
+    if (y.size() != state_size() || dy.size() != state_size())
+      throw std::invalid_argument("y, dy: expected arrays of the state's length " + std::to_string(state_size()));
+    step_y_.assign(y.data(), y.data() + y.size());
+    deriv(t, step_y_, step_dy_, alpha, profile, rechoose);
+    dy = Eigen::Map<const VectorXd>(step_dy_.data(), static_cast<Eigen::Index>(step_dy_.size()));
+  }
+  void depths_into(const Eigen::Ref<const VectorXd>& y, Eigen::Ref<VectorXd> out, const py::object& rechoose) {
+    if (y.size() != state_size() || out.size() != static_cast<Eigen::Index>(contacts_.size()))
+      throw std::invalid_argument("y, out: expected the state's length and one value per compliant wheel");
+    penetrations(y.data(), rechoose, step_depths_);
+    out = Eigen::Map<const VectorXd>(step_depths_.data(), static_cast<Eigen::Index>(step_depths_.size()));
+  }
+  // A Jacobian's differences are being taken (on: the projection skips its span check, as for rosenbrock4: a
+  // difference leaves the constraint manifold by ~1e-8)
+  void set_differencing(bool on) { differencing_ = on; }
+  double event_value(double t, const Eigen::Ref<const VectorXd>& y, double alpha,
+                     const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
+    if (y.size() != state_size()) throw std::invalid_argument("y: expected the state's length");
+    step_y_.assign(y.data(), y.data() + y.size());
+    return lift_off(t, step_y_, alpha, profile, rechoose);
+  }
+
   // Total mechanical energy [J] (kinetic 1/2 v^T M v, potential -sum m_i g . c_i as Pinocchio's
   // computePotentialEnergy) and the largest holonomic residual at a state y = (q, nu).
   void observe(const double* y, double& energy, double& residual, const py::object& rechoose) {
@@ -1304,6 +1333,7 @@ class Evaluator {
  private:
   double slip_error_t_ = 0.0;
   std::vector<double> event_y_, event_dy_, slip_error_y_;
+  std::vector<double> step_y_, step_dy_, step_depths_;  // deriv_into, depths_into, event_value
   std::vector<WheelGeometry> geo_;
   std::vector<Matrix6x> Jf_;
   std::vector<MatrixXd> Aw_;
@@ -1396,6 +1426,13 @@ PYBIND11_MODULE(_compiled, m) {
       .def_property_readonly("v", &Evaluator::v, py::return_value_policy::reference_internal)
       .def("rhs", &Evaluator::rhs)
       .def("simulate", &Evaluator::simulate)
+      .def("deriv_into", &Evaluator::deriv_into, "dy = d/dt y at (t, y, alpha, profile, rechoose): one evaluation "
+           "of simulate's ODE written into the float64 array dy (robotdyn.simulation.cvode)")
+      .def("depths_into", &Evaluator::depths_into, "the compliant wheels' penetrations [m] at y into out (y, out, rechoose)")
+      .def("event_value", &Evaluator::event_value, "the terminal event's value at (t, y, alpha, profile, rechoose): the "
+           "slipping wheels' smallest load [N] or the rolling compliant wheels' switch value")
+      .def_property_readonly("state_size", &Evaluator::state_size)
+      .def("set_differencing", &Evaluator::set_differencing, "a Jacobian's differences are being taken (on/off)")
       .def("set_controller", &Evaluator::set_controller, py::arg("controller").none(true),
            "a feedback law replacing the torque profile in simulate (None: none)")
       .def("control_torque", &Evaluator::control_torque)

@@ -33,8 +33,9 @@ friction and damper work as two extra states (``Trajectory.friction_work``, ``da
 stored elastic energy. Robots with compliant wheels are integrated by a stepper with dense output, on which each
 wheel's lift-off and touch-down are located (``stats["flight"]``, as :mod:`robotdyn.simulation.flight` reports them
 on the scipy path's LSODA): :data:`COMPLIANT_DEFAULT` by default, :data:`STIFF` (Boost.Odeint's ``rosenbrock4``, a
-finite-difference Jacobian: ``robotdyn/_stiff_integrator.hpp``) for stiff contacts; springs alone run on the
-default Adams stepper. Compliant wheels that roll while in contact run segment by segment between their contact
+finite-difference Jacobian: ``robotdyn/_stiff_integrator.hpp``) for stiff contacts, or :data:`CVODE` (SUNDIALS'
+variable-order BDF driven from Python, one compiled call per evaluation, its events by CVODE's rootfinding:
+:mod:`robotdyn.simulation.cvode`); springs alone run on the default Adams stepper. Compliant wheels that roll while in contact run segment by segment between their contact
 switches (:mod:`robotdyn.simulation.compiled_rolling`). Slipping wheels and model-based controllers on such
 robots, and :func:`robotdyn.simulation.many_runs.simulate_many`, stay on the Python path (refused in one line).
 
@@ -61,6 +62,7 @@ from .flight import airborne
 from .feedback import FeedbackLaw
 from .torque_profile import Constant, TorqueProfile, as_profile
 from .trajectory import Trajectory
+from .cvode import missing as missing_cvode
 
 
 METHODS = ("adams", "bulirsch_stoer", "dopri5", "rosenbrock4")
@@ -80,6 +82,9 @@ step); the scipy path's LSODA (:data:`robotdyn.simulation.flight.STIFF_METHOD`) 
 itself."""
 DENSE = ("dopri5", "bulirsch_stoer", "rosenbrock4")
 """The compiled integrators with dense output, which can locate compliant wheels' flight phases."""
+CVODE = "cvode"
+"""SUNDIALS CVODE's variable-order BDF on the compiled model (:mod:`robotdyn.simulation.cvode`), for robots with
+compliant wheels or joint springs: its events by CVODE's rootfinding."""
 
 DONE, INTERRUPTED, FAILED = 0, 1, 3
 """How a compiled run ended (``robotdyn/_integrator.hpp``, ``Status``)."""
@@ -115,7 +120,7 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
         t_eval: Output times (sorted, from t0 to t_end).
         rtol, atol: Tolerances of the stepper's error control (per component: :math:`atol + rtol |y_i|`).
         stabilisation: Gain [1/s] of the holonomic pull-back.
-        method: One of :data:`METHODS`.
+        method: One of :data:`METHODS`, or :data:`CVODE` (run by :func:`robotdyn.simulation.cvode.run`).
         progress: ``progress(t)`` called about every 50 ms (None: not called).
         t0: Start time [s] (the profile is evaluated at absolute times).
         controller: A :class:`~robotdyn.simulation.feedback.FeedbackLaw` evaluated in C++ instead of ``profile``
@@ -129,8 +134,8 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
         RobotDynError: The integration failed (its step size vanished or the state became non-finite), or the
             Python path's own error where the projection had to be re-chosen.
     """
-    if method not in METHODS:
-        raise RobotDynError(f"unknown compiled integrator {method!r}; expected one of {', '.join(METHODS)}")
+    if method not in (*METHODS, CVODE):
+        raise RobotDynError(f"unknown compiled integrator {method!r}; expected one of {', '.join(METHODS)}, {CVODE}")
     native = native_profile(profile)
     points = set(map(float, profile.breakpoints()))
     if controller is not None:
@@ -140,6 +145,11 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     rechoose = rechooser(robot, fast)
     fast.ev.set_controller(None if controller is None else controller.native_controller(robot, fast))
     try:
+        if method == CVODE:  # SUNDIALS' BDF driven from Python (robotdyn.simulation.cvode): its own result
+            from .cvode import run as run_cvode
+
+            return run_cvode(robot, fast, t_end, q0, nu0, native, breaks, t_eval, rtol, atol, stabilisation,
+                             rechoose, progress, t0)
         out = fast.ev.simulate(q0, nu0, float(t0), float(t_end), np.asarray(t_eval, float), rtol, atol, stabilisation,
                                native, breaks, method, progress, rechoose)
     except Fallback as exc:  # the Python path's row choice did not serve the compiled model either
@@ -202,7 +212,12 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     """
     if engine not in ("auto", "compiled", "scipy"):
         raise RobotDynError(f"engine = {engine!r}; expected auto, compiled or scipy")
-    if method is not None and method in METHODS:
+    from scipy.integrate._ivp.ivp import METHODS as SCIPY
+
+    if method is not None and not (isinstance(method, str) and method in (*METHODS, CVODE, *SCIPY)):
+        raise RobotDynError(f"method = {method!r}; expected a compiled integrator ({', '.join(METHODS)}, {CVODE}) or "
+                            f"a scipy solve_ivp method ({', '.join(SCIPY)})")
+    if method is not None and method in (*METHODS, CVODE):
         if engine == "scipy":
             raise RobotDynError(f"method {method!r} is a compiled integrator; the scipy engine has DOP853, RK45, "
                                 "LSODA, ...")
@@ -224,9 +239,14 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
             "the compiled fast path is turned off (ROBOTDYN_COMPILED=0 or use_compiled(False))")
     elif fast.slip_refusal is not None:
         reason = fast.slip_refusal
-    elif compliant_wheels(robot) and method not in (None, *DENSE):
+    elif method == CVODE and not forced:
+        reason = (f"method {CVODE!r} (SUNDIALS' stiff BDF) runs robots with compliant wheels or joint springs; "
+                  f"expected one of {', '.join(METHODS)} for rigid contacts")
+    elif method == CVODE and missing_cvode() is not None:
+        reason = missing_cvode()
+    elif compliant_wheels(robot) and method not in (None, CVODE, *DENSE):
         reason = (f"compliant wheels' flight phases are located on a dense output: method {COMPLIANT_DEFAULT} "
-                  f"(default), {STIFF} (stiff) or bulirsch_stoer, not {method}")
+                  f"(default), {STIFF} (stiff), {CVODE} or bulirsch_stoer, not {method}")
     elif forced and as_data(torque) is not None and not isinstance(torque, FeedbackLaw):
         reason = ("model-based controllers on robots with joint springs or compliant wheels are simulated on the "
                   "Python path")
@@ -314,6 +334,8 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
     n = robot.nq
     stats = {"nfev": out["nfev"], "steps": out["steps"], "wall": wall, "method": method, "rtol": rtol,
              "engine": f"compiled ({method})"}
+    if "jacobians" in out:  # CVODE: the difference-quotient Jacobians it formed (their evaluations are in nfev)
+        stats["jacobians"] = out["jacobians"]
     if out["interrupted"]:
         stats["partial"] = out["interrupted"]
     k = robot.mobility
@@ -443,4 +465,4 @@ def rechooser(robot, fast=None):
 
 
 __all__ = ["run", "simulate_compiled", "choose_engine", "engine_model", "default_method", "native_profile", "rechooser",
-           "at_time", "METHODS", "STIFF", "COMPLIANT_DEFAULT", "DENSE"]
+           "at_time", "METHODS", "STIFF", "COMPLIANT_DEFAULT", "DENSE", "CVODE"]

@@ -96,7 +96,7 @@ def simulate_rolling_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, 
         n_out: Number of evenly spaced output samples (unless ``times``).
         rtol: Relative error tolerance.
         atol: Absolute error tolerance per component.
-        method: A compiled integrator with dense output (dopri5, bulirsch_stoer, rosenbrock4).
+        method: A compiled integrator with dense output (dopri5, bulirsch_stoer, rosenbrock4) or cvode.
         stabilisation: Gain [1/s] of the holonomic pull-back and of the rolling rows' velocity residual.
         progress: The run's :class:`~robotdyn.simulation.progress.Progress` reporter.
         offsets: Holonomic residuals kept as constant offsets, by row label [m or rad].
@@ -139,7 +139,7 @@ def simulate_rolling_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, 
         todo = t_eval[t_eval > t] if switches else t_eval[t_eval >= t]
         out = run(robot, fast, t_end, q, nu, profile, todo, rtol, atol, stabilisation, method, report, t, law)
         nfev += out["nfev"]
-        steps += out["steps"]
+        steps = None if steps is None or out["steps"] is None else steps + out["steps"]  # (CVODE: not known)
         y = np.asarray(out["y"], float).reshape(len(out["t"]), n + k + 2)  # (q, nu, friction work, damper work)
         y[:, n + k:] += work
         ts.append(np.asarray(out["t"], float))

@@ -89,7 +89,8 @@ def simulate(
         rtol, atol: Error tolerances (relative, absolute per component) of either engine.
         method: The integrator: a ``scipy.integrate.solve_ivp`` method (default DOP853) or one of
             :data:`robotdyn.simulation.compiled_engine.METHODS` (default adams; dopri5 for compliant wheels,
-            rosenbrock4 for stiff ones); it selects the engine too.
+            rosenbrock4 for stiff ones) or ``"cvode"`` (SUNDIALS CVODE's BDF on the compiled model, for robots with
+            compliant wheels or joint springs: :mod:`robotdyn.simulation.cvode`); it selects the engine too.
         stabilisation: Gain [1/s] pulling holonomic residuals back to zero (:mod:`robotdyn.reduction.pull_back`).
         progress: Print progress to stderr on long runs.
         engine: ``auto``, ``compiled`` (an error naming why where it cannot run) or ``scipy``.

@@ -269,11 +269,17 @@ def evaluation_profile_bench() -> None:
     at the state a second into each robot's first scenario (the holonomic residuals are then nonzero, so the
     simulation's right-hand side pays the pull-back). Parts: rows = constraint rows, residuals and B; projection = S
     (LU of A_d, condition estimate, span check); drift = the rows' drift and w after RNEA; reduce = M_r, h, g_r, B_r;
-    rhs = the whole right-hand side of a compiled simulation with the pull-back at gain 1."""
-    parts = ("crba", "rnea", "frames", "rows", "projection", "drift", "reduce", "pull_back")
+    rhs = the whole right-hand side of a compiled simulation with the pull-back at gain 1; gravity = g from CRBA's
+    composite inertias; solve = the right-hand side's LLT of M_r and its solve; floor = Pinocchio's own CRBA + RNEA +
+    computeJointJacobians as a user calls them (each redoing the kinematics); then the heap allocations per
+    evaluation (bench/allocation_bench.py)."""
+    parts = ("crba", "rnea", "frames", "gravity", "rows", "projection", "drift", "reduce", "solve", "pull_back")
     print("\nwhere a compiled evaluation's time goes [us, C++ CPU time per call] (issue 26: pinocchio = Pinocchio's own "
           "CRBA + RNEA + frame Jacobians on the same model)")
-    print(f"{'robot':<20} {'evaluation':>10} {'pinocchio':>9} {'ratio':>6} {'rhs':>7} " + " ".join(f"{p:>10}" for p in parts))
+    print("(floor = Pinocchio's own CRBA + RNEA + computeJointJacobians as a user calls them; kinematics = "
+          "forwardKinematics alone)")
+    print(f"{'robot':<20} {'evaluation':>10} {'pinocchio':>9} {'ratio':>6} {'floor':>6} {'kinematics':>10} {'rhs':>7} "
+          + " ".join(f"{p:>10}" for p in parts))
     for name in names():
         robot = robotdyn.load(name)
         fast = compiled_model(robot)
@@ -288,8 +294,12 @@ def evaluation_profile_bench() -> None:
             print(f"{name:<20} skipped: {exc}")
             continue
         print(f"{name:<20} {1e6 * t['evaluation']:>10.2f} {1e6 * t['pinocchio']:>9.2f} "
-              f"{t['evaluation'] / t['pinocchio']:>6.2f} {1e6 * t['rhs']:>7.2f} "
-              + " ".join(f"{1e6 * t[p]:>10.2f}" for p in parts))
+              f"{t['evaluation'] / t['pinocchio']:>6.2f} {1e6 * t.get('pinocchio_jacobians', np.nan):>6.2f} "
+              f"{1e6 * t.get('kinematics', np.nan):>10.2f} {1e6 * t['rhs']:>7.2f} "
+              + " ".join(f"{1e6 * t.get(p, np.nan):>10.2f}" for p in parts))
+    from allocation_bench import allocation_bench  # bench/allocation_bench.py
+
+    allocation_bench()
 
 
 def _best_of(run, repeat: int) -> tuple[float, float, object]:

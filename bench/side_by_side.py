@@ -24,6 +24,7 @@ from robotdyn.simulation.engine import simulate
 
 SAMPLE = 0.05  # [s] output spacing: the scenario's own (1801 samples over 90 s)
 REPEAT = 3  # each timed run is repeated; the fastest counts (the machine may be shared)
+LOOSER = (1e-8, 1e-6)  # rtol of the compiled simulation's extra rows (its default is 1e-10)
 
 
 def compiled_engine() -> dict | None:
@@ -79,6 +80,11 @@ def manoeuvre(t_ends=(20.0, 90.0)) -> None:
         else:
             fast, wall = _robotdyn_run(robot, sc, t_end, **kw)
             rows.append(("robotdyn compiled simulation", wall, _as_run(fast, r), drift(robot, fast)))
+            evaluations = {"rtol 1e-10 (default)": (fast.stats["nfev"], wall)}
+            for rtol in LOOSER:  # the same engine at looser tolerances: accuracy against cost (stated per row)
+                loose, wall_loose = _robotdyn_run(robot, sc, t_end, rtol=rtol, atol=rtol * 1e-2, **kw)
+                rows.append((f"robotdyn compiled, rtol {rtol:g}", wall_loose, _as_run(loose, r), drift(robot, loose)))
+                evaluations[f"rtol {rtol:g}"] = (loose.stats["nfev"], wall_loose)
         if version is None:
             rows.append(("MuJoCo", None, "not installed (pip install -e .[bench])", None))
         else:
@@ -97,8 +103,36 @@ def manoeuvre(t_ends=(20.0, 90.0)) -> None:
                   f" {1e3 * acc['x_error']:>9.3g} mm {1e3 * acc['penetration']:>8.3g} mm"
                   f" {1e3 * acc['rolling_drift']:>7.2g} mm " + (f"{psi_drift:>9.1e}" if psi_drift is not None else
                                                                  f"{'-':>9}"))
+        if kw is not None:
+            print("  compiled simulation, whole call per evaluation (integrator, torque profile, output included): "
+                  + ", ".join(f"{label}: {n} evaluations, {1e6 * w / n:.2f} us" for label, (n, w) in
+                              evaluations.items()))
     print("(vs MuJoCo: MuJoCo default's cost / this row's cost; penetration r - z(C2) and |x - r theta1| are zero "
-          "by construction in robotdyn; psi drift: |psi - rho (theta2 - theta1)|, eq 11)")
+          "by construction in robotdyn; psi drift: |psi - rho (theta2 - theta1)|, eq 11; atol = rtol / 100 on the "
+          "looser rows)")
+    evaluation_cost(robot, sc)
+
+
+def evaluation_cost(robot, sc) -> None:
+    """One compiled evaluation of Quasimoro against its floor (issue 26): Evaluator.profile's C++ CPU time per call
+    of the evaluation, of the simulation's right-hand side, of Pinocchio's CRBA + RNEA + frame Jacobians inside it
+    and of Pinocchio's own CRBA + RNEA + computeJointJacobians as a user calls them, at the state 1 s into the
+    manoeuvre (median of 5 profiles of 2000 calls each)."""
+    from robotdyn.fast.dispatch import compiled_model
+
+    fast = compiled_model(robot)
+    if fast is None:
+        return
+    q0, nu0 = sc.initial_state(robot)
+    traj = simulate(robot, 1.0, q0, nu0, sc.torque, n_out=3, progress=False)
+    fast.compute(traj.q[-1], traj.nu[-1])
+    runs = [fast.ev.profile(traj.q[-1], traj.nu[-1], 2000, 1.0) for _ in range(5)]
+    t = {k: float(np.median([run[k] for run in runs])) for k in runs[0]}
+    floor = t.get("pinocchio_jacobians", t["pinocchio"])
+    print(f"  one compiled evaluation [us, C++ CPU time]: evaluation {1e6 * t['evaluation']:.2f}, right-hand side "
+          f"{1e6 * t['rhs']:.2f}; Pinocchio inside it (CRBA + RNEA + frames) {1e6 * t['pinocchio']:.2f}; Pinocchio's "
+          f"own CRBA + RNEA + computeJointJacobians {1e6 * floor:.2f} (evaluation / that floor "
+          f"{t['evaluation'] / floor:.2f})")
 
 
 def _sweep(spec, workers: int, batch: str):

@@ -1151,7 +1151,11 @@ class Evaluator {
   // next to Pinocchio's own C++ algorithms on the same model: "evaluation" (configure + dynamics, as compute),
   // "pinocchio" (CRBA + RNEA + the frames' placements and Jacobians, the rigid-body work inside it), "crba", "rnea",
   // "frames", "rows" (constraint rows, residuals, B), "projection", "drift" (drift and w, after RNEA), "reduce"
-  // (M_r, h, g_r, B_r), "rhs" (the simulation's right-hand side with the pull-back at gain `alpha`) and "pull_back".
+  // (M_r, h, g_r, B_r), "rhs" (the simulation's right-hand side with the pull-back at gain `alpha`), "pull_back",
+  // "gravity" (g from CRBA's composite inertias), "solve" (the right-hand side's LLT of M_r and its solve), "applied"
+  // (springs and compliant wheels; 0 without), "controller" (the feedback law; 0 without), and Pinocchio's own passes
+  // as a user calls them: "kinematics" (forwardKinematics) and "pinocchio_jacobians" (CRBA + RNEA +
+  // computeJointJacobians).
   // The evaluator is left evaluated at (q, nu).
   py::dict profile(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu, int repeat, double alpha) {
     if (repeat < 1) throw std::invalid_argument("repeat must be >= 1");
@@ -1209,6 +1213,33 @@ class Evaluator {
     });
     t["rhs"] = seconds([&] { rhs_into(q0, nu0, tau, alpha, out); });
     t["pull_back"] = seconds([&] { pull_back(alpha, out); });
+    configure(q0);
+    dynamics(nu0);
+    t["gravity"] = seconds([&] { gravity_torques(model_, data_, gravity_, nv_, g_); });
+    const VectorXd f0 = Br_ * tau - hr_;
+    t["solve"] = seconds([&] {  // rhs_into's solve: LLT of M_r, then M_r^-1 (B_r tau - h)
+      force_ = f0;
+      llt_.compute(Mr_);
+      llt_.solveInPlace(force_);
+    });
+    t["applied"] = applied() ? seconds([&] { applied_forces(); }) : 0.0;
+    if (controller_) {
+      control_tau_.resize(Br_.cols());
+      t["controller"] = seconds([&] {
+        controller_->eval(control_t_, q0, nu0, Mr_, hr_, Br_, S_, w_, v_,
+                          [this](int f) { return frame_kinematics(f); }, control_tau_);
+      });
+    } else {
+      t["controller"] = 0.0;
+    }
+    // Pinocchio's own passes as a user calls them (the floor of issue 26): the joints' placements alone, and CRBA
+    // (its default convention) + RNEA + computeJointJacobians, each redoing the kinematics
+    t["kinematics"] = seconds([&] { pin::forwardKinematics(model_, data_, q_); });
+    t["pinocchio_jacobians"] = seconds([&] {
+      pin::crba(model_, data_, q_);
+      pin::rnea(model_, data_, q_, v_, zero_);
+      pin::computeJointJacobians(model_, data_, q_);
+    });
     configure(q0);
     dynamics(nu0);
     return t;

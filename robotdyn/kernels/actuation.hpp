@@ -36,7 +36,8 @@ inline void motor_columns(const std::vector<Motor>& motors, const pin::Model& mo
     // joint's column is its axis in either convention
     const Vector3d ang = data.J.col(mo.index).tail<3>();
     const Vector3d axis = ang.squaredNorm() > 0.25 ? ang : Vector3d(data.J.col(mo.index).head<3>());
-    B.col(j).noalias() = -(Jf[mo.reaction].bottomRows<3>().transpose() * axis);
+    B.col(j).noalias() = Jf[mo.reaction].bottomRows<3>().transpose() * axis;  // then negated in place: the same
+    B.col(j) = -B.col(j);  // numbers as -(J^T axis), without the temporary (a heap allocation) that expression made
     for (const pin::JointIndex s : model.supports[mo.joint]) {
       if (s == 0) continue;
       const int c0 = model.joints[s].idx_v();

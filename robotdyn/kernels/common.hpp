@@ -44,5 +44,14 @@ inline Matrix3d skew(const Vector3d& x) {
   return m;
 }
 
+// Frame fid's classical acceleration in LOCAL_WORLD_ALIGNED axes, given its velocity v in the same axes (as
+// pin::getFrameVelocity gives it): pin::getFrameClassicalAcceleration's formula and operations (spatial acceleration
+// plus omega x v), without computing the frame's velocity a second time.
+inline pin::Motion classical_acceleration(const pin::Model& model, const pin::Data& data, int fid, const pin::Motion& v) {
+  pin::Motion acc = pin::getFrameAcceleration(model, data, static_cast<pin::FrameIndex>(fid), pin::LOCAL_WORLD_ALIGNED);
+  acc.linear() += v.angular().cross(v.linear());
+  return acc;
+}
+
 }  // namespace kernels
 }  // namespace robotdyn

@@ -52,8 +52,8 @@ inline int closure_drift(const Closure& c, const pin::Model& model, const pin::D
                          VectorXd& drift) {
   const pin::Motion V1 = pin::getFrameVelocity(model, data, fid1, pin::LOCAL_WORLD_ALIGNED);
   const pin::Motion V2 = pin::getFrameVelocity(model, data, fid2, pin::LOCAL_WORLD_ALIGNED);
-  const pin::Motion a1 = pin::getFrameClassicalAcceleration(model, data, fid1, pin::LOCAL_WORLD_ALIGNED);
-  const pin::Motion a2 = pin::getFrameClassicalAcceleration(model, data, fid2, pin::LOCAL_WORLD_ALIGNED);
+  const pin::Motion a1 = classical_acceleration(model, data, fid1, V1);
+  const pin::Motion a2 = classical_acceleration(model, data, fid2, V2);
   const Vector3d d = data.oMf[fid2].translation() - data.oMf[fid1].translation();
   const Vector3d w1 = V1.angular();
   const Vector3d ddot = V2.linear() - V1.linear();

@@ -18,8 +18,41 @@ namespace kernels {
 
 struct PullBack {
   MatrixXd Ah;
-  VectorXd phi, dq;
+  VectorXd phi, dq, y;
   Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod;
+
+  // x <- (I - tau u u^T) x on the entries (x0, xt) for u = (1, e) (Eigen's applyHouseholderOnTheLeft on one column,
+  // written out: its products made a heap temporary per reflector).
+  template <class E, class T>
+  static void reflect(double& x0, T&& xt, const E& e, double tau) {
+    if (xt.size() == 0) {
+      x0 *= 1.0 - tau;
+      return;
+    }
+    if (tau == 0.0) return;
+    const double t = e.dot(xt) + x0;
+    x0 -= tau * t;
+    for (Eigen::Index i = 0; i < xt.size(); ++i) xt[i] -= (tau * e[i]) * t;
+  }
+
+  // dq = cod's minimum-norm solution of Ah dq = phi (CompleteOrthogonalDecomposition::solve's steps: c = Q^T phi,
+  // T z = c on the rank's rows, y = Z^T (z, 0), dq = P y) in the buffers above, allocating nothing once sized
+  // (phi is overwritten with c).
+  void solve() {
+    const Eigen::Index m = Ah.rows(), n = Ah.cols(), rank = cod.rank();
+    const MatrixXd& QR = cod.matrixQTZ();  // Q's reflectors below the diagonal (ColPivHouseholderQR's storage)
+    for (Eigen::Index k = 0; k < rank; ++k)  // c = Q^T phi = H_{rank-1} ... H_0 phi
+      reflect(phi[k], phi.tail(m - k - 1), QR.col(k).tail(m - k - 1), cod.hCoeffs()[k]);
+    y.setZero(n);
+    y.head(rank) = phi.head(rank);
+    cod.matrixT().topLeftCorner(rank, rank).template triangularView<Eigen::Upper>().solveInPlace(y.head(rank));
+    if (rank < n)  // y = Z^T (z, 0): reflector k acts on entry k and the last n - rank entries
+      for (Eigen::Index k = 0; k < rank; ++k)
+        reflect(y[k], y.tail(n - rank), QR.row(k).tail(n - rank).transpose(), cod.zCoeffs()[k]);
+    dq.resize(n);
+    const auto& p = cod.colsPermutation().indices();
+    for (Eigen::Index i = 0; i < n; ++i) dq[p[i]] = y[i];
+  }
 
   // out.head(nv) -= alpha dq (nothing where every holonomic residual is exactly zero).
   void apply(const std::vector<bool>& holonomic, const VectorXd& residual, const MatrixXd& A, int nv, double alpha,
@@ -45,7 +78,7 @@ struct PullBack {
     cod.setThreshold(1e-9 * std::max(pmax, 1.0) / pmax);  // pivots <= 1e-9 max(p_max, 1) count as zero
     cod.compute(Ah);
     if (cod.rank() == 0) return;
-    dq = cod.solve(phi);
+    solve();
     out.head(nv).noalias() -= alpha * dq;
   }
 };

@@ -113,7 +113,7 @@ inline int wheel_rows(const Wheel& wh, const Terrain& terrain, const pin::SE3& o
 inline int wheel_drift(const Wheel& wh, const WheelGeometry& g, const Terrain& terrain, const pin::Model& model,
                        const pin::Data& data, int fid, MatrixXd& Aw, VectorXd& v, int row, VectorXd& drift) {
   const pin::Motion vf = pin::getFrameVelocity(model, data, fid, pin::LOCAL_WORLD_ALIGNED);
-  const pin::Motion af = pin::getFrameClassicalAcceleration(model, data, fid, pin::LOCAL_WORLD_ALIGNED);
+  const pin::Motion af = classical_acceleration(model, data, fid, vf);
   const Vector3d omega = vf.angular(), cdot = vf.linear();
   const double Rdot = wh.radius_index >= 0 ? v[wh.radius_index] : 0.0;
   const Vector3d& n = g.n;

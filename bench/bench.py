@@ -306,37 +306,54 @@ def _best_of(run, repeat: int) -> tuple[float, float, object]:
 
 def controller_bench() -> None:
     """The built-in controller scenarios (robotdyn.simulation.feedback: feedback laws as data) on the compiled loop
-    against the same law on the scipy loop, at each scenario's tolerances: cost per simulated second (whole
-    simulate() calls, best of 3; scipy best of 1, after a warm-up), speed-up in wall and in CPU time (the machine
-    may be shared), the final states' difference; then the same with 11 samples."""
+    against the same law on the scipy loop, at each scenario's tolerances and samples: cost per simulated second
+    (whole simulate() calls, best of 3 each, after a warm-up), speed-up in wall and in CPU time (the machine may be
+    shared: CPU is the steadier ratio), the final states' difference, the evaluations of each; then the same with 11
+    samples, with each engine's error against a tight reference (compiled dopri5 at rtol = atol = 1e-12, max abs. over
+    q and nu at the 11 samples); then where each compiled run's CPU time goes: the Python set-up of the call
+    (checks, start posture, model, law), the integration (evaluations, steps) and the samples (energy and residual of
+    each, interpolation), from the same call with the default samples and with 2 (wall times)."""
     rows = [("linkage_suspension", "straight_line", None), ("linkage_suspension", "pivot_steering", None),
             ("linkage_suspension", "bump", None), ("omni_caster", "circle", 20.0), ("omni_caster", "ellipse", None),
             ("mmr12_eod", "orientation", 50.0),
             ("mmr12_eod", "sinusoid", 50.0), ("mmr12_eod", "manipulation", None), ("mmr12_eod", "lifting", None)]
-    print("\ncontroller scenarios, compiled loop vs scipy loop (the same law), whole simulate() call:")
+    print("\ncontroller scenarios, compiled loop vs scipy loop (the same law), whole simulate() call (best of 3):")
     print(f"{'robot / scenario':<36} {'sim [s]':>8} {'scipy ms/s':>11} {'compiled ms/s':>14} {'speed-up':>9} "
-          f"{'cpu speed-up':>13} {'max|dy(t_end)|':>15} {'evals scipy/compiled':>21}")
+          f"{'cpu speed-up':>13} {'max|dy(t_end)|':>15} {'evals scipy/compiled':>21} {'err scipy':>10} "
+          f"{'err compiled':>13}")
+    costs = []
 
-    def line(label, t_end, scipy, compiled, dev=None):
+    def line(label, t_end, scipy, compiled, dev=None, errors=None):
         (ws, cs, ref), (wc, cc, fast) = scipy, compiled
         dev = f"{dev:>15.2e}" if dev is not None else f"{'':>15}"
+        errs = f" {errors[0]:>10.1e} {errors[1]:>13.1e}" if errors is not None else ""
         print(f"{label:<36} {t_end:>8.1f} {1e3 * ws / t_end:>11.2f} {1e3 * wc / t_end:>14.3f} {ws / wc:>8.1f}x "
-              f"{cs / cc:>12.1f}x {dev} {ref.stats['nfev']:>10d}/{fast.stats['nfev']:<10d}")
+              f"{cs / cc:>12.1f}x {dev} {ref.stats['nfev']:>10d}/{fast.stats['nfev']:<10d}{errs}")
+
+    def compare(label, run, t_end, n_out, reference):
+        runs = {engine: _best_of(lambda: run(engine, n_out), 3) for engine in ("scipy", "auto")}
+        ref, fast = runs["scipy"][2], runs["auto"][2]
+        assert fast.stats["engine"].startswith("compiled"), fast.stats["engine"]
+        dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
+        line(label, t_end, runs["scipy"], runs["auto"], dev)
+        sparse = {engine: _best_of(lambda: run(engine, 11), 3) for engine in ("scipy", "auto")}
+        tight = reference()
+        errors = [max(np.abs(sparse[e][2].q - tight.q).max(), np.abs(sparse[e][2].nu - tight.nu).max())
+                  for e in ("scipy", "auto")]
+        line("  the same, 11 samples", t_end, sparse["scipy"], sparse["auto"], errors=errors)
+        two = _best_of(lambda: run("auto", 2), 3)
+        whole = runs["auto"]
+        costs.append((label, t_end, whole[0], two[0] - two[2].stats["wall"], whole[0] - two[0], fast))
 
     for name, sc_name, t_end in rows:
         robot = robotdyn.load(name)
         sc = module(name).SCENARIOS[sc_name]
         t_end = sc.t_end if t_end is None else t_end
         sc.run(robot, t_end=0.1, progress=False)  # warm: imports, the compiled model, the projection
-        runs = {engine: _best_of(lambda: sc.run(robot, t_end=t_end, progress=False, engine=engine), repeat)
-                for engine, repeat in (("scipy", 1), ("auto", 3))}
-        ref, fast = runs["scipy"][2], runs["auto"][2]
-        assert fast.stats["engine"].startswith("compiled"), fast.stats["engine"]
-        dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
-        line(name + " / " + sc_name, t_end, runs["scipy"], runs["auto"], dev)
-        sparse = {engine: _best_of(lambda: sc.run(robot, t_end=t_end, n_out=11, progress=False, engine=engine), 1)
-                  for engine in ("scipy", "auto")}
-        line("  the same, 11 samples", t_end, sparse["scipy"], sparse["auto"])
+        n_out = sc.span(t_end)[1]
+        compare(name + " / " + sc_name,
+                lambda engine, n: sc.run(robot, t_end=t_end, n_out=n, progress=False, engine=engine), t_end, n_out,
+                lambda: sc.run(robot, t_end=t_end, n_out=11, progress=False, method="dopri5", rtol=1e-12, atol=1e-12))
     robot = robotdyn.load("quasimoro")  # the LQR of examples/quasimoro_lqr.py as data (lqr_law), 10 s
     from robotdyn.reduction.linearization import linearize, lqr
     from robotdyn.simulation.engine import simulate
@@ -348,16 +365,22 @@ def controller_bench() -> None:
     law = lqr_law(model, lqr(model, np.eye(4), np.eye(2))[0])
     start_q = q0.copy()
     start_q[robot.coordinate_index("theta3")] += 0.1
-    runs = {engine: _best_of(lambda: simulate(robot, 10.0, start_q, np.zeros(3), law, n_out=101, progress=False,
-                                              engine=engine), repeat) for engine, repeat in (("scipy", 1), ("auto", 3))}
-    ref, fast = runs["scipy"][2], runs["auto"][2]
-    dev = max(np.abs(fast.q[-1] - ref.q[-1]).max(), np.abs(fast.nu[-1] - ref.nu[-1]).max())
-    line("quasimoro / LQR (lqr_law)", 10.0, runs["scipy"], runs["auto"], dev)
-    print("  the linkage's compiled right-hand side costs ~35 us of CPU (25 coordinates, loop closures, the pull-back: "
-          "see 'where a compiled evaluation's time goes') on either loop, its scipy evaluation ~65 us: with few samples "
-          "its runs are bound by the evaluation; compiled Adams takes the samples between its steps from a Hermite "
-          "interpolant (before: it stepped onto each of the 400 samples per second, 3,700 evaluations where DOP853 "
-          "interpolates with 1,650), so the sampling no longer sets its steps")
+    compare("quasimoro / LQR (lqr_law)",
+            lambda engine, n: simulate(robot, 10.0, start_q, np.zeros(3), law, n_out=n, progress=False, engine=engine),
+            10.0, 101, lambda: simulate(robot, 10.0, start_q, np.zeros(3), law, n_out=11, progress=False,
+                                        method="dopri5", rtol=1e-12, atol=1e-12))
+    print("\nwhere each compiled run's time goes [ms, wall, best of 3] (default samples; set-up: the Python side of "
+          "the call; samples: the default samples' cost over 2 samples):")
+    print(f"{'robot / scenario':<36} {'total':>8} {'set-up':>8} {'integration':>12} {'samples':>8} {'evals':>7} "
+          f"{'steps':>7} {'us / eval':>10}")
+    for label, t_end, total, setup, samples, fast in costs:
+        integration = total - setup - samples
+        print(f"{label:<36} {1e3 * total:>8.2f} {1e3 * setup:>8.2f} {1e3 * integration:>12.2f} {1e3 * samples:>8.2f} "
+              f"{fast.stats['nfev']:>7d} {fast.stats['steps']:>7d} {1e6 * integration / fast.stats['nfev']:>10.1f}")
+    print("  the scipy loop evaluates the same compiled model (one Python call per evaluation, ~15-25 us more each) and "
+          "computes each sample's energy and residual in Python: where the compiled evaluation itself costs tens of "
+          "us (the linkage: 25 coordinates, loop closures) the ratio is bound by it (see 'where a compiled "
+          "evaluation's time goes')")
 
 
 def compiled_forces_bench() -> None:

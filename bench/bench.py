@@ -389,8 +389,9 @@ def controller_bench() -> None:
           "nfev_s (c + p) against the compiled loop's nfev_c c, c the compiled evaluation, p the Python around it. "
           "Where c is tens of us (the linkage: 25 coordinates, six wheels, the suspension's loop closures: c = 33-40 "
           "us, p = 4-7 us) the integrations' ratio is about nfev_s / nfev_c (1.9-2.8 with Adams up to order 10), "
-          "and each of the 400-820 samples per second costs a configuration pass on both loops (~17-23 us compiled against ~53 us): the "
-          "linkage's runs are bound at about 3x by its evaluation and its samples, not by the loop")
+          "and each of the 400-820 samples per second costs a configuration pass on both loops (~17-23 us compiled "
+          "against ~53 us): the linkage's runs are bound at about 3x by its evaluation and its samples, not by the "
+          "loop")
 
 
 def compiled_forces_bench() -> None:

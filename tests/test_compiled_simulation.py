@@ -201,3 +201,24 @@ def test_time_limit_stops_a_crawling_run_on_both_engines(quasimoro, engine):
     assert np.array_equal(free.q, limited.q)
     with pytest.raises(RobotDynError, match="time_limit = -1 s; expected a positive"):
         simulate(quasimoro, 0.5, q0, nu0, progress=False, engine=engine, time_limit=-1)
+
+
+@pytest.mark.parametrize("method", ["dopri5", "bulirsch_stoer"])
+def test_dense_steppers_cross_windows_meeting_one_double_apart(quasimoro, method):
+    """Two torque windows meeting one double apart (the second starts at nextafter(0.3)) give two breakpoints one
+    ulp apart. The dense-output driver restarted at each in turn and took the 1-ulp gap as its next step, which
+    then failed as vanishing ("Required step size is less than spacing between numbers": MMR12-EOD's manipulation
+    scenario with dopri5 at t = 10 s); it now restarts once there. The run ends where Adams (which skipped both
+    already) and the scipy path end, to the tolerances, and the torque did work: 0.5 N m on the wheels for 0.3 s,
+    then 0.2 N m."""
+    after = float(np.nextafter(0.3, np.inf))
+    torque = Sine([0.5, 0.5], 0.0, np.pi / 2, 0.0, 0.3) + Sine([0.2, 0.2], 0.0, np.pi / 2, after, 1.0)
+    assert len(torque.breakpoints()) == 4 and torque.breakpoints()[2] - torque.breakpoints()[1] < 1e-15
+    q0, nu0 = quasimoro.neutral(), np.zeros(3)
+    runs = {m: simulate(quasimoro, 0.5, q0, nu0, torque, n_out=6, progress=False, method=m, rtol=1e-10, atol=1e-12)
+            for m in (method, "adams")}
+    ref = simulate(quasimoro, 0.5, q0, nu0, torque, n_out=6, progress=False, engine="scipy")
+    assert runs[method].stats["engine"] == f"compiled ({method})" and runs[method].t[-1] == 0.5
+    for traj in runs.values():
+        assert np.max(np.abs(traj.q - ref.q)) <= 1e-8 and np.max(np.abs(traj.nu - ref.nu)) <= 1e-8
+    assert np.max(np.abs(ref.nu[-1])) > 0.1  # it moved

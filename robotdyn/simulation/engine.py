@@ -160,9 +160,10 @@ def simulate(
         as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
     if isinstance(torque, FeedbackLaw):
         torque = torque.bound(robot)  # one line if it does not fit the robot; its model is the robot simulated
+    rows0 = robot.rows_at(q0)  # (once: both checks below read them)
     if not t0:  # a continuation starts where the earlier run ended (its drift is reported, not refused)
-        robot.check_constraints(q0)
-    offsets = start_offsets(robot, q0, stabilisation)
+        robot.check_constraints(q0, rows=rows0)
+    offsets = start_offsets(robot, q0, stabilisation, rows0)
     stiff_slip_warning(robot, t_end - t0)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
     if stick_slip_wheels(robot):  # exact switching: segment by segment

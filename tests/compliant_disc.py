@@ -54,3 +54,21 @@ def landing(k: float, zeta: float, v_in: float) -> tuple[float, float]:
     x_star = v_in / wd * np.exp(-s * t_star) * np.sin(theta)
     v_out = -v_in * np.exp(-s * t_star) * (np.cos(theta) - s / wd * np.sin(theta))
     return t_star + x_star / v_out, v_out
+
+
+def check_landing(traj, k: float, zeta: float, v_in: float, gap: float) -> None:
+    """Assert a dropped disc's run (touching down at v_in [m/s] after falling gap [m], no gravity) against
+    :func:`landing`'s closed form: touch-down time to 1e-9 s, contact time and rebound speed to 1e-7 relative, the
+    damper's work equal to the kinetic energy lost, and energy = damper work + friction work at every sample."""
+    import pytest
+
+    contact, v_out = landing(k, zeta, v_in)
+    ev = phases(traj)
+    assert ev["touch-down"] == pytest.approx([gap / v_in], abs=1e-9)
+    assert len(ev["lift-off"]) == 1
+    assert ev["lift-off"][0] - ev["touch-down"][0] == pytest.approx(contact, rel=1e-7)
+    assert traj.column("z_dot")[-1] / v_in == pytest.approx(v_out / v_in, rel=1e-7)
+    lost = 0.5 * M * (v_in**2 - v_out**2)
+    assert -traj.damper_work[-1] == pytest.approx(lost, rel=1e-7, abs=1e-12)
+    assert np.max(np.abs(traj.energy - traj.energy[0] - traj.damper_work - traj.friction_work)) < 1e-8 * M * v_in**2
+    assert traj.stats["airborne"] == ["disc"]

@@ -493,11 +493,11 @@ def traction_bench() -> None:
         start = time.perf_counter()
         ref = traction(robot, traj, sc.torque, method="reference")
         t_ref, t_fast = time.perf_counter() - start, min(walls)
-        d_mu = (float(np.max(np.abs(fast.minimum_mu - ref.minimum_mu))) if ref.minimum_mu is not None
-                else float("nan"))
+        d_mu = (f"{float(np.max(np.abs(fast.minimum_mu - ref.minimum_mu))):>13.1e}" if ref.minimum_mu is not None
+                else f"{'- (no column)':>13}")  # the robot's forces are determined: no minimum-mu column
         print(f"{name + ' / ' + sc_name + f' {t_end:g} s':<40} {len(traj.t):>8} {t_fast:>9.3f} {t_ref:>8.2f} "
               f"{1e6 * t_fast / len(traj.t):>10.1f} {t_ref / t_fast:>8.0f}x "
-              f"{float(np.max(np.abs(fast.normal - ref.normal), initial=0.0)):>12.1e} {d_mu:>13.1e}"
+              f"{float(np.max(np.abs(fast.normal - ref.normal), initial=0.0)):>12.1e} {d_mu}"
               + ("" if fast.method == "fast" else f"   (fast pass not used: {fast.method})"))
 
 

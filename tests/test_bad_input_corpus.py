@@ -713,6 +713,7 @@ FLAG_CASES: dict = {
     "--plot": (["--plot", "{d}/p.xyz"], ("p.xyz",)),
     "--traction-plot": (["--traction-plot", "{d}/p.xyz"], ("p.xyz",)),
     "--stabilisation": (["--stabilisation", "-1"], ("--stabilisation",)),
+    "--method": (["--method", "nosuchmethod"], ("nosuchmethod",)),
     "--mu": (["--mu", "-1"], ("--mu",)),
     "--html": (["--html", "{d}/no/dir/v.html"], ("v.html",)),
     "--spec": (["--spec", "{d}/nosuch.toml"], ("nosuch.toml",)),

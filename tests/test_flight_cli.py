@@ -123,3 +123,21 @@ def test_dump_inverse_names_the_springs():
               "0", "0", "--json")
     data = json.loads(out.stdout)
     assert np.max(np.abs(data["tau"])) < 1e-6  # the chassis' weight, ~1e4 N, is carried by the springs
+
+
+def test_simulate_method_option_runs_cvode_and_refuses_an_unknown_one():
+    """--method reaches simulate: CVODE (SUNDIALS' BDF) on the compliant base gives the default dopri5's flight
+    phases to its tolerance (the API's own comparison is tests/test_cvode.py); an unknown name is one line, exit 2."""
+    base = ("simulate", "--constraints", str(EXAMPLES / "bump_base.toml"), "--scenario", "bump", "--t-end", "0.1",
+            "--quiet", "--json")
+    runs = {m: run(*base, *(("--method", m) if m else ())) for m in (None, "cvode")}
+    for out in runs.values():
+        assert out.returncode == 0, out.stderr
+    data = {m: json.loads(out.stdout) for m, out in runs.items()}
+    lifts = {m: sorted((e["wheel"], e["t"]) for e in d["flight"] if e["event"] == "lift-off") for m, d in data.items()}
+    assert [w for w, _ in lifts["cvode"]] == [w for w, _ in lifts[None]] == ["front_left", "front_right"]
+    assert np.allclose([t for _, t in lifts["cvode"]], [t for _, t in lifts[None]], atol=1e-6)
+    bad = run(*base, "--method", "cvod")
+    assert bad.returncode == 2
+    error = [line for line in bad.stderr.splitlines() if "warning" not in line]  # (the example's own warning)
+    assert len(error) == 1 and "method = 'cvod'; expected one of" in error[0] and "Traceback" not in bad.stderr

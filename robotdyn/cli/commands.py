@@ -331,6 +331,8 @@ def _simulate(args, limit) -> int:
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops the run like Ctrl-C: results kept
         signal.signal(signal.SIGTERM, _interrupt)
     extra = {} if args.stabilisation is None else {"stabilisation": args.stabilisation}
+    if args.method is not None:  # checked by simulate (robotdyn.simulation.run_options): one line if unknown
+        extra["method"] = args.method
     from ..contact.stick_slip_wheel import stick_slip_wheels
     from ..simulation.streaming import SEGMENT
 
@@ -711,6 +713,10 @@ def _add_simulate(sub, parents) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--stabilisation", type=_nonnegative, default=None, metavar="ALPHA",
                    help="gain [1/s] pulling holonomic residuals back (default 10; 0 turns the pull-back off)")
+    p.add_argument("--method", default=None,
+                   help="integrator: adams, bulirsch_stoer, dopri5, rosenbrock4 or cvode (SUNDIALS' BDF, for stiff "
+                        "compliant wheels and springs) on the compiled engine, or a scipy solve_ivp method (default: "
+                        "the scenario's; see robotdyn.simulation.engine.simulate)")
     p.add_argument("--mu", type=_nonnegative, default=None,
                    help="friction coefficient of every wheel for the slip check (default: each wheel's own mu)")
     p.add_argument("--traction-plot", metavar="FILE",

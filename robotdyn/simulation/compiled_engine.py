@@ -196,6 +196,25 @@ def as_data(torque):
     return torque if callable(form) and callable(getattr(torque, "native_controller", None)) and form() else None
 
 
+SCIPY_METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+"""``scipy.integrate.solve_ivp``'s methods by name (the scipy engine's)."""
+
+
+def check_method(method) -> None:
+    """Refuse an integrator that no engine has: the one check of a method's name, for every door.
+
+    Args:
+        method: ``None`` (the engine's default), a compiled method (:data:`METHODS` or :data:`CVODE`) or a scipy
+            method name (:data:`SCIPY_METHODS`).
+
+    Raises:
+        RobotDynError: One line naming the method and every name expected.
+    """
+    if method is not None and not (isinstance(method, str) and method in (*METHODS, CVODE, *SCIPY_METHODS)):
+        raise RobotDynError(f"method = {method!r}; expected one of {', '.join((*METHODS, CVODE))} (compiled) or "
+                            f"{', '.join(SCIPY_METHODS)} (scipy)")
+
+
 def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     """Whether :func:`robotdyn.simulation.engine.simulate` runs on the compiled engine (see its docstring).
 
@@ -213,11 +232,7 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     """
     if engine not in ("auto", "compiled", "scipy"):
         raise RobotDynError(f"engine = {engine!r}; expected auto, compiled or scipy")
-    from scipy.integrate._ivp.ivp import METHODS as SCIPY
-
-    if method is not None and not (isinstance(method, str) and method in (*METHODS, CVODE, *SCIPY)):
-        raise RobotDynError(f"method = {method!r}; expected a compiled integrator ({', '.join(METHODS)}, {CVODE}) or "
-                            f"a scipy solve_ivp method ({', '.join(SCIPY)})")
+    check_method(method)  # (simulate checked it first, with the other run options; engine_reason asks here)
     if method is not None and method in (*METHODS, CVODE):
         if engine == "scipy":
             raise RobotDynError(f"method {method!r} is a compiled integrator; the scipy engine has DOP853, RK45, "
@@ -465,5 +480,5 @@ def rechooser(robot, fast=None):
     return rechoose
 
 
-__all__ = ["run", "simulate_compiled", "choose_engine", "engine_model", "default_method", "native_profile", "rechooser",
+__all__ = ["run", "simulate_compiled", "choose_engine", "check_method", "engine_model", "default_method", "native_profile", "rechooser",
            "at_time", "METHODS", "STIFF", "COMPLIANT_DEFAULT", "DENSE", "CVODE"]

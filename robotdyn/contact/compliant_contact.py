@@ -241,6 +241,13 @@ class CompliantWheel(RollingWheel):
         # the rolling rows D (t1, t2)^T A_w through RollingWheel.jacobian/drift (self's own give no rows)
         self._directions = np.hstack([self.tangent_directions, np.zeros((self.tangent_directions.shape[0], 1))])
 
+    def __getstate__(self) -> dict:
+        """Pickle without a traction pass's memory of the contact state (an instance attribute ``state`` over the
+        method, :mod:`robotdyn.contact.traction_memo`: a copy made during a pass is the wheel as it is outside it)."""
+        state = self.__dict__.copy()
+        state.pop("state", None)
+        return state
+
     def rolling_labels(self) -> list[str]:
         """Labels of the rolling rows, in the order of :meth:`tangential_rows`.
 

@@ -32,9 +32,9 @@ Laws (:math:`\\delta` the penetration [m], :math:`\\dot\\delta` its rate [m/s]):
   form of Marhefka & Orin 1999: :math:`\\lambda = \\tfrac32 \\alpha k`), whose force is continuous at touch-down.
 
 References (the site's bibliography, ``docs/bibliography.md``): K. H. Hunt, F. R. E. Crossley, *Coefficient of
-restitution interpreted as damping in vibroimpact*, Journal of Applied Mechanics (ASME), 1975; D. W. Marhefka,
-D. E. Orin, *A compliant contact model with nonlinear damping for simulation of robotic systems*, IEEE Transactions
-on Systems, Man, and Cybernetics, Part A: Systems and Humans, 1999.
+restitution interpreted as damping in vibroimpact*, Journal of Applied Mechanics (ASME) 42(2), pp. 440-445, 1975;
+D. W. Marhefka, D. E. Orin, *A compliant contact model with nonlinear damping for simulation of robotic systems*,
+IEEE Transactions on Systems, Man, and Cybernetics, Part A: Systems and Humans 29(6), pp. 566-572, 1999.
 """
 
 from __future__ import annotations

@@ -17,6 +17,7 @@
 //   kernels/contact_forces.hpp     contact/contact_forces.py (lambda on the projection's rows, wheel forces)
 //   kernels/rigid_limit.hpp        contact/rigid_limit.py (the loads rigid-body dynamics leave open)
 //   kernels/sliding.hpp            contact/sliding.py and contact/friction.py (slipping wheels, friction laws)
+//   kernels/painleve.hpp           contact/painleve.py (the sliding wheels' Painleve check: a P-matrix of loads)
 //   kernels/joint_springs.hpp      reduction/joint_springs.py (springs and dampers on joints)
 //   kernels/compliant_contact.hpp  contact/compliant_contact.py (wheels that fly and land: normal force laws)
 //   kernels/compliant_rolling.hpp  contact/compliant_rolling.py (compliant wheels rolling while in contact)
@@ -1083,6 +1084,7 @@ class Evaluator {
     } lift_off{this, alpha, &profile, &rechoose, slipping || !rolling_contact_.empty()};
     int slip_error = -1;
     double slip_value = 0.0;
+    int slip_wheels = 0;  // kind 2 (Painleve check): the bit mask of the wheels named
     std::vector<std::tuple<double, int, int>> crossings;  // flight phases: (t, compliant wheel, +1 touch-down / -1 lift-off)
     {
       py::gil_scoped_release release;
@@ -1117,6 +1119,7 @@ class Evaluator {
       } catch (const SlipError& e) {
         slip_error = e.kind;
         slip_value = e.value;
+        slip_wheels = e.wheels;
         out.status = robotdyn::FAILED;
         out.t = slip_error_t_;
         out.y = slip_error_y_;
@@ -1143,6 +1146,7 @@ class Evaluator {
     result["event"] = out.event;
     result["slip_error"] = slip_error;
     result["slip_value"] = slip_value;
+    result["slip_wheels"] = slip_wheels;
     result["flights"] = crossings;
     return result;
   }

@@ -907,6 +907,7 @@ SPEC_CASES = {  # key: (TOML lines replacing or adding that key, the text the on
     "n_out": ("n_out = 0", "n_out"),
     "rtol": ("rtol = -1.0", "rtol"),
     "atol": ("atol = nan", "atol"),
+    "method": ('method = "cvod"', "cvod"),
     "columns": ("columns = 3", "columns"),
     "trajectories": ('trajectories = "yes"', "trajectories"),
     "plot_column": ("plot_column = 3", "plot_column"),

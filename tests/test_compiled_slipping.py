@@ -277,7 +277,8 @@ def test_painleve_decision_near_the_singular_friction_coefficient(monkeypatch):
     coefficients far from mu* and approaching it from both sides, conditions from 1e3 to beyond 1e15, Evaluator.slip_rhs raises
     exactly where np.linalg.cond(K) > 1e12 (on the Python path, sliding.forward raises there), with the same
     condition number; the states near the threshold (2-norm condition above 1e10) all went to the singular values
-    (none was cleared by the estimate)."""
+    (none was cleared by the estimate). Where K is regular but the effective normal matrix is no P-matrix (beyond
+    mu*: robotdyn.contact.painleve), both refuse with the Painleve check instead."""
     from robotdyn.contact.friction import RegularisedCoulomb as Coulomb
     from robotdyn.errors import SingularConstraintError
 
@@ -296,10 +297,11 @@ def test_painleve_decision_near_the_singular_friction_coefficient(monkeypatch):
 
     def python_K(mu):
         with_mu(mu)
+        seen["refusal"] = None
         try:
             forward(robot, q, nu, tau)
-        except SingularConstraintError:
-            pass
+        except SingularConstraintError as exc:
+            seen["refusal"] = str(exc)
         return seen["K"]
 
     K0, K1 = python_K(0.0), python_K(1.0)
@@ -313,25 +315,30 @@ def test_painleve_decision_near_the_singular_friction_coefficient(monkeypatch):
     mus = [0.5, 0.5 * mu_star, 2.0 * mu_star]  # far from it
     for target in (1e8, 1e9, 1e10, 1e11, 3e11, 6e11, 1.6e12, 3e12, 1e13, 1e15):
         mus += [mu_star - a / target, mu_star + a / target]
-    results = []
+    results, refused = [], []
     for mu in mus:
         cond = np.linalg.cond(python_K(mu))  # the Python path's decision
         python_singular = not np.isfinite(cond) or cond > 1e12
         fast = compiled_model(robot)
         fast.select(projection)
+        python_painleve = not python_singular and seen["refusal"] is not None  # (the Painleve check's refusal)
         try:
             fast.ev.slip_rhs(q, nu, tau, 0.0)
-            compiled_singular = False
+            compiled_singular = compiled_painleve = False
         except RuntimeError as exc:
-            assert "singular slipping contact problem" in str(exc)
-            compiled_singular = True
+            compiled_singular = "singular slipping contact problem" in str(exc)
+            compiled_painleve = "no P-matrix" in str(exc)
+            assert compiled_singular or compiled_painleve, str(exc)
         estimate, exact = fast.ev.slip_condition
         results.append((mu, cond, compiled_singular))
         assert compiled_singular == python_singular, (mu, cond, estimate, exact)
+        assert compiled_painleve == python_painleve, (mu, cond, seen["refusal"])
+        refused.append(compiled_painleve)
         if cond > 1e10:
             assert not np.isnan(exact), (mu, cond, estimate)  # the singular values decided
         if not np.isnan(exact) and cond < 1e14:  # the same number (both from singular values)
             assert exact == pytest.approx(cond, rel=1e-3)
+    assert not refused[0] and refused[2]  # regular at mu = 0.5, the Painleve check's refusal at 2 mu*
     conds = [c for _, c, _ in results]
     assert min(conds) < 1e5 and max(conds) > 1e14  # the sweep spans the threshold widely
     assert any(1e11 < c <= 1e12 for c in conds) and any(1e12 < c < 1e13 for c in conds)  # and near it

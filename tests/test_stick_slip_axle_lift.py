@@ -73,16 +73,34 @@ def sliding(tau: float) -> np.ndarray:
 
 def test_painleve_only_at_the_closed_form_mu():
     """The model's coupled solve is singular exactly at mu_P = 10.945 (D = 0) and gives the closed-form loads at
-    mu_P (1 -+ 1e-7): huge, positive below, negative above. mu_f = 0.3 is far below it."""
+    mu_P (1 - 1e-7) (huge, positive); above mu_P (D < 0: no or two solutions) it refuses in one line naming the
+    front wheels, mu and the threshold (robotdyn.contact.painleve on the rigid limit's one load direction of the
+    front axle) instead of returning the negative loads. mu_f = 0.3 is far below it. Sliding backwards
+    (friction +mu N_f, mu -> -mu in the closed form: D > 0 at every mu) it is no Painleve case at 2 mu_P."""
     mu_p = MP * L / (MC * (H - R))
     assert mu_p == pytest.approx(10.945, abs=1e-3) and MU_F < mu_p / 30
     with pytest.raises(SingularConstraintError, match="Painleve"):
         front_sliding_at_rest(car(mu_p), 10.0)
-    for factor in (1 - 1e-7, 1 + 1e-7):
-        mu = mu_p * factor
-        nf = np.linalg.solve([[MP, mu], [C1 + 2 * IW / R, L + R * mu]], [20.0 / R, M * G * L - W0])[1]
-        assert abs(nf) > 1e9 and np.sign(nf) == np.sign(1 - factor)
-        np.testing.assert_allclose(front_sliding_at_rest(car(mu), 10.0).normal, [nf / 2, nf / 2], rtol=1e-5)
+    closed = lambda mu: np.linalg.solve([[MP, mu], [C1 + 2 * IW / R, L + R * mu]], [20.0 / R, M * G * L - W0])  # noqa
+    mu = mu_p * (1 - 1e-7)
+    nf = closed(mu)[1]
+    assert nf > 1e9
+    np.testing.assert_allclose(front_sliding_at_rest(car(mu), 10.0).normal, [nf / 2, nf / 2], rtol=1e-5)
+    for factor in (1 + 1e-7, 1 + 1e-3):
+        with pytest.raises(SingularConstraintError) as exc:
+            front_sliding_at_rest(car(mu_p * factor), 10.0)
+        assert str(exc.value).startswith(f"sliding wheels front_left, front_right (mu = {mu_p * factor:g}): "
+                                         "Painleve paradox, their friction presses them into the ground")
+        assert f"; mu_P = {mu_p:.6g} for this sliding direction;" in str(exc.value)
+    robot = car(2 * mu_p)
+    for w in robot.constraints[:2]:
+        w.set_phase("slide", np.array([-1.0, 0.0]))
+    q = robot.neutral()
+    configure(robot, q)
+    st = forward(robot, q, np.zeros(len(robot.independent_indices)), np.array([0.0, 0.0, 10.0, 10.0]))
+    nf = closed(-2 * mu_p)[1]
+    assert 0 < nf < M * G
+    np.testing.assert_allclose(st.normal, [nf / 2, nf / 2], rtol=1e-9)
 
 
 def test_coupled_solve_past_the_lift_off_gives_the_pulling_loads():

@@ -45,6 +45,8 @@ def register(sub, parents) -> None:
     p.add_argument("--n-out", type=int, help="output samples per run (default: the scenario's rate)")
     p.add_argument("--rtol", type=float, help="relative tolerance of the integrator (default: the scenario's)")
     p.add_argument("--atol", type=float, help="absolute tolerance of the integrator (default: the scenario's)")
+    p.add_argument("--method", help="integrator of every run, as simulate --method takes it (e.g. cvode for stiff "
+                   "compliant wheels; default: simulate's)")
     p.add_argument("--column", action="append", default=[],
                    help="a column whose max and min are kept (repeatable; default: every coordinate and velocity)")
     p.add_argument("--trajectories", action="store_true", help="also keep every trajectory (DIR/trajectories/)")
@@ -90,7 +92,7 @@ def spec_from_args(args):
     spec.fixed.update(parse_assignments(args.param))
     return spec.merged(axes=[parse_axis(v) for v in args.vary], scenarios=args.scenario, terrains=args.terrain,
                        sample=args.sample, n=args.n, seed=args.seed, t_end=args.t_end, n_out=args.n_out,
-                       rtol=args.rtol, atol=args.atol, columns=args.column,
+                       rtol=args.rtol, atol=args.atol, method=args.method, columns=args.column,
                        trajectories=args.trajectories or None, plot_column=args.plot_column,
                        time_limit=args.time_limit)
 

@@ -28,6 +28,7 @@ from ..constraints.constraint import KinematicState
 from ..errors import ConstraintError, InputError, SingularConstraintError
 from .friction import FrictionLaw
 from ..constraints.rolling_contact import SupportWheel
+from . import painleve
 
 PAINLEVE_CONDITION = 1e12
 """Condition number of the coupled system above which it counts as singular."""
@@ -224,6 +225,7 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
     slip = np.zeros((len(wheels), 2))
     coef = np.zeros((len(wheels), 2))
     position = np.zeros(len(wheels), int)
+    U = np.zeros((G.shape[0], len(wheels)))  # each wheel's friction column J_t^T c (robotdyn.contact.painleve)
     for i, wheel in enumerate(wheels):
         row = rows.labels.index(f"{wheel.name}.normal")
         hit = np.flatnonzero(kept == row)
@@ -232,7 +234,8 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
         Jt, slip[i] = tangential(wheel, kin)
         coef[i] = wheel.friction_coefficient(slip[i])
         position[i] = hit[0]
-        G[:, hit[0]] -= Jt.T @ coef[i]
+        U[:, i] = Jt.T @ coef[i]
+        G[:, hit[0]] -= U[:, i]
     M = pin.crba(model, data, q)
     K = np.hstack([M @ red.S, -G])
     rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
@@ -244,6 +247,11 @@ def forward(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> SlidingSta
         raise painleve_error(wheels, cond)
     sol = np.linalg.solve(K, rhs)
     k = red.S.shape[1]
+    if wheels:  # a unique, consistent solution needs a P-matrix of effective normal coefficients
+        AR = rows.A[kept]
+        E = np.zeros((len(kept), len(wheels)))
+        E[position, np.arange(len(wheels))] = 1.0
+        painleve.check(K, k + position, M @ (AR.T @ np.linalg.solve(AR @ AR.T, E)), wheels, slip, U)
     normal = sol[k + position]
     force = -normal[:, None] * coef
     power = float(np.sum(force * slip)) + (app.friction_power if app is not None else 0.0)
@@ -318,14 +326,17 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
     slip = np.zeros((len(wheels), 2))
     coef = np.zeros((len(wheels), 2))
     where = np.zeros(len(wheels), int)
+    U = np.zeros((n, len(wheels)))  # each wheel's friction column J_t^T c (robotdyn.contact.painleve)
     for i, wheel in enumerate(wheels):
         Jt, slip[i] = tangential(wheel, kin)
         coef[i] = wheel.friction_coefficient(slip[i])
-        G[:, index[f"{wheel.name}.normal"]] -= Jt.T @ coef[i]
+        U[:, i] = Jt.T @ coef[i]
+        G[:, index[f"{wheel.name}.normal"]] -= U[:, i]
         where[i] = every.index(wheel)
     S = red.S
     kk = S.shape[1]
-    MS = pin.crba(model, data, q) @ S
+    M = pin.crba(model, data, q)
+    MS = M @ S
     rhs = input_matrix(robot.motors, kin) @ tau - pin.rnea(model, data, q, red.v, red.w)
     app = applied(robot, q, red.v, kin) if has_applied(robot) else None
     if app is not None:  # joint springs, compliant wheels: known at the state (robotdyn.contact.applied_forces)
@@ -353,13 +364,13 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
         free = [j for j in range(len(every)) if j not in unloaded]
         worst = min(free, key=lambda j: loads[j]) if free else None
         if u == 0:
-            compatible = sol, lam, loads
+            compatible = sol, lam, loads, K
         if worst is not None and loads[worst] < -PULL_TOL * scale:
             if np.linalg.matrix_rank(PV[unloaded + [worst]], tol=RANK_TOL) <= u:
                 # the open loads cannot hold this wheel at zero too (a whole axle would pull: it lifts off), so no
                 # split pulls on no wheel: the compatible loads, some negative, as rigid_limit.split gives them (the
                 # lift-off event then finds where the load reaches zero; holding both wheels was singular)
-                (sol, lam, loads), unloaded = compatible, []
+                (sol, lam, loads, K), unloaded = compatible, []
                 break
             unloaded.append(worst)
             continue
@@ -369,6 +380,18 @@ def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
         break
     else:
         raise painleve_error(wheels, float("inf"))
+    live = [i for i in range(len(wheels)) if where[i] not in unloaded]
+    if live:  # a unique, consistent solution: the Painleve check on the separations the rigid rows allow
+        sel = np.array([index[f"{wheels[i].name}.normal"] for i in live], int)
+        E = np.zeros((m, len(live)))
+        E[sel, np.arange(len(live))] = 1.0
+        _, sn, snt = np.linalg.svd(N.T @ E)
+        basis = snt[int(np.sum(sn > RANK_TOL)):].T if np.any(sn > RANK_TOL) else None
+        if basis is None or basis.shape[1]:
+            pad = np.zeros((K.shape[0] - n, len(live)))
+            MZ = np.vstack([M @ np.linalg.lstsq(A, E, rcond=None)[0], pad])
+            painleve.check(K, kk + sel, MZ, [wheels[i] for i in live], slip[live], np.vstack([U[:, live], pad]),
+                           basis)
     normal = loads[where]
     force = -normal[:, None] * coef
     power = float(np.sum(force * slip)) + (app.friction_power if app is not None else 0.0)

@@ -34,6 +34,7 @@ from ..constraints.row_derivatives import FramePass, velocity_dq, wheel_velocity
 from ..errors import InputError
 from ..reduction.dynamics_derivatives import DynamicsDerivatives, motor_rows, pieces, result
 from .friction import ExactCoulomb, LinearTyre, RegularisedCoulomb
+from . import painleve
 from .sliding import PAINLEVE_CONDITION, SlippingWheel, painleve_error, sliding_now, tangential
 
 TANGENT = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -147,6 +148,11 @@ def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
     cond = np.linalg.cond(Ks)
     if not np.isfinite(cond) or cond > PAINLEVE_CONDITION:
         raise painleve_error(wheels, cond)
+    if wheels:  # no derivative where forward dynamics refuses: the Painleve check (robotdyn.contact.painleve)
+        AR, sel = rows.A[kept], np.zeros((len(kept), len(wheels)))
+        sel[pos, np.arange(len(wheels))] = 1.0
+        painleve.check(Ks, k + np.array(pos), M @ (AR.T @ np.linalg.solve(AR @ AR.T, sel)), wheels, np.array(slip),
+                       np.column_stack([J.T @ c for J, c in zip(Jt, coef)]))
     sol = np.linalg.solve(Ks, B @ tau - pin.rnea(model, tree, q, v, w))
     nudot, lam = sol[:k], sol[k:]
     a = S @ nudot + w

@@ -17,6 +17,7 @@
 
 #include "common.hpp"
 #include "lu_solve.hpp"
+#include "painleve.hpp"
 #include "rolling_contact.hpp"
 
 #include <algorithm>
@@ -38,13 +39,18 @@ struct Slip {
 
 // The slipping wheels' contact problem cannot be solved here: kind 0 singular (Painleve; value: its 2-norm
 // condition number), kind 1 a slipping wheel's normal row is not among the projection's rows (value: the slip's
-// index). The Python side raises the reference path's error from it (robotdyn/simulation/compiled_engine.py).
+// index), kind 2 the effective normal matrix is no P-matrix (Painleve, painleve.hpp; value: the threshold mu_P or
+// NaN, wheels: the bit mask of the first minor that is not positive). The Python side raises the reference path's
+// error from it (robotdyn/simulation/compiled_engine.py).
 struct SlipError : std::runtime_error {
-  SlipError(int kind_, double value_)
-      : std::runtime_error(kind_ == 0 ? "singular slipping contact problem" : "slipping wheel's normal row redundant"),
-        kind(kind_), value(value_) {}
+  SlipError(int kind_, double value_, int wheels_ = 0)
+      : std::runtime_error(kind_ == 0   ? "singular slipping contact problem"
+                           : kind_ == 1 ? "slipping wheel's normal row redundant"
+                                        : "Painleve: the sliding wheels' effective normal matrix is no P-matrix"),
+        kind(kind_), value(value_), wheels(wheels_) {}
   int kind;
   double value;
+  int wheels;
 };
 
 // c(s) of a slipping wheel's law on its free directions (FrictionLaw.coefficient, SlippingWheel.
@@ -63,7 +69,8 @@ inline Eigen::Vector2d friction_coefficient(const Slip& sl, const Eigen::Vector2
 
 // The coupled system of the header, its solution and the Painleve test; the results stay in the members.
 struct SlipSystem {
-  MatrixXd K, Jt;
+  MatrixXd K, Jt, U;  // U: each slipping wheel's friction column J_t^T c (nv, W)
+  PainleveCheck painleve;
   VectorXd b, x, normal;
   Eigen::Matrix<double, Eigen::Dynamic, 2> s, c;  // per slipping wheel: slip velocity, c(s)
   std::vector<int> pos;                           // per slipping wheel: its normal row's place among the rows
@@ -89,6 +96,7 @@ struct SlipSystem {
     s.resize(nw, 2);
     c.resize(nw, 2);
     Jt.resize(2, nv);
+    U.resize(nv, nw);
     for (int i = 0; i < nw; ++i) {
       const Slip& sl = slips[i];
       const auto hit = std::find(rows.begin(), rows.end(), sl.normal_row);
@@ -101,7 +109,8 @@ struct SlipSystem {
       const Eigen::Vector2d ci = friction_coefficient(sl, si);
       s.row(i) = si.transpose();
       c.row(i) = ci.transpose();
-      K.col(k + pos[i]).noalias() += Jt.transpose() * ci;
+      U.col(i).noalias() = Jt.transpose() * ci;
+      K.col(k + pos[i]) += U.col(i);
     }
     b.noalias() = B * tau;
     b -= Cvg;
@@ -128,6 +137,7 @@ struct SlipSystem {
       if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, kappa2);
     }
     x = lu.solve(b);
+    if (nw > 0) check_painleve(slips, rows, A, M, nv, k, nr);
     normal.resize(nw);
     power = 0.0;
     min_normal = HUGE_VAL;
@@ -137,6 +147,45 @@ struct SlipSystem {
       min_normal = std::min(min_normal, fn);
       power += -fn * c(i, 0) * s(i, 0) + -fn * c(i, 1) * s(i, 1);
     }
+  }
+
+  // The Painleve check (painleve.hpp) on the factorised K: throws SlipError kind 2 where the effective normal
+  // matrix is no P-matrix.
+  void check_painleve(const std::vector<Slip>& slips, const std::vector<int>& rows, const MatrixXd& A,
+                      const MatrixXd& M, int nv, int k, int nr) {
+    const int nw = static_cast<int>(slips.size());
+    PainleveCheck& pc = painleve;
+    pc.AR.resize(nr, nv);
+    for (int r = 0; r < nr; ++r) pc.AR.row(r) = A.row(rows[r]);
+    pc.gram.noalias() = pc.AR * pc.AR.transpose();
+    pc.sel.setZero(nr, nw);
+    for (int i = 0; i < nw; ++i) pc.sel(pos[i], i) = 1.0;
+    pc.gram_lu.compute(pc.gram);
+    pc.Yg = pc.gram_lu.solve(pc.sel);
+    pc.Z.noalias() = pc.AR.transpose() * pc.Yg;
+    pc.MZ.noalias() = M * pc.Z;
+    pc.Y = lu.solve(pc.MZ);
+    pc.E.resize(nw, nw);
+    for (int i = 0; i < nw; ++i) pc.E.row(i) = -pc.Y.row(k + pos[i]);  // D^-1
+    pc.D = pc.E.inverse();
+    const int mask = pc.first_violation();
+    if (!mask) return;
+    double mu_p = std::numeric_limits<double>::quiet_NaN();
+    if ((mask & (mask - 1)) == 0) {  // one wheel: its threshold where its law is proportional to mu
+      int j = 0;
+      while (!((mask >> j) & 1)) ++j;
+      const Slip& sl = slips[j];
+      const Eigen::Vector2d sj = s.row(j).transpose().cwiseProduct(sl.free);
+      const double mu = sl.law == 0 ? sl.p0 : sl.p1;
+      const bool proportional = sl.law == 0 || std::sqrt(sj.dot(sj)) * sl.p0 > sl.p1;
+      pc.Y = lu.solve(U);
+      pc.Q.resize(nw, nw);
+      for (int i = 0; i < nw; ++i) pc.Q.row(i) = pc.Y.row(k + pos[i]);
+      const double f = -pc.D.row(j).dot(pc.Q.col(j));  // F = -D Q, the friction's part of D
+      const double t = (pc.D(j, j) + f) / f;           // D0_jj / F_jj
+      if (proportional && std::isfinite(mu) && f != 0.0 && std::isfinite(t) && t > 0.0 && t < 1.0) mu_p = mu * t;
+    }
+    throw SlipError(2, mu_p, mask);
   }
 };
 

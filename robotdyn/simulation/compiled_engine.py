@@ -164,6 +164,13 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
         wheels = slipping_wheels(robot)
         if out["slip_error"] == 0:
             raise painleve_error(wheels, float(out["slip_value"]))
+        if out["slip_error"] == 2:  # the effective normal matrix is no P-matrix (robotdyn.contact.painleve)
+            from ..contact.painleve import painleve_sign_error
+
+            mu_p, mask = float(out["slip_value"]), int(out["slip_wheels"])
+            raise painleve_sign_error([w for i, w in enumerate(wheels) if mask >> i & 1],
+                                      mu_p if np.isfinite(mu_p) else None,
+                                      [w for i, w in enumerate(wheels) if not mask >> i & 1])
         raise redundant_load_error(wheels[int(out["slip_value"])])
     interrupted = None
     if status == INTERRUPTED:

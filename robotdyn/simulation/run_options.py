@@ -30,11 +30,25 @@ def check_run_options(n_out, rtol, atol, method) -> int:
     if isinstance(n_out, bool) or not isinstance(n_out, numbers.Integral):
         raise RobotDynError(f"n_out = {n_out!r}; expected a whole number of output samples (>= 2)")
     for name, value in (("rtol", rtol), ("atol", atol)):
-        try:
-            ok = bool(np.ndim(value) == 0 and 0 < float(value) < 1)
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise RobotDynError(f"{name} = {value!r}; expected a tolerance in (0, 1)")
+        check_tolerance(name, value)
     check_method(method)
     return int(n_out)
+
+
+def check_tolerance(name: str, value) -> None:
+    """Refuse an integrator tolerance outside (0, 1) (NaN, zero, negative, not a number), as every engine and a
+    sweep file's ``rtol``/``atol`` need it.
+
+    Args:
+        name: ``rtol`` or ``atol`` (named in the message).
+        value: The tolerance given.
+
+    Raises:
+        RobotDynError: One line naming the option, its value and what was expected.
+    """
+    try:
+        ok = bool(np.ndim(value) == 0 and 0 < float(value) < 1)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise RobotDynError(f"{name} = {value!r}; expected a tolerance in (0, 1)")

@@ -119,6 +119,11 @@ def model_vectors(ctx: RunContext, runs: list[RunInput], mode: str = "auto") -> 
         raise RobotDynError(f"batch = {mode!r}; expected one of {', '.join(MODES)}")
     if mode == "never":
         return Batching({}, ["batch = never: every run is built from its parameters"])
+    from ..simulation.compiled_engine import METHODS
+
+    method = ctx.tolerances.get("method")
+    if method is not None and method not in METHODS:  # (simulate_many runs Boost.Odeint's steppers only)
+        return Batching({}, [f"method = {method!r}: every run is built and simulated on its own"])
     from ..fast.compiled import why_not
     from ..fast.dispatch import compiled_model, use_compiled
     from ..simulation.model_variants import ParameterModel, model_vector

@@ -36,7 +36,8 @@ class RunContext:
         terrains: Terrain definitions by label: ``("named", name)`` (the robot module's ``TERRAINS``) or
             ``("kind", kind, {arg: value})`` (:data:`robotdyn.interfaces.constraint_file.TERRAINS`).
         t_end, n_out: Duration [s] and output samples (``None``: the scenario's).
-        tolerances: ``rtol``/``atol`` given to the integrator (absent: the scenario's own choice).
+        tolerances: The integrator's options ``rtol``/``atol``/``method``, passed to
+            :func:`~robotdyn.simulation.engine.simulate` (absent: the scenario's own choice).
         columns: Columns whose maximum and minimum are summarised.
         trajectories: Also return each run's trajectory.
         compiled: Whether the compiled fast path is on (as in the process that planned the sweep).

@@ -203,13 +203,24 @@ def plan(spec: SweepSpec) -> Plan:
             raise SweepSpecError(f"column {c!r} listed {columns.count(c)} times; expected distinct columns")
         if c not in names:
             raise SweepSpecError(f"unknown column {c!r}; expected one of {', '.join(names)}")
-    tolerances = {}
+    from ..simulation.compiled_engine import check_method
+    from ..simulation.run_options import check_tolerance
+
+    tolerances = {}  # the integrator's options, checked as simulate checks them (simulation.run_options)
     for key in ("rtol", "atol"):
         value = getattr(spec, key)
         if value is not None:
-            if not (value > 0 and value < 1):
-                raise SweepSpecError(f"{key} = {value}; expected a tolerance in (0, 1)")
+            try:
+                check_tolerance(key, value)
+            except RobotDynError as exc:
+                raise SweepSpecError(str(exc)) from None
             tolerances[key] = float(value)
+    if spec.method is not None:
+        try:
+            check_method(spec.method)
+        except RobotDynError as exc:
+            raise SweepSpecError(str(exc)) from None
+        tolerances["method"] = spec.method
     limit = spec.time_limit or None
     if limit is not None and not (limit > 0 and limit < float("inf")):
         raise SweepSpecError(f"time_limit = {spec.time_limit}; expected a duration in s > 0 (0: no limit)")

@@ -13,6 +13,8 @@ and ``NAME=V1,V2,...``); :func:`from_toml` reads::
     seed = 1
     t_end = 10.0                        # [s] (default: each scenario's duration)
     time_limit = 600.0                  # wall-clock limit of one run [s] (0: none): beyond it, an error row
+    method = "dopri5"                   # the integrator, as simulate --method takes it (cvode: stiff compliant
+                                        # wheels and springs; default: simulate's); rtol, atol: its tolerances
     columns = ["theta3", "theta1_dot"]  # columns whose max and min are kept (default: every q and nu column)
     trajectories = false                # also keep each run's trajectory
     fixed = { inertia_about = "com" }   # parameters held at one value
@@ -56,7 +58,8 @@ RESERVED = ("run_id", "run_index", "robot", "scenario", "terrain", "status", "er
             "nfev", "wall", "run_wall")
 """Column names of the results that no varied parameter may take."""
 TOP_KEYS = ("robot", "constraints", "urdf", "xacro_args", "fixed", "parameters", "scenarios", "terrains", "sample",
-            "n", "seed", "t_end", "n_out", "rtol", "atol", "columns", "trajectories", "plot_column", "time_limit")
+            "n", "seed", "t_end", "n_out", "rtol", "atol", "method", "columns", "trajectories", "plot_column",
+            "time_limit")
 RANGE_KEYS = ("min", "max", "n", "scale")
 """The keys of a range of the ``[parameters]`` table."""
 _VALUE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*")
@@ -139,6 +142,7 @@ class SweepSpec:
         n_out: Output samples of each run (``None``: the scenario's).
         rtol: Integrator relative tolerance (``None``: default).
         atol: Integrator absolute tolerance (``None``: default).
+        method: The integrator, as :func:`~robotdyn.simulation.engine.simulate` takes it (``None``: its default).
         columns: Columns whose max and min are kept (default: every q and nu column).
         trajectories: Also keep every run's trajectory.
         plot_column: The column of ``summary.png`` (``None``: :func:`~robotdyn.sweep.plot.default_column`).
@@ -160,6 +164,7 @@ class SweepSpec:
     n_out: int | None = None
     rtol: float | None = None
     atol: float | None = None
+    method: str | None = None
     columns: list[str] = field(default_factory=list)
     trajectories: bool = False
     plot_column: str | None = None
@@ -339,7 +344,8 @@ def from_toml(path) -> SweepSpec:
         raise SweepSpecError(f"{path}: parameters: expected a table of NAME = [values] or {{min, max, n}}")
     spec.axes = [_toml_axis(path, name, v) for name, v in params.items()]
     for key, kind in (("sample", str), ("n", int), ("seed", int), ("t_end", float), ("n_out", int),
-                      ("rtol", float), ("atol", float), ("trajectories", bool), ("time_limit", float)):
+                      ("rtol", float), ("atol", float), ("method", str), ("trajectories", bool),
+                      ("time_limit", float)):
         if key in data:
             v = data[key]
             ok = isinstance(v, kind) if kind is not float else isinstance(v, (int, float)) and not isinstance(v, bool)

@@ -5,6 +5,16 @@ values g(z) at once, whose Jacobian is another ``Callback`` with a declared spar
 caller's own derivatives (analytic, or finite differences for comparison): CasADi's automatic differentiation is
 never used through Pinocchio. Used by :mod:`robotdyn.optimisation.trajectory` (collocation defects) and
 :mod:`robotdyn.optimisation.posture` (contact forces at a posture).
+
+Exact zeros: the Jacobian is declared in dense blocks, and many of its entries are zero in exact arithmetic but come
+out of the derivative kernels as rounding residues (1e-20 to 1e-13 of their row's largest entry on the linkage
+rover). IPOPT's linear solver MUMPS chooses a weighted matching and scaling of the KKT matrix from the entries'
+magnitudes (MC64, IPOPT's default ``mumps_permuting_scaling`` 5 and ``mumps_scaling`` 77): a residue taken into
+the matching is scaled up like a genuine entry, the factorization loses every digit (residual ratio 1e52 on the
+rover's traction-limited solve), and the least-squares multipliers IPOPT recomputes in its limited-memory mode
+(``recalc_y``) reach 1e22; half the starts perturbed by 1e-8 then ended in ``Invalid_Number_Detected``. So every
+entry at most :data:`ROUNDING` times its row's largest is passed as an exact zero (the derivatives are computed
+no better than that: the compiled and the Python kernels agree to 1e-12).
 """
 
 from __future__ import annotations
@@ -12,6 +22,10 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
+
+ROUNDING = 1e-12
+"""Jacobian entries at most this fraction of their row's largest magnitude are passed to IPOPT as exact zeros (the
+module docstring: rounding residues of exact zeros mislead MUMPS's scaling)."""
 
 
 def _casadi():
@@ -68,7 +82,7 @@ def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], 
 
         def eval(self, arg):
             try:
-                vals = jacobian_values(np.asarray(arg[0], float).ravel())
+                vals = exact_zeros(jacobian_values(np.asarray(arg[0], float).ravel()), rows, ng)
             except Exception as exc:  # noqa: BLE001 - see _refused
                 vals = _refused(keep, exc, len(order))
             return [ca.DM(sparsity, vals[order])]
@@ -107,6 +121,27 @@ def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], 
     return keep[-1]
 
 
+def exact_zeros(values: np.ndarray, rows: np.ndarray, ng: int) -> np.ndarray:
+    """A sparse Jacobian's values with every entry of magnitude at most :data:`ROUNDING` times its row's largest
+    set to exactly zero (rounding residues of exact zeros; the module docstring says why). NaN stays NaN.
+
+    Args:
+        values: The Jacobian's values (nnz,) at its structural nonzeros.
+        rows: Their row indices (nnz,), in 0 .. ng - 1.
+        ng: Number of rows.
+
+    Returns:
+        A new array (nnz,).
+    """
+    values = np.asarray(values, float)
+    size = np.abs(values)
+    largest = np.zeros(ng)
+    np.maximum.at(largest, rows, size)
+    out = values.copy()
+    out[size <= ROUNDING * largest[rows]] = 0.0
+    return out
+
+
 class Refusal:
     """The first error a callback raised at a point IPOPT tried (kept in the callbacks' ``keep`` list).
 
@@ -143,4 +178,4 @@ def refusal(keep: list) -> str | None:
     return None
 
 
-__all__ = ["Refusal", "refusal", "sparse_callback"]
+__all__ = ["ROUNDING", "Refusal", "exact_zeros", "refusal", "sparse_callback"]

@@ -103,11 +103,11 @@ def main() -> None:
     print(f"quasimoro one by one (robot.reduced in a loop): {N} states: {N / wall:,.0f} states/s")
     for label, flag in (("compiled", True), ("Python path", False)):
         with use_compiled(flag):
-            for processes in (1, 2):
+            for processes in (1, 2):  # 2: workers start only where the first 256 states say they pay (batch.evaluate)
                 start = time.perf_counter()
                 evaluate(robot, Q, NU, processes=processes)
                 wall = time.perf_counter() - start
-                print(f"quasimoro batch API ({label}): {N} states with {processes} process(es): {N / wall:,.0f} states/s")
+                print(f"quasimoro batch API ({label}): {N} states, processes={processes}: {N / wall:,.0f} states/s")
 
     print(f"\n{'robot / scenario':<36} {'sim [s]':>8} {'wall [s]':>9} {'sim/wall':>9} {'evals':>7} {'drift':>9}")
     for name, robot, _ in rows:
@@ -585,14 +585,18 @@ def simulate_many_bench(runs: int = 10_000) -> None:
 
 
 def trajectory_optimisation_bench() -> None:
-    """Quasimoro's minimum-effort rest-to-rest motion (1 m in 3 s, 21 nodes, |tau| <= 0.6 N m, |theta3| <= 0.06 rad)
-    on IPOPT, the defects' Jacobian from the analytic derivatives and from central finite differences, side by side
-    (issue 26: target analytic >= 5x faster)."""
+    """Quasimoro's minimum-effort rest-to-rest motion (1 m in 3 s, 21 nodes, abs(tau) <= 0.6 N m, abs(theta3) <= 0.06
+    rad) on IPOPT, the defects' Jacobian from the analytic derivatives and from central finite differences, side by
+    side (issue 26: target analytic >= 5x faster), with the nodes' dynamics batched (one compiled call per Jacobian,
+    robotdyn.optimisation.node_batches) and node by node; 'jacobian' is the CPU time in the nodes' Jacobians, 'rest'
+    the CPU time outside them (IPOPT, CasADi, the defects). The ceiling: with zero overhead the ratio tends to the
+    Jacobians' own, 2 (n + k + m) evaluations over one derivative set, both timed in C++ without Python."""
     try:
         import casadi  # noqa: F401
     except ImportError:
         print("\ntrajectory optimisation: skipped (casadi not installed: pip install casadi)")
         return
+    from robotdyn.optimisation import trajectory
     from robotdyn.robots.quasimoro.optimal_motion import rest_to_rest
 
     robot = robotdyn.load("quasimoro")
@@ -606,27 +610,65 @@ def trajectory_optimisation_bench() -> None:
     print(f"\nquasimoro per state: dynamics_derivatives {t_an * 1e3:.2f} ms (compiled); central differences "
           f"{2 * n_in} x forward_dynamics {t_fw * 1e3:.3f} ms (compiled) = {2 * n_in * t_fw * 1e3:.2f} ms "
           f"(Python path: {2 * n_in * t_fw_py * 1e3:.2f} ms)")
-    print("quasimoro rest-to-rest 1 m in 3 s, 21 nodes, IPOPT (CasADi), best of 2:")
-    print(f"{'jacobian':<18} {'wall [s]':>9} {'iterations':>11} {'cost [N^2 m^2 s]':>17} {'derivative calls':>17} "
-          f"{'dynamics calls':>15}")
-    walls = {}
-    for derivatives in ("analytic", "finite-difference"):
-        sols = [rest_to_rest(nodes=21, robot=robot, derivatives=derivatives).solve() for _ in range(2)]
-        best = min(sols, key=lambda s: s.wall_time)
-        walls[derivatives] = best
-        print(f"{derivatives:<18} {best.wall_time:>9.2f} {best.iterations:>11} {best.cost:>17.9f} "
-              f"{best.derivative_calls:>17} {best.dynamics_calls:>15}")
-    a, f = walls["analytic"], walls["finite-difference"]
-    print(f"speed-up of analytic over finite differences: {f.wall_time / a.wall_time:.2f}x (target >= 5x; the "
-          "derivatives and the forward dynamics compiled); "
-          f"|cost difference| {abs(a.cost - f.cost):.1e}")
+    ev = compiled_model(robot).ev
+    if hasattr(ev, "derivatives_seconds"):
+        t = ev.derivatives_seconds(q, nu, tau, 3000)
+        d, e = t["derivatives"], t["rhs"]
+        print(f"the same in C++ without Python (CPU): derivative set {d * 1e6:.1f} us = {d / e:.1f} evaluations of "
+              f"{e * 1e6:.2f} us; central differences {2 * n_in} x {e * 1e6:.2f} = {2 * n_in * e * 1e6:.1f} us: the "
+              f"ceiling of the optimisation's ratio (zero overhead) is {2 * n_in * e / d:.2f}x; 5x needs a derivative "
+              f"set of <= {2 * n_in / 5:.1f} evaluations")
 
+    def solve(derivatives: str) -> tuple:
+        problem = rest_to_rest(nodes=21, robot=robot, derivatives=derivatives)
+        spent, inner = [0.0], problem._jac_nodes
+
+        def timed(X, U):
+            start = time.process_time()
+            out = inner(X, U)
+            spent[0] += time.process_time() - start
+            return out
+
+        problem._jac_nodes = timed
+        start = time.process_time()
+        sol = problem.solve()
+        return sol, time.process_time() - start, spent[0]
+
+    batches = ("analytic_jacobians", "central_jacobians", "rhs_nodes")
+    batched = {name: getattr(trajectory, name) for name in batches}
+    print("quasimoro rest-to-rest 1 m in 3 s, 21 nodes, IPOPT (CasADi), best of 3:")
+    print("(wall: IPOPT's call, TrajectorySolution.wall_time; cpu: this process's CPU time of the whole solve(), its "
+          "set-up included (pattern, guess, nlpsol: about 8 ms); jacobian: the CPU time in the nodes' Jacobians; rest "
+          "= cpu - jacobian: IPOPT, CasADi, the defects, the set-up)")
+    print(f"{'nodes':<13} {'jacobian':<18} {'wall [s]':>9} {'cpu [s]':>8} {'jacobian [s]':>13} {'rest [s]':>9} "
+          f"{'iterations':>11} {'cost [N^2 m^2 s]':>17} {'derivative calls':>17} {'dynamics calls':>15}")
+    for mode in ("batched", "node by node"):
+        for name in batches:
+            setattr(trajectory, name, batched[name] if mode == "batched" else (lambda *args: None))
+        runs: dict = {"analytic": [], "finite-difference": []}
+        try:
+            for _ in range(3):
+                for derivatives in runs:
+                    runs[derivatives].append(solve(derivatives))
+        finally:
+            for name in batches:
+                setattr(trajectory, name, batched[name])
+        best = {key: min(value, key=lambda r: r[1]) for key, value in runs.items()}  # least CPU time
+        for derivatives, (sol, cpu, jac) in best.items():
+            print(f"{mode:<13} {derivatives:<18} {sol.wall_time:>9.3f} {cpu:>8.3f} {jac:>13.3f} {cpu - jac:>9.3f} "
+                  f"{sol.iterations:>11} {sol.cost:>17.9f} {sol.derivative_calls:>17} {sol.dynamics_calls:>15}")
+        (a, a_cpu, _), (f, f_cpu, _) = best["analytic"], best["finite-difference"]
+        print(f"{mode}: speed-up of analytic over finite differences {f.wall_time / a.wall_time:.2f}x wall, "
+              f"{f_cpu / a_cpu:.2f}x CPU (target >= 5x; the derivatives and the forward dynamics compiled); "
+              f"abs(cost difference) {abs(a.cost - f.cost):.1e}")
 
 if __name__ == "__main__":
     if sys.argv[1:] == ["controllers"]:  # only this section: python bench/bench.py controllers
         controller_bench()
     elif sys.argv[1:] == ["profile"]:  # only this section: python bench/bench.py profile
         evaluation_profile_bench()
+    elif sys.argv[1:] == ["trajectory"]:  # only this section: python bench/bench.py trajectory
+        trajectory_optimisation_bench()
     elif sys.argv[1:] == ["compliant"]:  # only this section: python bench/bench.py compliant
         compliant_bench()
         from compliant_rolling_bench import compliant_rolling_bench

@@ -1374,6 +1374,88 @@ class Evaluator {
   long generation_ = 0;
 };
 
+// The derivative set at one state by the evaluator's kind (slipping wheels, operational velocities, else the reduced
+// dynamics), the dispatch of the "derivatives" binding: for the batched and timed bindings below.
+robotdyn::derivs::Result derivative_set(Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
+  try {
+    if (ev.slipping()) return robotdyn::SlidingDerivatives<Evaluator>::run(ev, q, nu, tau);
+    if (robotdyn::OperationalDerivatives<Evaluator>::serves(ev))
+      return robotdyn::OperationalDerivatives<Evaluator>::run(ev, q, nu, tau);
+    return robotdyn::ReducedDerivatives<Evaluator>::run(ev, q, nu, tau);
+  } catch (const std::domain_error& e) {
+    throw Fallback(e.what());
+  }
+}
+
+// The state equation's Jacobians at many states, one per row of Q (N, n), NU (N, k), TAU (N, motors), in one call
+// (a collocation's nodes, robotdyn.optimisation.node_batches): f_x (N, (n+k)^2), each row the row-major
+// [[d(S nu)/dq, S], [dnudot/dq, dnudot/dnu]], and f_tau (N, (n+k) motors), each row [[0], [dnudot/dtau]].
+// Fallback at the first state where the compiled derivatives do not serve.
+py::tuple derivatives_many(Evaluator& ev, const Eigen::Ref<const RowMat>& Q, const Eigen::Ref<const RowMat>& NU,
+                           const Eigen::Ref<const RowMat>& TAU) {
+  const Eigen::Index N = Q.rows(), n = Q.cols(), k = NU.cols(), nm = TAU.cols(), nx = n + k;
+  if (NU.rows() != N || TAU.rows() != N) throw std::invalid_argument("Q, NU and TAU need as many rows");
+  RowMat Fx(N, nx * nx), Fu = RowMat::Zero(N, nx * nm);
+  for (Eigen::Index i = 0; i < N; ++i) {
+    const robotdyn::derivs::Result r =
+        derivative_set(ev, Q.row(i).transpose(), NU.row(i).transpose(), TAU.row(i).transpose());
+    if (r.Vq.rows() != n || r.dq.rows() != k || r.dtau.cols() != nm)
+      throw std::invalid_argument("Q, NU, TAU: the wrong number of columns");
+    Eigen::Map<RowMat> fx(Fx.row(i).data(), nx, nx), fu(Fu.row(i).data(), nx, nm);
+    fx.topLeftCorner(n, n) = r.Vq;
+    fx.topRightCorner(n, k) = r.S;
+    fx.bottomLeftCorner(k, n) = r.dq;
+    fx.bottomRightCorner(k, k) = r.dnu;
+    fu.bottomRows(k) = r.dtau;
+  }
+  return py::make_tuple(Fx, Fu);
+}
+
+// The right-hand side (qdot, nudot) at many states, one per row of Q, NU, TAU, pull-back gain alpha: (N, nv + k)
+// (a finite-difference Jacobian's evaluations in one call). Fallback as rhs.
+RowMat rhs_many(Evaluator& ev, const Eigen::Ref<const RowMat>& Q, const Eigen::Ref<const RowMat>& NU,
+                const Eigen::Ref<const RowMat>& TAU, double alpha) {
+  const Eigen::Index N = Q.rows();
+  if (NU.rows() != N || TAU.rows() != N) throw std::invalid_argument("Q, NU and TAU need as many rows");
+  RowMat out(N, ev.nv() + NU.cols());
+  VectorXd y(ev.nv() + NU.cols());
+  for (Eigen::Index i = 0; i < N; ++i) {
+    ev.rhs_into(Q.row(i).transpose(), NU.row(i).transpose(), TAU.row(i).transpose(), alpha, y);
+    out.row(i) = y.transpose();
+  }
+  return out;
+}
+
+// CPU seconds per call (this thread's clock, no Python in the loop) of the derivative set ("derivatives") and of one
+// evaluation, the right-hand side without pull-back ("rhs"), at (q, nu, tau): the ratio a finite-difference Jacobian
+// of 2 (n + k + motors) evaluations is compared with (bench/bench.py trajectory_optimisation_bench).
+py::dict derivatives_seconds(Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau, int repeat) {
+  if (repeat < 1) throw std::invalid_argument("repeat must be >= 1");
+  auto seconds = [repeat](auto&& f) {
+#ifdef CLOCK_THREAD_CPUTIME_ID
+    timespec a, b;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+    for (int i = 0; i < repeat; ++i) f();
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+    return ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / repeat;
+#else
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < repeat; ++i) f();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeat;
+#endif
+  };
+  VectorXd out(ev.nv() + nu.size());
+  double sink = 0.0;
+  py::dict t;
+  t["derivatives"] = seconds([&] { sink += derivative_set(ev, q, nu, tau).dq.sum(); });
+  t["rhs"] = seconds([&] {
+    ev.rhs_into(q, nu, tau, 0.0, out);
+    sink += out[0];
+  });
+  t["check"] = sink;  // (kept, so that no call is optimised away)
+  return t;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_compiled, m) {
@@ -1538,6 +1620,11 @@ PYBIND11_MODULE(_compiled, m) {
            "normal stiffnesses and the unloaded wheels' indices (robotdyn.contact.compiled_force_derivatives)")
       .def("profile", &Evaluator::profile, py::arg("q"), py::arg("nu"), py::arg("repeat"), py::arg("alpha") = 0.0,
            "seconds per call of each part of an evaluation, and of Pinocchio's CRBA + RNEA + frame Jacobians")
+      .def("derivatives_many", &derivatives_many, "(f_x (N, (n+k)^2), f_tau (N, (n+k) motors)) at the rows of (Q, NU, "
+           "TAU) (robotdyn.optimisation.node_batches)")
+      .def("rhs_many", &rhs_many, "(qdot, nudot) at the rows of (Q, NU, TAU), gain alpha: (N, nv + k)")
+      .def("derivatives_seconds", &derivatives_seconds, py::arg("q"), py::arg("nu"), py::arg("tau"), py::arg("repeat"),
+           "CPU seconds per call of the derivative set and of one evaluation (rhs), timed in C++")
       .def_property_readonly("condition", &Evaluator::condition,
                              "1-norm condition number of the last projection's block: LAPACK's estimate below 1e8, "
                              "exact above (operational velocities: exact)")

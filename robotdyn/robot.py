@@ -366,9 +366,11 @@ class Robot:
             warnings.warn(message(self.implausible_inertias), RobotDynWarning, stacklevel=2)
 
     def __getstate__(self) -> dict:
-        """Pickle without the per-thread caches (Pinocchio data and compiled models are rebuilt on use)."""
+        """Pickle without the per-thread caches (Pinocchio data and compiled models are rebuilt on use), nor a
+        traction pass's memory of the reduced model (an instance attribute ``reduced`` over the method,
+        :mod:`robotdyn.contact.traction_memo`: a copy made during a pass is the robot as it is outside it)."""
         state = self.__dict__.copy()
-        for key in ("_local", "_constraint_set", "_compiled_model", "_floating_twin"):
+        for key in ("_local", "_constraint_set", "_compiled_model", "_floating_twin", "reduced"):
             state.pop(key, None)
         return state
 

@@ -578,6 +578,10 @@ def _bump(**changes) -> dict:
 toml_case("compliant-stiffness-zero", "normal_stiffness", _bump(**{"wheels.0.normal_stiffness": 0.0}))
 toml_case("compliant-stiffness-inf", "normal_stiffness", _bump(**{"wheels.0.normal_stiffness": float("inf")}))
 toml_case("compliant-damping-negative", "normal_damping", _bump(**{"wheels.0.normal_damping": -1.0}))
+toml_case("compliant-hunt-crossley-stiffness-zero", "stiffness in N/m^n",  # (Hunt-Crossley's k: N/m^n, not N/m)
+          _bump(**{"wheels.0.contact_law": "hunt_crossley", "wheels.0.normal_stiffness": 0.0}))
+toml_case("compliant-hunt-crossley-damping-negative", "damping in N s/m^(n+1)",
+          _bump(**{"wheels.0.contact_law": "hunt_crossley", "wheels.0.normal_damping": -1.0}))
 toml_case("compliant-damping-text", "normal_damping", _bump(**{"wheels.0.normal_damping": "soft"}))
 toml_case("compliant-law-unknown", "contact_law", _bump(**{"wheels.0.contact_law": "hertz"}))
 toml_case("compliant-exponent-below-one", "contact_exponent",

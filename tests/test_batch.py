@@ -5,17 +5,28 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import robotdyn.simulation.batch as batch
 from robotdyn.simulation.batch import evaluate
 from robotdyn.errors import RobotDynError
 
 
-def test_batch_equals_single_evaluations(quasimoro):
+def _started(monkeypatch) -> list:
+    """Record each pool of workers evaluate() starts."""
+    started, context = [], batch.mp.get_context
+    monkeypatch.setattr(batch.mp, "get_context", lambda method: started.append(method) or context(method))
+    return started
+
+
+def test_batch_equals_single_evaluations(quasimoro, monkeypatch):
     rng = np.random.default_rng(0)
-    Q = rng.uniform(-2, 2, (40, quasimoro.nq))
-    NU = rng.normal(size=(40, quasimoro.mobility))
+    Q = rng.uniform(-2, 2, (400, quasimoro.nq))  # (the probe's 257 states here, the rest in two workers)
+    NU = rng.normal(size=(400, quasimoro.mobility))
     serial = evaluate(quasimoro, Q, NU, processes=1)
+    monkeypatch.setattr(batch, "MIN_WORK_PER_PROCESS", 0.0)  # (workers whatever the work)
+    started = _started(monkeypatch)
     parallel = evaluate(quasimoro, Q, NU, processes=2)
-    for i in (0, 17, 39):
+    assert started == ["fork"]
+    for i in (0, 17, 399):
         red = quasimoro.reduced(Q[i], NU[i])
         assert np.allclose(serial.M[i], red.M, atol=1e-15) and np.allclose(serial.h[i], red.h, atol=1e-15)
     for name in ("M", "h", "g", "B", "S"):
@@ -27,3 +38,17 @@ def test_batch_shape_errors(quasimoro):
         evaluate(quasimoro, np.zeros((3, 5)), np.zeros((3, 3)))
     with pytest.raises(RobotDynError, match="NaN"):
         evaluate(quasimoro, np.full((2, 6), np.nan), np.zeros((2, 3)))
+
+
+def test_small_batches_start_no_workers(quasimoro, monkeypatch):
+    """2000 compiled states take some 10 ms, less than forking two workers and shutting them down (20-60 ms
+    measured): evaluated in this process, the same numbers."""
+    rng = np.random.default_rng(1)
+    Q = rng.uniform(-2, 2, (2000, quasimoro.nq))
+    NU = rng.normal(size=(2000, quasimoro.mobility))
+    serial = evaluate(quasimoro, Q, NU, processes=1)
+    started = _started(monkeypatch)
+    two = evaluate(quasimoro, Q, NU, processes=2)
+    assert started == []
+    for name in ("M", "h", "g", "B", "S"):
+        assert np.array_equal(getattr(serial, name), getattr(two, name))

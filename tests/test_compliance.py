@@ -60,6 +60,11 @@ def test_given_values_and_damping_from_a_given_stiffness(tmp_path):
     ({"wheels": [{"name": "w", "normal_damping": -1.0}]}, "wheels[0] (w).normal_damping = -1.0; expected a normal "
                                                           "(radial) damping in N s/m, >= 0"),
     ({"wheels": [{"name": "w", "normal_stifness": 1.0}]}, "did you mean 'normal_stiffness'?"),
+    # Hunt-Crossley's f = d^n (k + lambda d'): k in N/m^n, lambda in N s/m^(n+1) (the hint said N/m, N s/m)
+    ({"wheels": [{"name": "w", "contact_law": "hunt_crossley", "normal_stiffness": 0.0}]},
+     "wheels[0] (w).normal_stiffness = 0.0; expected a normal (radial) stiffness in N/m^n (n the contact_exponent)"),
+    ({"wheels": [{"name": "w", "contact_law": "hunt_crossley", "normal_damping": -1.0}]},
+     "wheels[0] (w).normal_damping = -1.0; expected a normal (radial) damping in N s/m^(n+1) (n the contact_expo"),
 ])
 def test_bad_values_are_one_line(data, expected):
     message = schema_problem(data)

@@ -50,8 +50,7 @@ def bump_base():
     from robotdyn.interfaces.constraint_file import read
 
     cf = read(EXAMPLES / "bump_base.toml")
-    with pytest.warns(Warning, match="independent velocities"):
-        robot = cf.robot()
+    robot = cf.robot()
     return robot, cf.SCENARIOS["bump"]
 
 

@@ -48,8 +48,7 @@ def test_bump_base_equals_dopri5():
     from robotdyn.interfaces.constraint_file import read
 
     cf = read(EXAMPLES / "bump_base.toml")
-    with pytest.warns(Warning, match="independent velocities"):
-        robot = cf.robot()
+    robot = cf.robot()
     sc = cf.SCENARIOS["bump"]
     q0, nu0 = sc.initial_state(robot)
     options = dict(n_out=31, rtol=1e-9, atol=1e-11, progress=False)

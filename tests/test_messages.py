@@ -178,3 +178,25 @@ def test_sweep_example_runs_without_error_rows(tmp_path):
     df = load(tmp_path / "out")
     assert len(df) == 24 and (df["status"] == "ok").all(), df["error"].dropna().tolist()
     assert res is not None
+
+
+def test_the_suggested_line_where_the_motors_are_no_valid_set_keeps_the_automatic_choice(tmp_path):
+    """examples/bump_base.toml without its 'independent' line: its four spin motors cannot be the independent set of
+    ten free velocities (compliant wheels constrain none), so the warning suggests the automatic choice itself; the
+    example carries that line, loads silently, and chooses as before."""
+    example = ROOT / "examples/bump_base.toml"
+    text = example.read_text().replace('urdf = "skid_steer.urdf.xacro"',
+                                       f'urdf = "{(ROOT / "examples/skid_steer.urdf.xacro").as_posix()}"')
+    start = text.index("independent = [")
+    bare = tmp_path / "bump_base.toml"
+    bare.write_text(text[:start] + text[text.index("]", start) + 1:])
+    with pytest.warns(RobotDynWarning) as record:
+        robot = read(bare).robot()
+    (message,) = [str(w.message) for w in record if "independent" in str(w.message)]
+    chosen = [robot.coordinates[i] for i in robot.independent_indices]
+    assert chosen == robot.coordinates  # (all ten: nothing constrains them)
+    assert message.endswith(f"add independent = [{', '.join(repr(c) for c in chosen)}] to the file"), message
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RobotDynWarning)
+        given = read(example).robot()
+    np.testing.assert_array_equal(given.independent_indices, robot.independent_indices)

@@ -30,10 +30,8 @@ CASES = [("bump_base.toml", "bump", 0.05), ("husky_like.toml", "turn_in_place", 
 
 
 def _robot(name: str, scenario: str):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # (bump_base chooses its independent velocities automatically)
-        cf = read(EXAMPLES / name)
-        robot = cf.robot()
+    cf = read(EXAMPLES / name)
+    robot = cf.robot()
     sc = cf.SCENARIOS[scenario]
     q0, nu0 = sc.initial_state(robot)
     return robot, sc, q0, nu0, np.asarray(sc.torque(0.0, q0, nu0), float)

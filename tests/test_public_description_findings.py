@@ -29,10 +29,8 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def test_a_compliant_wheel_unloads_before_it_lifts_off_and_the_summary_says_so():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # (the example chooses its independent velocities automatically)
-        cf = read(EXAMPLES / "bump_base.toml")
-        robot = cf.robot()
+    cf = read(EXAMPLES / "bump_base.toml")
+    robot = cf.robot()
     scenario = cf.SCENARIOS["bump"]
     traj = scenario.run(robot, t_end=0.1, n_out=201, progress=False)
     tr = traction(robot, traj, scenario.torque)

@@ -159,3 +159,22 @@ def test_memories_serve_only_their_own_pass_and_thread():
         outer()
         assert robot.reduced(q0, nu) is not first  # forgotten at the next sample
     assert "reduced" not in robot.__dict__
+
+
+def test_a_robot_pickled_during_a_pass_carries_no_memory():
+    import copy
+    import pickle
+
+    from robotdyn.constraints.constraint import KinematicState
+    from test_compliant_rolling import R, disc, state
+
+    robot = disc(g=9.81)
+    q0, nu = state(robot, R, vx=1.0, w=1.0 / R)
+    with once_per_sample(robot) as next_sample:
+        next_sample()
+        first = robot.reduced(q0, nu)  # (the memory now holds a reduced model, which does not pickle)
+        robot.constraints[-1].state(KinematicState(robot.model, robot.data, q0, robot.velocity(q0, nu)))
+        for twin in (pickle.loads(pickle.dumps(robot)), copy.deepcopy(robot)):
+            assert "reduced" not in twin.__dict__ and "state" not in twin.constraints[-1].__dict__
+            np.testing.assert_array_equal(twin.reduced(q0, nu).M, first.M)  # (the method, not a stale memory)
+        assert robot.__dict__["reduced"] is next_sample.memos[-1]  # (the pass's own robot keeps its memory)

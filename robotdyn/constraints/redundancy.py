@@ -57,7 +57,8 @@ def violations(red, nudot=None, tol: float = TOL) -> list[RowViolation]:
     """The rows that the reduced model ``red`` dropped as redundant and that its velocity :math:`v = S\\nu`, or its
     accelerations :math:`a = S\\dot\\nu + w` for ``nudot``, violate by more than ``tol`` (relative).
 
-    Rows kept by the projection hold by construction and are not checked.
+    Rows kept by the projection hold by construction and are not checked. At rest (v = 0) the terms in
+    :math:`\\dot A v` vanish, so :math:`\\dot A` (a Python kinematics pass over every constraint) is not computed.
 
     Args:
         red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` at (q, nu).
@@ -84,12 +85,15 @@ def violations(red, nudot=None, tol: float = TOL) -> list[RowViolation]:
     vel_scale = np.abs(A) @ np.abs(v) + size * np.abs(v).sum()
     acc = acc_scale = None
     if nudot is not None:
-        full = red.rows
         a = red.S @ np.asarray(nudot, float) + red.w
-        Adot = full.Adot[dropped]
+        if v.any():
+            every = red.rows.Adot
+            Adot, largest = every[dropped], float(np.abs(every).max())
+        else:  # (at rest: the same numbers without Adot, whose terms are all Adot times zeros)
+            Adot, largest = np.zeros((dropped.size, v.size)), 0.0
         acc = A @ a + Adot @ v
         acc_scale = (np.abs(A) @ np.abs(a) + np.abs(Adot) @ np.abs(v)
-                     + size * np.abs(a).sum() + float(np.abs(full.Adot).max()) * np.abs(v).sum())
+                     + size * np.abs(a).sum() + largest * np.abs(v).sum())
     out = []
     for j, i in enumerate(dropped):
         bad_v = abs(vel[j]) > tol * vel_scale[j]

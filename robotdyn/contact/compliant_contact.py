@@ -32,9 +32,9 @@ Laws (:math:`\\delta` the penetration [m], :math:`\\dot\\delta` its rate [m/s]):
   form of Marhefka & Orin 1999: :math:`\\lambda = \\tfrac32 \\alpha k`), whose force is continuous at touch-down.
 
 References (the site's bibliography, ``docs/bibliography.md``): K. H. Hunt, F. R. E. Crossley, *Coefficient of
-restitution interpreted as damping in vibroimpact*, Journal of Applied Mechanics (ASME), 1975; D. W. Marhefka,
-D. E. Orin, *A compliant contact model with nonlinear damping for simulation of robotic systems*, IEEE Transactions
-on Systems, Man, and Cybernetics, Part A: Systems and Humans, 1999.
+restitution interpreted as damping in vibroimpact*, Journal of Applied Mechanics (ASME) 42(2), pp. 440-445, 1975;
+D. W. Marhefka, D. E. Orin, *A compliant contact model with nonlinear damping for simulation of robotic systems*,
+IEEE Transactions on Systems, Man, and Cybernetics, Part A: Systems and Humans 29(6), pp. 566-572, 1999.
 """
 
 from __future__ import annotations
@@ -240,6 +240,13 @@ class CompliantWheel(RollingWheel):
         self.rolling = bool(rolling) and self.tangent_directions.shape[0] > 0 and law is None
         # the rolling rows D (t1, t2)^T A_w through RollingWheel.jacobian/drift (self's own give no rows)
         self._directions = np.hstack([self.tangent_directions, np.zeros((self.tangent_directions.shape[0], 1))])
+
+    def __getstate__(self) -> dict:
+        """Pickle without a traction pass's memory of the contact state (an instance attribute ``state`` over the
+        method, :mod:`robotdyn.contact.traction_memo`: a copy made during a pass is the wheel as it is outside it)."""
+        state = self.__dict__.copy()
+        state.pop("state", None)
+        return state
 
     def rolling_labels(self) -> list[str]:
         """Labels of the rolling rows, in the order of :meth:`tangential_rows`.

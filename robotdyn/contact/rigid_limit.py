@@ -17,9 +17,10 @@ rests on the others) it is a least-distance program, solved exactly as Lawson & 
 (*Solving Least Squares Problems*, 1974, ch. 23; :func:`scipy.optimize.nnls`).
 
 References (the site's bibliography, ``docs/bibliography.md``): L. F. Menabrea, *Nouveau principe sur la
-distribution des tensions dans les systèmes élastiques*, Comptes rendus de l'Académie des sciences, 1858;
-A. Castigliano, *Théorie de l'équilibre des systèmes élastiques et ses applications*, Turin, 1879; C. L. Lawson,
-R. J. Hanson, *Solving Least Squares Problems*, Prentice-Hall, 1974.
+distribution des tensions dans les systèmes élastiques*, Comptes rendus hebdomadaires des séances de l'Académie des
+sciences, 1858 (volume and pages not confirmed); A. Castigliano, *Théorie de l'équilibre des systèmes élastiques et
+ses applications*, Turin: A. F. Negro, 1879; C. L. Lawson, R. J. Hanson, *Solving Least Squares Problems*,
+Englewood Cliffs, NJ: Prentice-Hall, 1974, ch. 23 (SIAM reprint, Classics in Applied Mathematics 15, 1995).
 
 Every combination of rows that rigid-body dynamics determine (totals, axle and side sums, moments) keeps its value:
 z moves only along N. Directions of N that move no normal load (e.g. two wheels of one axle pushing against each

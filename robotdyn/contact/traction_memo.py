@@ -13,7 +13,9 @@ Where :func:`robotdyn.contact.traction.traction` computes the loads sample by sa
 
 :func:`once_per_sample` keeps the last value of each and hands it back (wheel states as copies) when the next call is
 at the same arguments bit for bit; the reduced model only within one sample (the pass calls ``next_sample()`` before
-each, since a stick-slip run's phases change the projection between samples). On exit the robot is as before.
+each, since a stick-slip run's phases change the projection between samples). On exit the robot is as before;
+a copy or pickle made during a pass carries no memory (``Robot.__getstate__`` and
+``CompliantWheel.__getstate__`` drop them).
 
 A memory serves only the thread whose pass installed it (another thread's calls go straight to the method), and a
 pass leaves alone what another pass (in any thread) has already wrapped: that pass then runs without it.

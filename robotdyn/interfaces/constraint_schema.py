@@ -49,6 +49,12 @@ def _bounded(expected: str, limit: float) -> dict:
     return _number(f"{expected} of magnitude <= {limit:g}", -limit, limit)
 
 
+def _by_law(entry: dict, hunt_crossley: str) -> dict:
+    """A wheel's normal-law number whose unit depends on its table's ``contact_law``: ``hunt_crossley`` is the
+    expectation where the law is Hunt-Crossley's, f = d^n (k + lambda d') (k in N/m^n, lambda in N s/m^(n+1))."""
+    return {**entry, "expected_when": {"contact_law": {"hunt_crossley": hunt_crossley}}}
+
+
 def _string(expected: str = "a non-empty string") -> dict:
     return {"type": "string", "minLength": 1, "expected": expected}
 
@@ -144,8 +150,11 @@ SCHEMA: dict = _table({
         "slip_velocity": _number("a slip velocity in m/s, > 0", None, 1e6, 0.0),
         "stiffness": _number("a stiffness in s/m, > 0", None, 1e12, 0.0),
         "slip": {"enum": ["both", "lateral"], "expected": "both or lateral"},
-        "normal_stiffness": _number("a normal (radial) stiffness in N/m, > 0 and <= 1e12", None, 1e12, 0.0),
-        "normal_damping": _number("a normal (radial) damping in N s/m, >= 0 and <= 1e12", 0.0, 1e12),
+        "normal_stiffness": _by_law(_number("a normal (radial) stiffness in N/m, > 0 and <= 1e12", None, 1e12, 0.0),
+                                    "a normal (radial) stiffness in N/m^n (n the contact_exponent), > 0 and <= 1e12"),
+        "normal_damping": _by_law(_number("a normal (radial) damping in N s/m, >= 0 and <= 1e12", 0.0, 1e12),
+                                  "a normal (radial) damping in N s/m^(n+1) (n the contact_exponent), >= 0 and "
+                                  "<= 1e12"),
         "contact": {"enum": ["rigid", "compliant"], "expected": "rigid or compliant"},
         "contact_law": {"enum": ["linear", "hunt_crossley"], "expected": "linear or hunt_crossley"},
         "contact_exponent": _number("an exponent n >= 1 and <= 10", 1.0, 10.0),
@@ -191,7 +200,8 @@ def _ignore(validator, value, instance, schema):
     return iter(())
 
 
-_Validator = validators.extend(jsonschema.Draft202012Validator, {"finite": _finite, "expected": _ignore})
+_Validator = validators.extend(jsonschema.Draft202012Validator, {"finite": _finite, "expected": _ignore,
+                                                                  "expected_when": _ignore})
 _VALIDATOR = _Validator(SCHEMA)
 
 
@@ -234,8 +244,29 @@ def _message(error: jsonschema.ValidationError, data) -> str:
         return f"{where + ': ' if where else ''}missing {missing!r} ({schema['properties'][missing]['expected']})"
     if error.validator == "enum":
         return f"{where} = {_show(value)}{_suggest(value, error.validator_value)}; expected {schema['expected']}"
-    expected = schema.get("expected") or _parent_expected(error) or "a valid value"
+    expected = _table_expected(error, data) or schema.get("expected") or _parent_expected(error) or "a valid value"
     return f"{where or 'file'} = {_show(value)}; expected {expected}"
+
+
+def _table_expected(error: jsonschema.ValidationError, data) -> str | None:
+    """The expectation an entry's ``expected_when`` gives for the other keys of its table (e.g. a wheel's
+    ``contact_law``), or None."""
+    when = error.schema.get("expected_when")
+    if not when or not error.absolute_path:
+        return None
+    table = data
+    for key in list(error.absolute_path)[:-1]:
+        try:
+            table = table[key]
+        except (KeyError, IndexError, TypeError):
+            return None
+    if not isinstance(table, dict):
+        return None
+    for key, by_value in when.items():
+        value = table.get(key)
+        if isinstance(value, str) and value in by_value:
+            return by_value[value]
+    return None
 
 
 def _parent_expected(error: jsonschema.ValidationError) -> str | None:

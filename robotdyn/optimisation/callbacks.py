@@ -80,12 +80,17 @@ def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], 
         def get_sparsity_out(self, i):
             return sparsity
 
-        def eval(self, arg):
+        def has_eval_buffer(self):  # the raw nonzero buffers: no DM built per call
+            return True
+
+        def eval_buffer(self, arg, res):
+            z = np.frombuffer(arg[0], dtype=np.float64).copy()
             try:
-                vals = exact_zeros(jacobian_values(np.asarray(arg[0], float).ravel()), rows, ng)
+                vals = exact_zeros(jacobian_values(z), rows, ng)
             except Exception as exc:  # noqa: BLE001 - see _refused
                 vals = _refused(keep, exc, len(order))
-            return [ca.DM(sparsity, vals[order])]
+            np.frombuffer(res[0], dtype=np.float64)[:] = vals[order]  # compressed-column order
+            return 0
 
     class Values(ca.Callback):
         def __init__(self, name, opts):
@@ -104,11 +109,23 @@ def sparse_callback(name: str, nz: int, ng: int, values: Callable[[np.ndarray], 
         def get_sparsity_out(self, i):
             return ca.Sparsity.dense(ng, 1)
 
-        def eval(self, arg):
+        def has_eval_buffer(self):
+            return True
+
+        def eval_buffer(self, arg, res):
+            z = np.frombuffer(arg[0], dtype=np.float64).copy()
             try:
-                return [ca.DM(values(np.asarray(arg[0], float).ravel()))]
+                g = values(z)
             except Exception as exc:  # noqa: BLE001 - see _refused
-                return [ca.DM(_refused(keep, exc, ng))]
+                g = _refused(keep, exc, ng)
+            np.frombuffer(res[0], dtype=np.float64)[:] = g
+            return 0
+
+        def has_jac_sparsity(self, oind, iind):  # IPOPT sees the pattern (without it: a dense Jacobian and KKT)
+            return True
+
+        def get_jac_sparsity(self, oind, iind, symmetric):
+            return sparsity
 
         def has_jacobian(self):
             return True

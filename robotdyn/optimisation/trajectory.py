@@ -30,6 +30,8 @@ whereas cyipopt has no Linux wheel and its build fails without a system IPOPT (p
 scipy's ``trust-constr`` is not a sparse interior-point solver for large NLPs. The robot's dynamics enter as one
 CasADi ``Callback`` (all defects at once) whose Jacobian is another ``Callback`` with a declared sparsity pattern:
 the analytic derivatives are passed as callbacks; CasADi's automatic differentiation is not used through Pinocchio.
+On the compiled model the nodes' dynamics (the defects, and either Jacobian) take one compiled call per iterate
+(:mod:`robotdyn.optimisation.node_batches`), so that Python's per-call cost does not dwarf a 3 us evaluation.
 
 Holonomic rows (wheels on a terrain, loop closures, couplings): every node is kept on the constraint manifold. The
 defects of the dependent position coordinates (those the holonomic rows fix, :attr:`~robotdyn.reduction.
@@ -57,7 +59,10 @@ import numpy as np
 
 from ..errors import InputError, NonFiniteError
 from ..inputs import MAX_POSITION
+from ..fast.compiled import Fallback
+from ..fast.compiled_derivatives import raw_derivatives
 from .callbacks import _casadi, refusal, sparse_callback
+from .node_batches import analytic_jacobians, central_jacobians, rhs_nodes
 
 DERIVATIVES = ("analytic", "finite-difference")
 """How the dynamics' Jacobian is computed (``derivatives`` of :class:`TrajectoryProblem`)."""
@@ -352,8 +357,6 @@ class TrajectoryProblem:
         self.calls["dynamics"] += 1
         q, nu = x[:self.n], x[self.n:]
         if self._fast is not None:
-            from ..fast.compiled import Fallback
-
             try:
                 return np.array(self._fast.rhs(q, nu, u, 0.0))
             except Fallback:
@@ -368,8 +371,6 @@ class TrajectoryProblem:
         if self.derivatives == "analytic":
             self.calls["derivatives"] += 1
             if self._fast is not None:  # the compiled derivative set in one call (as _f takes the compiled rhs)
-                from ..fast.compiled_derivatives import raw_derivatives
-
                 raw = raw_derivatives(self._fast, x[:n], x[n:], u)
                 if raw is not None:
                     _, dq, dnu, dtau, _, Vq, S, _ = raw
@@ -399,8 +400,19 @@ class TrajectoryProblem:
 
     def _jac_nodes(self, X: np.ndarray, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:math:`(\\partial f/\\partial x, \\partial f/\\partial\\tau)` at every node, (N, nx, nx) and (N, nx, m)
-        (:meth:`_jac_node` at each), written into two stacked arrays that :meth:`jacobian_values` slices at once."""
+        (all nodes in one compiled call, :mod:`robotdyn.optimisation.node_batches`, where it serves, else
+        :meth:`_jac_node` at each), in two stacked arrays that :meth:`jacobian_values` slices at once."""
         N = len(X)
+        if self.derivatives == "analytic":  # all nodes in one compiled call where it serves (node_batches)
+            batch = analytic_jacobians(self._fast, self.n, X, U)
+            self.calls["derivatives"] += N if batch is not None else 0
+        else:
+            batch = central_jacobians(self._fast, self.n, X, U, self.steps)
+            if batch is not None:
+                self.calls["dynamics"] += batch[2]
+                batch = batch[:2]
+        if batch is not None:
+            return batch
         Fx = np.empty((N, self.nx, self.nx))
         Fu = np.empty((N, self.nx, self.m))
         for j in range(N):
@@ -421,7 +433,11 @@ class TrajectoryProblem:
         if self._defect_cache[0] == key:
             return self._defect_cache[1]
         X, U = self._split(z)
-        F = np.array([self._f(X[j], U[j]) for j in range(self.nodes)])
+        F = rhs_nodes(self._fast, self.n, X, U)  # all nodes in one compiled call, else node by node
+        if F is None:
+            F = np.array([self._f(X[j], U[j]) for j in range(self.nodes)])
+        else:
+            self.calls["dynamics"] += self.nodes
         h = self.t_end / (self.nodes - 1)
         out = (X[1:] - X[:-1] - 0.5 * h * (F[1:] + F[:-1])).ravel()
         if not np.all(np.isfinite(out)):

@@ -38,7 +38,7 @@ computed at each call. Slipping wheels (friction laws) are refused here in one l
 
 Reference for the tree's derivatives (``computeRNEADerivatives``, the frame velocity and acceleration derivatives):
 J. Carpentier, N. Mansard, *Analytical derivatives of rigid body dynamics algorithms*, Robotics: Science and
-Systems (RSS), 2018.
+Systems XIV (RSS 2018), paper 38.
 """
 
 from __future__ import annotations

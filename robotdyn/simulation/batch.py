@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import os
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,12 @@ from ..fast.dispatch import compiled_model
 from ..errors import RobotDynError, SingularConstraintError
 
 _WORKER_ROBOT = None
+PROBE = 256
+"""States :func:`evaluate` times in its own process before it decides whether worker processes pay off."""
+MIN_WORK_PER_PROCESS = 0.1
+"""Least estimated work [s] per worker process for :func:`evaluate` to start them: forking a pool of two and shutting
+it down cost 20-60 ms here (measured on 2 cores, beside the 8 ms that 1000 compiled states take), so below this the
+states are evaluated in the calling process."""
 
 
 @dataclass
@@ -103,9 +110,10 @@ def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
         robot: A :class:`~robotdyn.robot.Robot`.
         Q: Natural coordinates, shape (N, n).
         NU: Independent velocities, shape (N, k).
-        processes: Worker processes (``None``: one per CPU; 1: in this process). With the compiled model a
-            process evaluates some 3e5 states/s, so starting workers pays off only for batches of about 1e5
-            states and more (``make bench``; 2 workers: 54k states/s for 2000 states, 376k/s for 200,000).
+        processes: Worker processes (``None``: one per CPU; 1: in this process). Workers are started only where
+            the first :data:`PROBE` states, timed here, let the rest take at least :data:`MIN_WORK_PER_PROCESS`
+            per worker (with the compiled model, some 3e5 states/s per process: batches of about 6e4 states and
+            more); smaller batches are evaluated here, the same numbers without the workers' start-up.
 
     Returns:
         A :class:`Batch` of the reduced model at the N states (arrays stacked along a first axis of length N).
@@ -124,15 +132,23 @@ def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
     processes = (os.cpu_count() or 1) if processes is None else int(processes)
     if processes <= 1 or len(Q) < 2 * processes or "fork" not in mp.get_all_start_methods():
         return Batch(*_evaluate_chunk(robot, Q, NU, 0))
-    global _WORKER_ROBOT
-    _WORKER_ROBOT = robot
-    bounds = np.linspace(0, len(Q), processes + 1).astype(int)
-    chunks = [(Q[a:b], NU[a:b], a) for a, b in zip(bounds[:-1], bounds[1:])]
-    try:
-        with mp.get_context("fork").Pool(processes) as pool:
-            parts = pool.map(_worker, chunks)
-    finally:
-        _WORKER_ROBOT = None
+    head = min(len(Q), PROBE + 1)  # (the first state alone: it may choose the projection's rows)
+    parts = [_evaluate_chunk(robot, Q[:1], NU[:1], 0)]
+    start = time.perf_counter()
+    parts.append(_evaluate_chunk(robot, Q[1:head], NU[1:head], 1))
+    per_state = (time.perf_counter() - start) / max(head - 1, 1)
+    if (len(Q) - head) * per_state / processes < MIN_WORK_PER_PROCESS:
+        parts.append(_evaluate_chunk(robot, Q[head:], NU[head:], head))
+    else:
+        global _WORKER_ROBOT
+        _WORKER_ROBOT = robot
+        bounds = np.linspace(head, len(Q), processes + 1).astype(int)
+        chunks = [(Q[a:b], NU[a:b], a) for a, b in zip(bounds[:-1], bounds[1:])]
+        try:
+            with mp.get_context("fork").Pool(processes) as pool:
+                parts += pool.map(_worker, chunks)
+        finally:
+            _WORKER_ROBOT = None
     return Batch(*(np.concatenate([p[j] for p in parts]) for j in range(5)))
 
 

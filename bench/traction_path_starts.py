@@ -3,12 +3,13 @@ traction_path) against its start: IPOPT from the minimum-effort motion with its 
 ``eps`` (seeds 0 .. starts - 1), as the notebook ``rover_path_traction.ipynb`` starts it with ``eps = 0``.
 
 Prints, per start, IPOPT's status, the cost, its iterations and wall time, then how many converged and the spread
-of their costs (relative). Measured (issue 26): before the Jacobian's rounding residues reached IPOPT as exact zeros
-(robotdyn.optimisation.callbacks.exact_zeros), 16 of 32 starts at 1e-8 and 1 of 32 at 1e-6 converged; after,
-32 of 32 at both, 12 iterations each, costs equal to 2e-15.
+of their costs (relative). Measured (issue 26), before the Jacobian's rounding residues reached IPOPT as exact
+zeros (robotdyn.optimisation.callbacks.exact_zeros): with the Jacobian dense to CasADi, 16 of 32 starts at 1e-8
+and 1 of 32 at 1e-6 converged; with its pattern declared, 32/32, 32/32, 14/16 and 0/16 at 1e-8, 1e-6, 1e-4 and
+1e-2. After: 32/32, 32/32, 16/16 and 16/16, costs equal to 2e-15, 12 to 17 iterations.
 
-Run: ``python bench/traction_path_starts.py [starts [eps ...]]`` (default: 32 starts at 1e-8 and 1e-6; about 1 s
-per start on an idle machine).
+Run: ``python bench/traction_path_starts.py [starts [eps ...]]`` (default: 16 starts at 1e-8, 1e-6, 1e-4 and
+1e-2; about 1 s per start on an idle machine).
 """
 
 from __future__ import annotations
@@ -56,8 +57,8 @@ def main(argv: list[str]) -> None:
     import robotdyn
     from robotdyn.robots.linkage_suspension import traction_path as tp
 
-    count = int(argv[0]) if argv else 32
-    epsilons = [float(a) for a in argv[1:]] or [1e-8, 1e-6]
+    count = int(argv[0]) if argv else 16
+    epsilons = [float(a) for a in argv[1:]] or [1e-8, 1e-6, 1e-4, 1e-2]
     robot = robotdyn.load("linkage_suspension")
     free = tp.traction_path(mu_max=None, min_load=None, robot=robot).solve()
     for eps in epsilons:

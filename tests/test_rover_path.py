@@ -140,12 +140,13 @@ def test_rounding_residues_reach_ipopt_as_exact_zeros(robot):
 
 
 def test_perturbed_start_converges(robot):
-    """From the stored minimum-effort motion with its torques perturbed by 1e-8 (seed 0: a start that ended in
-    Invalid_Number_Detected before the residues were zeroed, measured: 16 of 32 such starts did), IPOPT converges to
-    the stored traction-limited optimum (cost to 1e-9 relative)."""
+    """From the stored minimum-effort motion with its torques perturbed by 1e-2 (seed 0), IPOPT converges to the
+    stored traction-limited optimum (cost to 1e-9 relative). Before the residues were zeroed, MUMPS's first
+    factorization left a residual ratio of 1e6 there and the solve ended in Invalid_Number_Detected (measured: 0 of
+    16 such starts converged; at 1e-8, 16 of 32 before the Jacobian's pattern was declared to CasADi)."""
     rng = np.random.default_rng(0)
     p = tp.traction_path(robot=robot)
-    p.guess = (CACHE["free_q"], CACHE["free_nu"], CACHE["free_tau"] * (1 + 1e-8 * rng.normal(size=(tp.NODES, 6))))
+    p.guess = (CACHE["free_q"], CACHE["free_nu"], CACHE["free_tau"] * (1 + 1e-2 * rng.normal(size=(tp.NODES, 6))))
     s = p.solve()
     assert s.success, s
     assert np.isclose(s.cost, float(CACHE["limited_cost"]), rtol=1e-9, atol=0)

@@ -1588,7 +1588,9 @@ PYBIND11_MODULE(_compiled, m) {
              } catch (const std::domain_error& e) {
                throw Fallback(e.what());
              }
-             return py::make_tuple(r.nudot, r.dq, r.dnu, r.dtau, r.v, r.Vq, r.S, r.A);
+             // moved into the arrays (no copies)
+             return py::make_tuple(std::move(r.nudot), std::move(r.dq), std::move(r.dnu), std::move(r.dtau),
+                                   std::move(r.v), std::move(r.Vq), std::move(r.S), std::move(r.A));
            },
            "(nudot, dnudot/dq, dnudot/dnu, dnudot/dtau, v, dv/dq, S, A) at (q, nu, tau) "
            "(robotdyn.fast.compiled_derivatives)")

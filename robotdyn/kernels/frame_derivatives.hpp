@@ -1,9 +1,13 @@
 // robotdyn/kernels/frame_derivatives.hpp: frame velocities and accelerations with their configuration derivatives
 // at one state (q, x), twin of robotdyn/constraints/row_derivatives.py (FramePass, _rot_dq, _cross_d).
 //
-// One computeForwardKinematicsDerivatives per pass, on a Pinocchio data of its own (first order where no
-// acceleration is needed); per joint, Pinocchio's getJointVelocityDerivatives / getJointAccelerationDerivatives in
-// WORLD, carried to each frame's origin (FramePass below). The Python twin rotates the LOCAL frame derivatives to
+// A pass with accelerations runs computeForwardKinematicsDerivatives on a Pinocchio data of its own and takes, per
+// joint, Pinocchio's getJointVelocityDerivatives / getJointAccelerationDerivatives in WORLD, carried to each frame's
+// origin (FramePass below). A velocity-only pass (run_velocities) reuses the evaluator's configuration pass instead
+// of recomputing the placements: the world joint velocities ov_i = ov_parent + J_i x_i from the world Jacobian
+// columns J (CRBA's data.J) and, per column c of a joint on the support of j, the same WORLD derivative that
+// getJointVelocityDerivatives assembles from computeForwardKinematicsDerivatives' dVdq:
+// d ov_j / dq_c = J_c x (ov_j - ov_parent(c)) (motion cross product; Pinocchio's right-perturbation tangent). The Python twin rotates the LOCAL frame derivatives to
 // world axes instead; both are the derivatives of the LOCAL_WORLD_ALIGNED J(q) x at fixed x and of its classical
 // acceleration, which is what the constraint rows need. Placements and world Jacobians come from the evaluator's
 // configuration pass (its data and frame Jacobians at q).
@@ -58,6 +62,8 @@ struct FramePass {
   pin::Data data;
   VectorXd x;
   bool accelerations = false;
+  const pin::Data* base = nullptr;  // velocity-only pass: the evaluator's data at q (oMi, world columns J)
+  std::vector<pin::Motion> ov;      // velocity-only pass: world joint velocities at x
   std::vector<char> has_vel, has_acc, has_jv, has_ja;
   std::vector<Vector6d> V, Acc;
   std::vector<Matrix6x> dV, dAcc, jdV, jdA;
@@ -68,10 +74,35 @@ struct FramePass {
       data = pin::Data(model);
     x = x_;
     accelerations = with_accelerations;
+    base = nullptr;
     if (accelerations)
       pin::computeForwardKinematicsDerivatives(model, data, q, x, VectorXd::Zero(model.nv));
     else
       pin::computeForwardKinematicsDerivatives(model, data, q, x);  // velocities only (first order)
+    reset(model);
+  }
+
+  // a velocity-only pass at x on the evaluator's configuration pass `at_q` (placements and CRBA's world Jacobian
+  // columns at q, which must outlive the pass's use): no Pinocchio pass of its own
+  template <class X>
+  void run_velocities(const pin::Model& model, const pin::Data& at_q, const Eigen::MatrixBase<X>& x_) {
+    x = x_;
+    accelerations = false;
+    base = &at_q;
+    ov.resize(static_cast<size_t>(model.njoints));
+    ov[0].setZero();
+    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model.njoints); ++i) {
+      const int c0 = model.joints[i].idx_v(), nvi = model.joints[i].nv();
+      ov[i] = ov[model.parents[i]];
+      ov[i].toVector().noalias() += at_q.J.middleCols(c0, nvi) * x.segment(c0, nvi);
+    }
+    reset(model);
+  }
+
+  // a joint's world velocity at x (spatial, at the world origin)
+  const pin::Motion& joint_velocity(pin::JointIndex jid) const { return base ? ov[jid] : data.ov[jid]; }
+
+  void reset(const pin::Model& model) {
     const size_t nf = model.frames.size(), nj = static_cast<size_t>(model.njoints);
     has_vel.assign(nf, 0);
     has_acc.assign(nf, 0);
@@ -93,8 +124,22 @@ struct FramePass {
   const Matrix6x& joint_velocity_dq(const pin::Model& model, pin::JointIndex jid) {
     if (!has_jv[jid]) {
       jdV[jid].setZero(6, model.nv);
-      t2_.setZero(6, model.nv);
-      pin::getJointVelocityDerivatives(model, data, jid, pin::WORLD, jdV[jid], t2_);
+      if (base) {  // d ov_j / dq_c = J_c x (ov_j - ov_parent(c)) on the support of j (header)
+        for (const pin::JointIndex s : model.supports[jid]) {
+          if (s == 0) continue;
+          const pin::Motion rel = ov[jid] - ov[model.parents[s]];
+          const int c0 = model.joints[s].idx_v();
+          for (int c = c0; c < c0 + model.joints[s].nv(); ++c) {
+            const auto Jc = base->J.col(c);
+            const Vector3d lin = Jc.template head<3>(), ang = Jc.template tail<3>();
+            jdV[jid].col(c).template head<3>() = ang.cross(rel.linear()) + lin.cross(rel.angular());
+            jdV[jid].col(c).template tail<3>() = ang.cross(rel.angular());
+          }
+        }
+      } else {
+        t2_.setZero(6, model.nv);
+        pin::getJointVelocityDerivatives(model, data, jid, pin::WORLD, jdV[jid], t2_);
+      }
       has_jv[jid] = 1;
     }
     return jdV[jid];
@@ -106,9 +151,9 @@ struct FramePass {
     if (has_vel[fid]) return;
     const pin::JointIndex jid = model.frames[fid].parentJoint;
     const Matrix6x& jd = joint_velocity_dq(model, jid);
-    const pin::Motion& ov = data.ov[jid];
-    const Vector3d p = oMf.translation(), w = ov.angular();
-    const Vector3d vp = ov.linear() + w.cross(p);
+    const pin::Motion& vj = joint_velocity(jid);
+    const Vector3d p = oMf.translation(), w = vj.angular();
+    const Vector3d vp = vj.linear() + w.cross(p);
     V[fid] << vp, w;
     dV[fid].resize(6, model.nv);
     dV[fid].topRows<3>() = jd.topRows<3>() - skew3(p) * jd.bottomRows<3>() + skew3(w) * J.topRows<3>();
@@ -152,7 +197,7 @@ struct FramePass {
 
   // world angular velocity of a joint's body and its q-derivative at fixed x (the motors' reaction terms)
   void joint_angular(const pin::Model& model, pin::JointIndex jid, Vector3d& w, Matrix3x& dw) {
-    w = data.ov[jid].angular();
+    w = joint_velocity(jid).angular();
     dw = joint_velocity_dq(model, jid).bottomRows<3>();
   }
 };

@@ -157,7 +157,8 @@ struct ReducedDerivatives {
     }
   }
 
-  // -K^-1 [X_rows] for the selection projection (Projection.solve_neg): zero except the dependent rows
+  // -K^-1 [X_rows] for the selection projection (Projection.solve_neg): zero except the dependent rows (the
+  // operational-space, sliding and contact-force derivative kernels use it; run() makes its three solves in one)
   static MatrixXd solve_neg(Ev& ev, const MatrixXd& X) {
     const int nd = static_cast<int>(ev.dependent_.size());
     MatrixXd out = MatrixXd::Zero(ev.nv_, X.cols());
@@ -186,20 +187,45 @@ struct ReducedDerivatives {
     derivs::Result out;
     const Eigen::LLT<MatrixXd> llt = reduced_mass(ev, tau, out);
     const VectorXd a = S * out.nudot + w;
-    frame_passes(ev, [](int, derivs::FramePass&) {});
+    frame_passes(ev, [](int, derivs::FramePass&) {}, nu.data());
     const MatrixXd& dA_w = ws.dA[k];
     const MatrixXd& dA_v = ws.dA[k + 1];
     const MatrixXd dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
-    out.Vq = solve_neg(ev, dA_v);            // v = S(q) nu: dv/dq = -K^-1 d(K v)/dq
-    const MatrixXd dgA = ws.dgam_q + dgam_v * out.Vq;
-    const MatrixXd Wnu = solve_neg(ev, dgam_v * S);
+    // the projection's three solves in one: with Y = K^-1 [d(K v)/dq, d(K gamma)/dv, d(K a)/dq + dgamma/dq at fixed
+    // v] (dependent rows), dv/dq = -Y_v (v = S(q) nu), W_nu = -Y_g S, and Aq = -(Y_a + Y_g dv/dq) (Pieces.Aq)
+    const int nd = static_cast<int>(ev.dependent_.size());
+    out.Vq = MatrixXd::Zero(n, n);
+    MatrixXd Wnu = MatrixXd::Zero(n, k), Aq = MatrixXd::Zero(n, n);
+    if (nd) {
+      MatrixXd X(nd, 3 * n);
+      for (int r = 0; r < nd; ++r) {
+        const int row = ev.rows_[r];
+        X.row(r).segment(0, n) = dA_v.row(row);
+        X.row(r).segment(n, n) = dgam_v.row(row);
+        auto xa = X.row(r).segment(2 * n, n);
+        xa = dA_w.row(row) + ws.dgam_q.row(row);
+        for (int l = 0; l < k; ++l) xa += out.nudot[l] * ws.dA[l].row(row);
+      }
+      const MatrixXd Y = ev.lu_.solve(X);
+      MatrixXd Vd = -Y.leftCols(n);  // dependent rows of dv/dq
+      const MatrixXd Wd = -Y.middleCols(n, n) * S;
+      MatrixXd Ygd(nd, nd);  // Y_g's dependent columns: Vq is zero off the dependent rows
+      for (int r = 0; r < nd; ++r) Ygd.col(r) = Y.col(n + ev.dependent_[r]);
+      MatrixXd Ad = -Y.rightCols(n);
+      Ad.noalias() -= Ygd * Vd;  // -(Y_a + Y_g Vq)
+      for (int r = 0; r < nd; ++r) {
+        const int i = ev.dependent_[r];
+        out.Vq.row(i) = Vd.row(r);
+        Wnu.row(i) = Wd.row(r);
+        Aq.row(i) = Ad.row(r);
+      }
+    }
     // the tree: RNEA(q, v, a) and its derivatives, with gravity
     MatrixXd dtau_dq, dtau_dv;
     tree(ev, a, dtau_dq, dtau_dv);
     const VectorXd rho = ws.tree.tau - ev.B_ * tau;
     // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d
     MatrixXd L = MatrixXd::Zero(k, n);
-    const int nd = static_cast<int>(ev.dependent_.size());
     if (nd) {
       VectorXd rd(nd);
       for (int r = 0; r < nd; ++r) rd[r] = rho[ev.dependent_[r]];
@@ -207,10 +233,7 @@ struct ReducedDerivatives {
       for (int l = 0; l < k; ++l)
         for (int r = 0; r < nd; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
     }
-    // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot
-    MatrixXd dKa = dA_w + dgA;
-    for (int l = 0; l < k; ++l) dKa += out.nudot[l] * ws.dA[l];
-    const MatrixXd Aq = solve_neg(ev, dKa);
+    // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot: from the one solve above
     const MatrixXd ST = S.transpose();
     MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * out.Vq + (ST * M) * Aq;
     motor_rows(ev, tau, G);
@@ -221,9 +244,12 @@ struct ReducedDerivatives {
   // the shared set-up of the derivative kernels at the evaluator's state (configure(q), dynamics(nu) done): the
   // contact geometry's derivatives (ws.geo), the frame passes at the columns of S, at w and at v (ws.passes, the
   // last with accelerations) with every row's d(A x)/dq there (ws.dA), then per_pass(l, pass) (the
-  // operational-space rows' own), and the drift's derivatives on the pass at v (ws.dgam_q, ws.Adot)
+  // operational-space rows' own), and the drift's derivatives on the pass at v (ws.dgam_q, ws.Adot). With `nu`
+  // (run's selection projection, v = S nu) the passes at the columns of S and at w are velocity-only passes on the
+  // evaluator's configuration pass (FramePass::run_velocities) and d(A v)/dq = sum_l nu_l d(A S_l)/dq (A x is linear
+  // in x), one row pass fewer
   template <class PerPass>
-  static void frame_passes(Ev& ev, PerPass&& per_pass) {
+  static void frame_passes(Ev& ev, PerPass&& per_pass, const double* nu = nullptr) {
     const Model& model = ev.model_;
     auto& ws = ev.deriv_;
     const int k = static_cast<int>(ev.S_.cols());
@@ -235,9 +261,20 @@ struct ReducedDerivatives {
     ws.dA.resize(k + 2);
     for (int l = 0; l < k + 2; ++l) {
       derivs::FramePass& fp = ws.passes[l];
-      fp.run(model, ev.q_, l < k ? VectorXd(ev.S_.col(l)) : l == k ? ev.w_ : ev.v_, l == k + 1);
+      const bool fast = nu != nullptr && l <= k;
+      if (fast && l < k)
+        fp.run_velocities(model, ev.data_, ev.S_.col(l));
+      else if (fast)
+        fp.run_velocities(model, ev.data_, ev.w_);
+      else
+        fp.run(model, ev.q_, l < k ? VectorXd(ev.S_.col(l)) : l == k ? ev.w_ : ev.v_, l == k + 1);
       prepare(ev, fp, l == k + 1);
-      velocity_dq(ev, fp, ws.dA[l]);
+      if (nu != nullptr && l == k + 1) {
+        ws.dA[l].setZero(ev.nrows(), ev.nv_);
+        for (int j = 0; j < k; ++j) ws.dA[l] += nu[j] * ws.dA[j];
+      } else {
+        velocity_dq(ev, fp, ws.dA[l]);
+      }
       per_pass(l, fp);
     }
     drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);

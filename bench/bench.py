@@ -394,6 +394,17 @@ def controller_bench() -> None:
         integration, nfev, count = total - setup - samples, traj.stats["nfev"], len(traj.t)
         print(f"{label:<36} {1e3 * total:>8.2f} {1e3 * setup:>8.2f} {1e3 * integration:>12.2f} {1e3 * samples:>8.2f} "
               f"{1e6 * samples / max(count - 2, 1):>12.1f} {nfev:>7d} {1e6 * integration / nfev:>10.1f}")
+    print("a compiled sample's energy and residual [us, C++ CPU time per call, at each run's last state]: observe = the "
+          "whole configuration pass (what every sample cost before), sample = the lean pass of a run that kept its row "
+          "choice (no gravity torques, motor columns, condition or span checks; the same bits)")
+    seen = set()
+    for label, _, _, _, traj in costs:
+        if label.startswith(" ") or traj.robot is None or id(traj.robot) in seen:
+            continue
+        seen.add(id(traj.robot))
+        t = compiled_model(traj.robot).ev.profile(traj.q[-1], traj.nu[-1], 500, 0.0)
+        print(f"  {traj.robot.spec.name:<20} observe {1e6 * t['observe']:>6.2f}  sample {1e6 * t['sample']:>6.2f}  "
+              f"({t['observe'] / t['sample']:.2f}x)")
     print("  the scipy loop evaluates the same compiled model (one Python call per evaluation around it) and computes "
           "each sample's v and residual with the compiled model and its energy with Pinocchio: its integration costs "
           "nfev_s (c + p) against the compiled loop's nfev_c c, c the compiled evaluation, p the Python around it. "

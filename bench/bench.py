@@ -399,9 +399,9 @@ def controller_bench() -> None:
           "choice (no gravity torques, motor columns, condition or span checks; the same bits)")
     seen = set()
     for label, _, _, _, traj in costs:
-        if label.startswith(" ") or traj.robot is None or id(traj.robot) in seen:
+        if label.startswith(" ") or traj.robot is None or traj.robot.spec.name in seen:
             continue
-        seen.add(id(traj.robot))
+        seen.add(traj.robot.spec.name)
         t = compiled_model(traj.robot).ev.profile(traj.q[-1], traj.nu[-1], 500, 0.0)
         print(f"  {traj.robot.spec.name:<20} observe {1e6 * t['observe']:>6.2f}  sample {1e6 * t['sample']:>6.2f}  "
               f"({t['observe'] / t['sample']:.2f}x)")
@@ -410,9 +410,10 @@ def controller_bench() -> None:
           "nfev_s (c + p) against the compiled loop's nfev_c c, c the compiled evaluation, p the Python around it. "
           "Where c is tens of us (the linkage: 25 coordinates, six wheels, the suspension's loop closures: c = 33-40 "
           "us, p = 4-7 us) the integrations' ratio is about nfev_s / nfev_c (1.9-2.8 with Adams up to order 10), "
-          "and each of the 400-820 samples per second costs a configuration pass on both loops (~17-23 us compiled "
-          "against ~53 us): the linkage's runs are bound at about 3x by its evaluation and its samples, not by the "
-          "loop")
+          "and each of the 400-820 samples per second costs a configuration pass on both loops (~13-16 us compiled by the "
+          "lean pass, 17-23 us before it, against ~53 us): the linkage's runs are bound at about 3x by its evaluation "
+          "and its samples, not by the loop; with free samples and set-up they would reach nfev_s (c + p) + the scipy "
+          "samples over nfev_c c, about 7x")
 
 
 def compiled_forces_bench() -> None:

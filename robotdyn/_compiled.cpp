@@ -1100,6 +1100,7 @@ class Evaluator {
     ts.reserve(samples.size());
     ys.reserve(samples.size() * dim);
     long nfev = 0;
+    const long rechoices = rechoices_;  // (the samples' pass is the lean one where the run makes no re-choice)
     auto system = [&](const robotdyn::State& x, robotdyn::State& dxdt, double t) {
       ++nfev;
       deriv(t, x, dxdt, alpha, profile, rechoose);
@@ -1144,7 +1145,6 @@ class Evaluator {
     } lift_off{this, alpha, &profile, &rechoose, slipping || !rolling_contact_.empty()};
     int slip_error = -1;
     double slip_value = 0.0;
-    const long rechoices = rechoices_;
     std::vector<std::tuple<double, int, int>> crossings;  // flight phases: (t, compliant wheel, +1 touch-down / -1 lift-off)
     {
       py::gil_scoped_release release;

@@ -394,14 +394,26 @@ def controller_bench() -> None:
         integration, nfev, count = total - setup - samples, traj.stats["nfev"], len(traj.t)
         print(f"{label:<36} {1e3 * total:>8.2f} {1e3 * setup:>8.2f} {1e3 * integration:>12.2f} {1e3 * samples:>8.2f} "
               f"{1e6 * samples / max(count - 2, 1):>12.1f} {nfev:>7d} {1e6 * integration / nfev:>10.1f}")
+    print("a compiled sample's energy and residual [us, C++ CPU time per call, at each run's last state]: observe = the "
+          "whole configuration pass (what every sample cost before), sample = the lean pass of a run that kept its row "
+          "choice (no gravity torques, motor columns, condition or span checks; the same bits)")
+    seen = set()
+    for label, _, _, _, traj in costs:
+        if label.startswith(" ") or traj.robot is None or traj.robot.spec.name in seen:
+            continue
+        seen.add(traj.robot.spec.name)
+        t = compiled_model(traj.robot).ev.profile(traj.q[-1], traj.nu[-1], 500, 0.0)
+        print(f"  {traj.robot.spec.name:<20} observe {1e6 * t['observe']:>6.2f}  sample {1e6 * t['sample']:>6.2f}  "
+              f"({t['observe'] / t['sample']:.2f}x)")
     print("  the scipy loop evaluates the same compiled model (one Python call per evaluation around it) and computes "
           "each sample's v and residual with the compiled model and its energy with Pinocchio: its integration costs "
           "nfev_s (c + p) against the compiled loop's nfev_c c, c the compiled evaluation, p the Python around it. "
           "Where c is tens of us (the linkage: 25 coordinates, six wheels, the suspension's loop closures: c = 33-40 "
           "us, p = 4-7 us) the integrations' ratio is about nfev_s / nfev_c (1.9-2.8 with Adams up to order 10), "
-          "and each of the 400-820 samples per second costs a configuration pass on both loops (~17-23 us compiled "
-          "against ~53 us): the linkage's runs are bound at about 3x by its evaluation and its samples, not by the "
-          "loop")
+          "and each of the 400-820 samples per second costs a configuration pass on both loops (~13-16 us compiled by the "
+          "lean pass, 17-23 us before it, against ~53 us): the linkage's runs are bound at about 3x by its evaluation "
+          "and its samples, not by the loop; with free samples and set-up they would reach nfev_s (c + p) + the scipy "
+          "samples over nfev_c c, about 7x")
 
 
 def compiled_forces_bench() -> None:

@@ -206,6 +206,14 @@ class Evaluator {
     // which g_k = -J_k^T (Y_subtree(k) * gravity): the torque that holds the subtree's weight
     pin::crba(model_, data_, q_, pin::Convention::WORLD);
     gravity_torques(model_, data_, gravity_, nv_, g_);
+    rows_pass(true);
+    project();
+    configured_ = true;
+  }
+
+  // After CRBA's kinematics at q_: the frames' placements and Jacobians, then every constraint's rows (A, residual)
+  // and, with `motors`, the motors' columns B.
+  void rows_pass(bool motors) {
     pin::updateFramePlacements(model_, data_);
     const int m = nrows();
     A_.setZero(m, nv_);
@@ -217,18 +225,17 @@ class Evaluator {
       pin::getFrameJacobian(model_, data_, frames_[f], pin::LOCAL_WORLD_ALIGNED, Jf_[f]);
     }
     Aw_.resize(wheels_.size());
-    constraint_rows();
-    project();
-    configured_ = true;
+    constraint_rows(motors);
   }
 
   // Every constraint's rows (A, residual: kernels/rolling_contact, loop_closure, joint_coupling) in the rows'
-  // order, and the motors' columns B (kernels/actuation), at the configured placements and frame Jacobians.
-  void constraint_rows() {
+  // order, and with `motors` the motors' columns B (kernels/actuation), at the configured placements and frame
+  // Jacobians.
+  void constraint_rows(bool motors = true) {
     int row = 0;
     for (const auto& [kind, i] : order_)
       row = kind == 0 ? wheel_rows(i, row) : kind == 1 ? closure_rows(i, row) : coupling_rows(i, row);
-    motor_columns(motors_, model_, data_, Jf_, nv_, B_);
+    if (motors) motor_columns(motors_, model_, data_, Jf_, nv_, B_);
   }
 
   // Every constraint's drift at v (the joint accelerations at zero joint acceleration in data_.a), then w, the
@@ -576,6 +583,7 @@ class Evaluator {
         const int k = mobility();
         VectorXd q(Eigen::Map<const VectorXd>(y, nv_)), nu(Eigen::Map<const VectorXd>(y + nv_, k));
         py::tuple sel = run_ < 0 ? rechoose(q, nu) : rechoose(run_, q, nu);
+        ++rechoices_;
         configured_ = false;
         rows_ = sel[0].cast<std::vector<int>>();
         if (!operational_) {
@@ -672,6 +680,11 @@ class Evaluator {
   void observe(const double* y, double& energy, double& residual, const py::object& rechoose) {
     with_rechoice(y, rechoose, [&] { configure(Eigen::Map<const VectorXd>(y, nv_)); });
     v_.noalias() = S_ * Eigen::Map<const VectorXd>(y + nv_, mobility());  // (no dynamics needed)
+    energy_residual(energy, residual);
+  }
+
+  // observe's energy and residual from the evaluator's M (CRBA's upper triangle), placements, v_ and residuals.
+  void energy_residual(double& energy, double& residual) {
     double potential = 0.0;
     for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) {
       const pin::Inertia& Y = model_.inertias[i];
@@ -682,6 +695,50 @@ class Evaluator {
     residual = 0.0;
     for (size_t r = 0; r < holonomic_.size(); ++r)
       if (holonomic_[r]) residual = std::max(residual, std::fabs(residual_[r]));
+  }
+
+  // A sample's energy and residual after a run that kept its row choice (no re-choice): observe's numbers, the same
+  // bits, without what a sample does not use. The choice in force served, and passed its checks at, every
+  // evaluation of the run, the evaluations on both sides of the sample included; so the configuration pass here
+  // skips the gravity torques, the motors' columns B and, for a selection of v, the projection's condition and span
+  // checks (projection.hpp's project_selection otherwise, step by step: S from A_d's LU factors). Operational
+  // velocities keep their projection with its checks; springs and compliant wheels (their stored energy) and an S
+  // that is not finite (a zero pivot) go through observe.
+  void sample(const double* y, double& energy, double& residual, const py::object& rechoose) {
+    if (applied() || !selected_ || differencing_) return observe(y, energy, residual, rechoose);
+    bool finite = true;
+    with_rechoice(y, rechoose, [&] {
+      configured_ = false;  // (this pass leaves g_ and B_ from another configuration)
+      q_ = Eigen::Map<const VectorXd>(y, nv_);
+      pin::crba(model_, data_, q_, pin::Convention::WORLD);
+      rows_pass(false);
+      if (operational_) project();
+      else finite = sample_selection();
+    });
+    if (!finite) return observe(y, energy, residual, rechoose);
+    v_.noalias() = S_ * Eigen::Map<const VectorXd>(y + nv_, mobility());
+    energy_residual(energy, residual);
+  }
+
+  // S of project_selection (kernels/projection.hpp) without its condition number and span checks (sample); false
+  // where it is not finite.
+  bool sample_selection() {
+    const int nd = static_cast<int>(dependent_.size()), k = static_cast<int>(independent_.size());
+    S_.setZero(nv_, k);
+    for (int j = 0; j < k; ++j) S_(independent_[j], j) = 1.0;
+    if (nd == 0) return true;
+    sel_.Ad.resize(nd, nd);
+    sel_.Ai.resize(nd, k);
+    for (int r = 0; r < nd; ++r) {
+      for (int c = 0; c < nd; ++c) sel_.Ad(r, c) = A_(rows_[r], dependent_[c]);
+      for (int c = 0; c < k; ++c) sel_.Ai(r, c) = A_(rows_[r], independent_[c]);
+    }
+    lu_.compute(sel_.Ad);
+    sel_.Sd = sel_.Ai;
+    for (int c = 0; c < k; ++c) lus_.solve(lu_, sel_.Sd.col(c));
+    if (!sel_.Sd.allFinite()) return false;
+    for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -sel_.Sd.row(r);
+    return true;
   }
 
   // ------------------------------------------------------------------------------------------ constraint forces
@@ -933,9 +990,13 @@ class Evaluator {
             return !stop.load() && !timed_out;
           };
           size_t next = 0;
+          const long rechoices = ev.rechoices_;
           robotdyn::Outcome out = robotdyn::integrate(method, system, y0, 0.0, t_end, samples, next, breaks[i], rtol,
                                                       atol, observer, poll);
-          for (long j = 0; j < count; ++j) ev.observe(yi + j * dim, ei[j], ri[j], rechoose);
+          const bool kept = ev.rechoices_ == rechoices;  // as simulate: the lean pass where the choice was kept
+          for (long j = 0; j < count; ++j)
+            if (kept) ev.sample(yi + j * dim, ei[j], ri[j], rechoose);
+            else ev.observe(yi + j * dim, ei[j], ri[j], rechoose);
           status_out[i] = out.status;
           if (timed_out && out.status == robotdyn::INTERRUPTED) {
             status_out[i] = robotdyn::FAILED;
@@ -1040,6 +1101,7 @@ class Evaluator {
     ts.reserve(samples.size());
     ys.reserve(samples.size() * dim);
     long nfev = 0;
+    const long rechoices = rechoices_;  // (the samples' pass is the lean one where the run makes no re-choice)
     auto system = [&](const robotdyn::State& x, robotdyn::State& dxdt, double t) {
       ++nfev;
       deriv(t, x, dxdt, alpha, profile, rechoose);
@@ -1127,7 +1189,10 @@ class Evaluator {
       }
       energy.resize(ts.size());
       residual.resize(ts.size());
-      for (size_t i = 0; i < ts.size(); ++i) observe(ys.data() + i * dim, energy[i], residual[i], rechoose);
+      const bool kept = rechoices_ == rechoices;  // the run kept its row choice: the lean pass (sample)
+      for (size_t i = 0; i < ts.size(); ++i)
+        if (kept) sample(ys.data() + i * dim, energy[i], residual[i], rechoose);
+        else observe(ys.data() + i * dim, energy[i], residual[i], rechoose);
     }
     const long N = static_cast<long>(ts.size());
     py::dict result;
@@ -1157,7 +1222,8 @@ class Evaluator {
   // "frames", "rows" (constraint rows, residuals, B), "projection", "drift" (drift and w, after RNEA), "reduce"
   // (M_r, h, g_r, B_r), "rhs" (the simulation's right-hand side with the pull-back at gain `alpha`), "pull_back",
   // "gravity" (g from CRBA's composite inertias), "solve" (the right-hand side's LLT of M_r and its solve), "applied"
-  // (springs and compliant wheels; 0 without), "controller" (the feedback law; 0 without), and Pinocchio's own passes
+  // (springs and compliant wheels; 0 without), "controller" (the feedback law; 0 without), "observe" and "sample" (a
+  // run's sample: its energy and residual by the whole configuration pass and by the lean one), and Pinocchio's own passes
   // as a user calls them: "kinematics" (forwardKinematics) and "pinocchio_jacobians" (CRBA + RNEA +
   // computeJointJacobians).
   // The evaluator is left evaluated at (q, nu).
@@ -1235,6 +1301,16 @@ class Evaluator {
       });
     } else {
       t["controller"] = 0.0;
+    }
+    // a run's sample at (q, nu): its energy and residual by observe (the whole configuration pass) and by sample
+    // (the lean pass after a run that kept its row choice)
+    {
+      std::vector<double> y(q0.data(), q0.data() + q0.size());
+      y.insert(y.end(), nu0.data(), nu0.data() + nu0.size());
+      const py::object none = py::none();
+      double energy = 0.0, residual = 0.0;
+      t["observe"] = seconds([&] { observe(y.data(), energy, residual, none); });
+      t["sample"] = seconds([&] { sample(y.data(), energy, residual, none); });
     }
     // Pinocchio's own passes as a user calls them (the floor of issue 26): the joints' placements alone, and CRBA
     // (its default convention) + RNEA + computeJointJacobians, each redoing the kinematics
@@ -1375,6 +1451,7 @@ class Evaluator {
   robotdyn::derivs::Workspace deriv_;  // the derivatives' passes (kernels/reduced_dynamics_derivatives.hpp)
   const double* buffers_[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   int run_ = -1;  // the run a batch thread is on (its rechoice callback gets it), -1 alone
+  long rechoices_ = 0;  // the row choices made by the Python path so far (with_rechoice)
   long generation_ = 0;
 };
 
@@ -1572,6 +1649,12 @@ PYBIND11_MODULE(_compiled, m) {
         if (y.size() != ev.nv() + ev.mobility()) throw std::invalid_argument("y has the wrong length");
         double e, r;
         ev.observe(y.data(), e, r, py::none());
+        return py::make_tuple(e, r);
+      })
+      .def("sample", [](Evaluator& ev, const VectorXd& y) {  // the lean pass of a run that kept its row choice
+        if (y.size() != ev.nv() + ev.mobility()) throw std::invalid_argument("y has the wrong length");
+        double e, r;
+        ev.sample(y.data(), e, r, py::none());
         return py::make_tuple(e, r);
       })
       .def("evaluate_many", &Evaluator::evaluate_many)

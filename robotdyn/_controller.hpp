@@ -49,17 +49,41 @@ struct FrameKinematics {
   const Eigen::Matrix<double, 6, Eigen::Dynamic>* J = nullptr;
 };
 
-// numpy.linalg.pinv(A, rcond): singular values below rcond * the largest dropped.
-inline Eigen::MatrixXd pinv(const Eigen::MatrixXd& A, double rcond) {
-  if (A.size() == 0) return Eigen::MatrixXd::Zero(A.cols(), A.rows());
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+// numpy.linalg.pinv(A, rcond): singular values below rcond * the largest dropped; into P, with the SVD's and the
+// inverted singular values' buffers (kept by the caller: sized once, no allocation per call after the first).
+inline void pinv_into(const Eigen::MatrixXd& A, double rcond, Eigen::JacobiSVD<Eigen::MatrixXd>& svd,
+                      Eigen::VectorXd& inv, Eigen::MatrixXd& P) {
+  if (A.size() == 0) {
+    P.setZero(A.cols(), A.rows());
+    return;
+  }
+  svd.compute(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Eigen::VectorXd& s = svd.singularValues();
   const double cut = rcond * (s.size() ? s[0] : 0.0);
-  Eigen::VectorXd inv = Eigen::VectorXd::Zero(s.size());
+  inv.setZero(s.size());
   for (Eigen::Index i = 0; i < s.size(); ++i)
     if (s[i] > cut) inv[i] = 1.0 / s[i];
-  return svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose();
+  P.noalias() = svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose();
 }
+
+// The buffers of one evaluation of the linearising law (Linearising::eval): owned by each copy of a Controller (one
+// per thread of simulate_many), sized on the first evaluation and reused, so that an evaluation allocates nothing
+// afterwards. Every product is formed into its buffer as the allocating expressions formed it into a temporary,
+// so the torques are the same bits.
+struct LinearisingWork {
+  struct TaskWork {  // one task's rows
+    Eigen::VectorXd y, drift, yr, ydr, yddr, ydot, Jw;
+    Eigen::MatrixXd J, Jp, JS;
+    Eigen::Matrix<double, 3, Eigen::Dynamic> skJ;  // (the type of the temporary it replaces)
+  };
+  std::vector<TaskWork> tasks;  // the primary tasks, then the secondary ones
+  Eigen::MatrixXd A, A2, A2N, P, P2, PA, N, N2, NN, lhs;
+  Eigen::VectorXd b, b2, u, r2, A2u, P2r2, d, Nd, rhs, x, inv, inv2;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd, svd2;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+  std::vector<int> ctrl, free;
+  std::vector<char> is_ctrl;
+};
 
 class Linearising {
  public:
@@ -69,95 +93,108 @@ class Linearising {
       : kp_(kp), kd_(kd), damping_(damping), controlled_(controlled), tasks_(std::move(tasks)),
         secondary_(std::move(secondary)) {}
 
-  // The motor torques (out) at (t, q, nu) from the reduced model (M, h, B, S, w, v) and frame(f) -> kinematics.
+  // The motor torques (out) at (t, q, nu) from the reduced model (M, h, B, S, w, v) and frame(f) -> kinematics, with
+  // the buffers in wk (no allocation once they are sized).
   template <class Frames>
   void eval(double t, const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& nu,
             const Eigen::MatrixXd& M, const Eigen::VectorXd& h, const Eigen::MatrixXd& B, const Eigen::MatrixXd& S,
-            const Eigen::VectorXd& w, const Eigen::VectorXd& v, Frames&& frame, Eigen::Ref<Eigen::VectorXd> out) {
+            const Eigen::VectorXd& w, const Eigen::VectorXd& v, Frames&& frame, Eigen::Ref<Eigen::VectorXd> out,
+            LinearisingWork& wk) {
     const Eigen::Index k = M.rows();
-    Eigen::MatrixXd A;
-    Eigen::VectorXd b;
-    rows(tasks_, t, q, S, w, v, frame, A, b);
-    const Eigen::MatrixXd P = pinv(A, 1e-10);
-    Eigen::VectorXd u = P * b;
-    Eigen::MatrixXd N = Eigen::MatrixXd::Identity(k, k) - P * A;
+    wk.tasks.resize(tasks_.size() + secondary_.size());
+    rows(tasks_, 0, t, q, S, w, v, frame, wk.A, wk.b, wk);
+    pinv_into(wk.A, 1e-10, wk.svd, wk.inv, wk.P);
+    wk.u.noalias() = wk.P * wk.b;
+    wk.PA.noalias() = wk.P * wk.A;
+    wk.N = Eigen::MatrixXd::Identity(k, k) - wk.PA;
     if (!secondary_.empty()) {
-      Eigen::MatrixXd A2;
-      Eigen::VectorXd b2;
-      rows(secondary_, t, q, S, w, v, frame, A2, b2);
-      const Eigen::MatrixXd A2N = A2 * N;
-      const Eigen::MatrixXd P2 = pinv(A2N, 1e-8);
-      const Eigen::VectorXd r2 = b2 - A2 * u;
-      u = u + P2 * r2;
-      const Eigen::MatrixXd N2 = Eigen::MatrixXd::Identity(k, k) - P2 * A2N;
-      N = (N * N2).eval();
+      rows(secondary_, tasks_.size(), t, q, S, w, v, frame, wk.A2, wk.b2, wk);
+      wk.A2N.noalias() = wk.A2 * wk.N;
+      pinv_into(wk.A2N, 1e-8, wk.svd2, wk.inv2, wk.P2);
+      wk.A2u.noalias() = wk.A2 * wk.u;
+      wk.r2 = wk.b2 - wk.A2u;
+      wk.P2r2.noalias() = wk.P2 * wk.r2;
+      wk.u = wk.u + wk.P2r2;
+      wk.PA.noalias() = wk.P2 * wk.A2N;
+      wk.N2 = Eigen::MatrixXd::Identity(k, k) - wk.PA;
+      wk.NN.noalias() = wk.N * wk.N2;
+      wk.N = wk.NN;
     }
     if (damping_ != 0.0) {
-      const Eigen::VectorXd d = damping_ * nu;
-      u -= N * d;
+      wk.d = damping_ * nu;
+      wk.Nd.noalias() = wk.N * wk.d;
+      wk.u -= wk.Nd;
     }
     // computed_torque: M nudot + h = B tau with nudot[controlled] = u[controlled], the free ones unknown
     const Eigen::Index m = B.cols();
-    std::vector<int> ctrl = controlled_, free;
-    if (ctrl.empty())
-      for (int i = 0; i < k; ++i) ctrl.push_back(i);
-    std::vector<char> is_ctrl(k, 0);
-    for (int c : ctrl) is_ctrl[c] = 1;
+    wk.ctrl = controlled_;
+    wk.free.clear();
+    if (wk.ctrl.empty())
+      for (int i = 0; i < k; ++i) wk.ctrl.push_back(i);
+    wk.is_ctrl.assign(k, 0);
+    for (int c : wk.ctrl) wk.is_ctrl[c] = 1;
     for (int i = 0; i < k; ++i)
-      if (!is_ctrl[i]) free.push_back(i);
-    Eigen::MatrixXd lhs(k, m + free.size());
-    lhs.leftCols(m) = B;
-    for (size_t j = 0; j < free.size(); ++j) lhs.col(m + j) = -M.col(free[j]);
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(k);
-    for (int c : ctrl) rhs += M.col(c) * u[c];
-    rhs += h;
-    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(lhs);
-    out += cod.solve(rhs).head(m);
+      if (!wk.is_ctrl[i]) wk.free.push_back(i);
+    wk.lhs.resize(k, m + static_cast<Eigen::Index>(wk.free.size()));
+    wk.lhs.leftCols(m) = B;
+    for (size_t j = 0; j < wk.free.size(); ++j) wk.lhs.col(m + j) = -M.col(wk.free[j]);
+    wk.rhs.setZero(k);
+    for (int c : wk.ctrl) wk.rhs += M.col(c) * wk.u[c];
+    wk.rhs += h;
+    wk.cod.compute(wk.lhs);
+    wk.x = wk.cod.solve(wk.rhs);
+    out += wk.x.head(m);
   }
 
  private:
+  // The rows A (tasks' dimension, k) and right-hand sides b of `tasks`, whose buffers are wk.tasks[first + i].
   template <class Frames>
-  void rows(const std::vector<Task>& tasks, double t, const Eigen::Ref<const Eigen::VectorXd>& q,
+  void rows(const std::vector<Task>& tasks, size_t first, double t, const Eigen::Ref<const Eigen::VectorXd>& q,
             const Eigen::MatrixXd& S, const Eigen::VectorXd& w, const Eigen::VectorXd& v, Frames& frame,
-            Eigen::MatrixXd& A, Eigen::VectorXd& b) {
+            Eigen::MatrixXd& A, Eigen::VectorXd& b, LinearisingWork& wk) {
     int total = 0;
     for (const Task& task : tasks) total += task.dim();
     const Eigen::Index n = S.rows();
     A.resize(total, S.cols());
     b.resize(total);
     int row = 0;
-    for (const Task& task : tasks) {
+    for (size_t ti = 0; ti < tasks.size(); ++ti) {
+      const Task& task = tasks[ti];
+      LinearisingWork::TaskWork& tw = wk.tasks[first + ti];
       const int d = task.dim();
-      Eigen::VectorXd y(d), drift(d), yr(d), ydr(d), yddr(d);
-      Eigen::MatrixXd J(d, n);
+      tw.y.resize(d), tw.drift.resize(d), tw.yr.resize(d), tw.ydr.resize(d), tw.yddr.resize(d);
+      tw.J.resize(d, n);
       if (task.kind == 0) {
         const FrameKinematics f = frame(task.frame);
         const Eigen::Vector3d r = f.R * task.offset;
         const Eigen::Vector3d omega = f.J->bottomRows<3>() * v;
         Eigen::Matrix3d sk;
         sk << 0.0, -r[2], r[1], r[2], 0.0, -r[0], -r[1], r[0], 0.0;
-        const Eigen::MatrixXd Jp = f.J->topRows<3>() - sk * f.J->bottomRows<3>();
+        tw.skJ.noalias() = sk * f.J->bottomRows<3>();
+        tw.Jp = f.J->topRows<3>() - tw.skJ;
         const Eigen::Vector3d dr = f.a + f.alpha.cross(r) + omega.cross(omega.cross(r));
         const Eigen::Vector3d pos = f.p + r;
         for (int i = 0; i < d; ++i) {
-          y[i] = pos[task.select[i]];
-          J.row(i) = Jp.row(task.select[i]);
-          drift[i] = dr[task.select[i]];
+          tw.y[i] = pos[task.select[i]];
+          tw.J.row(i) = tw.Jp.row(task.select[i]);
+          tw.drift[i] = dr[task.select[i]];
         }
       } else {
-        J.setZero();
+        tw.J.setZero();
         for (int i = 0; i < d; ++i) {
-          y[i] = q[task.select[i]];
-          J(i, task.select[i]) = 1.0;
+          tw.y[i] = q[task.select[i]];
+          tw.J(i, task.select[i]) = 1.0;
         }
-        drift.setZero();
+        tw.drift.setZero();
       }
-      task.y->eval(t, yr);
-      task.yd->eval(t, ydr);
-      task.ydd->eval(t, yddr);
-      const Eigen::VectorXd ydot = J * v;
-      A.middleRows(row, d) = J * S;
-      b.segment(row, d) = yddr + kd_ * (ydr - ydot) + kp_ * (yr - y) - J * w - drift;
+      task.y->eval(t, tw.yr);
+      task.yd->eval(t, tw.ydr);
+      task.ydd->eval(t, tw.yddr);
+      tw.ydot.noalias() = tw.J * v;
+      tw.JS.noalias() = tw.J * S;
+      A.middleRows(row, d) = tw.JS;
+      tw.Jw.noalias() = tw.J * w;
+      b.segment(row, d) = tw.yddr + kd_ * (tw.ydr - tw.ydot) + kp_ * (tw.yr - tw.y) - tw.Jw - tw.drift;
       row += d;
     }
   }
@@ -229,17 +266,19 @@ class Controller {
       force_.noalias() = M * nubuf_;
       force_ += h;
       cod_.compute(B);
-      out.noalias() += cod_.solve(force_);
+      solved_ = cod_.solve(force_);  // (into its buffer: no temporary per evaluation)
+      out += solved_;
     }
-    if (lin_) lin_->eval(t, q, nu, M, h, B, S, w, v, frame, out);
+    if (lin_) lin_->eval(t, q, nu, M, h, B, S, w, v, frame, out, lin_work_);
   }
 
  private:
   int motors_ = 0, n_ = 0, k_ = 0;
   std::shared_ptr<TorqueProfile> ff_, qd_, nud_, acc_;
-  std::shared_ptr<Linearising> lin_;  // shared by copies (its evaluation keeps no state)
+  std::shared_ptr<Linearising> lin_;  // shared by copies (its evaluation keeps no state: its buffers are lin_work_)
+  LinearisingWork lin_work_;          // each copy's own (simulate_many's threads)
   Eigen::MatrixXd Kq_, Knu_;
-  Eigen::VectorXd qbuf_, nubuf_, force_;
+  Eigen::VectorXd qbuf_, nubuf_, force_, solved_;
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
 };
 

@@ -13,7 +13,8 @@ from robotdyn.fast import dispatch
 from robotdyn.fast.dispatch import compiled_model
 
 PARTS = ("evaluation", "pinocchio", "crba", "rnea", "frames", "rows", "projection", "drift", "reduce", "rhs",
-         "pull_back", "gravity", "solve", "applied", "controller", "kinematics", "pinocchio_jacobians")
+         "pull_back", "gravity", "solve", "applied", "controller", "observe", "sample", "kinematics",
+         "pinocchio_jacobians")
 OPTIONAL = ("pull_back", "applied", "controller")  # zero where there is nothing to do
 
 

@@ -400,53 +400,6 @@ Outcome run_sampled(Stepper& stepper, System& system, const State& y0, double t0
   return out;
 }
 
-// The step-size controller of the Adams runs: odeint's H211PI controller (detail::pid_step_adjuster with
-// pid_step_adjuster_coefficients<H211PI>, controlled_adams_bashforth_moulton's default), formula for formula, but with
-// its two powers per component taken as one exponential of the largest sum of logarithms:
-//   e_i = abs(err_i) / (atol + rtol (abs(x_i) + dt abs(dxdt_i))),  ratio = min_i e_i^(-b1/(k+1)) p_i^(-b2/(k+1))
-//       = exp(-max_i (b1 log e_i + b2 log p_i) / (k+1))
-// with p the errors of the last accepted step, (b1, b2) = (1/6, 2/6) once two steps were accepted in a row, else
-// (0.7, 0); then ratio <- 1 + atan(ratio - 1), capped at dtmax / dt; a step with ratio < 0.9 is rejected (and the
-// history of accepted steps restarts). The same step sizes as odeint's to rounding, at n logarithms and one
-// exponential per step instead of 2 n powers. Measured on Quasimoro's 90 s manoeuvre (state of 9, 4,637 steps, its
-// closed-form right-hand side): the whole run 5.02 -> 3.98 ms with the Hermite history's storage reused; the samples
-// moved by at most 3.2e-11 (against a 1e-13 reference: 1.51e-9 before, 1.50e-9 after).
-class PiStepAdjuster {
- public:
-  static double threshold() { return 0.9; }
-  explicit PiStepAdjuster(double abs_tol = 1e-6, double rel_tol = 1e-6, double dtmax = 1.0)
-      : atol_(abs_tol), rtol_(rel_tol), dtmax_(dtmax) {}
-  double adjust_stepsize(size_t steps, double dt, State& err, const State& x, const State& dxdt) {
-    const size_t n = err.size();
-    log_.resize(n);
-    if (prev_.size() != n) prev_.assign(n, 0.0), init_ = 0;
-    const bool pi = init_ >= 2;
-    const double b1 = pi ? 1.0 / 6.0 : 0.7, b2 = 2.0 / 6.0, adt = std::fabs(dt);
-    double worst = -std::numeric_limits<double>::infinity();
-    for (size_t i = 0; i < n; ++i) {
-      err[i] = std::fabs(err[i]) / (atol_ + rtol_ * (1.0 * std::fabs(x[i]) + adt * std::fabs(dxdt[i])));
-      log_[i] = std::log(err[i]);
-      const double s = pi ? b1 * log_[i] + b2 * prev_[i] : b1 * log_[i];
-      if (s > worst) worst = s;
-    }
-    double ratio = std::exp(-worst / static_cast<double>(steps + 1));
-    ratio = 1.0 + std::atan(ratio - 1.0);
-    if (ratio * dt >= dtmax_) ratio = dtmax_ / dt;
-    if (ratio >= threshold()) {
-      prev_.swap(log_);
-      ++init_;
-    } else {
-      init_ = 0;
-    }
-    return dt * ratio;
-  }
-
- private:
-  double atol_, rtol_, dtmax_;
-  size_t init_ = 0;
-  State log_, prev_;  // log e of this step and of the last accepted one
-};
-
 // Adams (default), Bulirsch-Stoer or Dormand-Prince 5(4) at tolerances rtol, atol on every component (odeint's
 // error checkers, max norm: |err_i| <= atol + rtol (|y_i| + dt |dy_i/dt|) for adams and dopri5,
 // atol + rtol |y_i| for bulirsch_stoer).
@@ -467,9 +420,8 @@ Outcome integrate(const std::string& method, System& system, const State& y0, do
     // orders up to 10: against 8, 28 % fewer evaluations on Quasimoro's 90 s manoeuvre (9,420 against 13,090) and 7 to
     // 19 % fewer on the linkage's and Quasimoro's controller scenarios, at the same errors against a tight
     // reference; 12 gained nothing more (bench/bench.py controllers)
-    using Adams =
-        odeint::controlled_adams_bashforth_moulton<odeint::adaptive_adams_bashforth_moulton<10, State>, PiStepAdjuster>;
-    Adams stepper(PiStepAdjuster(atol, rtol, 1.0));
+    using Adams = odeint::controlled_adams_bashforth_moulton<odeint::adaptive_adams_bashforth_moulton<10, State>>;
+    Adams stepper(typename Adams::step_adjuster_type(atol, rtol, 1.0));
     return run_sampled(stepper, system, y0, t0, t_end, samples, next, breaks, dt0, observer, poll, event, rtol,
                        atol);
   }

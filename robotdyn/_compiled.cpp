@@ -114,6 +114,7 @@ class Evaluator {
     nv_ = model_.nv;
     data_ = pin::Data(model_);
     zero_.setZero(nv_);
+    bias_fast_ = kernels::bias_forces_apply(model_);
   }
 
   // ----------------------------------------------------------------------------------------------- set-up
@@ -123,6 +124,7 @@ class Evaluator {
     frames_.push_back(static_cast<int>(model_.addFrame(
         pin::Frame(name, static_cast<pin::JointIndex>(joint), 0, placement, pin::OP_FRAME))));
     data_ = pin::Data(model_);
+    crba_at_q_ = false;
     return static_cast<int>(frames_.size()) - 1;
   }
   void set_terrain(int kind, const std::vector<double>& c) {
@@ -187,6 +189,7 @@ class Evaluator {
   // The full-coordinate model at q (for the self-check against the Python model): M, g and RNEA(q, v, a).
   py::tuple full(const VectorXd& q, const VectorXd& v, const VectorXd& a) {
     model_.gravity = gravity_;
+    crba_at_q_ = false, configured_ = false;  // data_ at another q: the next right-hand side configures again
     MatrixXd M = pin::crba(model_, data_, q);
     M.triangularView<Eigen::StrictlyLower>() = M.transpose().triangularView<Eigen::StrictlyLower>();
     VectorXd g = pin::computeGeneralizedGravity(model_, data_, q);
@@ -205,6 +208,7 @@ class Evaluator {
     // one pass: placements, world joint Jacobians, M (upper triangle) and the subtrees' composite inertias, from
     // which g_k = -J_k^T (Y_subtree(k) * gravity): the torque that holds the subtree's weight
     pin::crba(model_, data_, q_, pin::Convention::WORLD);
+    crba_at_q_ = true;  // (bias_pass reuses its joint placements)
     gravity_torques(model_, data_, gravity_, nv_, g_);
     rows_pass(true);
     project();
@@ -214,7 +218,7 @@ class Evaluator {
   // After CRBA's kinematics at q_: the frames' placements and Jacobians, then every constraint's rows (A, residual)
   // and, with `motors`, the motors' columns B.
   void rows_pass(bool motors) {
-    pin::updateFramePlacements(model_, data_);
+    for (int f : frames_) pin::updateFramePlacement(model_, data_, static_cast<pin::FrameIndex>(f));  // those used
     const int m = nrows();
     A_.setZero(m, nv_);
     residual_.setZero(m);
@@ -259,10 +263,17 @@ class Evaluator {
     v_.noalias() = S_ * nu;
     // one pass: RNEA(q, v, 0) without gravity = C v, whose forward sweep leaves the joint velocities and their
     // accelerations at zero joint acceleration (for the drift terms); RNEA(q, v, w) = C v + g + M w
-    pin::rnea(model_, data_, q_, v_, zero_);
+    bias_pass();
     for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) data_.a[i] = data_.a_gf[i];
     drift_pass();
     reduce(data_.M, S_, g_, data_.tau, w_, B_, SM_, Mr_, hr_, gr_, Br_);
+  }
+
+  // RNEA(q_, v_, 0) into data_ (tau = C v): on CRBA's joint placements where configure left them at q_
+  // (kernels/reduced_dynamics.hpp, bias_forces: the same bits), else Pinocchio's own pass.
+  void bias_pass() {
+    if (bias_fast_ && crba_at_q_) kernels::bias_forces(model_, data_, v_, zero_);
+    else pin::rnea(model_, data_, q_, v_, zero_);
   }
 
   py::tuple evaluate(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
@@ -869,6 +880,7 @@ class Evaluator {
   }
   void set_model_vector(const double* x) {
     configured_ = false;
+    crba_at_q_ = false;
     Eigen::Index i = 0;
     auto get_se3 = [&]() {
       Matrix3d R;
@@ -1248,7 +1260,7 @@ class Evaluator {
 #endif
     };
     auto frames = [&] {
-      pin::updateFramePlacements(model_, data_);
+      for (int f : frames_) pin::updateFramePlacement(model_, data_, static_cast<pin::FrameIndex>(f));
       for (size_t f = 0; f < frames_.size(); ++f) {
         Jf_[f].setZero(6, nv_);
         pin::getFrameJacobian(model_, data_, frames_[f], pin::LOCAL_WORLD_ALIGNED, Jf_[f]);
@@ -1264,7 +1276,7 @@ class Evaluator {
     t["evaluation"] = seconds([&] { configure(q0); dynamics(nu0); });
     t["pinocchio"] = seconds([&] {
       pin::crba(model_, data_, q_, pin::Convention::WORLD);
-      pin::rnea(model_, data_, q_, v_, zero_);
+      bias_pass();
       frames();
     });
     t["crba"] = seconds([&] { pin::crba(model_, data_, q_, pin::Convention::WORLD); });
@@ -1272,7 +1284,7 @@ class Evaluator {
     t["rows"] = seconds(rows);
     t["projection"] = seconds([&] { project(); });
     t["rnea"] = seconds([&] {
-      pin::rnea(model_, data_, q_, v_, zero_);
+      bias_pass();
       for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model_.njoints); ++i) data_.a[i] = data_.a_gf[i];
     });
     t["drift"] = seconds(drift);
@@ -1402,6 +1414,8 @@ class Evaluator {
   int op_frame_ = -1;
   bool op_local_ = true, operational_ = false, selected_ = false, configured_ = false;
   bool differencing_ = false;  // a stiff Jacobian's differences are being taken (project skips its span check)
+  bool bias_fast_ = false;    // bias_pass may reuse CRBA's placements (kernels::bias_forces_apply)
+  bool crba_at_q_ = false;    // data_ holds configure's CRBA at q_ for the current model
   // state and work buffers (sized on first use, then reused)
   VectorXd tau_, e_, lambda_, lr_, nudot_, a_;
   RowMat wl_, ww_, wf_, wp_;

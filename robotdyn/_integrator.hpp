@@ -30,6 +30,7 @@
 #include <boost/numeric/odeint/util/odeint_error.hpp>
 #include <boost/numeric/odeint/integrate/integrate_adaptive.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -210,10 +211,14 @@ class HermiteHistory {
   size_t size() const { return t_.size(); }
   double back() const { return t_.back(); }
   void push(double t, const State& x, const State& f) {
-    if (t_.size() == cap_) {
-      t_.erase(t_.begin()), x_.erase(x_.begin()), f_.erase(f_.begin());
+    if (t_.size() == cap_) {  // the oldest point's storage takes the newest (no allocation per step)
+      std::rotate(t_.begin(), t_.begin() + 1, t_.end());
+      std::rotate(x_.begin(), x_.begin() + 1, x_.end());
+      std::rotate(f_.begin(), f_.begin() + 1, f_.end());
+      t_.back() = t, x_.back() = x, f_.back() = f;
+    } else {
+      t_.push_back(t), x_.push_back(x), f_.push_back(f);
     }
-    t_.push_back(t), x_.push_back(x), f_.push_back(f);
     fresh_ = false;
   }
   // The interpolant at s into out (size of a state). The divided differences are computed once per accepted point

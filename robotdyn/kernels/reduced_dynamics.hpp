@@ -25,6 +25,83 @@ inline void gravity_torques(const pin::Model& model, const pin::Data& data, cons
   }
 }
 
+// Whether bias_forces may run on this model: every joint a 1-dof revolute or prismatic joint (axis-aligned or not),
+// whose joint velocity Pinocchio computes without q (calc(data, Blank, v)) and whose bias acceleration c is zero.
+inline bool bias_forces_apply(const pin::Model& model) {
+  for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model.njoints); ++i) {
+    const std::string kind = model.joints[i].shortname();
+    if (!(kind == "JointModelRX" || kind == "JointModelRY" || kind == "JointModelRZ" || kind == "JointModelPX" ||
+          kind == "JointModelPY" || kind == "JointModelPZ" || kind == "JointModelRevoluteUnaligned" ||
+          kind == "JointModelPrismaticUnaligned"))
+      return false;
+  }
+  return true;
+}
+
+// The joint models bias_forces runs on (those of bias_forces_apply): 1-dof revolute and prismatic joints, which
+// compute their velocity without q (calc(data, Blank, v)) and have no bias acceleration. (A composite joint holding
+// a mimic joint does not compile with a velocity-only calc.)
+template <class JointModel>
+struct VelocityOnlyCalc : std::false_type {};
+template <int axis>
+struct VelocityOnlyCalc<pin::JointModelRevoluteTpl<double, 0, axis>> : std::true_type {};
+template <int axis>
+struct VelocityOnlyCalc<pin::JointModelPrismaticTpl<double, 0, axis>> : std::true_type {};
+template <>
+struct VelocityOnlyCalc<pin::JointModelRevoluteUnalignedTpl<double, 0>> : std::true_type {};
+template <>
+struct VelocityOnlyCalc<pin::JointModelPrismaticUnalignedTpl<double, 0>> : std::true_type {};
+
+// RNEA's forward step (Pinocchio's RneaForwardStep, src/algorithm/rnea.hxx, operation for operation) on joint
+// placements already in data: the joint placements jdata.M and data.liMi are CRBA's at the same q (computed by the
+// same formula), so only the joint velocity is recomputed (calc(jdata, Blank, v)).
+struct BiasForwardStep : pin::fusion::JointUnaryVisitorBase<BiasForwardStep> {
+  typedef boost::fusion::vector<const pin::Model&, pin::Data&, const VectorXd&, const VectorXd&> ArgsType;
+  template <typename JointModel>
+  static void algo(const pin::JointModelBase<JointModel>& jmodel,
+                   pin::JointDataBase<typename JointModel::JointDataDerived>& jdata, const pin::Model& model,
+                   pin::Data& data, const VectorXd& v, const VectorXd& a) {
+    if constexpr (!VelocityOnlyCalc<JointModel>::value) {  // (never reached: bias_forces_apply refuses them)
+      throw std::logic_error("bias_forces on a joint without a velocity-only calc");
+    } else {
+      algo_velocity(jmodel, jdata, model, data, v, a);
+    }
+  }
+  template <typename JointModel>
+  static void algo_velocity(const pin::JointModelBase<JointModel>& jmodel,
+                            pin::JointDataBase<typename JointModel::JointDataDerived>& jdata, const pin::Model& model,
+                            pin::Data& data, const VectorXd& v, const VectorXd& a) {
+    const pin::JointIndex i = jmodel.id();
+    const pin::JointIndex parent = model.parents[i];
+    jmodel.derived().calc(jdata.derived(), pin::Blank(), v);
+    data.v[i] = jdata.v();
+    if (parent > 0) data.v[i] += data.liMi[i].actInv(data.v[parent]);
+    data.a_gf[i] = jdata.c() + (data.v[i] ^ jdata.v());
+    data.a_gf[i] += jdata.S() * jmodel.JointMappedVelocitySelector(a);
+    data.a_gf[i] += data.liMi[i].actInv(data.a_gf[parent]);
+    model.inertias[i].__mult__(data.v[i], data.h[i]);
+    model.inertias[i].__mult__(data.a_gf[i], data.f[i]);
+    data.f[i] += data.v[i].cross(data.h[i]);
+  }
+};
+
+// pin::rnea(model, data, q, v, a) after pin::crba(model, data, q, WORLD) at the same q, on a model for which
+// bias_forces_apply holds: the same numbers bit for bit (data.tau, data.v, data.a_gf, data.f), without computing
+// the joint placements a second time. In robotdyn a is zero and the model's gravity is zero: data.tau = C(q, v) v.
+inline void bias_forces(const pin::Model& model, pin::Data& data, const VectorXd& v, const VectorXd& a) {
+  data.tau.setZero();
+  data.v[0].setZero();
+  data.a_gf[0] = -model.gravity;
+  BiasForwardStep::ArgsType arg1(model, data, v, a);
+  for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model.njoints); ++i)
+    BiasForwardStep::run(model.joints[i], data.joints[i], arg1);
+  typedef pin::impl::RneaBackwardStep<double, 0, pin::JointCollectionDefaultTpl> Pass2;
+  Pass2::ArgsType arg2(model, data);
+  for (pin::JointIndex i = static_cast<pin::JointIndex>(model.njoints) - 1; i > 0; --i)
+    Pass2::run(model.joints[i], data.joints[i], arg2);
+  data.tau.array() += model.armature.array() * a.array();
+}
+
 // M_r, h, g_r, B_r from M (CRBA's upper triangle: its lower one is filled here), S, g, Cv (RNEA's C v: g is added to
 // it in place, so it holds C v + g after), w and B; SM = M S is kept (the slipping wheels' system and the constraint
 // forces use it). S, g, w and B are read only (non-const references: Eigen's products of non-const operands, which

@@ -18,8 +18,6 @@ from robotdyn.sweep import load, run
 from robotdyn.sweep.plan import plan
 from robotdyn.sweep.spec import SweepSpecError, from_toml
 
-pytestmark = pytest.mark.filterwarnings("ignore:.*no .independent. given")
-
 BUMP = Path(__file__).resolve().parents[1] / "examples" / "bump_base.toml"
 OPTIONS = dict(t_end=0.02, n_out=5, rtol=1e-9, atol=1e-11)
 
@@ -39,8 +37,7 @@ def test_cvode_sweep_equals_simulate_cvode(tmp_path):
     run(spec, tmp_path / "out", workers=0, progress=False, plot=False)
     row = load(tmp_path / "out").iloc[0]
     assert row["status"] == "ok", row["error"]
-    with pytest.warns(Warning, match="independent velocities"):
-        robot = read(BUMP).robot()
+    robot = read(BUMP).robot()
     scenario = read(BUMP).SCENARIOS["bump"]
     cvode = scenario.run(robot, method="cvode", progress=False, **OPTIONS)
     default = scenario.run(robot, progress=False, **OPTIONS)

@@ -38,7 +38,7 @@ chromium:
 ## directory outside the repository, its outputs kept in $(NB_CACHE) for make docs (tools/notebook_cache.py)
 NB_CACHE := docs/_build/.jupyter_cache
 test: $(STAMP) chromium
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n auto tests  # pytest-xdist: one worker per CPU
 	$(PY) tools/notebook_cache.py execute $(NB_CACHE) notebooks/*.ipynb
 
 ## make docs: the documentation site into docs/_build/html (Sphinx + MyST-NB: the notebooks executed, the API

@@ -75,6 +75,23 @@ using namespace robotdyn::kernels;  // pin, the Eigen names, RowMat, Matrix6x an
 
 namespace {
 
+// Seconds per call of f() over `repeat` calls: this thread's CPU time (the machine may be shared; no Python in the
+// loop), else wall time. Used by Evaluator::profile and derivatives_seconds.
+template <class F>
+double call_seconds(int repeat, F&& f) {
+#ifdef CLOCK_THREAD_CPUTIME_ID
+  timespec a, b;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+  for (int i = 0; i < repeat; ++i) f();
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+  return ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / repeat;
+#else
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < repeat; ++i) f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeat;
+#endif
+}
+
 class Evaluator {
   template <class> friend struct robotdyn::ReducedDerivatives;  // kernels/reduced_dynamics_derivatives.hpp
   template <class> friend struct robotdyn::ContactForcesDerivatives;  // kernels/contact_forces_derivatives.hpp
@@ -734,22 +751,8 @@ class Evaluator {
   // S of project_selection (kernels/projection.hpp) without its condition number and span checks (sample); false
   // where it is not finite.
   bool sample_selection() {
-    const int nd = static_cast<int>(dependent_.size()), k = static_cast<int>(independent_.size());
-    S_.setZero(nv_, k);
-    for (int j = 0; j < k; ++j) S_(independent_[j], j) = 1.0;
-    if (nd == 0) return true;
-    sel_.Ad.resize(nd, nd);
-    sel_.Ai.resize(nd, k);
-    for (int r = 0; r < nd; ++r) {
-      for (int c = 0; c < nd; ++c) sel_.Ad(r, c) = A_(rows_[r], dependent_[c]);
-      for (int c = 0; c < k; ++c) sel_.Ai(r, c) = A_(rows_[r], independent_[c]);
-    }
-    lu_.compute(sel_.Ad);
-    sel_.Sd = sel_.Ai;
-    for (int c = 0; c < k; ++c) lus_.solve(lu_, sel_.Sd.col(c));
-    if (!sel_.Sd.allFinite()) return false;
-    for (int r = 0; r < nd; ++r) S_.row(dependent_[r]) = -sel_.Sd.row(r);
-    return true;
+    if (!kernels::selection_blocks(A_, rows_, independent_, dependent_, nv_, lu_, sel_, S_)) return true;
+    return kernels::selection_solve(dependent_, lus_, lu_, sel_, S_);
   }
 
   // ------------------------------------------------------------------------------------------ constraint forces
@@ -1246,19 +1249,7 @@ class Evaluator {
     const VectorXd q0 = q, nu0 = nu;
     const VectorXd tau = VectorXd::Zero(Br_.cols());
     VectorXd out(nv_ + nu.size());
-    auto seconds = [repeat](auto&& f) {  // this thread's CPU time (the machine may be shared), else wall time
-#ifdef CLOCK_THREAD_CPUTIME_ID
-      timespec a, b;
-      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
-      for (int i = 0; i < repeat; ++i) f();
-      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
-      return ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / repeat;
-#else
-      const auto start = std::chrono::steady_clock::now();
-      for (int i = 0; i < repeat; ++i) f();
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeat;
-#endif
-    };
+    auto seconds = [repeat](auto&& f) { return call_seconds(repeat, f); };
     auto frames = [&] {
       for (int f : frames_) pin::updateFramePlacement(model_, data_, static_cast<pin::FrameIndex>(f));
       for (size_t f = 0; f < frames_.size(); ++f) {
@@ -1526,19 +1517,7 @@ RowMat rhs_many(Evaluator& ev, const Eigen::Ref<const RowMat>& Q, const Eigen::R
 // of 2 (n + k + motors) evaluations is compared with (bench/bench.py trajectory_optimisation_bench).
 py::dict derivatives_seconds(Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau, int repeat) {
   if (repeat < 1) throw std::invalid_argument("repeat must be >= 1");
-  auto seconds = [repeat](auto&& f) {
-#ifdef CLOCK_THREAD_CPUTIME_ID
-    timespec a, b;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
-    for (int i = 0; i < repeat; ++i) f();
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
-    return ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / repeat;
-#else
-    const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < repeat; ++i) f();
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeat;
-#endif
-  };
+  auto seconds = [repeat](auto&& f) { return call_seconds(repeat, f); };
   VectorXd out(ev.nv() + nu.size());
   double sink = 0.0;
   py::dict t;

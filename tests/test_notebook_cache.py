@@ -53,9 +53,9 @@ def test_failing_notebook_fails_the_run_and_the_passing_one_is_served_to_the_doc
     (cache / "executed").mkdir(parents=True)  # a previous run's outputs: emptied first
     assert _tool().main(["execute", str(cache), str(bad), str(good)]) == 1
     out = capsys.readouterr().out
-    assert re.search(r"^bad\.ipynb: FAILED in [\d.]+ s: ZeroDivisionError: division by zero$", out, re.MULTILINE)
+    assert re.search(r"^bad\.ipynb: FAILED(?: in [\d.]+ s)?: ZeroDivisionError: division by zero$", out, re.MULTILINE)
     assert "1 / 0" in out  # the failing cell is shown
-    assert re.search(r"^good\.ipynb: passed in [\d.]+ s$", out, re.MULTILINE)  # ran after the failure
+    assert re.search(r"^good\.ipynb: passed(?: in [\d.]+ s)?$", out, re.MULTILINE)  # runs despite the failure
     assert "notebooks: 1 of 2 failed" in out
 
     store = get_cache(str(cache))

@@ -6,9 +6,9 @@ Usage::
     python tools/notebook_cache.py execute CACHE NOTEBOOK...   # make test: run each, fail if any fails
     python tools/notebook_cache.py drop-stale CACHE            # make docs: forget outputs older than the code
 
-``execute`` empties the cache ``CACHE`` (outputs of older code are never kept), then runs each notebook with
-jupyter-cache's ``temp-serial`` executor: in the venv's kernel, in a fresh temporary directory (outside the
-repository), each cell allowed 900 s, as the docs build allows. A notebook that runs through is stored in the
+``execute`` empties the cache ``CACHE`` (outputs of older code are never kept), then runs the notebooks with
+jupyter-cache's ``temp-parallel`` executor (one process per CPU; ``temp-serial`` on one CPU): each in the venv's
+kernel, in a fresh temporary directory (outside the repository), each cell allowed 900 s, as the docs build allows. A notebook that runs through is stored in the
 cache; one that fails is named with its error, and the command exits with status 1 after running the rest.
 
 ``CACHE`` is MyST-NB's ``nb_execution_cache_path`` (``docs/conf.py``, ``nb_execution_mode = "cache"``): the docs
@@ -26,6 +26,7 @@ cache was empty), so that ``make docs`` never shows outputs of older code.
 from __future__ import annotations
 
 import logging
+import os
 import re
 import shutil
 import sys
@@ -40,7 +41,10 @@ STAMP = "robotdyn-code.stamp"
 TIMEOUT = 900
 """Time allowed to each cell [s] (``nb_execution_timeout`` in docs/conf.py)."""
 EXECUTOR = "temp-serial"
-"""jupyter-cache's executor: one notebook at a time, each in a fresh temporary directory."""
+"""jupyter-cache's executor on one CPU: one notebook at a time, each in a fresh temporary directory."""
+PARALLEL_EXECUTOR = "temp-parallel"
+"""jupyter-cache's executor on several CPUs: the notebooks over a pool of one process per CPU, each in a fresh
+temporary directory (its own kernel); used where the machine has more than one CPU."""
 ANSI = re.compile(r"\x1b\[[0-9;]*m")
 """Terminal colour codes in the kernel's traceback."""
 CELL_ERROR = re.compile(r"^nbclient\.exceptions\.\w+: ", re.MULTILINE)
@@ -133,23 +137,27 @@ def execute(cache: Path, notebooks: list[Path]) -> int:
     logger = logging.getLogger("notebook_cache")
     logger.addHandler(logging.StreamHandler(sys.stderr))
     logger.setLevel(logging.ERROR)  # our own line per notebook; the executor's own failures still shown
-    executor = load_executor(EXECUTOR, store, logger=logger)
+    parallel = (os.cpu_count() or 1) > 1 and len(notebooks) > 1
+    executor = load_executor(PARALLEL_EXECUTOR if parallel else EXECUTOR, store, logger=logger)
     failed: list[str] = []
     start = time.perf_counter()
-    for nb in notebooks:
-        uri = store.add_nb_to_project(str(nb.resolve())).uri
+    uris = [store.add_nb_to_project(str(nb.resolve())).uri for nb in notebooks]
+    batches = [uris] if parallel else [[uri] for uri in uris]  # in parallel: no time per notebook
+    for batch in batches:
         tic = time.perf_counter()
-        result = executor.run_and_cache(filter_uris=[uri], timeout=TIMEOUT, allow_errors=False, force=True)
-        seconds = time.perf_counter() - tic
-        if uri in result.succeeded:
-            print(f"{nb.name}: passed in {seconds:.1f} s", flush=True)
-            continue
-        trace = ANSI.sub("", store.get_project_record(uri).traceback or "(no traceback: see the error above)")
-        cell = CELL_ERROR.search(trace)  # from nbclient's error on (the failing cell), without its own frames
-        trace = trace[cell.start():] if cell else trace
-        last = [line for line in trace.strip().splitlines() if line.strip()][-1]
-        print(f"{nb.name}: FAILED in {seconds:.1f} s: {last}\n{trace}", flush=True)
-        failed.append(f"{nb.name}: {last}")
+        result = executor.run_and_cache(filter_uris=batch, timeout=TIMEOUT, allow_errors=False, force=True)
+        took = "" if parallel else f" in {time.perf_counter() - tic:.1f} s"
+        for uri in batch:
+            name = Path(uri).name
+            if uri in result.succeeded:
+                print(f"{name}: passed{took}", flush=True)
+                continue
+            trace = ANSI.sub("", store.get_project_record(uri).traceback or "(no traceback: see the error above)")
+            cell = CELL_ERROR.search(trace)  # from nbclient's error on (the failing cell), without its own frames
+            trace = trace[cell.start():] if cell else trace
+            last = [line for line in trace.strip().splitlines() if line.strip()][-1]
+            print(f"{name}: FAILED{took}: {last}\n{trace}", flush=True)
+            failed.append(f"{name}: {last}")
     total = time.perf_counter() - start
     if failed:
         print(f"notebooks: {len(failed)} of {len(notebooks)} failed ({total:.0f} s):\n  " + "\n  ".join(failed))

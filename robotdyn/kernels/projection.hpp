@@ -25,20 +25,17 @@ struct SelectionBuffers {
   MatrixXd Ad, Ai, Adinv, Sd;
 };
 
-// S (nv, k) from the constraint rows A with the chosen rows and velocities; leaves A_d's LU factors in lu and its
-// 1-norm condition number (estimated below 1e8, exact above) in cond. Returns false where no velocity is dependent
-// (S a selection, nothing to check), true where check_span should follow.
-inline bool project_selection(const MatrixXd& A, const std::vector<int>& rows, const std::vector<int>& independent,
-                              const std::vector<int>& dependent, int nv, LuSolver& lus,
-                              Eigen::PartialPivLU<MatrixXd>& lu, SelectionBuffers& b, double& cond, MatrixXd& S) {
+// The selection's blocks: S (nv, k) set to the identity on the independent velocities (zero elsewhere), and, where
+// some velocity is dependent, A_d and A_i of the chosen rows (in b) with A_d's LU factors in lu. Returns false where
+// no velocity is dependent (S is then complete).
+inline bool selection_blocks(const MatrixXd& A, const std::vector<int>& rows, const std::vector<int>& independent,
+                             const std::vector<int>& dependent, int nv, Eigen::PartialPivLU<MatrixXd>& lu,
+                             SelectionBuffers& b, MatrixXd& S) {
   const int nd = static_cast<int>(dependent.size());
   const int k = static_cast<int>(independent.size());
   S.setZero(nv, k);
   for (int j = 0; j < k; ++j) S(independent[j], j) = 1.0;
-  if (nd == 0) {
-    cond = 1.0;
-    return false;
-  }
+  if (nd == 0) return false;
   b.Ad.resize(nd, nd);
   b.Ai.resize(nd, k);
   for (int r = 0; r < nd; ++r) {
@@ -46,6 +43,30 @@ inline bool project_selection(const MatrixXd& A, const std::vector<int>& rows, c
     for (int c = 0; c < k; ++c) b.Ai(r, c) = A(rows[r], independent[c]);
   }
   lu.compute(b.Ad);
+  return true;
+}
+
+// S's dependent rows, -A_d^-1 A_i, from the LU factors selection_blocks left; false (S unchanged there) where the
+// solve is not finite (an exactly singular block: a zero pivot).
+inline bool selection_solve(const std::vector<int>& dependent, LuSolver& lus, const Eigen::PartialPivLU<MatrixXd>& lu,
+                            SelectionBuffers& b, MatrixXd& S) {
+  b.Sd = b.Ai;
+  for (Eigen::Index c = 0; c < b.Sd.cols(); ++c) lus.solve(lu, b.Sd.col(c));
+  if (!b.Sd.allFinite()) return false;
+  for (size_t r = 0; r < dependent.size(); ++r) S.row(dependent[r]) = -b.Sd.row(static_cast<Eigen::Index>(r));
+  return true;
+}
+
+// S (nv, k) from the constraint rows A with the chosen rows and velocities; leaves A_d's LU factors in lu and its
+// 1-norm condition number (estimated below 1e8, exact above) in cond. Returns false where no velocity is dependent
+// (S a selection, nothing to check), true where check_span should follow.
+inline bool project_selection(const MatrixXd& A, const std::vector<int>& rows, const std::vector<int>& independent,
+                              const std::vector<int>& dependent, int nv, LuSolver& lus,
+                              Eigen::PartialPivLU<MatrixXd>& lu, SelectionBuffers& b, double& cond, MatrixXd& S) {
+  if (!selection_blocks(A, rows, independent, dependent, nv, lu, b, S)) {
+    cond = 1.0;
+    return false;
+  }
   // The Python path refuses a block whose 1-norm condition number exceeds 1e10 (projection.MAX_CONDITION).
   // LAPACK's estimate (O(n^2), LuSolver::inverse_norm_estimate) decides far from that bound; from an estimate of 1e8
   // on, the exact number (an O(n^3) inverse) decides, as in Python. The exact number is reported by the Python side
@@ -57,10 +78,7 @@ inline bool project_selection(const MatrixXd& A, const std::vector<int>& rows, c
     cond = b.Ad.cwiseAbs().colwise().sum().maxCoeff() * b.Adinv.cwiseAbs().colwise().sum().maxCoeff();
     if (!(std::isfinite(cond) && cond <= 1e10)) throw Fallback("singular");
   }
-  b.Sd = b.Ai;
-  for (int c = 0; c < k; ++c) lus.solve(lu, b.Sd.col(c));
-  if (!b.Sd.allFinite()) throw Fallback("singular");  // an exactly singular block (a zero pivot)
-  for (int r = 0; r < nd; ++r) S.row(dependent[r]) = -b.Sd.row(r);
+  if (!selection_solve(dependent, lus, lu, b, S)) throw Fallback("singular");
   return true;
 }
 

@@ -3,8 +3,13 @@
 The extension uses Pinocchio's C++ headers as installed by the ``pin`` wheel (its ``cmeel.prefix``), Eigen from
 ``cmeel-eigen`` and pybind11; all three are build requirements in pyproject.toml. Without a C++ compiler the build
 of the extension is skipped (``optional``) and robotdyn runs on its Python path alone.
+
+``make venv`` compiles the extension in place (``setup.py build_ext --inplace``, one CPU) while pip installs robotdyn
+editable with ``ROBOTDYN_EXTENSION_IN_PLACE=1`` (no extension: it would compile it a second time) and its
+dependencies on the other CPU.
 """
 
+import os
 import sys
 import sysconfig
 from pathlib import Path
@@ -19,6 +24,8 @@ def _prefix_include(marker: str) -> list[str]:
 
 
 def _extension() -> list[Extension]:
+    if os.environ.get("ROBOTDYN_EXTENSION_IN_PLACE") == "1":  # make venv compiles it in place beside pip (Makefile)
+        return []
     try:
         import pybind11
     except ImportError:

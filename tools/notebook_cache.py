@@ -8,8 +8,9 @@ Usage::
 
 ``execute`` empties the cache ``CACHE`` (outputs of older code are never kept), then runs the notebooks with
 jupyter-cache's ``temp-parallel`` executor (one process per CPU; ``temp-serial`` on one CPU): each in the venv's
-kernel, in a fresh temporary directory (outside the repository), each cell allowed 900 s, as the docs build allows. A notebook that runs through is stored in the
-cache; one that fails is named with its error, and the command exits with status 1 after running the rest.
+kernel, in a fresh temporary directory (outside the repository), each cell allowed 900 s, as the docs build
+allows. A notebook that runs through is stored in the cache; one that fails is named with its error, and the
+command exits with status 1 after running the rest.
 
 ``CACHE`` is MyST-NB's ``nb_execution_cache_path`` (``docs/conf.py``, ``nb_execution_mode = "cache"``): the docs
 build looks each notebook up with jupyter-cache's own key (the code cells' source and the kernel spec), renders

@@ -1461,7 +1461,7 @@ class Evaluator {
 };
 
 // The derivative set at one state by the evaluator's kind (slipping wheels, operational velocities, else the reduced
-// dynamics), the dispatch of the "derivatives" binding: for the batched and timed bindings below.
+// dynamics): for the "derivatives" binding and the batched and timed bindings below.
 robotdyn::derivs::Result derivative_set(Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
   try {
     if (ev.slipping()) return robotdyn::SlidingDerivatives<Evaluator>::run(ev, q, nu, tau);
@@ -1653,17 +1653,7 @@ PYBIND11_MODULE(_compiled, m) {
       .def("evaluate_many", &Evaluator::evaluate_many)
       .def("derivatives",
            [](Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
-             robotdyn::derivs::Result r;
-             try {
-               if (ev.slipping())
-                 r = robotdyn::SlidingDerivatives<Evaluator>::run(ev, q, nu, tau);
-               else if (robotdyn::OperationalDerivatives<Evaluator>::serves(ev))
-                 r = robotdyn::OperationalDerivatives<Evaluator>::run(ev, q, nu, tau);
-               else
-                 r = robotdyn::ReducedDerivatives<Evaluator>::run(ev, q, nu, tau);
-             } catch (const std::domain_error& e) {
-               throw Fallback(e.what());
-             }
+             robotdyn::derivs::Result r = derivative_set(ev, q, nu, tau);
              // moved into the arrays (no copies)
              return py::make_tuple(std::move(r.nudot), std::move(r.dq), std::move(r.dnu), std::move(r.dtau),
                                    std::move(r.v), std::move(r.Vq), std::move(r.S), std::move(r.A));

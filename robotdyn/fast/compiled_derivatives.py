@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import NonFiniteError
+from ..inputs import all_finite
 from ..reduction.dynamics_derivatives import DynamicsDerivatives, position_coordinates
 from .compiled import Fallback
 from .dispatch import compiled_model
@@ -77,8 +78,8 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
     except Fallback:
         return None
     arrays = (nudot, dq, dnu, dtau, Vq)
-    if not _all_finite(arrays):
-        name = ("nudot", "dq", "dnu", "dtau", "dqdot_dq")[[_finite(x) for x in arrays].index(False)]
+    if not all_finite(arrays):
+        name = ("nudot", "dq", "dnu", "dtau", "dqdot_dq")[[all_finite((x,)) for x in arrays].index(False)]
         raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
                              f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g})")
     out = _CompiledDerivatives.__new__(_CompiledDerivatives)
@@ -88,17 +89,6 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
                         _manifold=(A, fast.holonomic,
                                    None if fast.operational is not None else fast._hint.dependent))
     return out
-
-
-def _finite(x: np.ndarray) -> bool:
-    """Whether every entry of ``x`` is finite (``np.isfinite(x).all()``, in a third of its time on small arrays)."""
-    return np.count_nonzero(np.isfinite(x)) == x.size
-
-
-def _all_finite(arrays: tuple) -> bool:
-    """Whether every entry of every array is finite: one test of their concatenation (``ravel("K")`` is a view of
-    the binding's column-major matrices), cheaper than one per array."""
-    return _finite(np.concatenate([x.ravel("K") for x in arrays]))
 
 
 def raw_derivatives(fast, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tuple | None:
@@ -123,7 +113,7 @@ def raw_derivatives(fast, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tup
         out = fast.ev.derivatives(q, nu, tau)
     except Fallback:
         return None
-    return out if _all_finite(out[:6]) else None
+    return out if all_finite(out[:6]) else None
 
 
 __all__ = ["compiled_derivatives", "raw_derivatives"]

@@ -96,14 +96,29 @@ def test_checked_state_follows_joint_limits_changed_in_place():
 
 
 @compiled_only
-def test_derivatives_are_the_binding_s_arrays(quasimoro):
-    """Robot.dynamics_derivatives returns the binding's numbers bit for bit (no conversion on the way)."""
-    r = quasimoro
-    q, nu, tau = admissible_state(r, None, np.random.default_rng(4))
+@pytest.mark.parametrize("name", robotdyn.robots_available())
+def test_the_doors_return_the_binding_s_arrays(name):
+    """Robot.dynamics_derivatives and Robot.reduced return the binding's numbers bit for bit (no conversion on the
+    way), and linearize's A and B are the derivatives' blocks as np.block would stack them, on every built-in
+    robot (at its neutral configuration, random velocities and torques: off the ground is a state like another)."""
+    from robotdyn.reduction.linearization import linearize
+
+    r = robotdyn.load(name)
+    rng = np.random.default_rng(4)
+    q, nu, tau = r.neutral(), rng.normal(size=r.mobility) * 0.5, rng.normal(size=len(r.motors))
     D = r.dynamics_derivatives(q, nu, tau)
-    raw = compiled_model(r).ev.derivatives(q, nu, tau)
-    for name, x in zip(FIELDS, raw):
-        assert getattr(D, name).tobytes() == x.tobytes(), name
+    fast = compiled_model(r)
+    for field, x in zip(FIELDS, fast.ev.derivatives(q, nu, tau)):
+        assert getattr(D, field).tobytes() == x.tobytes(), field
+    red = r.reduced(q, nu)
+    for field, x in zip(("M", "h", "g", "B", "S", "w", "v"), fast.ev.evaluate(q, nu)):
+        assert getattr(red, field).tobytes() == x.tobytes(), field
+    model = linearize(r, q, nu, tau)
+    P = D.positions
+    A = np.block([[(D.dqdot_dq @ D.tangent)[P], D.S[P]], [D.dq_manifold, D.dnu]])
+    B = np.vstack([np.zeros((len(P), D.dtau.shape[1])), D.dtau])
+    assert model.A.tobytes() == A.tobytes() and model.B.tobytes() == B.tobytes()
+    assert np.abs(A[len(P):]).max() > 0  # not a vacuous comparison
 
 
 def _same_as_python(r, q, nu, tau):

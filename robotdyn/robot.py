@@ -24,7 +24,7 @@ from .description.urdf import _ROOT_CHAINS, URDF_DIR, Description, build_descrip
 from .reduction.dynamics import energy
 from .errors import ConstraintError, DescriptionError, InputError, NonFiniteError, RobotDynWarning
 from .contact.friction import make_law
-from .inputs import MAX_ACCELERATION, MAX_ANGLE, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector
+from .inputs import MAX_ACCELERATION, MAX_ANGLE, MAX_FORCE, MAX_POSITION, MAX_VELOCITY, as_vector, within
 from .constraints.loop_closure import LoopClosure
 from .reduction.projection import auto_independent
 from .fast.dispatch import reduce
@@ -370,7 +370,7 @@ class Robot:
         traction pass's memory of the reduced model (an instance attribute ``reduced`` over the method,
         :mod:`robotdyn.contact.traction_memo`: a copy made during a pass is the robot as it is outside it)."""
         state = self.__dict__.copy()
-        for key in ("_local", "_constraint_set", "_compiled_model", "_floating_twin", "reduced"):
+        for key in ("_local", "_constraint_set", "_compiled_model", "_floating_twin", "reduced", "_state_bounds"):
             state.pop(key, None)
         return state
 
@@ -539,6 +539,41 @@ class Robot:
             InputError: Wrong length, or a non-finite or huge value.
         """
         return as_vector(tau, len(self.motors), "tau", [m.name for m in self.motors], MAX_FORCE, "N m or N")
+
+    def checked_state(self, q, nu, tau) -> tuple:
+        """:meth:`check_q`, :meth:`check_nu` and :meth:`check_tau` at once: where all three are float arrays of the
+        right lengths, one vectorised test of their concatenation against the bounds those checks accept (the hot
+        path of a caller evaluating many states, e.g. :meth:`dynamics_derivatives`); anything else goes through the
+        three checks, whose one-line errors name the mistake.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad], ordered as :attr:`coordinates`.
+            nu: Independent velocities (k,) [m/s, rad/s], ordered as :attr:`velocity_names`.
+            tau: Motor torques [N m] or forces [N], one per motor, ordered as :attr:`motors`.
+
+        Returns:
+            ``(q, nu, tau)`` as float arrays (copies: the caller's arrays may change afterwards).
+
+        Raises:
+            InputError: As :meth:`check_q`, :meth:`check_nu`, :meth:`check_tau`.
+        """
+        if type(q) is np.ndarray and type(nu) is np.ndarray and type(tau) is np.ndarray \
+                and q.dtype == nu.dtype == tau.dtype == np.float64:
+            lo, hi = self.description.lower, self.description.upper
+            key = (lo.tobytes(), hi.tobytes(), self.mobility, len(self.motors))
+            bounds = self.__dict__.get("_state_bounds")
+            if bounds is None or bounds[0] != key:  # the bounds check_q/check_nu/check_tau accept, concatenated
+                lower = np.concatenate((np.maximum(lo - 1e-12, -MAX_POSITION), np.full(key[2], -MAX_VELOCITY),
+                                        np.full(key[3], -MAX_FORCE)))
+                upper = np.concatenate((np.minimum(hi + 1e-12, MAX_POSITION), np.full(key[2], MAX_VELOCITY),
+                                        np.full(key[3], MAX_FORCE)))
+                bounds = self._state_bounds = (key, lower, upper)
+            n, k = lo.size, key[2]
+            if q.shape == (n,) and nu.shape == (k,) and tau.shape == (key[3],):
+                x = np.concatenate((q, nu, tau))
+                if within(x, bounds[1], bounds[2]):
+                    return x[:n], x[n:n + k], x[n + k:]
+        return self.check_q(q), self.check_nu(nu), self.check_tau(tau)
 
     def _state(self, q, nu, tau=None, what: str = "nu") -> tuple:
         """``q``, ``nu`` (and ``tau``) as float arrays, their lengths checked (a wrong length is a one-line
@@ -799,25 +834,29 @@ class Robot:
             NonFiniteError: A non-finite result.
         """
         from .fast.compiled_derivatives import compiled_derivatives
-        from .reduction.dynamics_derivatives import dynamics_derivatives
         from .constraints.row_derivatives import kind
 
         sliding = bool(sliding_now(self))
-        python_path = dynamics_derivatives
-        if sliding:
-            from .contact.sliding_derivatives import sliding_derivatives, smooth_sliding
-
-            python_path = sliding_derivatives
         if check:
-            q, nu, tau = self.check_q(q), self.check_nu(nu), self.check_tau(tau)
+            q, nu, tau = self.checked_state(q, nu, tau)
             if sliding:
+                from .contact.sliding_derivatives import smooth_sliding
+
                 smooth_sliding(self)  # the one-line refusal of stick-slip and exact Coulomb friction, on either path
             for c in self.constraints:
                 kind(c, sliding=sliding)  # the one-line refusal of a constraint without derivatives, on either path
         else:  # lengths only (a one-line InputError, never the binding's TypeError); values are the caller's
             q, nu, tau = self._state(q, nu, self.check_tau(tau) if tau is None else tau)
         fast = compiled_derivatives(self, q, nu, tau)  # the compiled twin where the compiled model serves
-        return fast if fast is not None else python_path(self, q, nu, tau)
+        if fast is not None:
+            return fast
+        if sliding:
+            from .contact.sliding_derivatives import sliding_derivatives
+
+            return sliding_derivatives(self, q, nu, tau)
+        from .reduction.dynamics_derivatives import dynamics_derivatives
+
+        return dynamics_derivatives(self, q, nu, tau)
 
     def contact_force_derivatives(self, q, nu, tau):
         """The wheel contact forces (normal load, tangential components in the contact frame) and each wheel's

@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import NonFiniteError
+from ..inputs import all_finite
 from ..reduction.dynamics_derivatives import DynamicsDerivatives, position_coordinates
 from .compiled import Fallback
 from .dispatch import compiled_model
@@ -70,15 +71,15 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
     if fast is None or fast.slip_refusal is not None \
             or not hasattr(fast.ev, "derivatives"):  # (an extension built before the derivatives)
         return None
-    if not fast.ready:
+    if fast._hint is None:  # (not fast.ready)
         fast._choose(q, nu)
     try:
         nudot, dq, dnu, dtau, v, Vq, S, A = fast.ev.derivatives(q, nu, tau)
     except Fallback:
         return None
     arrays = (nudot, dq, dnu, dtau, Vq)
-    if not all(np.isfinite(x).all() for x in arrays):
-        name = ("nudot", "dq", "dnu", "dtau", "dqdot_dq")[[np.isfinite(x).all() for x in arrays].index(False)]
+    if not all_finite(arrays):
+        name = ("nudot", "dq", "dnu", "dtau", "dqdot_dq")[[all_finite((x,)) for x in arrays].index(False)]
         raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
                              f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g})")
     out = _CompiledDerivatives.__new__(_CompiledDerivatives)
@@ -112,7 +113,7 @@ def raw_derivatives(fast, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tup
         out = fast.ev.derivatives(q, nu, tau)
     except Fallback:
         return None
-    return out if all(np.all(np.isfinite(x)) for x in out[:6]) else None
+    return out if all_finite(out[:6]) else None
 
 
 __all__ = ["compiled_derivatives", "raw_derivatives"]

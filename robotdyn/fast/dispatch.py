@@ -73,17 +73,18 @@ def compiled_model(robot) -> CompiledModel | None:
     # overwrite (the robot's Pinocchio data is per thread as well, see Robot.data)
     local = getattr(robot, "_local", None)
     cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
-    gravity = robot.model.gravity.linear
+    gravity = robot.model.gravity.linear.tobytes()  # (bit for bit: a cheaper test than np.array_equal)
+    constraints = robot.constraints
     if cached is not None and (cached[3] is None or cached[3].owner == threading.get_ident()) \
-            and cached[0] == robot.constraints and np.array_equal(cached[1], gravity) and all(
+            and cached[1] == gravity and cached[0] == constraints and all(
         getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r and getattr(c, "law", None) is law
-        for c, (t, r, law) in zip(robot.constraints, cached[2])
+        for c, t, r, law in cached[2]  # (only the constraints that have any of the three: a closure has none)
     ):
         return cached[3]
     fast = CompiledModel(robot) if why_not(robot) is None else None
-    state = [(getattr(c, "terrain", None), getattr(c, "radius", None), getattr(c, "law", None))
-             for c in robot.constraints]
-    entry = (list(robot.constraints), gravity.copy(), state, fast)
+    state = [(c, getattr(c, "terrain", None), getattr(c, "radius", None), getattr(c, "law", None))
+             for c in constraints]
+    entry = (list(constraints), gravity, [s for s in state if s[1:] != (None, None, None)], fast)
     if local is not None:
         local.compiled = entry
     else:

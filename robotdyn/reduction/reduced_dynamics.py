@@ -19,6 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InputError, NonFiniteError
+from ..inputs import all_finite
 from .actuation import input_matrix
 from ..constraints.constraint import ConstraintRows, KinematicState
 from .projection import Projection, project
@@ -287,7 +288,7 @@ def checked(out: ReducedDynamics, q, nu) -> ReducedDynamics:
     Raises:
         NonFiniteError: They are not (a state beyond what double precision holds).
     """
-    if not (np.isfinite(out.M).all() and np.isfinite(out.h).all() and np.isfinite(out.w).all()):
+    if not all_finite((out.M, out.h, out.w)):
         raise NonFiniteError(f"the reduced model at this state is not finite (|q| up to "
                              f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g}): the "
                              "state is beyond what double precision holds")

@@ -983,7 +983,7 @@ class Robot:
             self.check_nu(nudot, "nudot")
         self._refuse_rolling_contact(q, red.v, "inverse dynamics")
         Q = red.M @ nudot + red.h - reduced_applied(self, red, np.asarray(q, float))[0]
-        self._warn_dropped(red, nudot)
+        self._warn_dropped(red, nudot, q)
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)

@@ -61,8 +61,8 @@ def test_drift_estimate_is_the_python_rows_drift_well_within_the_checks_toleranc
 def test_screen_gives_the_exact_checks_violations_and_messages(swerve, monkeypatch):
     """Near the swerve base's zero steering (rear lateral rows coincident, dropped one violated by
     abs(s'_rl - s'_rr) x'), random rear steering rates: the screen's list equals the exact check's at every state,
-    violated or not; forward_dynamics' warning is the exact check's message; a screen that cleared everything would
-    fail here (the violated states are more than half)."""
+    violated or not; forward_dynamics' and inverse_dynamics' warning is the exact check's message; a screen that
+    cleared everything would fail here (the violated states are more than half)."""
     rng = np.random.default_rng(5)
     q = swerve.neutral()
     exact_calls = []
@@ -78,10 +78,11 @@ def test_screen_gives_the_exact_checks_violations_and_messages(swerve, monkeypat
         found = exact(red, nudot)
         assert dropped_rows.violations(swerve, red, q, nudot) == found
         assert messages == ([redundancy.message(found)] if found else [])
+        assert warned(swerve.inverse_dynamics, q, nu, nudot)[1] == messages  # the same check, the same warning
         violated += bool(found)
         if found:
             assert abs(found[0].acceleration) == pytest.approx(abs(nu[2] - nu[3]) * abs(nu[0]), rel=1e-9)
-    assert violated >= 6 and len(exact_calls) >= 2 * violated  # each violated state went to the exact check
+    assert violated >= 6 and len(exact_calls) >= 3 * violated  # each violated state went to the exact check
 
 
 def test_screen_without_a_compiled_model_is_the_exact_check(swerve):

@@ -679,14 +679,16 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar) -> ConstraintForces:
         return out
 
     qt, vt, at = lift(q), lift(v), lift(a)
-    out = _forces(twin, qt, vt, at, tau, None, {}, nudot)  # (the twin's rows: compiled where it serves)
-    if out.residual > TWIN_RESIDUAL:
+    solved = _solve(twin, qt, vt, at, tau, None, {})  # (the twin's rows: compiled where it serves)
+    residual = solved[4]
+    if residual > TWIN_RESIDUAL:  # (the twin's forces are not assembled then)
         planar = planar() if callable(planar) else planar
         planar.undetermined_reason.append(
             f"the wheels cannot hold this planar model's out-of-plane equilibrium (relative residual "
-            f"{out.residual:.3g} on its floating twin): the description lacks a support, so its normal loads stay "
+            f"{residual:.3g} on its floating twin): the description lacks a support, so its normal loads stay "
             "undetermined")
         return planar
+    out = _assemble(twin, solved, nudot, tau, {})
     out.notes.append("normal loads from the out-of-plane equilibrium (vertical force, roll and pitch moments) of the "
                      "same description on a floating root: the planar root's z, roll and pitch are held by the ground")
     return out

@@ -586,7 +586,7 @@ def _normal_open(robot, solved: tuple) -> bool:
     for c in robot.constraints:
         if isinstance(c, RollingWheel) and not getattr(c, "compliant", False):  # (a compliant wheel's is its law's)
             idx = [index[lab] for lab in c._labels()]
-            if not np.linalg.norm(c._directions.T @ N[idx], axis=1)[2] <= DETERMINED_TOL:
+            if not _row_norms(c._directions.T @ N[idx])[2] <= DETERMINED_TOL:
                 return True
     return False
 
@@ -596,7 +596,7 @@ def _assemble(robot, solved: tuple, nudot, tau, friction) -> ConstraintForces:
     rows, lam, N, rank, residual, condition, geometry, compliant = solved
     A = rows.A
     served = isinstance(geometry, dict)
-    determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
+    determined = np.ones(len(lam), bool) if N.shape[1] == 0 else _row_norms(N) <= DETERMINED_TOL
     out = ConstraintForces(list(rows.labels), lam, determined, N, rank, residual, nudot, tau)
     out.condition = condition
     if condition > ILL_DETERMINED:
@@ -623,8 +623,9 @@ def _assemble(robot, solved: tuple, nudot, tau, friction) -> ConstraintForces:
             else:
                 geo = c._geometry(geometry)
                 E, p = geo[9], geo[5]
-            out.wheels.append(_wheel_force(c, E, p, index, lam, N, fr))
-            out._tangential.append(([index[lab] for lab in c._labels()], c._directions, fr))
+            idx = [index[lab] for lab in c._labels()]
+            out.wheels.append(_wheel_force(c, E, p, index, lam, N, fr, idx))
+            out._tangential.append((idx, c._directions, fr))
         elif isinstance(c, LoopClosure):
             out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
                                     if f"{c.name}.{comp}" in index}
@@ -744,16 +745,22 @@ def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale), condition
 
 
+def _row_norms(X: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(X, axis=1)`` of a real 2-D array, by the same operations without its dispatch."""
+    return np.sqrt(np.add.reduce(X * X, axis=1))
+
+
 def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict, lam: np.ndarray,
-                 N: np.ndarray, friction: np.ndarray | None = None) -> WheelForce:
+                 N: np.ndarray, friction: np.ndarray | None = None, idx: list | None = None) -> WheelForce:
     """A wheel's force in its contact frame (E: columns t1, t2, n; contact point p), from its rows' multipliers
-    (row i acts along D[i] of (t1, t2, n)); a slipping wheel's tangential part is its friction force (t1, t2)."""
-    labels = wheel._labels()
-    idx = [index[lab] for lab in labels]
+    (row i acts along D[i] of (t1, t2, n), ``idx``: the rows' indices, by default from ``index`` and its labels); a
+    slipping wheel's tangential part is its friction force (t1, t2)."""
+    if idx is None:
+        idx = [index[lab] for lab in wheel._labels()]
     D = wheel._directions
     force = D.T @ lam[idx]
     if N.shape[1]:
-        determined = np.linalg.norm(D.T @ N[idx], axis=1) <= DETERMINED_TOL
+        determined = _row_norms(D.T @ N[idx]) <= DETERMINED_TOL
         # a direction with no row at all (e.g. the lateral direction of an omni wheel) carries no force: determined
     else:
         determined = np.ones(3, bool)

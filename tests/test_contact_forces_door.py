@@ -1,4 +1,5 @@
-"""robot.contact_forces' cost (issue 26): a planar model's own forces are assembled only where its floating twin
+"""robot.contact_forces' cost (issue 26): a planar model's own forces are solved (where a wheel's normal row is
+exactly zero: it acts on nothing, so its load is open without a solve) and assembled only where its floating twin
 cannot replace them (the twin's only where it can), and the reasons for undetermined rows are found row by row in one vectorised pass; the
 results are those of the eager composition (the planar forces assembled first, then replaced), bit for bit, on a
 robot whose twin holds the loads (QuasiMoRo) and one whose twin cannot (MMR12-EOD, on its two wheels)."""
@@ -47,10 +48,13 @@ def test_lazy_planar_assembly_gives_the_eager_result_bit_for_bit(name, twin_hold
     q, nu, tau = state(robot, name)
     robot.reduced(q, nu)  # (the projection chosen: both compositions below then take the compiled path)
     ref = eager(robot, q, nu, tau)
-    calls = []
-    assemble = cf._assemble
+    calls, solves = [], []
+    assemble, solve = cf._assemble, cf._solve
     monkeypatch.setattr(cf, "_assemble", lambda r, *a: calls.append(r) or assemble(r, *a))
+    monkeypatch.setattr(cf, "_solve", lambda r, *a: solves.append(r) or solve(r, *a))
     got = robot.contact_forces(q, nu, tau=tau)
+    # QuasiMoRo's and the omni platform's planar normal rows are zero (no planar solve); MMR12-EOD's are not
+    assert [r is robot for r in solves] == ([False] if name != "mmr12_eod" else [True, False])
     assert any(TWIN in n for n in got.notes) == twin_holds
     # the twin's forces assembled only where it holds the loads, the planar model's only where it cannot
     assert [r is robot for r in calls] == ([False] if twin_holds else [True])
@@ -84,3 +88,23 @@ def test_reasons_name_the_rows_of_the_row_by_row_tests():
     reasons = cf._reasons(A, labels, N)
     assert len(reasons) == 2 and reasons[0].startswith("rows a.normal act on no coordinate")
     assert "1 combination(s) of rows a.lateral, b.lateral " in reasons[1] and "no normal load" in reasons[1]
+
+
+@pytest.mark.parametrize("name", ["quasimoro", "omni_caster", "mmr12_eod"])
+def test_an_exactly_zero_normal_row_is_an_open_normal_load_after_the_solve(name):
+    """The shortcut's premise, at random states of the planar built-in robots: where _inert_normal sees a zero
+    normal row, the solve's null space leaves that load open (_normal_open); MMR12-EOD's planar normal rows are not
+    zero (its rows involve its tracks' joints), so it always takes the solve."""
+    robot = robotdyn.load(name)
+    rng = np.random.default_rng(10)
+    inert = []
+    for _ in range(4):
+        q = robot.neutral()
+        q[robot.coordinate_index("psi")] = rng.uniform(-3, 3)
+        nu, tau = rng.normal(size=robot.mobility), rng.normal(size=len(robot.motors))
+        red = robot.reduced(q, nu)
+        nudot = solve_mass(red.M, red.B @ tau - red.h)
+        solved = cf._solve(robot, q, red.v, red.S @ nudot + red.w, tau, red.jacobian_rows, {})
+        inert.append(cf._inert_normal(robot, red.jacobian_rows))
+        assert not inert[-1] or cf._normal_open(robot, solved)
+    assert all(inert) == (name != "mmr12_eod") and any(inert) == (name != "mmr12_eod")

@@ -451,19 +451,24 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         else:
             tau = robot.check_tau(tau)
     a = red.S @ nudot + red.w
-    solved = _solve(robot, q, red.v, a, tau, jrows, friction)
+    solve = lambda: _solve(robot, q, red.v, a, tau, jrows, friction)  # noqa: E731
+    solved = None
     unsupported = False  # a planar model whose wheels cannot hold its out-of-plane equilibrium
-    if twin and robot.spec.root == "planar" and not friction and _normal_open(robot, solved):
-        planar = []  # the planar model's own forces: assembled only where the twin cannot replace them
+    use_twin = twin and robot.spec.root == "planar" and not friction
+    if use_twin and not _inert_normal(robot, jrows):  # (a normal row acting on nothing is undetermined: no solve)
+        solved = solve()
+        use_twin = _normal_open(robot, solved)
+    if use_twin:
+        planar = []  # the planar model's own forces: solved and assembled only where the twin cannot replace them
 
         def assemble_planar() -> ConstraintForces:
-            planar.append(_assemble(robot, solved, nudot, tau, friction))
+            planar.append(_assemble(robot, solve() if solved is None else solved, nudot, tau, friction))
             return planar[0]
 
         out = _from_floating_twin(robot, q, red.v, a, tau, nudot, assemble_planar)
         unsupported = bool(planar)
     else:
-        out = _assemble(robot, solved, nudot, tau, friction)
+        out = _assemble(robot, solve() if solved is None else solved, nudot, tau, friction)
     if st is not None and st.lam is not None:  # the loads of the coupled solve (rigid limit with friction)
         apply_rigid_limit(robot, out, st.lam, st.unloaded)
     elif compliance and not friction and not unsupported:  # no equilibrium to split where support is lacking
@@ -574,6 +579,19 @@ def _solve(robot, q, v, a, tau, rows, friction) -> tuple:
     if not (np.all(np.isfinite(lam)) and np.isfinite(residual)):
         raise NonFiniteError(f"constraint forces at this state are not finite (max |e| = {np.max(np.abs(e)):.3g})")
     return rows, lam, N, rank, residual, condition, geometry, compliant
+
+
+def _inert_normal(robot, rows: ConstraintRows) -> bool:
+    """Whether some rigid wheel's normal row is exactly zero in ``rows`` (a planar root's, on flat ground): it acts
+    on no coordinate, so it is a null direction of :math:`A^T` and that wheel's normal load is undetermined
+    (:func:`_normal_open` says so too, after the solve)."""
+    index = {lab: i for i, lab in enumerate(rows.labels)}
+    for c in robot.constraints:
+        if isinstance(c, RollingWheel) and not getattr(c, "compliant", False):
+            i = index.get(f"{c.name}.normal")
+            if i is not None and not rows.A[i].any():
+                return True
+    return False
 
 
 def _normal_open(robot, solved: tuple) -> bool:

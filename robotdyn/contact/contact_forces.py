@@ -548,10 +548,10 @@ def _solve(robot, q, v, a, tau, rows, friction) -> tuple:
     call (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`) and :math:`\\lambda` is made minimum-norm with the
     null space of :math:`A^T` (:func:`_from_basic`), the Python path's choice on undetermined rows; else all of it in
     Python."""
-    served = None if friction else _compiled_forces(robot, q, v, a, tau)
+    fast = None if friction else compiled_model(robot)
+    served = None if fast is None else _compiled_forces(robot, q, v, a, tau, fast)
     if rows is None:  # the rows at (q, v): the compiled evaluation's, else the Python path's
         if served is not None:
-            fast = compiled_model(robot)
             rows = ConstraintRows(served[3], None, np.zeros(len(fast.labels)), fast.holonomic, list(fast.labels))
         else:
             rows = robot.constraint_rows(KinematicState(robot.model, robot.data, q, v))
@@ -559,7 +559,7 @@ def _solve(robot, q, v, a, tau, rows, friction) -> tuple:
     compliant = {}
     if served is not None:  # lambda on the projection's rows and the wheels' contact frames, in C++
         lam_basic, e, (_, _, frames, points), _ = served
-        geometry = {id(w): (f.reshape(3, 3).T, p) for w, f, p in zip(compiled_model(robot).wheels, frames, points)}
+        geometry = {id(w): (f.reshape(3, 3).T, p) for w, f, p in zip(fast.wheels, frames, points)}
         with np.errstate(all="ignore"):
             lam, N, rank, residual, condition = _from_basic(A, e, lam_basic)
     else:
@@ -713,12 +713,13 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar) -> ConstraintForces:
     return out
 
 
-def _compiled_forces(robot, q, v, a, tau):
+def _compiled_forces(robot, q, v, a, tau, fast=None):
     """``(lambda on the projection's rows, e, wheel forces and frames)`` by the robot's compiled model
-    (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`), or ``None`` where it does not serve."""
+    (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`; ``fast``: that model, default ``None``: the robot's),
+    or ``None`` where it does not serve."""
     from ..fast.compiled import Fallback
 
-    fast = compiled_model(robot)
+    fast = compiled_model(robot) if fast is None else fast
     if fast is None:
         return None
     try:

@@ -803,7 +803,7 @@ class Robot:
             raise NonFiniteError("the accelerations at this state are not finite (the state or torques are beyond "
                                  "what double precision holds)")
         if check:
-            self._warn_dropped(red, out)
+            self._warn_dropped(red, out, q)
             self.warn_conditioning(red, out)
         return out
 
@@ -941,10 +941,15 @@ class Robot:
 
         return violations(self.reduced(q, nu), nudot)
 
-    def _warn_dropped(self, red, nudot) -> None:
+    def _warn_dropped(self, red, nudot, q=None) -> None:
         from .constraints.redundancy import message, violations
 
-        found = violations(red, nudot)
+        if q is None:
+            found = violations(red, nudot)
+        else:  # the same check, its Adot pass skipped where the compiled rows prove no violation
+            from .fast.dropped_rows import violations as screened
+
+            found = screened(self, red, q, nudot)
         if found:
             warnings.warn(message(found), RobotDynWarning, stacklevel=3)
 
@@ -978,7 +983,7 @@ class Robot:
             self.check_nu(nudot, "nudot")
         self._refuse_rolling_contact(q, red.v, "inverse dynamics")
         Q = red.M @ nudot + red.h - reduced_applied(self, red, np.asarray(q, float))[0]
-        self._warn_dropped(red, nudot)
+        self._warn_dropped(red, nudot, q)
         if red.B.shape[1] == 0:
             return Q, np.zeros(0), float(np.linalg.norm(Q))
         tau, *_ = np.linalg.lstsq(red.B, Q, rcond=None)

@@ -451,12 +451,24 @@ def constraint_forces(robot, q, nu, tau=None, nudot=None, twin: bool = True, com
         else:
             tau = robot.check_tau(tau)
     a = red.S @ nudot + red.w
-    out = _forces(robot, q, red.v, a, tau, jrows, friction, nudot)
+    solve = lambda: _solve(robot, q, red.v, a, tau, jrows, friction)  # noqa: E731
+    solved = None
     unsupported = False  # a planar model whose wheels cannot hold its out-of-plane equilibrium
-    if twin and robot.spec.root == "planar" and not friction and any(not w.determined[2] for w in out.wheels):
-        planar = out
-        out = _from_floating_twin(robot, q, red.v, a, tau, nudot, out)
-        unsupported = out is planar
+    use_twin = twin and robot.spec.root == "planar" and not friction
+    if use_twin and not _inert_normal(robot, jrows):  # (a normal row acting on nothing is undetermined: no solve)
+        solved = solve()
+        use_twin = _normal_open(robot, solved)
+    if use_twin:
+        planar = []  # the planar model's own forces: solved and assembled only where the twin cannot replace them
+
+        def assemble_planar() -> ConstraintForces:
+            planar.append(_assemble(robot, solve() if solved is None else solved, nudot, tau, friction))
+            return planar[0]
+
+        out = _from_floating_twin(robot, q, red.v, a, tau, nudot, assemble_planar)
+        unsupported = bool(planar)
+    else:
+        out = _assemble(robot, solve() if solved is None else solved, nudot, tau, friction)
     if st is not None and st.lam is not None:  # the loads of the coupled solve (rigid limit with friction)
         apply_rigid_limit(robot, out, st.lam, st.unloaded)
     elif compliance and not friction and not unsupported:  # no equilibrium to split where support is lacking
@@ -524,22 +536,30 @@ def apply_rigid_limit(robot, out: ConstraintForces, lam: np.ndarray | None = Non
 
 def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     """:math:`A^T\\lambda = \\mathrm{RNEA}(q, v, a) - B\\tau - \\sum J_t^T F_t` and the per-wheel and per-closure
-    forces, at a state whose accelerations are known (``rows``: the constraint rows there, ``None``: computed here).
-    Without friction forces and where the robot's compiled model serves, e, :math:`\\lambda` on the projection's
-    rows and the wheels' contact frames come from one compiled call (:meth:`robotdyn.fast.compiled.CompiledModel.
-    forces_at`) and :math:`\\lambda` is made minimum-norm with the null space of :math:`A^T` (:func:`_from_basic`),
-    the Python path's choice on undetermined rows; else all of it in Python."""
-    served = None if friction else _compiled_forces(robot, q, v, a, tau)
+    forces, at a state whose accelerations are known (``rows``: the constraint rows there, ``None``: computed here):
+    :func:`_assemble` of :func:`_solve`."""
+    return _assemble(robot, _solve(robot, q, v, a, tau, rows, friction), nudot, tau, friction)
+
+
+def _solve(robot, q, v, a, tau, rows, friction) -> tuple:
+    """The solve of :func:`_forces`: ``(rows, lam, N, rank, residual, condition, wheel geometry, compliant wheels'
+    states)``, refusing non-finite multipliers in one line. Without friction forces and where the robot's compiled
+    model serves, e, :math:`\\lambda` on the projection's rows and the wheels' contact frames come from one compiled
+    call (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`) and :math:`\\lambda` is made minimum-norm with the
+    null space of :math:`A^T` (:func:`_from_basic`), the Python path's choice on undetermined rows; else all of it in
+    Python."""
+    fast = None if friction else compiled_model(robot)
+    served = None if fast is None else _compiled_forces(robot, q, v, a, tau, fast)
     if rows is None:  # the rows at (q, v): the compiled evaluation's, else the Python path's
         if served is not None:
-            fast = compiled_model(robot)
             rows = ConstraintRows(served[3], None, np.zeros(len(fast.labels)), fast.holonomic, list(fast.labels))
         else:
             rows = robot.constraint_rows(KinematicState(robot.model, robot.data, q, v))
     A = rows.A
+    compliant = {}
     if served is not None:  # lambda on the projection's rows and the wheels' contact frames, in C++
         lam_basic, e, (_, _, frames, points), _ = served
-        geometry = {id(w): (f.reshape(3, 3).T, p) for w, f, p in zip(compiled_model(robot).wheels, frames, points)}
+        geometry = {id(w): (f.reshape(3, 3).T, p) for w, f, p in zip(fast.wheels, frames, points)}
         with np.errstate(all="ignore"):
             lam, N, rank, residual, condition = _from_basic(A, e, lam_basic)
     else:
@@ -547,7 +567,6 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
         kin = KinematicState(model, data, q, v)
         B = input_matrix(robot.motors, kin)
         e = pin.rnea(model, data, q, v, a) - B @ tau
-        compliant = {}
         if has_applied(robot):  # joint springs and compliant wheels (robotdyn.contact.applied_forces)
             app = applied(robot, q, v, kin)
             e -= app.Q
@@ -556,7 +575,46 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
             e -= Jt.T @ force
         with np.errstate(all="ignore"):  # an overflow is refused below as a NonFiniteError, in one line
             lam, N, rank, residual, condition = _solve_transpose(A, e)
-    determined = np.ones(len(lam), bool) if N.shape[1] == 0 else np.linalg.norm(N, axis=1) <= DETERMINED_TOL
+        geometry = kin
+    if not (np.all(np.isfinite(lam)) and np.isfinite(residual)):
+        raise NonFiniteError(f"constraint forces at this state are not finite (max |e| = {np.max(np.abs(e)):.3g})")
+    return rows, lam, N, rank, residual, condition, geometry, compliant
+
+
+def _inert_normal(robot, rows: ConstraintRows) -> bool:
+    """Whether some rigid wheel's normal row is exactly zero in ``rows`` (a planar root's, on flat ground): it acts
+    on no coordinate, so it is a null direction of :math:`A^T` and that wheel's normal load is undetermined
+    (:func:`_normal_open` says so too, after the solve)."""
+    index = {lab: i for i, lab in enumerate(rows.labels)}
+    for c in robot.constraints:
+        if isinstance(c, RollingWheel) and not getattr(c, "compliant", False):
+            i = index.get(f"{c.name}.normal")
+            if i is not None and not rows.A[i].any():
+                return True
+    return False
+
+
+def _normal_open(robot, solved: tuple) -> bool:
+    """Whether some wheel's normal load is undetermined in :func:`_solve`'s result: ``any(not w.determined[2] for w
+    in _assemble(...).wheels)`` (the same test, :func:`_wheel_force`'s), without assembling the forces."""
+    rows, _, N = solved[:3]
+    if N.shape[1] == 0:
+        return False
+    index = {lab: i for i, lab in enumerate(rows.labels)}
+    for c in robot.constraints:
+        if isinstance(c, RollingWheel) and not getattr(c, "compliant", False):  # (a compliant wheel's is its law's)
+            idx = [index[lab] for lab in c._labels()]
+            if not _row_norms(c._directions.T @ N[idx])[2] <= DETERMINED_TOL:
+                return True
+    return False
+
+
+def _assemble(robot, solved: tuple, nudot, tau, friction) -> ConstraintForces:
+    """The :class:`ConstraintForces` of :func:`_solve`'s result: per wheel, per closure, the reasons and notes."""
+    rows, lam, N, rank, residual, condition, geometry, compliant = solved
+    A = rows.A
+    served = isinstance(geometry, dict)
+    determined = np.ones(len(lam), bool) if N.shape[1] == 0 else _row_norms(N) <= DETERMINED_TOL
     out = ConstraintForces(list(rows.labels), lam, determined, N, rank, residual, nudot, tau)
     out.condition = condition
     if condition > ILL_DETERMINED:
@@ -578,13 +636,14 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
             out._tangential.append((idx, c._directions, None) if idx else ([], np.zeros((0, 3)), force[:2]))
         elif isinstance(c, RollingWheel):
             fr = friction.get(c.name, (None, None))[1]
-            if served is not None:
+            if served:
                 E, p = geometry[id(c)]
             else:
-                geo = c._geometry(kin)
+                geo = c._geometry(geometry)
                 E, p = geo[9], geo[5]
-            out.wheels.append(_wheel_force(c, E, p, index, lam, N, fr))
-            out._tangential.append(([index[lab] for lab in c._labels()], c._directions, fr))
+            idx = [index[lab] for lab in c._labels()]
+            out.wheels.append(_wheel_force(c, E, p, index, lam, N, fr, idx))
+            out._tangential.append((idx, c._directions, fr))
         elif isinstance(c, LoopClosure):
             out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
                                     if f"{c.name}.{comp}" in index}
@@ -592,8 +651,6 @@ def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
     if N.shape[1]:
         scale = max(np.abs(A).max(initial=0.0), 1.0)
         out._inert = bool(np.any(np.abs(A).max(axis=1, initial=0.0) <= 1e-12 * scale))
-    if not (np.all(np.isfinite(lam)) and np.isfinite(residual)):
-        raise NonFiniteError(f"constraint forces at this state are not finite (max |e| = {np.max(np.abs(e)):.3g})")
     return out
 
 
@@ -623,7 +680,7 @@ def floating_twin(robot) -> tuple:
     return twin, [names.index("yaw" if j == "psi" else j) for j in robot.description.joint_names]
 
 
-def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) -> ConstraintForces:
+def _from_floating_twin(robot, q, v, a, tau, nudot, planar) -> ConstraintForces:
     """The loads of a planar-root model from its floating twin.
 
     A planar root holds the robot at z = 0, pitch = roll = 0 without saying by what; physically the ground does,
@@ -631,7 +688,8 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
     same state with zero z, pitch and roll rates and accelerations, has those rows active, and the out-of-plane
     equations of motion (vertical force, roll and pitch moments of the whole robot) then determine the normal
     loads. If the wheels cannot hold that equilibrium (e.g. a robot on two wheels with no other support) the
-    residual says so and the planar result is kept, with the reason."""
+    residual says so and the planar result is kept, with the reason. ``planar``: the planar model's
+    :class:`ConstraintForces`, or a function giving them (called only then)."""
     twin, index = floating_twin(robot)
 
     def lift(x):
@@ -640,24 +698,28 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar: ConstraintForces) ->
         return out
 
     qt, vt, at = lift(q), lift(v), lift(a)
-    out = _forces(twin, qt, vt, at, tau, None, {}, nudot)  # (the twin's rows: compiled where it serves)
-    if out.residual > TWIN_RESIDUAL:
+    solved = _solve(twin, qt, vt, at, tau, None, {})  # (the twin's rows: compiled where it serves)
+    residual = solved[4]
+    if residual > TWIN_RESIDUAL:  # (the twin's forces are not assembled then)
+        planar = planar() if callable(planar) else planar
         planar.undetermined_reason.append(
             f"the wheels cannot hold this planar model's out-of-plane equilibrium (relative residual "
-            f"{out.residual:.3g} on its floating twin): the description lacks a support, so its normal loads stay "
+            f"{residual:.3g} on its floating twin): the description lacks a support, so its normal loads stay "
             "undetermined")
         return planar
+    out = _assemble(twin, solved, nudot, tau, {})
     out.notes.append("normal loads from the out-of-plane equilibrium (vertical force, roll and pitch moments) of the "
                      "same description on a floating root: the planar root's z, roll and pitch are held by the ground")
     return out
 
 
-def _compiled_forces(robot, q, v, a, tau):
+def _compiled_forces(robot, q, v, a, tau, fast=None):
     """``(lambda on the projection's rows, e, wheel forces and frames)`` by the robot's compiled model
-    (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`), or ``None`` where it does not serve."""
+    (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`; ``fast``: that model, default ``None``: the robot's),
+    or ``None`` where it does not serve."""
     from ..fast.compiled import Fallback
 
-    fast = compiled_model(robot)
+    fast = compiled_model(robot) if fast is None else fast
     if fast is None:
         return None
     try:
@@ -702,16 +764,22 @@ def _solve_transpose(A: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return lam, N, rank, float(np.linalg.norm(A.T @ lam - e) / scale), condition
 
 
+def _row_norms(X: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(X, axis=1)`` of a real 2-D array, by the same operations without its dispatch."""
+    return np.sqrt(np.add.reduce(X * X, axis=1))
+
+
 def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict, lam: np.ndarray,
-                 N: np.ndarray, friction: np.ndarray | None = None) -> WheelForce:
+                 N: np.ndarray, friction: np.ndarray | None = None, idx: list | None = None) -> WheelForce:
     """A wheel's force in its contact frame (E: columns t1, t2, n; contact point p), from its rows' multipliers
-    (row i acts along D[i] of (t1, t2, n)); a slipping wheel's tangential part is its friction force (t1, t2)."""
-    labels = wheel._labels()
-    idx = [index[lab] for lab in labels]
+    (row i acts along D[i] of (t1, t2, n), ``idx``: the rows' indices, by default from ``index`` and its labels); a
+    slipping wheel's tangential part is its friction force (t1, t2)."""
+    if idx is None:
+        idx = [index[lab] for lab in wheel._labels()]
     D = wheel._directions
     force = D.T @ lam[idx]
     if N.shape[1]:
-        determined = np.linalg.norm(D.T @ N[idx], axis=1) <= DETERMINED_TOL
+        determined = _row_norms(D.T @ N[idx]) <= DETERMINED_TOL
         # a direction with no row at all (e.g. the lateral direction of an omni wheel) carries no force: determined
     else:
         determined = np.ones(3, bool)
@@ -729,14 +797,16 @@ def _reasons(A: np.ndarray, labels: list[str], N: np.ndarray) -> list[str]:
         return []
     out = []
     scale = max(np.abs(A).max(initial=0.0), 1.0)
-    zero = [lab for lab, row in zip(labels, A) if np.abs(row).max(initial=0.0) <= 1e-12 * scale]
+    inert = np.abs(A).max(axis=1, initial=0.0) <= 1e-12 * scale  # (row by row, vectorised)
+    zero = [lab for lab, z in zip(labels, inert) if z]
     if zero:
         out.append(f"rows {', '.join(zero)} act on no coordinate of this model at this configuration (the tree "
                    "already enforces them; a wheel's normal row does so under a planar root, which has no vertical, "
                    "roll or pitch motion: a floating root determines normal loads)")
     others = N.shape[1] - len(zero)
     if others > 0:
-        mixed = sorted({lab for col in N.T for lab, c in zip(labels, col) if abs(c) > DETERMINED_TOL} - set(zero))
+        weighed = np.any(np.abs(N) > DETERMINED_TOL, axis=1)  # rows with a weight in some null-space direction
+        mixed = sorted({lab for lab, w in zip(labels, weighed) if w} - set(zero))
         if any(lab.endswith(".normal") for lab in mixed):
             why = "the rows are redundant, e.g. more wheels than a rigid body needs"
         else:  # only tangential rows: wheels pushing against each other, which normal compliance does not fix

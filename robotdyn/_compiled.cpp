@@ -728,10 +728,10 @@ class Evaluator {
   // A sample's energy and residual after a run that kept its row choice (no re-choice): observe's numbers, the same
   // bits, without what a sample does not use. The choice in force served, and passed its checks at, every
   // evaluation of the run, the evaluations on both sides of the sample included; so the configuration pass here
-  // skips the gravity torques, the motors' columns B and, for a selection of v, the projection's condition and span
-  // checks (projection.hpp's project_selection otherwise, step by step: S from A_d's LU factors). Operational
-  // velocities keep their projection with its checks; springs and compliant wheels (their stored energy) and an S
-  // that is not finite (a zero pivot) go through observe.
+  // skips the gravity torques, the motors' columns B and the projection's condition and span checks
+  // (projection.hpp's project_selection otherwise, step by step: S from A_d's LU factors; for operational
+  // velocities operational_space.hpp's operational_inverse). Springs and compliant wheels (their stored energy) and
+  // an S that is not finite (a zero pivot) go through observe.
   void sample(const double* y, double& energy, double& residual, const py::object& rechoose) {
     if (applied() || !selected_ || differencing_) return observe(y, energy, residual, rechoose);
     bool finite = true;
@@ -740,7 +740,9 @@ class Evaluator {
       q_ = Eigen::Map<const VectorXd>(y, nv_);
       pin::crba(model_, data_, q_, pin::Convention::WORLD);
       rows_pass(false);
-      if (operational_) project();
+      if (operational_)
+        finite = kernels::operational_inverse(A_, rows_, op_select_, model_, data_, frames_[op_frame_], op_local_, nv_,
+                                              K_, Jc_, lu_, Kinv_, S_);
       else finite = sample_selection();
     });
     if (!finite) return observe(y, energy, residual, rechoose);

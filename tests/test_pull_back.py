@@ -104,3 +104,38 @@ def test_correction_is_the_truncated_pseudo_inverse():
     # a row that is a combination of others keeps rank: nothing is dropped below the tolerance
     C = np.vstack([A[:2], A[0] + A[1] + 10 * RANK_TOL * rng.normal(size=6)])
     assert offsets(C, C @ rng.normal(size=6), ["a", "b", "c"]) == {}
+
+
+def test_compiled_pull_back_on_the_columns_rows_move():
+    """The compiled pull-back (robotdyn/kernels/pull_back.hpp) decomposes A_h on its columns that are not exactly zero
+    only. The linkage rover's A_h (22 holonomic rows, 25 coordinates) has such columns: coordinates that enter no
+    holonomic row. Off its closures (psi + 0.03 rad: residuals above 1e-3) at gain 10, q-dot minus v is -10 dq with
+    dq = A_h^+ phi (the Python path's truncated pseudo-inverse, to 1e-10 of its largest entry), and exactly zero on
+    those columns (q-dot there is v, bit for bit), where the pseudo-inverse has no component either."""
+    import robotdyn
+    from robotdyn.fast import dispatch
+    from robotdyn.fast.dispatch import compiled_model
+
+    if not dispatch.enabled():
+        pytest.skip("the compiled fast path is off")
+    robot = robotdyn.load("linkage_suspension")
+    q = robot.neutral().copy()
+    q[robot.coordinates.index("psi")] += 0.03
+    nu, tau = np.array([0.3, -0.2]), np.zeros(len(robot.motors))
+    with use_compiled(False):
+        red = robot.reduced(q, nu)
+    fast = compiled_model(robot)
+    fast.select(red.projection)
+    out = fast.evaluate(q, nu)
+    A, residual, hol = out[7], out[8], np.asarray(fast.holonomic, bool)
+    A_h, phi = A[hol], residual[hol]
+    assert np.abs(phi).max() > 1e-3
+    unmoved = ~np.any(A_h != 0.0, axis=0)
+    assert unmoved.sum() >= 1 and (~unmoved).sum() >= A_h.shape[0] // 2
+    plain, pulled = fast.rhs(q, nu, tau, 0.0), fast.rhs(q, nu, tau, 10.0)
+    n = robot.nq
+    assert np.array_equal(pulled[:n][unmoved], plain[:n][unmoved])
+    assert np.array_equal(pulled[n:], plain[n:])
+    dq = correction(A_h, phi)  # the Python path's truncated pseudo-inverse (an SVD)
+    assert np.abs(dq).max() > 1e-4 and np.abs(dq[unmoved]).max() <= 1e-15 * np.abs(dq).max()
+    assert np.abs((plain[:n] - pulled[:n]) / 10.0 - dq).max() <= 1e-10 * np.abs(dq).max()

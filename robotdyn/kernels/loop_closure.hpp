@@ -30,14 +30,23 @@ inline int closure_rows(const Closure& c, const pin::SE3& M1, const pin::SE3& M2
                         MatrixXd& A, VectorXd& residual) {
   const Matrix3d R1T = M1.rotation().transpose();
   const Vector3d dp = M2.translation() - M1.translation();
+  // only the halves (translation, rotation) that some selected component reads: a ball joint's closure (x y z)
+  // computes no rotation rows and no log3 (each entry of the others the same operations as before: the same bits)
+  bool translation = false, rotation = false;
+  for (int s : c.select) (s < 3 ? translation : rotation) = true;
   Jrel.resize(6, nv);  // relative velocity in frame 1's axes (LoopClosure.jacobian)
-  K3 = J2.topRows<3>() - J1.topRows<3>();
-  K3.noalias() += skew(dp).lazyProduct(J1.bottomRows<3>());
-  Jrel.topRows<3>().noalias() = R1T.lazyProduct(K3);
-  K3 = J2.bottomRows<3>() - J1.bottomRows<3>();
-  Jrel.bottomRows<3>().noalias() = R1T.lazyProduct(K3);
-  const Vector3d e_pos = R1T * dp;
-  const Vector3d e_rot = pin::log3(Matrix3d(R1T * M2.rotation()));
+  Vector3d e_pos = Vector3d::Zero(), e_rot = Vector3d::Zero();
+  if (translation) {
+    K3 = J2.topRows<3>() - J1.topRows<3>();
+    K3.noalias() += skew(dp).lazyProduct(J1.bottomRows<3>());
+    Jrel.topRows<3>().noalias() = R1T.lazyProduct(K3);
+    e_pos = R1T * dp;
+  }
+  if (rotation) {
+    K3 = J2.bottomRows<3>() - J1.bottomRows<3>();
+    Jrel.bottomRows<3>().noalias() = R1T.lazyProduct(K3);
+    e_rot = pin::log3(Matrix3d(R1T * M2.rotation()));
+  }
   for (size_t r = 0; r < c.select.size(); ++r) {
     const int s = c.select[r];
     A.row(row + r) = Jrel.row(s);

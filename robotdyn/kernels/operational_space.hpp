@@ -16,12 +16,13 @@
 namespace robotdyn {
 namespace kernels {
 
-// S (nv, k) and K^-1 from the rows A, the chosen rows and the operational frame fid's selected components; leaves
-// K's LU factors in lu and its exact 1-norm condition number in cond (K, Jc work buffers).
-inline void project_operational(const MatrixXd& A, const std::vector<int>& rows, const std::vector<int>& select,
+// K = [A_r; J_o] from the rows A, the chosen rows and the operational frame fid's selected components, its LU
+// factors (in lu) and K^-1, and S (nv, k), K^-1's last k columns: project_operational without its condition number
+// (a run's sample, after evaluations that all passed it: Evaluator::sample). Returns false where K^-1 is not finite
+// (S is then not set). Jc is a work buffer.
+inline bool operational_inverse(const MatrixXd& A, const std::vector<int>& rows, const std::vector<int>& select,
                                 const pin::Model& model, pin::Data& data, int fid, bool local, int nv, MatrixXd& K,
-                                Matrix6x& Jc, Eigen::PartialPivLU<MatrixXd>& lu, MatrixXd& Kinv, double& cond,
-                                MatrixXd& S) {
+                                Matrix6x& Jc, Eigen::PartialPivLU<MatrixXd>& lu, MatrixXd& Kinv, MatrixXd& S) {
   const int k = static_cast<int>(select.size());
   const int nr = static_cast<int>(rows.size());
   if (nr + k != nv) throw Fallback("operational rows do not match");
@@ -31,10 +32,23 @@ inline void project_operational(const MatrixXd& A, const std::vector<int>& rows,
   pin::getFrameJacobian(model, data, fid, local ? pin::LOCAL : pin::LOCAL_WORLD_ALIGNED, Jc);
   for (int r = 0; r < k; ++r) K.row(nr + r) = Jc.row(select[r]);
   lu.compute(K);
-  Kinv = lu.inverse();
-  cond = K.cwiseAbs().colwise().sum().maxCoeff() * Kinv.cwiseAbs().colwise().sum().maxCoeff();
-  if (!(std::isfinite(cond) && cond <= 1e10) || !Kinv.allFinite()) throw Fallback("singular");
+  // K^-1 as lu.inverse() computes it (Eigen's Inverse<PartialPivLU> assigns lu.solve(I): the same bits), without the
+  // copy of the factors that the Inverse expression holds (three heap allocations per call)
+  Kinv = lu.solve(MatrixXd::Identity(nv, nv));
+  if (!Kinv.allFinite()) return false;
   S = Kinv.rightCols(k);
+  return true;
+}
+
+// S (nv, k) and K^-1 as operational_inverse; leaves K's LU factors in lu and its exact 1-norm condition number in
+// cond; above 1e10, or K^-1 not finite: Fallback (K, Jc work buffers).
+inline void project_operational(const MatrixXd& A, const std::vector<int>& rows, const std::vector<int>& select,
+                                const pin::Model& model, pin::Data& data, int fid, bool local, int nv, MatrixXd& K,
+                                Matrix6x& Jc, Eigen::PartialPivLU<MatrixXd>& lu, MatrixXd& Kinv, double& cond,
+                                MatrixXd& S) {
+  const bool finite = operational_inverse(A, rows, select, model, data, fid, local, nv, K, Jc, lu, Kinv, S);
+  cond = K.cwiseAbs().colwise().sum().maxCoeff() * Kinv.cwiseAbs().colwise().sum().maxCoeff();
+  if (!(std::isfinite(cond) && cond <= 1e10) || !finite) throw Fallback("singular");
 }
 
 // The last k entries of out from entry `base` on: d/dt J_o at zero joint acceleration, times v (after an RNEA pass at

@@ -1157,6 +1157,11 @@ class Robot:
             notes.append(f"at the neutral configuration the wheels do not all touch the ground (contact heights above "
                          f"it: {listed}); a {self.spec.root} root cannot fix that with one height: check the radii, "
                          "the joint values (neutral) or the terrain")
+        if self.spec.root != "fixed":  # an axis in the wrong axes (robotdyn.constraints.rolling_contact.lying_flat)
+            from .constraints.rolling_contact import lying_flat
+
+            notes += lying_flat(self.constraints, KinematicState(self.model, self.data, self.neutral(),
+                                                                 np.zeros(self.model.nv)))
         return {
             "mobility_at_neutral": mobility,
             "mobility_notes": notes,

@@ -280,6 +280,42 @@ class OmniWheel(RollingWheel):
                 f"{np.degrees(self.roller_angle):.6g} deg, terrain={self.terrain!r})")
 
 
+FLAT_TILT = math.pi / 4
+"""Axle tilts from the ground normal [rad] below which :func:`lying_flat` names a wheel (an upright wheel's is
+pi/2; the contact geometry refuses only an axle exactly along the normal)."""
+
+
+def lying_flat(constraints, kin: KinematicState, limit: float = FLAT_TILT) -> list[str]:
+    """One line for each wheel whose axle is within ``limit`` of the terrain's normal under its centre: a wheel
+    lying (almost) flat, whose contact point sits up to a radius to the side of its centre instead of below it, as
+    when ``axis`` is given in the world's axes for a frame that its URDF joint turns (a ROS ``rpy="-1.57 0 0"``).
+
+    Args:
+        constraints: The robot's constraints (its :class:`RollingWheel` and subclasses are checked).
+        kin: The kinematic state (a configuration; its velocity is not used).
+        limit: The tilt [rad] below which a wheel is named (default :data:`FLAT_TILT`).
+
+    Returns:
+        The lines (empty where every wheel stands up).
+    """
+    out = []
+    for c in constraints:
+        if not isinstance(c, RollingWheel):
+            continue
+        placement, _ = kin.pose(c.fid)
+        a = placement.rotation @ c.axis
+        centre = placement.translation
+        n = np.asarray(c.terrain.normal(centre[0], centre[1]), float)
+        tilt = math.acos(min(1.0, abs(float(n @ a)) / float(np.linalg.norm(n))))
+        if tilt < limit:
+            out.append(f"wheel {c.name!r}: its axle {np.round(c.axis, 6).tolist()} (in the axes of frame {c.frame!r}) "
+                       f"is {tilt:.2g} rad from the ground normal (a wheel lying flat: its contact point is "
+                       f"{c.radius * math.cos(tilt):.3g} m to the side of its centre, not below it); expected the "
+                       "wheel's spin axis in that frame's own axes, horizontal in the world (any horizontal axis for "
+                       "a support)")
+    return out
+
+
 class SupportWheel(RollingWheel):
     """A wheel that only touches the ground: the holonomic normal row, no tangential rows (a frictionless
     support, e.g. a free castor or a skid whose friction is neglected). Arguments as :class:`RollingWheel`."""

@@ -33,6 +33,7 @@ import pinocchio as pin
 from ..constraints.row_derivatives import FramePass, velocity_dq, wheel_velocity_dq
 from ..errors import InputError
 from ..reduction.dynamics_derivatives import DynamicsDerivatives, motor_rows, pieces, result
+from ..reduction.joint_springs import spring_terms
 from .friction import ExactCoulomb, LinearTyre, RegularisedCoulomb
 from . import painleve
 from .sliding import PAINLEVE_CONDITION, SlippingWheel, painleve_error, sliding_now, tangential
@@ -153,10 +154,13 @@ def sliding_derivatives(robot, q, nu, tau, pc=None) -> DynamicsDerivatives:
         sel[pos, np.arange(len(wheels))] = 1.0
         painleve.check(Ks, k + np.array(pos), M @ (AR.T @ np.linalg.solve(AR @ AR.T, sel)), wheels, np.array(slip),
                        np.column_stack([J.T @ c for J, c in zip(Jt, coef)]))
-    sol = np.linalg.solve(Ks, B @ tau - pin.rnea(model, tree, q, v, w))
+    Q, dQ_dq, dQ_dv = spring_terms(getattr(robot, "springs", ()), q, v)  # joint springs and dampers (zeros: none)
+    sol = np.linalg.solve(Ks, B @ tau - pin.rnea(model, tree, q, v, w) + Q)
     nudot, lam = sol[:k], sol[k:]
     a = S @ nudot + w
     dtau_dq, dtau_dv, _ = (x.copy() for x in pin.computeRNEADerivatives(model, tree, q, v, a))
+    dtau_dq -= dQ_dq  # Phi's derivatives: the tree's less the springs' (stiffness) and dampers' (damping)
+    dtau_dv -= dQ_dv
     # every column of dA/dq: T[i, j, p] = d A_ij / d q_p (and the slipping wheels' tangential rows likewise)
     units = [FramePass(kin0, e) for e in np.eye(n)]
     T = np.stack([velocity_dq(pc.constraints, fp) for fp in units], axis=1)

@@ -41,10 +41,11 @@ class ManifoldSteps:
         self.positions = np.asarray(positions, int)
         self.dependent = np.setdiff1d(np.arange(n), self.positions)
         self.n = n
+        self.held = set()  # coordinates held at their value (robotdyn.optimisation.held_coordinates): never stepped
 
     def pair(self, q: np.ndarray, i: int, step: float) -> tuple[np.ndarray, np.ndarray] | None:
         """The configurations ``(q+, q-)`` a central difference in coordinate i uses, or ``None`` for a dependent
-        coordinate (its column is zero).
+        coordinate or one in :attr:`held` (its column is zero).
 
         Args:
             q: Natural coordinates (n,) [m, rad].
@@ -58,7 +59,7 @@ class ManifoldSteps:
         Raises:
             ConstraintError: Newton's method does not reach the level set (a singular :math:`A_h[:, d]`).
         """
-        if i not in self.positions:
+        if i not in self.positions or i in self.held:
             return None
         phi0 = self.holonomic(q)[0]
         out = []

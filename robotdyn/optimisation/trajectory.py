@@ -74,6 +74,9 @@ memory)."""
 square of the largest required friction coefficient over wheels and nodes plus ``effort_weight`` times the effort."""
 HOLONOMIC_TOL = 1e-8
 """Largest holonomic residual [m or rad] accepted at q0 (the collocation keeps every node on the manifold)."""
+HELD_TOL = 1e-6
+"""Largest defect [state units] of a held coordinate or velocity (:mod:`robotdyn.optimisation.held_coordinates`)
+accepted at the optimum: their rows are not the NLP's, and a larger one means the motion would leave them."""
 
 
 @dataclass
@@ -189,8 +192,14 @@ class TrajectoryProblem:
             none) [cost units per N^2 m^2 / s]: it suppresses the node-to-node oscillation the trapezoidal rule
             leaves free in directions without inertia of their own (a massless mechanism).
 
+    Where the constraints change rank along a coordinate at q0 (rows redundant only there, e.g. a car whose
+    no-slip wheels allow a roll velocity at zero roll only), that coordinate and the velocity moving it are held at
+    their q0 values (:attr:`held`, :mod:`robotdyn.optimisation.held_coordinates`): no motion of the robot leaves
+    them, and the dynamics refuse every configuration off them.
+
     Raises:
-        InputError: A wrong size, name or bound, non-finite data.
+        InputError: A wrong size, name or bound, non-finite data; an end value, start value or bound asking a held
+            coordinate or velocity to move.
         ConstraintError: q0 off the holonomic constraint manifold (by more than :data:`HOLONOMIC_TOL`).
     """
 
@@ -266,6 +275,8 @@ class TrajectoryProblem:
             self.x_lo[i], self.x_hi[i] = max(lo[0], self.x_lo[i]), min(hi[0], self.x_hi[i])
             if self.x_lo[i] > self.x_hi[i]:
                 raise InputError(f"bounds[{name!r}] = {pair!r} lies outside the joint range of {name}")
+        self.held_rows = np.zeros(0, int)
+        self.held = self._hold_rank_changes()
         x0 = np.concatenate([self.q0, self.nu0])
         for what, x in (("the initial state", x0), ("the final state", self.x_end)):
             bad = [names[i] for i in range(nx) if np.isfinite(x[i]) and not self.x_lo[i] <= x[i] <= self.x_hi[i]]
@@ -301,6 +312,46 @@ class TrajectoryProblem:
         # finite differences in q step along the holonomic level set (a redundant loop would open otherwise)
         self.steps = ManifoldSteps(self._holonomic, self.positions, self.n) if self.mh else None
 
+    def _hold_rank_changes(self) -> list[str]:
+        """Hold, at their q0 values, the coordinates along which the constraints change rank and the velocities that
+        move them (:mod:`robotdyn.optimisation.held_coordinates`: no motion of the robot leaves q0 along them): their
+        bounds become that value and finite differences never step them.
+
+        Returns:
+            The held coordinates' and velocities' names (empty: none).
+
+        Raises:
+            InputError: ``q_end``, ``bounds``, ``nu0`` or ``nu_end`` asking one of them for another value.
+        """
+        from .held_coordinates import held_velocities, rank_changing
+        from .manifold_steps import ManifoldSteps
+
+        held = rank_changing(self.robot, self.q0, self.positions, None if self.steps is None else self.steps.pair)
+        if not held:
+            return []
+        S = self.robot.reduced(self.q0, np.zeros(self.k)).S
+        idx = held + [self.n + j for j in held_velocities(S, held, self.robot.coordinates, self.robot.velocity_names)]
+        value = np.concatenate([self.q0, np.zeros(self.k)])
+        why = (f"the constraints change rank along {', '.join(self.names[i] for i in held)} at q0 (rows redundant "
+               "only there), so no motion leaves it and the optimisation holds")
+        for i in idx:
+            asked = [x for x in (self.x_end[i], self.nu0[i - self.n] if i >= self.n else value[i]) if np.isfinite(x)]
+            if any(x != value[i] for x in asked) or not self.x_lo[i] <= value[i] <= self.x_hi[i]:
+                raise InputError(f"{self.names[i]} is asked to move, but {why} it at {value[i]:g}; expected no end "
+                                 f"value, start value or bound on {self.names[i]} other than {value[i]:g}")
+            self.x_lo[i] = self.x_hi[i] = value[i]
+        if self.steps is None:  # finite differences step through ManifoldSteps, which skips the held coordinates
+            self.steps = ManifoldSteps(self._holonomic, self.positions, self.n)
+            if self.limits is not None:
+                self.limits.steps = self.steps
+        self.steps.held = set(held)
+        # their defects are not constraints of the NLP: a held coordinate's is 0 = 0, a held velocity's (its
+        # acceleration at the nodes) is implied to first order by the holonomic rows at the held coordinates, and
+        # kept would leave the constraints' Jacobian rank-deficient; solve() checks them at the optimum instead
+        self.held_rows = np.asarray(idx, int)
+        self.keep = self.keep[~np.isin(self.keep, idx)]
+        return [self.names[i] for i in idx]
+
     def _holonomic(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The independent holonomic rows' residuals (mh,) [m or rad] at q and their Jacobian (mh, n) (the rows
         A_h, exactly the residuals' gradient on the manifold)."""
@@ -316,7 +367,7 @@ class TrajectoryProblem:
                 f"derivatives={self.derivatives!r}"
                 + ("" if self.limits is None else f", min_load={self.limits.min_load}, mu_max={self.limits.mu_max}")
                 + ("" if self.cost_kind == "effort" else f", cost='peak-mu', effort_weight={self.effort_weight:g}")
-                + ")")
+                + (f", held={self.held} (the constraints change rank along them)" if self.held else "") + ")")
 
     # --- the dynamics at the nodes -------------------------------------------------------------------------------
 
@@ -385,6 +436,9 @@ class TrajectoryProblem:
         y = np.concatenate([x, u])
         J = np.empty((self.nx, y.size))
         for i in range(y.size):
+            if i < self.nx and self.x_lo[i] == self.x_hi[i]:  # a variable its bounds fix: IPOPT never uses its column
+                J[:, i] = 0.0
+                continue
             step = np.cbrt(np.finfo(float).eps) * (1.0 + abs(y[i]))
             yp, ym = y.copy(), y.copy()
             yp[i] += step
@@ -647,6 +701,9 @@ class TrajectoryProblem:
         g = self.constraints(zopt)
         nd = (N - 1) * (len(self.keep) + self.mh)
         max_defect = float(np.max(np.abs(g[:nd])))
+        held = float(np.max(np.abs(self.defects(zopt).reshape(N - 1, nx)[:, self.held_rows]), initial=0.0))
+        success = bool(stats["success"]) and held <= HELD_TOL  # the held rows' defects (see _hold_rank_changes)
+        max_defect = max(max_defect, held)
         t = np.linspace(0.0, self.t_end, N)
         forces, wheels = None, []
         if self.limits is not None:
@@ -654,7 +711,9 @@ class TrajectoryProblem:
             wheels = list(self.limits.wheels)
         effort = float(np.sum(np.repeat(w, m) * U.ravel() ** 2))
         return TrajectorySolution(t, X[:, :self.n].copy(), X[:, self.n:].copy(), U.copy(), float(res["f"]),
-                                  str(stats["return_status"]), bool(stats["success"]), int(stats["iter_count"]),
+                                  str(stats["return_status"]) + ("" if success or not stats["success"] else
+                                                                 f"; held rows' largest defect {held:.2g}"),
+                                  success, int(stats["iter_count"]),
                                   wall, calls["dynamics"], calls["derivatives"], max_defect, self.derivatives,
                                   list(self.robot.coordinates), list(self.robot.velocity_names),
                                   [mo.name for mo in self.robot.motors], forces=forces, wheels=wheels,
@@ -707,4 +766,4 @@ def _fmt(a: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:g}" for v in a) + "]"
 
 
-__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES", "COSTS", "HOLONOMIC_TOL"]
+__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES", "COSTS", "HOLONOMIC_TOL", "HELD_TOL"]

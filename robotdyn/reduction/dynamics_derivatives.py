@@ -55,6 +55,7 @@ from ..errors import InputError, NonFiniteError
 from .actuation import input_matrix
 from .operational_space import project_operational
 from .projection import _pivoted_qr, independent_rows, project
+from .joint_springs import spring_terms
 from .reduced_dynamics import constraint_set, solve_mass
 
 
@@ -379,10 +380,13 @@ def dynamics_derivatives(robot, q, nu, tau, pc: Pieces | None = None) -> Dynamic
     model, tree, v, w, B = pc.model, pc.tree, pc.v, pc.w, pc.B
     Mr = S.T @ M @ S
     Br = S.T @ B
-    nudot = solve_mass(Mr, Br @ tau - S.T @ pin.rnea(model, tree, q, v, w))
+    Q, dQ_dq, dQ_dv = spring_terms(getattr(robot, "springs", ()), q, v)  # joint springs and dampers (zeros: none)
+    nudot = solve_mass(Mr, Br @ tau - S.T @ (pin.rnea(model, tree, q, v, w) - Q))
     a = S @ nudot + w
-    rho = pin.rnea(model, tree, q, v, a) - B @ tau
+    rho = pin.rnea(model, tree, q, v, a) - B @ tau - Q
     dtau_dq, dtau_dv, _ = (x.copy() for x in pin.computeRNEADerivatives(model, tree, q, v, a))
+    dtau_dq -= dQ_dq  # rho's derivatives: the tree's less the springs' (stiffness) and dampers' (damping)
+    dtau_dv -= dQ_dv
     # dS^T rho = -S^T dK^T mu
     P = pc.P
     muA, muJ = P.multiplier(rho)

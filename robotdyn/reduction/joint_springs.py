@@ -112,6 +112,28 @@ class SpringForce:
                 f"{self.unit})")
 
 
+def spring_terms(springs, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The springs' generalised force and its derivatives, for the dynamics' derivatives
+    (:mod:`robotdyn.reduction.dynamics_derivatives`, :mod:`robotdyn.contact.sliding_derivatives`).
+
+    Args:
+        springs: The robot's :class:`SpringForce` list (empty: zeros).
+        q: Natural coordinates (n,) [m, rad].
+        v: Full velocities (n,) [m/s, rad/s] (natural coordinates: nq == nv).
+
+    Returns:
+        ``(Q, dQ/dq, dQ/dv)``: Q (n,) [N, N m] and its Jacobians (n, n), diagonal: :math:`-k` and :math:`-c` at each
+        spring's coordinate.
+    """
+    n = len(v)
+    Q, dq, dv = np.zeros(n), np.zeros((n, n)), np.zeros((n, n))
+    for s in springs:
+        Q[s.index] += s.force(q, v)
+        dq[s.index, s.index] -= s.stiffness
+        dv[s.index, s.index] -= s.damping
+    return Q, dq, dv
+
+
 def build_springs(robot, springs) -> list[SpringForce]:
     """The robot's :class:`SpringForce` list from its spec's :class:`JointSpring` declarations.
 
@@ -145,4 +167,4 @@ def build_springs(robot, springs) -> list[SpringForce]:
     return out
 
 
-__all__ = ["JointSpring", "SpringForce", "build_springs"]
+__all__ = ["JointSpring", "SpringForce", "build_springs", "spring_terms"]

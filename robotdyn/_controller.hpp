@@ -66,42 +66,6 @@ inline void pinv_into(const Eigen::MatrixXd& A, double rcond, Eigen::JacobiSVD<E
   P.noalias() = svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose();
 }
 
-// The buffers of cod_solve (sized on its first call, reused after).
-struct CodSolveWork {
-  Eigen::VectorXd c, temp, y;
-};
-
-// x = cod.solve(rhs) for one right-hand side, step for step as Eigen 3.4's CompleteOrthogonalDecomposition::
-// _solve_impl computes it (the same operations in the same order: the same bits), but into the caller's buffers:
-// Eigen's own allocates its copy of rhs, the Z transformation's temporary and the in-place permutation's mask on
-// every call. c = Q^T rhs; T z = c[:rank]; y = Z^T [z; 0]; x = P y.
-inline void cod_solve(const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>& cod, const Eigen::VectorXd& rhs,
-                      CodSolveWork& w, Eigen::VectorXd& x) {
-  const Eigen::Index rank = cod.rank(), cols = cod.cols();
-  x.resize(cols);
-  if (rank == 0) {
-    x.setZero();
-    return;
-  }
-  w.c = rhs;
-  w.c.applyOnTheLeft(cod.matrixQ().setLength(rank).adjoint());  // (its workspace is fixed-size for a vector)
-  x.topRows(rank) = cod.matrixT().topLeftCorner(rank, rank).template triangularView<Eigen::Upper>().solve(
-      w.c.topRows(rank));
-  if (rank < cols) {  // applyZAdjointOnTheLeftInPlace, with the temporary kept
-    x.bottomRows(cols - rank).setZero();
-    w.temp.resize(cols);
-    for (Eigen::Index k = 0; k < rank; ++k) {
-      if (k != rank - 1) x.row(k).swap(x.row(rank - 1));
-      x.middleRows(rank - 1, cols - rank + 1)
-          .applyHouseholderOnTheLeft(cod.matrixQTZ().row(k).tail(cols - rank).adjoint(), cod.zCoeffs()(k),
-                                     &w.temp(0));
-      if (k != rank - 1) x.row(k).swap(x.row(rank - 1));
-    }
-  }
-  w.y.noalias() = cod.colsPermutation() * x;  // (not in place: the in-place product allocates a mask)
-  x = w.y;
-}
-
 // The buffers of one evaluation of the linearising law (Linearising::eval): owned by each copy of a Controller (one
 // per thread of simulate_many), sized on the first evaluation and reused, so that an evaluation allocates nothing
 // afterwards. Every product is formed into its buffer as the allocating expressions formed it into a temporary,
@@ -117,7 +81,6 @@ struct LinearisingWork {
   Eigen::VectorXd b, b2, u, r2, A2u, P2r2, d, Nd, rhs, x, inv, inv2;
   Eigen::JacobiSVD<Eigen::MatrixXd> svd, svd2;
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
-  CodSolveWork cod_work;
   std::vector<int> ctrl, free;
   std::vector<char> is_ctrl;
 };
@@ -179,7 +142,7 @@ class Linearising {
     for (int c : wk.ctrl) wk.rhs += M.col(c) * wk.u[c];
     wk.rhs += h;
     wk.cod.compute(wk.lhs);
-    cod_solve(wk.cod, wk.rhs, wk.cod_work, wk.x);
+    wk.x = wk.cod.solve(wk.rhs);
     out += wk.x.head(m);
   }
 
@@ -303,7 +266,7 @@ class Controller {
       force_.noalias() = M * nubuf_;
       force_ += h;
       cod_.compute(B);
-      cod_solve(cod_, force_, cod_work_, solved_);  // (into its buffers: no allocation per evaluation)
+      solved_ = cod_.solve(force_);  // (into its buffer: no temporary per evaluation)
       out += solved_;
     }
     if (lin_) lin_->eval(t, q, nu, M, h, B, S, w, v, frame, out, lin_work_);
@@ -317,7 +280,6 @@ class Controller {
   Eigen::MatrixXd Kq_, Knu_;
   Eigen::VectorXd qbuf_, nubuf_, force_, solved_;
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
-  CodSolveWork cod_work_;
 };
 
 }  // namespace robotdyn

@@ -32,6 +32,9 @@ struct Workspace {
   std::vector<WheelGeometryDq> geo;
   MatrixXd dgam_q, Adot;
   Matrix6x dJ1, dJ2;
+  // run()'s work matrices, kept between calls (sized on first use: no allocation per derivative set)
+  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Ygd, Ad, dgam_v, Wnu, Aq, L, G, ST, STM;
+  VectorXd a, rho, rd, mu;
 };
 
 // The outputs (DynamicsDerivatives' analytic contents, SI units).
@@ -68,7 +71,7 @@ struct ReducedDerivatives {
         fp.velocity(model, fid, ev.data_.oMf[fid], J);
         const double xR = wh.radius_index >= 0 ? fp.x[wh.radius_index] : 0.0;
         const int nd = static_cast<int>(wh.D.rows());
-        derivs::wheel_velocity_dq(g, ev.deriv_.geo[i], MatrixXd(wh.D), fp.V[fid], fp.dV[fid], xR,
+        derivs::wheel_velocity_dq(g, ev.deriv_.geo[i], wh.D, fp.V[fid], fp.dV[fid], xR,
                                   out.middleRows(g.row, nd));
       } else if (kind == 1) {
         const auto& c = ev.closures_[i];
@@ -136,7 +139,7 @@ struct ReducedDerivatives {
         fp.acceleration(model, fid, ev.data_.oMf[fid], J);
         fp.jacobian_dot(model, fid, ws.dJ1);
         const int nd = static_cast<int>(wh.D.rows());
-        derivs::wheel_drift_dq(g, ws.geo[i], MatrixXd(wh.D), ev.terrain_, ev.terrain_.flat(), J, wh.radius_index, fp.x,
+        derivs::wheel_drift_dq(g, ws.geo[i], wh.D, ev.terrain_, ev.terrain_.flat(), J, wh.radius_index, fp.x,
                                fp.V[fid], fp.dV[fid], fp.Acc[fid], fp.dAcc[fid], ws.dJ1, ev.Aw_[i],
                                dgam.middleRows(g.row, nd), Adot.middleRows(g.row, nd));
       } else if (kind == 1) {
@@ -186,18 +189,25 @@ struct ReducedDerivatives {
     const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
     derivs::Result out;
     const Eigen::LLT<MatrixXd> llt = reduced_mass(ev, tau, out);
-    const VectorXd a = S * out.nudot + w;
+    VectorXd& a = ws.a;  // (the work matrices are the workspace's: no allocation once sized)
+    a.noalias() = S * out.nudot;
+    a += w;
     frame_passes(ev, [](int, derivs::FramePass&) {}, nu.data());
     const MatrixXd& dA_w = ws.dA[k];
     const MatrixXd& dA_v = ws.dA[k + 1];
-    const MatrixXd dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
+    MatrixXd& dgam_v = ws.dgam_v;
+    dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
     // the projection's three solves in one: with Y = K^-1 [d(K v)/dq, d(K gamma)/dv, d(K a)/dq + dgamma/dq at fixed
     // v] (dependent rows), dv/dq = -Y_v (v = S(q) nu), W_nu = -Y_g S, and Aq = -(Y_a + Y_g dv/dq) (Pieces.Aq)
     const int nd = static_cast<int>(ev.dependent_.size());
     out.Vq = MatrixXd::Zero(n, n);
-    MatrixXd Wnu = MatrixXd::Zero(n, k), Aq = MatrixXd::Zero(n, n);
+    MatrixXd& Wnu = ws.Wnu;
+    MatrixXd& Aq = ws.Aq;
+    Wnu.setZero(n, k);
+    Aq.setZero(n, n);
     if (nd) {
-      MatrixXd X(nd, 3 * n);
+      MatrixXd& X = ws.X;
+      X.resize(nd, 3 * n);
       for (int r = 0; r < nd; ++r) {
         const int row = ev.rows_[r];
         X.row(r).segment(0, n) = dA_v.row(row);
@@ -206,12 +216,17 @@ struct ReducedDerivatives {
         xa = dA_w.row(row) + ws.dgam_q.row(row);
         for (int l = 0; l < k; ++l) xa += out.nudot[l] * ws.dA[l].row(row);
       }
-      const MatrixXd Y = ev.lu_.solve(X);
-      MatrixXd Vd = -Y.leftCols(n);  // dependent rows of dv/dq
-      const MatrixXd Wd = -Y.middleCols(n, n) * S;
-      MatrixXd Ygd(nd, nd);  // Y_g's dependent columns: Vq is zero off the dependent rows
+      MatrixXd& Y = ws.Y;
+      Y = ev.lu_.solve(X);
+      MatrixXd& Vd = ws.Vd;  // dependent rows of dv/dq
+      Vd = -Y.leftCols(n);
+      MatrixXd& Wd = ws.Wd;
+      Wd.noalias() = -Y.middleCols(n, n) * S;
+      MatrixXd& Ygd = ws.Ygd;  // Y_g's dependent columns: Vq is zero off the dependent rows
+      Ygd.resize(nd, nd);
       for (int r = 0; r < nd; ++r) Ygd.col(r) = Y.col(n + ev.dependent_[r]);
-      MatrixXd Ad = -Y.rightCols(n);
+      MatrixXd& Ad = ws.Ad;
+      Ad = -Y.rightCols(n);
       Ad.noalias() -= Ygd * Vd;  // -(Y_a + Y_g Vq)
       for (int r = 0; r < nd; ++r) {
         const int i = ev.dependent_[r];
@@ -221,21 +236,35 @@ struct ReducedDerivatives {
       }
     }
     // the tree: RNEA(q, v, a) and its derivatives, with gravity
-    MatrixXd dtau_dq, dtau_dv;
+    MatrixXd& dtau_dq = ws.dtau_dq;
+    MatrixXd& dtau_dv = ws.dtau_dv;
     tree(ev, a, dtau_dq, dtau_dv);
-    const VectorXd rho = ws.tree.tau - ev.B_ * tau;
+    VectorXd& rho = ws.rho;
+    rho.noalias() = ev.B_ * tau;
+    rho = ws.tree.tau - rho;
     // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d
-    MatrixXd L = MatrixXd::Zero(k, n);
+    MatrixXd& L = ws.L;
+    L.setZero(k, n);
     if (nd) {
-      VectorXd rd(nd);
+      VectorXd& rd = ws.rd;
+      rd.resize(nd);
       for (int r = 0; r < nd; ++r) rd[r] = rho[ev.dependent_[r]];
-      const VectorXd mu = ev.lu_.transpose().solve(rd);
+      VectorXd& mu = ws.mu;
+      mu = ev.lu_.transpose().solve(rd);
       for (int l = 0; l < k; ++l)
         for (int r = 0; r < nd; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
     }
     // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot: from the one solve above
-    const MatrixXd ST = S.transpose();
-    MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * out.Vq + (ST * M) * Aq;
+    MatrixXd& ST = ws.ST;
+    ST = S.transpose();
+    MatrixXd& G = ws.G;  // -L + S^T dtau_dq + (S^T dtau_dv) Vq + (S^T M) Aq
+    G = -L;
+    G.noalias() += ST * dtau_dq;
+    MatrixXd& STM = ws.STM;
+    STM.noalias() = ST * dtau_dv;
+    G.noalias() += STM * out.Vq;
+    STM.noalias() = ST * M;
+    G.noalias() += STM * Aq;
     motor_rows(ev, tau, G);
     solve_reduced(ev, llt, G, dtau_dv, Wnu, out);
     return out;
@@ -315,7 +344,8 @@ struct ReducedDerivatives {
     }
     dtau_dq.setZero(n, n);
     dtau_dv.setZero(n, n);
-    MatrixXd dtau_da = MatrixXd::Zero(n, n);
+    MatrixXd& dtau_da = ws.dtau_da;  // (M, which the evaluation's CRBA already holds: Pinocchio fills it anyway)
+    dtau_da.setZero(n, n);
     ev.model_.gravity = ev.gravity_;
     try {
       pinocchio::computeRNEADerivatives(ev.model_, ws.tree, ev.q_, ev.v_, a, dtau_dq, dtau_dv, dtau_da);

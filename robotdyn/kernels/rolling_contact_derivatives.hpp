@@ -106,7 +106,7 @@ void wheel_velocity_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<c
   const Vector3d E[3] = {g.t1, g.t2, g.n};
   Matrix3x dEs(3, ds.cols());
   for (int i = 0; i < 3; ++i) dEs.row(i) = E[i].transpose() * ds + s.transpose() * gd.E(i);
-  out = D * dEs;
+  out.noalias() = D * dEs;
 }
 
 // dgamma/dq at fixed v of the wheel's drift rows (wheel_drift_dq) into drift_out (rows x n), and the rows' time
@@ -205,16 +205,22 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   for (int i = 0; i < 3; ++i)
     rows.row(i) = Ed[i].transpose() * ds + s.transpose() * (*dEd[i]) + E[i].transpose() * dacc +
                   acc.transpose() * gd.E(i);
-  drift_out = D * rows;
-  // Adot = Wdot Aw + W Awdot, Awdot = dJ_c - [rdot]x Jw - [r]x dJ_w (- udot at the radius column)
-  Matrix3x Awdot = dJ.topRows<3>() - skew3(rdot) * jac.bottomRows<3>() - skew3(r) * dJ.bottomRows<3>();
+  drift_out.noalias() = D * rows;
+  // Adot = Wdot Aw + W Awdot, Awdot = dJ_c - [rdot]x Jw - [r]x dJ_w (- udot at the radius column); the same sums,
+  // the products written in place (no temporaries)
+  Matrix3x Awdot = dJ.topRows<3>();
+  Awdot.noalias() -= skew3(rdot) * jac.bottomRows<3>();
+  Awdot.noalias() -= skew3(r) * dJ.bottomRows<3>();
   if (radius_index >= 0) Awdot.col(radius_index) -= udot;
   Matrix3d ET, EdT;
   for (int i = 0; i < 3; ++i) {
     ET.row(i) = E[i].transpose();
     EdT.row(i) = Ed[i].transpose();
   }
-  adot_out = D * (EdT * Aw + ET * Awdot);
+  Matrix3x Wd(3, nv);
+  Wd.noalias() = EdT * Aw;
+  Wd.noalias() += ET * Awdot;
+  adot_out.noalias() = D * Wd;
 }
 
 }  // namespace derivs

@@ -44,6 +44,18 @@ inline Matrix3d skew3(const Vector3d& x) {
   return m;
 }
 
+// out = the columns `cols` of a block (rows x cols.size()), and back: the columns of a block into `cols` of out
+// (the rows' zero blocks: ReducedDerivatives' compact columns)
+template <class M, class O>
+void gather_cols(const M& full, const std::vector<int>& cols, O& out) {
+  out.resize(full.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (size_t j = 0; j < cols.size(); ++j) out.col(static_cast<Eigen::Index>(j)) = full.col(cols[j]);
+}
+template <class Out>
+void scatter_cols(const MatrixXd& part, const std::vector<int>& cols, Out&& out) {
+  for (size_t j = 0; j < cols.size(); ++j) out.col(cols[j]) = part.col(static_cast<Eigen::Index>(j));
+}
+
 // R^T ([y]x Jw + dy) into out (3 x n), the products written in place (the closure rows' last step)
 template <class JW, class Out>
 void rotate_skew_add(const Matrix3d& RT, const Vector3d& y, const JW& Jw, const Matrix3x& dy, Out&& out) {
@@ -184,6 +196,12 @@ struct FramePass {
     }
   }
 
+  // one past a joint's last velocity column (0 for the universe): the columns after it are zero in its Jacobian and
+  // its derivatives (the supporting joints come first in Pinocchio's depth-first order)
+  static int end_col(const pin::Model& model, pin::JointIndex jid) {
+    return jid == 0 ? 0 : model.joints[jid].idx_v() + model.joints[jid].nv();
+  }
+
   // world-axes (LOCAL_WORLD_ALIGNED) frame velocity V = J x and dV/dq at fixed x (FramePass.velocity);
   // oMf: the frame's placement at q, J: its LOCAL_WORLD_ALIGNED Jacobian at q (6 x n)
   void velocity(const pin::Model& model, pin::FrameIndex fid, const pin::SE3& oMf, const Matrix6x& J) {
@@ -195,10 +213,14 @@ struct FramePass {
     const Vector3d vp = vj.linear() + w.cross(p);
     V[fid] << vp, w;
     dV[fid].resize(6, model.nv);
-    auto top = dV[fid].topRows<3>();  // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place
-    top = jd.topRows<3>();
-    top.noalias() -= skew3(p) * jd.bottomRows<3>();
-    top.noalias() += skew3(w) * J.topRows<3>();
+    // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place, on the columns up to the joint's last (jd
+    // and J are zero beyond: only the supporting joints' columns can be nonzero)
+    const int ce = end_col(model, jid);
+    auto top = dV[fid].topRows<3>().leftCols(ce);
+    top = jd.topRows<3>().leftCols(ce);
+    top.noalias() -= skew3(p) * jd.bottomRows<3>().leftCols(ce);
+    top.noalias() += skew3(w) * J.topRows<3>().leftCols(ce);
+    dV[fid].topRows<3>().rightCols(model.nv - ce).setZero();
     dV[fid].bottomRows<3>() = jd.bottomRows<3>();
     has_vel[fid] = 1;
   }
@@ -219,12 +241,14 @@ struct FramePass {
     const Vector3d vp = V[fid].head<3>();
     Acc[fid] << oa.linear() + al.cross(p) + w.cross(vp), al;
     dAcc[fid].resize(6, model.nv);
-    auto top = dAcc[fid].topRows<3>();  // the same sum, the products written in place (no temporaries)
-    top = ja.topRows<3>();
-    top.noalias() -= skew3(p) * ja.bottomRows<3>();
-    top.noalias() += skew3(al) * J.topRows<3>();
-    top.noalias() += skew3(w) * dV[fid].topRows<3>();
-    top.noalias() -= skew3(vp) * dV[fid].bottomRows<3>();
+    const int ce = end_col(model, jid);  // the same sum, products in place, on the columns that can be nonzero
+    auto top = dAcc[fid].topRows<3>().leftCols(ce);
+    top = ja.topRows<3>().leftCols(ce);
+    top.noalias() -= skew3(p) * ja.bottomRows<3>().leftCols(ce);
+    top.noalias() += skew3(al) * J.topRows<3>().leftCols(ce);
+    top.noalias() += skew3(w) * dV[fid].topRows<3>().leftCols(ce);
+    top.noalias() -= skew3(vp) * dV[fid].bottomRows<3>().leftCols(ce);
+    dAcc[fid].topRows<3>().rightCols(model.nv - ce).setZero();
     dAcc[fid].bottomRows<3>() = ja.bottomRows<3>();
     has_acc[fid] = 1;
   }

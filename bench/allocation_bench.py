@@ -60,7 +60,21 @@ for name in {robots!r}:
         fast.ev.profile(q, nu, repeat, 1.0)
         counts.append(lib.robotdyn_malloc_count() - start)
         lib.robotdyn_malloc_counting(0)
-    print(f"{{name:<20}} {{(counts[1] - counts[0]) / 200:>8.2f}}")
+    dcounts = []  # the derivative set (derivatives_seconds: the set and one evaluation, repeated in C++)
+    tau = np.zeros(len(robot.motors))
+    try:
+        fast.ev.derivatives(q, nu, tau)
+    except Exception:  # (a state the compiled derivatives do not serve: no count)
+        dcounts = None
+    for repeat in (10, 210) if dcounts is not None else ():
+        fast.ev.derivatives_seconds(q, nu, tau, repeat)
+        lib.robotdyn_malloc_counting(1)
+        start = lib.robotdyn_malloc_count()
+        fast.ev.derivatives_seconds(q, nu, tau, repeat)
+        dcounts.append(lib.robotdyn_malloc_count() - start)
+        lib.robotdyn_malloc_counting(0)
+    deriv = f"{{(dcounts[1] - dcounts[0]) / 200:>10.1f}}" if dcounts else f"{{'-':>10}}"
+    print(f"{{name:<20}} {{(counts[1] - counts[0]) / 200:>8.2f}} {{deriv}}")
 """
 
 
@@ -78,7 +92,9 @@ def allocation_bench(robots=("quasimoro", "linkage_suspension", "mmr12_eod", "om
         env = {**os.environ, "LD_PRELOAD": str(lib)}
         out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     print("\nheap allocations (mallocs) per repeat of all of Evaluator.profile's parts (evaluation, right-hand side "
-          "with the pull-back, and each part again; C++ only):")
+          "with the pull-back, and each part again; C++ only), and per derivative set (Evaluator.derivatives_seconds: "
+          "the set and one evaluation, C++ only; most of it the outputs' own matrices):")
+    print(f"{'robot':<20} {'profile':>8} {'derivs':>10}")
     print(out.stdout.rstrip() if out.returncode == 0 else f"  failed: {out.stderr.strip().splitlines()[-1:]}")
 
 

@@ -36,11 +36,32 @@ constexpr int kMaxNv = 128;
 using Matrix3x = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxNv>;
 using RowX = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxNv>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6xB = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxNv>;  // 6 x n work block on the stack
 
 inline Matrix3d skew3(const Vector3d& x) {
   Matrix3d m;
   m << 0.0, -x[2], x[1], x[2], 0.0, -x[0], -x[1], x[0], 0.0;
   return m;
+}
+
+// out = the columns `cols` of a block (rows x cols.size()), and back: the columns of a block into `cols` of out
+// (the rows' zero blocks: ReducedDerivatives' compact columns)
+template <class M, class O>
+void gather_cols(const M& full, const std::vector<int>& cols, O& out) {
+  out.resize(full.rows(), static_cast<Eigen::Index>(cols.size()));
+  for (size_t j = 0; j < cols.size(); ++j) out.col(static_cast<Eigen::Index>(j)) = full.col(cols[j]);
+}
+template <class Out>
+void scatter_cols(const MatrixXd& part, const std::vector<int>& cols, Out&& out) {
+  for (size_t j = 0; j < cols.size(); ++j) out.col(cols[j]) = part.col(static_cast<Eigen::Index>(j));
+}
+
+// R^T ([y]x Jw + dy) into out (3 x n), the products written in place (the closure rows' last step)
+template <class JW, class Out>
+void rotate_skew_add(const Matrix3d& RT, const Vector3d& y, const JW& Jw, const Matrix3x& dy, Out&& out) {
+  Matrix3x t = dy;
+  t.noalias() += skew3(y) * Jw;
+  out.noalias() = RT * t;
 }
 
 // d(R(q) y)/dq at fixed y for a frame rotation R with world angular Jacobian Jw: -[R y]x Jw (_rot_dq)
@@ -67,7 +88,7 @@ struct FramePass {
   std::vector<char> has_vel, has_acc, has_jv, has_ja;
   std::vector<Vector6d> V, Acc;
   std::vector<Matrix6x> dV, dAcc, jdV, jdA;
-  Matrix6x t1_, t2_, t3_, t4_;  // work
+  VectorXd zero_;  // the acceleration of a pass with accelerations (zero)
 
   void run(const pin::Model& model, const VectorXd& q, const VectorXd& x_, bool with_accelerations) {
     if (data.oMi.size() != static_cast<size_t>(model.njoints) || data.oMf.size() != model.frames.size())
@@ -75,9 +96,10 @@ struct FramePass {
     x = x_;
     accelerations = with_accelerations;
     base = nullptr;
-    if (accelerations)
-      pin::computeForwardKinematicsDerivatives(model, data, q, x, VectorXd::Zero(model.nv));
-    else
+    if (accelerations) {
+      zero_.setZero(model.nv);
+      pin::computeForwardKinematicsDerivatives(model, data, q, x, zero_);
+    } else
       pin::computeForwardKinematicsDerivatives(model, data, q, x);  // velocities only (first order)
     reset(model);
   }
@@ -136,13 +158,48 @@ struct FramePass {
             jdV[jid].col(c).template tail<3>() = ang.cross(rel.angular());
           }
         }
-      } else {
-        t2_.setZero(6, model.nv);
-        pin::getJointVelocityDerivatives(model, data, jid, pin::WORLD, jdV[jid], t2_);
+      } else {  // getJointVelocityDerivatives(WORLD)'s v_partial_dq, its own steps (not its v_partial_dv = J)
+        const pin::Motion& vlast = data.ov[jid];
+        for (const pin::JointIndex s : model.supports[jid]) {
+          if (s == 0) continue;
+          const pin::JointIndex parent = model.parents[s];
+          const int c0 = model.joints[s].idx_v(), nvs = model.joints[s].nv();
+          const pin::Motion vtmp = parent > 0 ? pin::Motion(data.ov[parent] - vlast) : pin::Motion(-vlast);
+          auto cols = jdV[jid].middleCols(c0, nvs);
+          pin::motionSet::motionAction(vtmp, data.J.middleCols(c0, nvs), cols);
+        }
       }
       has_jv[jid] = 1;
     }
     return jdV[jid];
+  }
+
+  // d(oa)/dq of a joint at fixed (x, vdot = 0), WORLD (6 x n): the a_partial_dq of Pinocchio's
+  // getJointAccelerationDerivatives(WORLD) on this pass's computeForwardKinematicsDerivatives, its own steps on the
+  // support of jid (motionSet::motionAction of (oa_parent - oa_j) on the joint's columns J, plus that of
+  // (ov_parent - ov_j) on dJ), without the three outputs it also fills and the pass does not read
+  void joint_acceleration_dq(const pin::Model& model, pin::JointIndex jid, Matrix6x& out) {
+    out.setZero(6, model.nv);
+    const pin::Motion& vlast = data.ov[jid];
+    const pin::Motion& alast = data.oa[jid];
+    for (const pin::JointIndex s : model.supports[jid]) {
+      if (s == 0) continue;
+      const pin::JointIndex parent = model.parents[s];
+      const int c0 = model.joints[s].idx_v(), nvs = model.joints[s].nv();
+      auto cols = out.middleCols(c0, nvs);
+      const pin::Motion atmp = parent > 0 ? pin::Motion(data.oa[parent] - alast) : pin::Motion(-alast);
+      pin::motionSet::motionAction(atmp, data.J.middleCols(c0, nvs), cols);
+      if (parent > 0) {
+        const pin::Motion vtmp = data.ov[parent] - vlast;
+        pin::motionSet::motionAction<pin::ADDTO>(vtmp, data.dJ.middleCols(c0, nvs), cols);
+      }
+    }
+  }
+
+  // one past a joint's last velocity column (0 for the universe): the columns after it are zero in its Jacobian and
+  // its derivatives (the supporting joints come first in Pinocchio's depth-first order)
+  static int end_col(const pin::Model& model, pin::JointIndex jid) {
+    return jid == 0 ? 0 : model.joints[jid].idx_v() + model.joints[jid].nv();
   }
 
   // world-axes (LOCAL_WORLD_ALIGNED) frame velocity V = J x and dV/dq at fixed x (FramePass.velocity);
@@ -156,7 +213,14 @@ struct FramePass {
     const Vector3d vp = vj.linear() + w.cross(p);
     V[fid] << vp, w;
     dV[fid].resize(6, model.nv);
-    dV[fid].topRows<3>() = jd.topRows<3>() - skew3(p) * jd.bottomRows<3>() + skew3(w) * J.topRows<3>();
+    // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place, on the columns up to the joint's last (jd
+    // and J are zero beyond: only the supporting joints' columns can be nonzero)
+    const int ce = end_col(model, jid);
+    auto top = dV[fid].topRows<3>().leftCols(ce);
+    top = jd.topRows<3>().leftCols(ce);
+    top.noalias() -= skew3(p) * jd.bottomRows<3>().leftCols(ce);
+    top.noalias() += skew3(w) * J.topRows<3>().leftCols(ce);
+    dV[fid].topRows<3>().rightCols(model.nv - ce).setZero();
     dV[fid].bottomRows<3>() = jd.bottomRows<3>();
     has_vel[fid] = 1;
   }
@@ -168,12 +232,7 @@ struct FramePass {
     velocity(model, fid, oMf, J);
     const pin::JointIndex jid = model.frames[fid].parentJoint;
     if (!has_ja[jid]) {
-      const int n = model.nv;
-      t1_.setZero(6, n);
-      jdA[jid].setZero(6, n);
-      t3_.setZero(6, n);
-      t4_.setZero(6, n);
-      pin::getJointAccelerationDerivatives(model, data, jid, pin::WORLD, t1_, jdA[jid], t3_, t4_);
+      joint_acceleration_dq(model, jid, jdA[jid]);
       has_ja[jid] = 1;
     }
     const Matrix6x& ja = jdA[jid];
@@ -182,8 +241,14 @@ struct FramePass {
     const Vector3d vp = V[fid].head<3>();
     Acc[fid] << oa.linear() + al.cross(p) + w.cross(vp), al;
     dAcc[fid].resize(6, model.nv);
-    dAcc[fid].topRows<3>() = ja.topRows<3>() - skew3(p) * ja.bottomRows<3>() + skew3(al) * J.topRows<3>() +
-                             skew3(w) * dV[fid].topRows<3>() - skew3(vp) * dV[fid].bottomRows<3>();
+    const int ce = end_col(model, jid);  // the same sum, products in place, on the columns that can be nonzero
+    auto top = dAcc[fid].topRows<3>().leftCols(ce);
+    top = ja.topRows<3>().leftCols(ce);
+    top.noalias() -= skew3(p) * ja.bottomRows<3>().leftCols(ce);
+    top.noalias() += skew3(al) * J.topRows<3>().leftCols(ce);
+    top.noalias() += skew3(w) * dV[fid].topRows<3>().leftCols(ce);
+    top.noalias() -= skew3(vp) * dV[fid].bottomRows<3>().leftCols(ce);
+    dAcc[fid].topRows<3>().rightCols(model.nv - ce).setZero();
     dAcc[fid].bottomRows<3>() = ja.bottomRows<3>();
     has_acc[fid] = 1;
   }

@@ -21,7 +21,7 @@ struct ClosureFrames {
 
 // copy the selected components (0..5: x y z rx ry rz in frame 1's axes) of a 6 x n block into out
 template <class Out>
-void select_rows(const Matrix6x& full, const std::vector<int>& select, Out&& out) {
+void select_rows(const Matrix6xB& full, const std::vector<int>& select, Out&& out) {
   for (size_t r = 0; r < select.size(); ++r) out.row(static_cast<Eigen::Index>(r)) = full.row(select[r]);
 }
 
@@ -37,9 +37,9 @@ void closure_velocity_dq(const ClosureFrames& f, const std::vector<int>& select,
   const Vector3d yr = V2.tail<3>() - V1.tail<3>();
   const Matrix3x dyt = dV2.topRows<3>() - dV1.topRows<3>() + cross_d(d, dd, V1.tail<3>(), dV1.bottomRows<3>());
   const Matrix3x dyr = dV2.bottomRows<3>() - dV1.bottomRows<3>();
-  Matrix6x full(6, J1.cols());
-  full.topRows<3>() = R1T * (skew3(yt) * J1.bottomRows<3>() + dyt);
-  full.bottomRows<3>() = R1T * (skew3(yr) * J1.bottomRows<3>() + dyr);
+  Matrix6xB full(6, J1.cols());
+  rotate_skew_add(R1T, yt, J1.bottomRows<3>(), dyt, full.topRows<3>());
+  rotate_skew_add(R1T, yr, J1.bottomRows<3>(), dyr, full.bottomRows<3>());
   select_rows(full, select, out);
 }
 
@@ -70,19 +70,23 @@ void closure_drift_dq(const ClosureFrames& f, const std::vector<int>& select, co
   const Vector3d yt = jt - w1.cross(kt), yr = jr - w1.cross(kr);
   const Matrix3x dyt = djt - cross_d(w1, dw1, kt, dkt_q);
   const Matrix3x dyr = djr - cross_d(w1, dw1, kr, dkr);
-  Matrix6x full(6, J1.cols());
-  full.topRows<3>() = R1T * (skew3(yt) * J1.bottomRows<3>() + dyt);
-  full.bottomRows<3>() = R1T * (skew3(yr) * J1.bottomRows<3>() + dyr);
+  Matrix6xB full(6, J1.cols());
+  rotate_skew_add(R1T, yt, J1.bottomRows<3>(), dyt, full.topRows<3>());
+  rotate_skew_add(R1T, yr, J1.bottomRows<3>(), dyr, full.bottomRows<3>());
   select_rows(full, select, drift_out);
   // Adot: R1^T (dK - [w1]x K) with K = [J2_c - J1_c + [d]x J1_w; J2_w - J1_w]
   const Matrix3d W = skew3(w1);
-  const Matrix3x Kt = dd + skew3(d) * J1.bottomRows<3>();
-  const Matrix3x dKt = dJ2.topRows<3>() - dJ1.topRows<3>() + skew3(ddot) * J1.bottomRows<3>() +
-                       skew3(d) * dJ1.bottomRows<3>();
+  Matrix3x Kt = dd;  // (the sums below in the same order, the products written in place)
+  Kt.noalias() += skew3(d) * J1.bottomRows<3>();
+  Matrix3x dKt = dJ2.topRows<3>() - dJ1.topRows<3>();
+  dKt.noalias() += skew3(ddot) * J1.bottomRows<3>();
+  dKt.noalias() += skew3(d) * dJ1.bottomRows<3>();
   const Matrix3x Kr = J2.bottomRows<3>() - J1.bottomRows<3>();
-  const Matrix3x dKr = dJ2.bottomRows<3>() - dJ1.bottomRows<3>();
-  full.topRows<3>() = R1T * (dKt - W * Kt);
-  full.bottomRows<3>() = R1T * (dKr - W * Kr);
+  Matrix3x dKr = dJ2.bottomRows<3>() - dJ1.bottomRows<3>();
+  dKt.noalias() -= W * Kt;
+  dKr.noalias() -= W * Kr;
+  full.topRows<3>().noalias() = R1T * dKt;
+  full.bottomRows<3>().noalias() = R1T * dKr;
   select_rows(full, select, adot_out);
 }
 

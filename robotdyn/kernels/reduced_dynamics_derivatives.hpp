@@ -11,6 +11,7 @@
 
 #include <pinocchio/algorithm/rnea-derivatives.hpp>
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
@@ -32,6 +33,19 @@ struct Workspace {
   std::vector<WheelGeometryDq> geo;
   MatrixXd dgam_q, Adot;
   Matrix6x dJ1, dJ2;
+  // the rows' nonzero columns (zero blocks: a wheel's rows depend on q only through its frame's supporting joints and
+  // its radius coordinate, a closure's through its two frames' supporting joints): per wheel and per closure the
+  // sorted columns, the wheels' geometry derivatives and the closures' frame Jacobians on them (frame_passes), and
+  // gather buffers (velocity_dq with `compact`)
+  std::vector<std::vector<int>> wheel_cols, closure_cols;
+  std::vector<int> radius_col;  // a wheel's radius column among its columns, or -1
+  std::vector<WheelGeometryDq> geoc;
+  std::vector<Matrix6x> cJ1, cJ2;
+  Matrix6x gJ, gdV1, gdV2, gdA1, gdA2, gdJ1, gdJ2;
+  MatrixXd gout, gout2, gAw;
+  // run()'s work matrices, kept between calls (sized on first use: no allocation per derivative set)
+  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Ygd, Ad, dgam_v, Wnu, Aq, L, G, ST, STM, Minv, T, T2;
+  VectorXd a, rho, rd, mu;
 };
 
 // The outputs (DynamicsDerivatives' analytic contents, SI units).
@@ -55,9 +69,12 @@ struct ReducedDerivatives {
   using VectorXd = Eigen::VectorXd;
   using Matrix3d = Eigen::Matrix3d;
 
-  // d(A x)/dq of every row at the pass's x (velocity_dq), stacked in constraint order
-  static void velocity_dq(Ev& ev, derivs::FramePass& fp, MatrixXd& out) {
+  // d(A x)/dq of every row at the pass's x (velocity_dq), stacked in constraint order. With `compact` (after
+  // frame_passes' column lists) each wheel's and closure's formulas run on their nonzero columns only, gathered, and
+  // are scattered back: the same formulas, column by column, on fewer columns
+  static void velocity_dq(Ev& ev, derivs::FramePass& fp, MatrixXd& out, bool compact = false) {
     const Model& model = ev.model_;
+    auto& ws = ev.deriv_;
     out.setZero(ev.nrows(), ev.nv_);
     for (const auto& [kind, i] : ev.order_) {
       if (kind == 0) {
@@ -68,15 +85,33 @@ struct ReducedDerivatives {
         fp.velocity(model, fid, ev.data_.oMf[fid], J);
         const double xR = wh.radius_index >= 0 ? fp.x[wh.radius_index] : 0.0;
         const int nd = static_cast<int>(wh.D.rows());
-        derivs::wheel_velocity_dq(g, ev.deriv_.geo[i], MatrixXd(wh.D), fp.V[fid], fp.dV[fid], xR,
-                                  out.middleRows(g.row, nd));
+        if (compact) {
+          const std::vector<int>& cols = ws.wheel_cols[i];
+          derivs::gather_cols(fp.dV[fid], cols, ws.gdV1);
+          ws.gout.resize(nd, static_cast<int>(cols.size()));
+          derivs::wheel_velocity_dq(g, ws.geoc[i], wh.D, fp.V[fid], ws.gdV1, xR, ws.gout);
+          derivs::scatter_cols(ws.gout, cols, out.middleRows(g.row, nd));
+        } else {
+          derivs::wheel_velocity_dq(g, ws.geo[i], wh.D, fp.V[fid], fp.dV[fid], xR, out.middleRows(g.row, nd));
+        }
       } else if (kind == 1) {
         const auto& c = ev.closures_[i];
-        const int row = closure_row(ev, i);
-        const auto fr = frames_of(ev, c);
-        derivs::closure_velocity_dq(fr, c.select, fp.V[ev.frames_[c.f1]], fp.dV[ev.frames_[c.f1]],
-                                    fp.V[ev.frames_[c.f2]], fp.dV[ev.frames_[c.f2]],
-                                    out.middleRows(row, static_cast<int>(c.select.size())));
+        const int row = closure_row(ev, i), nr = static_cast<int>(c.select.size());
+        const int f1 = ev.frames_[c.f1], f2 = ev.frames_[c.f2];
+        auto fr = frames_of(ev, c);
+        prepare_closure(ev, fp, c);
+        if (compact) {
+          const std::vector<int>& cols = ws.closure_cols[i];
+          fr.J1 = &ws.cJ1[i];
+          fr.J2 = &ws.cJ2[i];
+          derivs::gather_cols(fp.dV[f1], cols, ws.gdV1);
+          derivs::gather_cols(fp.dV[f2], cols, ws.gdV2);
+          ws.gout.resize(nr, static_cast<int>(cols.size()));
+          derivs::closure_velocity_dq(fr, c.select, fp.V[f1], ws.gdV1, fp.V[f2], ws.gdV2, ws.gout);
+          derivs::scatter_cols(ws.gout, cols, out.middleRows(row, nr));
+        } else {
+          derivs::closure_velocity_dq(fr, c.select, fp.V[f1], fp.dV[f1], fp.V[f2], fp.dV[f2], out.middleRows(row, nr));
+        }
       } else {
         const auto& c = ev.couplings_[i];
         const derivs::CosineCoupling cc{c.i, c.j, c.amplitude, c.rate, c.phase};
@@ -113,12 +148,62 @@ struct ReducedDerivatives {
   // the frames' velocities in a pass (the closures' velocity_dq reads them from the cache)
   static void prepare(Ev& ev, derivs::FramePass& fp, bool accelerations) {
     const Model& model = ev.model_;
-    for (const auto& c : ev.closures_)
-      for (int f : {c.f1, c.f2}) {
-        const int fid = ev.frames_[f];
-        fp.velocity(model, fid, ev.data_.oMf[fid], ev.Jf_[f]);
-        if (accelerations) fp.acceleration(model, fid, ev.data_.oMf[fid], ev.Jf_[f]);
+    for (const auto& c : ev.closures_) {
+      prepare_closure(ev, fp, c);
+      if (accelerations)
+        for (int f : {c.f1, c.f2}) fp.acceleration(model, ev.frames_[f], ev.data_.oMf[ev.frames_[f]], ev.Jf_[f]);
+    }
+  }
+  template <class C>
+  static void prepare_closure(Ev& ev, derivs::FramePass& fp, const C& c) {
+    for (int f : {c.f1, c.f2}) fp.velocity(ev.model_, ev.frames_[f], ev.data_.oMf[ev.frames_[f]], ev.Jf_[f]);
+  }
+
+  // the columns a joint's world Jacobian and velocity derivatives can be nonzero in: its supporting joints' (sorted)
+  static void support_cols(const Model& model, pinocchio::JointIndex jid, std::vector<int>& cols) {
+    for (const pinocchio::JointIndex s : model.supports[jid]) {
+      if (s == 0) continue;
+      for (int c = model.joints[s].idx_v(); c < model.joints[s].idx_v() + model.joints[s].nv(); ++c)
+        cols.push_back(c);
+    }
+  }
+
+  // frame_passes' column lists and the quantities gathered on them once per state (the workspace's, above)
+  static void compact_columns(Ev& ev) {
+    const Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    const size_t nw = ev.wheels_.size(), nc = ev.closures_.size();
+    ws.wheel_cols.resize(nw);
+    ws.radius_col.assign(nw, -1);
+    ws.geoc.resize(nw);
+    for (size_t i = 0; i < nw; ++i) {
+      const auto& wh = ev.wheels_[i];
+      std::vector<int>& cols = ws.wheel_cols[i];
+      cols.clear();
+      support_cols(model, model.frames[ev.frames_[wh.frame]].parentJoint, cols);
+      if (wh.radius_index >= 0 && std::find(cols.begin(), cols.end(), wh.radius_index) == cols.end()) {
+        cols.push_back(wh.radius_index);
+        std::sort(cols.begin(), cols.end());
       }
+      if (wh.radius_index >= 0)
+        ws.radius_col[i] = static_cast<int>(std::find(cols.begin(), cols.end(), wh.radius_index) - cols.begin());
+      derivs::gather_cols(ev.Jf_[wh.frame], cols, ws.gJ);
+      derivs::wheel_geometry_dq(ev.geo_[i], ws.gJ, ws.radius_col[i], ev.terrain_.flat(), ws.geoc[i]);
+    }
+    ws.closure_cols.resize(nc);
+    ws.cJ1.resize(nc);
+    ws.cJ2.resize(nc);
+    for (size_t i = 0; i < nc; ++i) {
+      const auto& c = ev.closures_[i];
+      std::vector<int>& cols = ws.closure_cols[i];
+      cols.clear();
+      support_cols(model, model.frames[ev.frames_[c.f1]].parentJoint, cols);
+      support_cols(model, model.frames[ev.frames_[c.f2]].parentJoint, cols);
+      std::sort(cols.begin(), cols.end());
+      cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+      derivs::gather_cols(ev.Jf_[c.f1], cols, ws.cJ1[i]);
+      derivs::gather_cols(ev.Jf_[c.f2], cols, ws.cJ2[i]);
+    }
   }
 
   // drift_dq and Adot of every row on the pass at v
@@ -136,18 +221,45 @@ struct ReducedDerivatives {
         fp.acceleration(model, fid, ev.data_.oMf[fid], J);
         fp.jacobian_dot(model, fid, ws.dJ1);
         const int nd = static_cast<int>(wh.D.rows());
-        derivs::wheel_drift_dq(g, ws.geo[i], MatrixXd(wh.D), ev.terrain_, ev.terrain_.flat(), J, wh.radius_index, fp.x,
-                               fp.V[fid], fp.dV[fid], fp.Acc[fid], fp.dAcc[fid], ws.dJ1, ev.Aw_[i],
-                               dgam.middleRows(g.row, nd), Adot.middleRows(g.row, nd));
+        // on the wheel's nonzero columns (compact_columns), scattered back
+        const std::vector<int>& cols = ws.wheel_cols[i];
+        const int nc = static_cast<int>(cols.size());
+        derivs::gather_cols(J, cols, ws.gJ);
+        derivs::gather_cols(fp.dV[fid], cols, ws.gdV1);
+        derivs::gather_cols(fp.dAcc[fid], cols, ws.gdA1);
+        derivs::gather_cols(ws.dJ1, cols, ws.gdJ1);
+        derivs::gather_cols(ev.Aw_[i], cols, ws.gAw);
+        ws.gout.resize(nd, nc);
+        ws.gout2.resize(nd, nc);
+        derivs::wheel_drift_dq(g, ws.geoc[i], wh.D, ev.terrain_, ev.terrain_.flat(), ws.gJ, wh.radius_index,
+                               ws.radius_col[i], fp.x, fp.V[fid], ws.gdV1, fp.Acc[fid], ws.gdA1, ws.gdJ1, ws.gAw,
+                               ws.gout, ws.gout2);
+        derivs::scatter_cols(ws.gout, cols, dgam.middleRows(g.row, nd));
+        derivs::scatter_cols(ws.gout2, cols, Adot.middleRows(g.row, nd));
       } else if (kind == 1) {
         const auto& c = ev.closures_[i];
         const int row = closure_row(ev, i), nr = static_cast<int>(c.select.size());
         const int f1 = ev.frames_[c.f1], f2 = ev.frames_[c.f2];
         fp.jacobian_dot(model, f1, ws.dJ1);
         fp.jacobian_dot(model, f2, ws.dJ2);
-        derivs::closure_drift_dq(frames_of(ev, c), c.select, fp.V[f1], fp.dV[f1], fp.V[f2], fp.dV[f2], fp.Acc[f1],
-                                 fp.dAcc[f1], fp.Acc[f2], fp.dAcc[f2], ws.dJ1, ws.dJ2, dgam.middleRows(row, nr),
-                                 Adot.middleRows(row, nr));
+        // on the closure's nonzero columns (compact_columns), scattered back
+        const std::vector<int>& cols = ws.closure_cols[i];
+        const int nc = static_cast<int>(cols.size());
+        auto fr = frames_of(ev, c);
+        fr.J1 = &ws.cJ1[i];
+        fr.J2 = &ws.cJ2[i];
+        derivs::gather_cols(fp.dV[f1], cols, ws.gdV1);
+        derivs::gather_cols(fp.dV[f2], cols, ws.gdV2);
+        derivs::gather_cols(fp.dAcc[f1], cols, ws.gdA1);
+        derivs::gather_cols(fp.dAcc[f2], cols, ws.gdA2);
+        derivs::gather_cols(ws.dJ1, cols, ws.gdJ1);
+        derivs::gather_cols(ws.dJ2, cols, ws.gdJ2);
+        ws.gout.resize(nr, nc);
+        ws.gout2.resize(nr, nc);
+        derivs::closure_drift_dq(fr, c.select, fp.V[f1], ws.gdV1, fp.V[f2], ws.gdV2, fp.Acc[f1], ws.gdA1, fp.Acc[f2],
+                                 ws.gdA2, ws.gdJ1, ws.gdJ2, ws.gout, ws.gout2);
+        derivs::scatter_cols(ws.gout, cols, dgam.middleRows(row, nr));
+        derivs::scatter_cols(ws.gout2, cols, Adot.middleRows(row, nr));
       } else {
         const auto& c = ev.couplings_[i];
         const derivs::CosineCoupling cc{c.i, c.j, c.amplitude, c.rate, c.phase};
@@ -186,18 +298,25 @@ struct ReducedDerivatives {
     const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
     derivs::Result out;
     const Eigen::LLT<MatrixXd> llt = reduced_mass(ev, tau, out);
-    const VectorXd a = S * out.nudot + w;
+    VectorXd& a = ws.a;  // (the work matrices are the workspace's: no allocation once sized)
+    a.noalias() = S * out.nudot;
+    a += w;
     frame_passes(ev, [](int, derivs::FramePass&) {}, nu.data());
     const MatrixXd& dA_w = ws.dA[k];
     const MatrixXd& dA_v = ws.dA[k + 1];
-    const MatrixXd dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
+    MatrixXd& dgam_v = ws.dgam_v;
+    dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
     // the projection's three solves in one: with Y = K^-1 [d(K v)/dq, d(K gamma)/dv, d(K a)/dq + dgamma/dq at fixed
     // v] (dependent rows), dv/dq = -Y_v (v = S(q) nu), W_nu = -Y_g S, and Aq = -(Y_a + Y_g dv/dq) (Pieces.Aq)
     const int nd = static_cast<int>(ev.dependent_.size());
     out.Vq = MatrixXd::Zero(n, n);
-    MatrixXd Wnu = MatrixXd::Zero(n, k), Aq = MatrixXd::Zero(n, n);
+    MatrixXd& Wnu = ws.Wnu;
+    MatrixXd& Aq = ws.Aq;
+    Wnu.setZero(n, k);
+    Aq.setZero(n, n);
     if (nd) {
-      MatrixXd X(nd, 3 * n);
+      MatrixXd& X = ws.X;
+      X.resize(nd, 3 * n);
       for (int r = 0; r < nd; ++r) {
         const int row = ev.rows_[r];
         X.row(r).segment(0, n) = dA_v.row(row);
@@ -206,12 +325,17 @@ struct ReducedDerivatives {
         xa = dA_w.row(row) + ws.dgam_q.row(row);
         for (int l = 0; l < k; ++l) xa += out.nudot[l] * ws.dA[l].row(row);
       }
-      const MatrixXd Y = ev.lu_.solve(X);
-      MatrixXd Vd = -Y.leftCols(n);  // dependent rows of dv/dq
-      const MatrixXd Wd = -Y.middleCols(n, n) * S;
-      MatrixXd Ygd(nd, nd);  // Y_g's dependent columns: Vq is zero off the dependent rows
+      MatrixXd& Y = ws.Y;
+      Y = ev.lu_.solve(X);
+      MatrixXd& Vd = ws.Vd;  // dependent rows of dv/dq
+      Vd = -Y.leftCols(n);
+      MatrixXd& Wd = ws.Wd;
+      Wd.noalias() = -Y.middleCols(n, n) * S;
+      MatrixXd& Ygd = ws.Ygd;  // Y_g's dependent columns: Vq is zero off the dependent rows
+      Ygd.resize(nd, nd);
       for (int r = 0; r < nd; ++r) Ygd.col(r) = Y.col(n + ev.dependent_[r]);
-      MatrixXd Ad = -Y.rightCols(n);
+      MatrixXd& Ad = ws.Ad;
+      Ad = -Y.rightCols(n);
       Ad.noalias() -= Ygd * Vd;  // -(Y_a + Y_g Vq)
       for (int r = 0; r < nd; ++r) {
         const int i = ev.dependent_[r];
@@ -221,21 +345,35 @@ struct ReducedDerivatives {
       }
     }
     // the tree: RNEA(q, v, a) and its derivatives, with gravity
-    MatrixXd dtau_dq, dtau_dv;
+    MatrixXd& dtau_dq = ws.dtau_dq;
+    MatrixXd& dtau_dv = ws.dtau_dv;
     tree(ev, a, dtau_dq, dtau_dv);
-    const VectorXd rho = ws.tree.tau - ev.B_ * tau;
+    VectorXd& rho = ws.rho;
+    rho.noalias() = ev.B_ * tau;
+    rho = ws.tree.tau - rho;
     // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d
-    MatrixXd L = MatrixXd::Zero(k, n);
+    MatrixXd& L = ws.L;
+    L.setZero(k, n);
     if (nd) {
-      VectorXd rd(nd);
+      VectorXd& rd = ws.rd;
+      rd.resize(nd);
       for (int r = 0; r < nd; ++r) rd[r] = rho[ev.dependent_[r]];
-      const VectorXd mu = ev.lu_.transpose().solve(rd);
+      VectorXd& mu = ws.mu;
+      mu = ev.lu_.transpose().solve(rd);
       for (int l = 0; l < k; ++l)
         for (int r = 0; r < nd; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
     }
     // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot: from the one solve above
-    const MatrixXd ST = S.transpose();
-    MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * out.Vq + (ST * M) * Aq;
+    MatrixXd& ST = ws.ST;
+    ST = S.transpose();
+    MatrixXd& G = ws.G;  // -L + S^T dtau_dq + (S^T dtau_dv) Vq + (S^T M) Aq
+    G = -L;
+    G.noalias() += ST * dtau_dq;
+    MatrixXd& STM = ws.STM;
+    STM.noalias() = ST * dtau_dv;
+    G.noalias() += STM * out.Vq;
+    STM.noalias() = ST * M;
+    G.noalias() += STM * Aq;
     motor_rows(ev, tau, G);
     solve_reduced(ev, llt, G, dtau_dv, Wnu, out);
     return out;
@@ -257,6 +395,7 @@ struct ReducedDerivatives {
     for (size_t i = 0; i < ev.wheels_.size(); ++i)
       derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
                                 ev.terrain_.flat(), ws.geo[i]);
+    compact_columns(ev);
     ws.passes.resize(k + 2);
     ws.dA.resize(k + 2);
     for (int l = 0; l < k + 2; ++l) {
@@ -273,7 +412,7 @@ struct ReducedDerivatives {
         ws.dA[l].setZero(ev.nrows(), ev.nv_);
         for (int j = 0; j < k; ++j) ws.dA[l] += nu[j] * ws.dA[j];
       } else {
-        velocity_dq(ev, fp, ws.dA[l]);
+        velocity_dq(ev, fp, ws.dA[l], true);
       }
       per_pass(l, fp);
     }
@@ -295,11 +434,19 @@ struct ReducedDerivatives {
     const MatrixXd& S = ev.S_;
     const MatrixXd& M = ev.data_.M;
     const int k = static_cast<int>(S.cols());
-    const MatrixXd ST = S.transpose();
-    const MatrixXd Minv = llt.solve(MatrixXd::Identity(k, k));
-    out.dq = -Minv * G;
-    out.dnu = -Minv * (ST * (dtau_dv * S + M * Wnu));
-    out.dtau = Minv * ev.Br_;
+    auto& ws = ev.deriv_;  // (its work matrices: the same products, without temporaries)
+    MatrixXd& Minv = ws.Minv;
+    Minv.setIdentity(k, k);
+    llt.solveInPlace(Minv);
+    out.dq.noalias() = -Minv * G;
+    MatrixXd& T = ws.T;  // dtau_dv S + M W_nu
+    T.noalias() = dtau_dv * S;
+    ws.T2.noalias() = M * Wnu;
+    T += ws.T2;
+    ws.ST = S.transpose();
+    ws.T2.noalias() = ws.ST * T;
+    out.dnu.noalias() = -Minv * ws.T2;
+    out.dtau.noalias() = Minv * ev.Br_;
     out.v = ev.v_;
     out.S = S;
     out.A = ev.A_;
@@ -315,7 +462,8 @@ struct ReducedDerivatives {
     }
     dtau_dq.setZero(n, n);
     dtau_dv.setZero(n, n);
-    MatrixXd dtau_da = MatrixXd::Zero(n, n);
+    MatrixXd& dtau_da = ws.dtau_da;  // (M, which the evaluation's CRBA already holds: Pinocchio fills it anyway)
+    dtau_da.setZero(n, n);
     ev.model_.gravity = ev.gravity_;
     try {
       pinocchio::computeRNEADerivatives(ev.model_, ws.tree, ev.q_, ev.v_, a, dtau_dq, dtau_dv, dtau_da);

@@ -106,16 +106,19 @@ void wheel_velocity_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<c
   const Vector3d E[3] = {g.t1, g.t2, g.n};
   Matrix3x dEs(3, ds.cols());
   for (int i = 0; i < 3; ++i) dEs.row(i) = E[i].transpose() * ds + s.transpose() * gd.E(i);
-  out = D * dEs;
+  out.noalias() = D * dEs;
 }
 
 // dgamma/dq at fixed v of the wheel's drift rows (wheel_drift_dq) into drift_out (rows x n), and the rows' time
 // derivative Adot = Wdot Aw + W Awdot (RollingWheel.rows) into adot_out (rows x n).
 // V/dV, Acc/dAcc: the frame's world velocity and classical acceleration at v with q-derivatives; dJ: its world
-// Jacobian's time variation along v; Aw: the wheel's world contact-point Jacobian (3 x n) at q.
+// Jacobian's time variation along v; Aw: the wheel's world contact-point Jacobian (3 x n) at q. The matrices may hold
+// a subset of the n columns (all of those that can be nonzero: ReducedDerivatives' compact columns): radius_index
+// indexes v, radius_col the radius coordinate's column among them (-1: none).
 template <class G, class T, class Out1, class Out2>
 void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<const MatrixXd>& D, const T& terrain,
-                    bool flat, const Matrix6x& jac, int radius_index, const VectorXd& v, const Vector6d& V,
+                    bool flat, const Matrix6x& jac, int radius_index, int radius_col, const VectorXd& v,
+                    const Vector6d& V,
                     const Matrix6x& dV, const Vector6d& Acc, const Matrix6x& dAcc, const Matrix6x& dJ,
                     const MatrixXd& Aw, Out1&& drift_out, Out2&& adot_out) {
   const int nv = static_cast<int>(jac.cols());
@@ -205,16 +208,22 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   for (int i = 0; i < 3; ++i)
     rows.row(i) = Ed[i].transpose() * ds + s.transpose() * (*dEd[i]) + E[i].transpose() * dacc +
                   acc.transpose() * gd.E(i);
-  drift_out = D * rows;
-  // Adot = Wdot Aw + W Awdot, Awdot = dJ_c - [rdot]x Jw - [r]x dJ_w (- udot at the radius column)
-  Matrix3x Awdot = dJ.topRows<3>() - skew3(rdot) * jac.bottomRows<3>() - skew3(r) * dJ.bottomRows<3>();
-  if (radius_index >= 0) Awdot.col(radius_index) -= udot;
+  drift_out.noalias() = D * rows;
+  // Adot = Wdot Aw + W Awdot, Awdot = dJ_c - [rdot]x Jw - [r]x dJ_w (- udot at the radius column); the same sums,
+  // the products written in place (no temporaries)
+  Matrix3x Awdot = dJ.topRows<3>();
+  Awdot.noalias() -= skew3(rdot) * jac.bottomRows<3>();
+  Awdot.noalias() -= skew3(r) * dJ.bottomRows<3>();
+  if (radius_col >= 0) Awdot.col(radius_col) -= udot;
   Matrix3d ET, EdT;
   for (int i = 0; i < 3; ++i) {
     ET.row(i) = E[i].transpose();
     EdT.row(i) = Ed[i].transpose();
   }
-  adot_out = D * (EdT * Aw + ET * Awdot);
+  Matrix3x Wd(3, nv);
+  Wd.noalias() = EdT * Aw;
+  Wd.noalias() += ET * Awdot;
+  adot_out.noalias() = D * Wd;
 }
 
 }  // namespace derivs

@@ -6,12 +6,12 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test bench venv clean chromium docs
 
-$(STAMP): pyproject.toml setup.py $(wildcard robotdyn/*.cpp) robotdyn/_evaluator.hpp robotdyn/_integrator.hpp robotdyn/_torque_profile.hpp robotdyn/_controller.hpp robotdyn/_stiff_integrator.hpp $(wildcard robotdyn/kernels/*.hpp)
+$(STAMP): pyproject.toml setup.py robotdyn/_compiled.cpp robotdyn/_integrator.hpp robotdyn/_torque_profile.hpp robotdyn/_controller.hpp robotdyn/_stiff_integrator.hpp $(wildcard robotdyn/kernels/*.hpp)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet "setuptools>=77" wheel "pybind11>=2.12" "pin>=4.1,<5" "cmeel-eigen>=3.4"  # build requirements (pyproject.toml)
-	@# robotdyn._compiled compiles in place, its two translation units on two CPUs (setup.py: ParallelCompile), while
-	@# pip installs robotdyn (editable, without the extension) and its dependencies
+	@# robotdyn._compiled compiles in place on one CPU (~8 min) while pip installs robotdyn (editable, without the
+	@# extension) and its dependencies on another (setup.py)
 	$(PY) setup.py -q build_ext --inplace > $(VENV)/build-ext.log 2>&1 & build=$$!; \
 	  ROBOTDYN_EXTENSION_IN_PLACE=1 $(PY) -m pip install --quiet --no-build-isolation -e ".[test]"; installed=$$?; \
 	  wait $$build; built=$$?; tail -3 $(VENV)/build-ext.log; [ $$installed = 0 ] && [ $$built = 0 ]

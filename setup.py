@@ -4,11 +4,9 @@ The extension uses Pinocchio's C++ headers as installed by the ``pin`` wheel (it
 ``cmeel-eigen`` and pybind11; all three are build requirements in pyproject.toml. Without a C++ compiler the build
 of the extension is skipped (``optional``) and robotdyn runs on its Python path alone.
 
-The extension is two translation units (robotdyn/_evaluator.hpp says what each holds, and why not more), compiled
-in parallel by pybind11's ``ParallelCompile``: one compiler per CPU, or ``ROBOTDYN_BUILD_JOBS`` of them (1: one after
-the other).
-``make venv`` compiles the extension in place (``setup.py build_ext --inplace``) while pip installs robotdyn editable
-with ``ROBOTDYN_EXTENSION_IN_PLACE=1`` (no extension: it would compile it a second time) and its dependencies.
+``make venv`` compiles the extension in place (``setup.py build_ext --inplace``, one CPU) while pip installs robotdyn
+editable with ``ROBOTDYN_EXTENSION_IN_PLACE=1`` (no extension: it would compile it a second time) and its
+dependencies on the other CPU.
 """
 
 import os
@@ -30,19 +28,17 @@ def _extension() -> list[Extension]:
         return []
     try:
         import pybind11
-        from pybind11.setup_helpers import ParallelCompile
     except ImportError:
         return []
-    ParallelCompile("ROBOTDYN_BUILD_JOBS", default=0).install()  # the units below at once, one per CPU by default
     pinocchio, eigen = _prefix_include("pinocchio"), _prefix_include("eigen3")
     if not pinocchio or not eigen:
         return []
     return [
         Extension(
             "robotdyn._compiled",
-            ["robotdyn/_compiled.cpp", "robotdyn/_evaluator.cpp"],  # two units of about equal compile time
-            depends=["robotdyn/_evaluator.hpp", "robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp",
-                     "robotdyn/_controller.hpp", "robotdyn/_stiff_integrator.hpp",
+            ["robotdyn/_compiled.cpp"],
+            depends=["robotdyn/_integrator.hpp", "robotdyn/_torque_profile.hpp", "robotdyn/_controller.hpp",
+                     "robotdyn/_stiff_integrator.hpp",
                      *sorted(p.as_posix() for p in Path("robotdyn/kernels").glob("*.hpp"))],  # the kernels
             include_dirs=[pybind11.get_include(), *pinocchio, *(str(Path(e) / "eigen3") for e in eigen)],
             define_macros=[

@@ -1,4 +1,4 @@
-"""Evaluator.profile (robotdyn/_evaluator.cpp; make bench's 'where a compiled evaluation's time goes'): every part's
+"""Evaluator.profile (robotdyn/_compiled.cpp; make bench's 'where a compiled evaluation's time goes'): every part's
 time is a positive, finite number of seconds (zero for the parts a robot does not have: springs, a feedback law),
 Pinocchio's own CRBA + RNEA + frame Jacobians cost less than the whole evaluation that contains them, and
 profiling leaves the evaluator evaluated at the state it was given (the same numbers as compute there)."""

@@ -1,4 +1,4 @@
-"""The lean sampling pass of a compiled run (Evaluator.sample, robotdyn/_evaluator.cpp): after a run that kept its row
+"""The lean sampling pass of a compiled run (Evaluator.sample, robotdyn/_compiled.cpp): after a run that kept its row
 choice, each sample's energy and holonomic residual come from a configuration pass without the gravity torques, the
 motors' columns and the projection's condition and span checks. Its numbers are observe's (the whole configuration
 pass) bit for bit: the same CRBA, rows, LU factors and solves. Checked at states along runs of robots whose

@@ -1,4 +1,4 @@
-"""Slipping wheels on the compiled engine (robotdyn/_evaluator.cpp: Evaluator.slip_rhs, robotdyn/_integrator.hpp: the
+"""Slipping wheels on the compiled engine (robotdyn/_compiled.cpp: Evaluator.slip_rhs, robotdyn/_integrator.hpp: the
 lift-off event) against the Python reference path (robotdyn.contact.sliding.forward, scipy's solve_ivp with its event) and
 closed forms: one state at a time, whole trajectories of the skid-steer rover (both directions and lateral slip,
 linear and Coulomb laws), a disc sliding down an incline (g (sin a - mu cos a) when tan a > 3 mu), the energy

@@ -221,22 +221,3 @@ def test_compiled_kernels_name_their_python_twins():
         elif path.stem not in helpers:
             assert any(t.rpartition("/")[2] == path.stem for t in twins), f"{path.name} names no Python twin {twins}"
     assert 'Path("robotdyn/kernels").glob("*.hpp")' in (PKG.parent / "setup.py").read_text()
-
-
-def test_extension_units_are_all_built():
-    """The C++ extension is several translation units compiled in parallel (robotdyn/*.cpp, listed in the opening
-    comment of robotdyn/_evaluator.hpp): every unit is one of setup.py's sources and a prerequisite of the Makefile's
-    install stamp, and every header beside them one of setup.py's depends and a Makefile prerequisite, so that none
-    is left out of the build or of its rebuild."""
-    setup = (PKG.parent / "setup.py").read_text()
-    makefile = (PKG.parent / "Makefile").read_text()
-    listed = (PKG / "_evaluator.hpp").read_text().split("#pragma once")[0]
-    units = sorted(p.name for p in PKG.glob("*.cpp"))
-    assert "_compiled.cpp" in units and len(units) >= 2
-    assert "$(wildcard robotdyn/*.cpp)" in makefile
-    for name in units:
-        assert f'"robotdyn/{name}"' in setup, f"{name}: not in setup.py's sources"
-        assert f"  {name} " in listed, f"{name}: not in _evaluator.hpp's list of units"
-    for header in sorted(PKG.glob("*.hpp")):
-        assert f'"robotdyn/{header.name}"' in setup, f"{header.name}: not in setup.py's depends"
-        assert f"robotdyn/{header.name}" in makefile, f"{header.name}: not in the Makefile's prerequisites"

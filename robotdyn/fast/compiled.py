@@ -3,7 +3,7 @@
 :class:`CompiledModel` evaluates :math:`M_r = S^TMS`, :math:`h = C_r\\nu + g_r = S^T\\,\\mathrm{RNEA}(q, S\\nu, w)`,
 :math:`g_r`, :math:`B_r`, :math:`S` and :math:`w = \\dot S\\nu` with the formulas of the Python reference
 (:mod:`robotdyn.constraints.rolling_contact` on a plane, :mod:`robotdyn.constraints.loop_closure`, :mod:`robotdyn.reduction.projection`,
-:mod:`robotdyn.reduction.operational_space`, :mod:`robotdyn.reduction.actuation`) in C++ (``robotdyn/_evaluator.hpp``: the
+:mod:`robotdyn.reduction.operational_space`, :mod:`robotdyn.reduction.actuation`) in C++ (``robotdyn/_compiled.cpp``: the
 evaluator; its formulas are the kernels of ``robotdyn/kernels/``, one header per constraint kind named like its Python
 module), on a copy of
 the robot's Pinocchio model rebuilt joint by joint and checked against it when built (M, g and RNEA at a random
@@ -83,7 +83,7 @@ _COMPILED_FORMULAS = {
     RollingWheel: ("rows", "jacobian", "drift", "contact", "_geometry", "_world_jacobian"),
     LoopClosure: ("rows", "jacobian", "drift"),
 }
-"""The methods of each constraint class whose formulas the compiled evaluator reproduces."""
+"""The methods of each constraint class whose formulas ``_compiled.cpp`` reproduces."""
 
 
 def _compiled_formulas(constraint, base: type) -> bool:

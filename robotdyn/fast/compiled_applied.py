@@ -1,5 +1,5 @@
 """Joint springs and compliant wheels on the compiled model: the applied forces of
-:mod:`robotdyn.contact.applied_forces` encoded for ``robotdyn/_evaluator.cpp`` (formulas in
+:mod:`robotdyn.contact.applied_forces` encoded for ``robotdyn/_compiled.cpp`` (formulas in
 ``robotdyn/kernels/joint_springs.hpp`` and ``robotdyn/kernels/compliant_contact.hpp``).
 
 This module encodes them for :class:`robotdyn.fast.compiled.CompiledModel`. The general compiled model

@@ -1,9 +1,10 @@
-// robotdyn/kernels/common.hpp: what every kernel of the compiled evaluator shares (robotdyn/_evaluator.hpp).
+// robotdyn/kernels/common.hpp: what every kernel of the compiled evaluator shares (robotdyn/_compiled.cpp).
 //
 // The kernels under robotdyn/kernels/ are the C++ twins of robotdyn's Python reference formulas, one header per
 // constraint kind or reduction step, each named like its Python module (rolling_contact.hpp beside
-// robotdyn/constraints/rolling_contact.py, ...). They are header-only, included by robotdyn/_evaluator.hpp (the
-// Evaluator's orchestration, whose translation units it lists), and work on the buffers the Evaluator passes them, so that an evaluation allocates nothing once the buffers are sized. Derivatives of a kernel go
+// robotdyn/constraints/rolling_contact.py, ...). They are header-only, included by robotdyn/_compiled.cpp (one
+// translation unit: the Evaluator's orchestration and the Python bindings), and work on the buffers the Evaluator
+// passes them, so that an evaluation allocates nothing once the buffers are sized. Derivatives of a kernel go
 // beside it as <kind>_derivatives.hpp (as Pinocchio puts rnea-derivatives.hpp beside rnea.hpp).
 #pragma once
 

@@ -3,7 +3,7 @@
 N runs -- differing in initial states, torque profiles (:mod:`robotdyn.simulation.torque_profile`), and parameters that change
 only numbers of the model (masses, inertias, lengths, radii, g: :mod:`robotdyn.simulation.model_variants`) or in built robots
 of one description -- are simulated by the compiled engine (:mod:`robotdyn.simulation.compiled_engine`) on C++ threads
-(``Evaluator.simulate_many`` in ``robotdyn/_evaluator.cpp``: the GIL released, one model copy per thread, the runs
+(``Evaluator.simulate_many`` in ``robotdyn/_compiled.cpp``: the GIL released, one model copy per thread, the runs
 handed out one at a time). Every run's numbers are those of the same run alone, whatever the number of threads.
 Results come back as arrays per run (:class:`ManyRuns`); a failing run is flagged with its message, not raised.
 """

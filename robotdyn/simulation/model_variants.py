@@ -2,7 +2,7 @@
 
 A compiled model (:mod:`robotdyn.fast.compiled`) is built from a vector of numbers, its *model vector*: per joint its
 placement and body inertia (mass, centre of mass, inertia about it), per frame its placement, per wheel its radius
-and axle, per joint coupling its law, and the gravity (``robotdyn/_evaluator.cpp``, ``model_vector``). Robots built
+and axle, per joint coupling its law, and the gravity (``robotdyn/_compiled.cpp``, ``model_vector``). Robots built
 from one description with different parameter values share everything else (joints, frames, constraints, motors),
 so one compiled model can simulate all of them by swapping that vector: no Xacro expansion, URDF parsing or model
 build per run (:func:`robotdyn.simulation.batch.simulate_many`).

@@ -36,13 +36,17 @@ struct Workspace {
   // the rows' nonzero columns (zero blocks: a wheel's rows depend on q only through its frame's supporting joints and
   // its radius coordinate, a closure's through its two frames' supporting joints): per wheel and per closure the
   // sorted columns, the wheels' geometry derivatives and the closures' frame Jacobians on them (frame_passes), and
-  // gather buffers (velocity_dq with `compact`)
+  // gather buffers (velocity_dq with `compact`), one set per wheel and per closure: each keeps its size between
+  // calls (shared buffers resized from one row's column count to the next reallocated on every derivative set)
   std::vector<std::vector<int>> wheel_cols, closure_cols;
   std::vector<int> radius_col;  // a wheel's radius column among its columns, or -1
   std::vector<WheelGeometryDq> geoc;
   std::vector<Matrix6x> cJ1, cJ2;
-  Matrix6x gJ, gdV1, gdV2, gdA1, gdA2, gdJ1, gdJ2;
-  MatrixXd gout, gout2, gAw;
+  struct Gathered {
+    Matrix6x J, dV1, dV2, dA1, dA2, dJ1, dJ2;
+    MatrixXd out, out2, Aw;
+  };
+  std::vector<Gathered> wheel_gather, closure_gather;
   // run()'s work matrices, kept between calls (sized on first use: no allocation per derivative set)
   MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Ygd, Ad, dgam_v, Wnu, Aq, L, G, ST, STM, Minv, T, T2;
   VectorXd a, rho, rd, mu;
@@ -87,10 +91,11 @@ struct ReducedDerivatives {
         const int nd = static_cast<int>(wh.D.rows());
         if (compact) {
           const std::vector<int>& cols = ws.wheel_cols[i];
-          derivs::gather_cols(fp.dV[fid], cols, ws.gdV1);
-          ws.gout.resize(nd, static_cast<int>(cols.size()));
-          derivs::wheel_velocity_dq(g, ws.geoc[i], wh.D, fp.V[fid], ws.gdV1, xR, ws.gout);
-          derivs::scatter_cols(ws.gout, cols, out.middleRows(g.row, nd));
+          auto& gb = ws.wheel_gather[i];
+          derivs::gather_cols(fp.dV[fid], cols, gb.dV1);
+          gb.out.resize(nd, static_cast<int>(cols.size()));
+          derivs::wheel_velocity_dq(g, ws.geoc[i], wh.D, fp.V[fid], gb.dV1, xR, gb.out);
+          derivs::scatter_cols(gb.out, cols, out.middleRows(g.row, nd));
         } else {
           derivs::wheel_velocity_dq(g, ws.geo[i], wh.D, fp.V[fid], fp.dV[fid], xR, out.middleRows(g.row, nd));
         }
@@ -102,13 +107,14 @@ struct ReducedDerivatives {
         prepare_closure(ev, fp, c);
         if (compact) {
           const std::vector<int>& cols = ws.closure_cols[i];
+          auto& gb = ws.closure_gather[i];
           fr.J1 = &ws.cJ1[i];
           fr.J2 = &ws.cJ2[i];
-          derivs::gather_cols(fp.dV[f1], cols, ws.gdV1);
-          derivs::gather_cols(fp.dV[f2], cols, ws.gdV2);
-          ws.gout.resize(nr, static_cast<int>(cols.size()));
-          derivs::closure_velocity_dq(fr, c.select, fp.V[f1], ws.gdV1, fp.V[f2], ws.gdV2, ws.gout);
-          derivs::scatter_cols(ws.gout, cols, out.middleRows(row, nr));
+          derivs::gather_cols(fp.dV[f1], cols, gb.dV1);
+          derivs::gather_cols(fp.dV[f2], cols, gb.dV2);
+          gb.out.resize(nr, static_cast<int>(cols.size()));
+          derivs::closure_velocity_dq(fr, c.select, fp.V[f1], gb.dV1, fp.V[f2], gb.dV2, gb.out);
+          derivs::scatter_cols(gb.out, cols, out.middleRows(row, nr));
         } else {
           derivs::closure_velocity_dq(fr, c.select, fp.V[f1], fp.dV[f1], fp.V[f2], fp.dV[f2], out.middleRows(row, nr));
         }
@@ -176,6 +182,7 @@ struct ReducedDerivatives {
     ws.wheel_cols.resize(nw);
     ws.radius_col.assign(nw, -1);
     ws.geoc.resize(nw);
+    ws.wheel_gather.resize(nw);
     for (size_t i = 0; i < nw; ++i) {
       const auto& wh = ev.wheels_[i];
       std::vector<int>& cols = ws.wheel_cols[i];
@@ -187,12 +194,13 @@ struct ReducedDerivatives {
       }
       if (wh.radius_index >= 0)
         ws.radius_col[i] = static_cast<int>(std::find(cols.begin(), cols.end(), wh.radius_index) - cols.begin());
-      derivs::gather_cols(ev.Jf_[wh.frame], cols, ws.gJ);
-      derivs::wheel_geometry_dq(ev.geo_[i], ws.gJ, ws.radius_col[i], ev.terrain_.flat(), ws.geoc[i]);
+      derivs::gather_cols(ev.Jf_[wh.frame], cols, ws.wheel_gather[i].J);
+      derivs::wheel_geometry_dq(ev.geo_[i], ws.wheel_gather[i].J, ws.radius_col[i], ev.terrain_.flat(), ws.geoc[i]);
     }
     ws.closure_cols.resize(nc);
     ws.cJ1.resize(nc);
     ws.cJ2.resize(nc);
+    ws.closure_gather.resize(nc);
     for (size_t i = 0; i < nc; ++i) {
       const auto& c = ev.closures_[i];
       std::vector<int>& cols = ws.closure_cols[i];
@@ -224,18 +232,19 @@ struct ReducedDerivatives {
         // on the wheel's nonzero columns (compact_columns), scattered back
         const std::vector<int>& cols = ws.wheel_cols[i];
         const int nc = static_cast<int>(cols.size());
-        derivs::gather_cols(J, cols, ws.gJ);
-        derivs::gather_cols(fp.dV[fid], cols, ws.gdV1);
-        derivs::gather_cols(fp.dAcc[fid], cols, ws.gdA1);
-        derivs::gather_cols(ws.dJ1, cols, ws.gdJ1);
-        derivs::gather_cols(ev.Aw_[i], cols, ws.gAw);
-        ws.gout.resize(nd, nc);
-        ws.gout2.resize(nd, nc);
-        derivs::wheel_drift_dq(g, ws.geoc[i], wh.D, ev.terrain_, ev.terrain_.flat(), ws.gJ, wh.radius_index,
-                               ws.radius_col[i], fp.x, fp.V[fid], ws.gdV1, fp.Acc[fid], ws.gdA1, ws.gdJ1, ws.gAw,
-                               ws.gout, ws.gout2);
-        derivs::scatter_cols(ws.gout, cols, dgam.middleRows(g.row, nd));
-        derivs::scatter_cols(ws.gout2, cols, Adot.middleRows(g.row, nd));
+        auto& gb = ws.wheel_gather[i];
+        derivs::gather_cols(J, cols, gb.J);
+        derivs::gather_cols(fp.dV[fid], cols, gb.dV1);
+        derivs::gather_cols(fp.dAcc[fid], cols, gb.dA1);
+        derivs::gather_cols(ws.dJ1, cols, gb.dJ1);
+        derivs::gather_cols(ev.Aw_[i], cols, gb.Aw);
+        gb.out.resize(nd, nc);
+        gb.out2.resize(nd, nc);
+        derivs::wheel_drift_dq(g, ws.geoc[i], wh.D, ev.terrain_, ev.terrain_.flat(), gb.J, wh.radius_index,
+                               ws.radius_col[i], fp.x, fp.V[fid], gb.dV1, fp.Acc[fid], gb.dA1, gb.dJ1, gb.Aw,
+                               gb.out, gb.out2);
+        derivs::scatter_cols(gb.out, cols, dgam.middleRows(g.row, nd));
+        derivs::scatter_cols(gb.out2, cols, Adot.middleRows(g.row, nd));
       } else if (kind == 1) {
         const auto& c = ev.closures_[i];
         const int row = closure_row(ev, i), nr = static_cast<int>(c.select.size());
@@ -245,21 +254,22 @@ struct ReducedDerivatives {
         // on the closure's nonzero columns (compact_columns), scattered back
         const std::vector<int>& cols = ws.closure_cols[i];
         const int nc = static_cast<int>(cols.size());
+        auto& gb = ws.closure_gather[i];
         auto fr = frames_of(ev, c);
         fr.J1 = &ws.cJ1[i];
         fr.J2 = &ws.cJ2[i];
-        derivs::gather_cols(fp.dV[f1], cols, ws.gdV1);
-        derivs::gather_cols(fp.dV[f2], cols, ws.gdV2);
-        derivs::gather_cols(fp.dAcc[f1], cols, ws.gdA1);
-        derivs::gather_cols(fp.dAcc[f2], cols, ws.gdA2);
-        derivs::gather_cols(ws.dJ1, cols, ws.gdJ1);
-        derivs::gather_cols(ws.dJ2, cols, ws.gdJ2);
-        ws.gout.resize(nr, nc);
-        ws.gout2.resize(nr, nc);
-        derivs::closure_drift_dq(fr, c.select, fp.V[f1], ws.gdV1, fp.V[f2], ws.gdV2, fp.Acc[f1], ws.gdA1, fp.Acc[f2],
-                                 ws.gdA2, ws.gdJ1, ws.gdJ2, ws.gout, ws.gout2);
-        derivs::scatter_cols(ws.gout, cols, dgam.middleRows(row, nr));
-        derivs::scatter_cols(ws.gout2, cols, Adot.middleRows(row, nr));
+        derivs::gather_cols(fp.dV[f1], cols, gb.dV1);
+        derivs::gather_cols(fp.dV[f2], cols, gb.dV2);
+        derivs::gather_cols(fp.dAcc[f1], cols, gb.dA1);
+        derivs::gather_cols(fp.dAcc[f2], cols, gb.dA2);
+        derivs::gather_cols(ws.dJ1, cols, gb.dJ1);
+        derivs::gather_cols(ws.dJ2, cols, gb.dJ2);
+        gb.out.resize(nr, nc);
+        gb.out2.resize(nr, nc);
+        derivs::closure_drift_dq(fr, c.select, fp.V[f1], gb.dV1, fp.V[f2], gb.dV2, fp.Acc[f1], gb.dA1, fp.Acc[f2],
+                                 gb.dA2, gb.dJ1, gb.dJ2, gb.out, gb.out2);
+        derivs::scatter_cols(gb.out, cols, dgam.middleRows(row, nr));
+        derivs::scatter_cols(gb.out2, cols, Adot.middleRows(row, nr));
       } else {
         const auto& c = ev.couplings_[i];
         const derivs::CosineCoupling cc{c.i, c.j, c.amplitude, c.rate, c.phase};

@@ -22,7 +22,7 @@ def eager(robot, q, nu, tau):
     red = robot.reduced(q, nu)
     nudot = solve_mass(red.M, red.B @ tau - red.h)
     a = red.S @ nudot + red.w
-    out = cf._forces(robot, q, red.v, a, tau, red.jacobian_rows, {}, nudot)
+    out = cf._assemble(robot, cf._solve(robot, q, red.v, a, tau, red.jacobian_rows, {}), nudot, tau, {})
     unsupported = False
     if any(not w.determined[2] for w in out.wheels):
         planar = out

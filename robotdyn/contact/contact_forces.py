@@ -519,10 +519,7 @@ def apply_rigid_limit(robot, out: ConstraintForces, lam: np.ndarray | None = Non
         force = D.T @ res.lam[idx]
         if fr is not None:
             force[:2] += fr
-        if res.open.shape[1]:
-            known = np.linalg.norm(D.T @ res.open[idx], axis=1) <= DETERMINED_TOL
-        else:
-            known = np.ones(3, bool)
+        known = _directions_determined(D, res.open, idx)
         w.compliance = known & ~w.determined
         w.force = np.where(w.determined, w.force, force)
         if w.frame is not None:
@@ -534,16 +531,11 @@ def apply_rigid_limit(robot, out: ConstraintForces, lam: np.ndarray | None = Non
 
 
 
-def _forces(robot, q, v, a, tau, rows, friction, nudot) -> ConstraintForces:
-    """:math:`A^T\\lambda = \\mathrm{RNEA}(q, v, a) - B\\tau - \\sum J_t^T F_t` and the per-wheel and per-closure
-    forces, at a state whose accelerations are known (``rows``: the constraint rows there, ``None``: computed here):
-    :func:`_assemble` of :func:`_solve`."""
-    return _assemble(robot, _solve(robot, q, v, a, tau, rows, friction), nudot, tau, friction)
-
-
 def _solve(robot, q, v, a, tau, rows, friction) -> tuple:
-    """The solve of :func:`_forces`: ``(rows, lam, N, rank, residual, condition, wheel geometry, compliant wheels'
-    states)``, refusing non-finite multipliers in one line. Without friction forces and where the robot's compiled
+    """:math:`A^T\\lambda = \\mathrm{RNEA}(q, v, a) - B\\tau - \\sum J_t^T F_t` at a state whose accelerations are
+    known (``rows``: the constraint rows there, ``None``: computed here), for :func:`_assemble`: ``(rows, lam, N,
+    rank, residual, condition, wheel geometry, compliant wheels' states)``, refusing non-finite multipliers in one
+    line. Without friction forces and where the robot's compiled
     model serves, e, :math:`\\lambda` on the projection's rows and the wheels' contact frames come from one compiled
     call (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`) and :math:`\\lambda` is made minimum-norm with the
     null space of :math:`A^T` (:func:`_from_basic`), the Python path's choice on undetermined rows; else all of it in
@@ -603,8 +595,7 @@ def _normal_open(robot, solved: tuple) -> bool:
     index = {lab: i for i, lab in enumerate(rows.labels)}
     for c in robot.constraints:
         if isinstance(c, RollingWheel) and not getattr(c, "compliant", False):  # (a compliant wheel's is its law's)
-            idx = [index[lab] for lab in c._labels()]
-            if not _row_norms(c._directions.T @ N[idx])[2] <= DETERMINED_TOL:
+            if not _directions_determined(c._directions, N, [index[lab] for lab in c._labels()])[2]:
                 return True
     return False
 
@@ -769,6 +760,15 @@ def _row_norms(X: np.ndarray) -> np.ndarray:
     return np.sqrt(np.add.reduce(X * X, axis=1))
 
 
+def _directions_determined(D: np.ndarray, N: np.ndarray, idx: list) -> np.ndarray:
+    """Which of a wheel's contact-frame directions (t1, t2, n) carry a determined load: those on which no direction
+    of the null space ``N`` of :math:`A^T` (columns) weighs more than :data:`DETERMINED_TOL` through the wheel's rows
+    ``idx`` (row i acts along ``D[i]``); all three where ``N`` has no column."""
+    if not N.shape[1]:
+        return np.ones(3, bool)
+    return _row_norms(D.T @ N[idx]) <= DETERMINED_TOL
+
+
 def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict, lam: np.ndarray,
                  N: np.ndarray, friction: np.ndarray | None = None, idx: list | None = None) -> WheelForce:
     """A wheel's force in its contact frame (E: columns t1, t2, n; contact point p), from its rows' multipliers
@@ -778,11 +778,8 @@ def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict,
         idx = [index[lab] for lab in wheel._labels()]
     D = wheel._directions
     force = D.T @ lam[idx]
-    if N.shape[1]:
-        determined = _row_norms(D.T @ N[idx]) <= DETERMINED_TOL
-        # a direction with no row at all (e.g. the lateral direction of an omni wheel) carries no force: determined
-    else:
-        determined = np.ones(3, bool)
+    # a direction with no row at all (e.g. the lateral direction of an omni wheel) carries no force: determined
+    determined = _directions_determined(D, N, idx)
     kind = "support" if D.shape[0] == 1 else ("omni" if D.shape[0] == 2 else "standard")
     if friction is not None:  # the law's force along its free directions (zero along a rolling one)
         force[:2] += friction

@@ -941,15 +941,11 @@ class Robot:
 
         return violations(self.reduced(q, nu), nudot)
 
-    def _warn_dropped(self, red, nudot, q=None) -> None:
-        from .constraints.redundancy import message, violations
+    def _warn_dropped(self, red, nudot, q) -> None:
+        from .constraints.redundancy import message
+        from .fast.dropped_rows import violations  # the exact check, its Adot pass skipped where it cannot fire
 
-        if q is None:
-            found = violations(red, nudot)
-        else:  # the same check, its Adot pass skipped where the compiled rows prove no violation
-            from .fast.dropped_rows import violations as screened
-
-            found = screened(self, red, q, nudot)
+        found = violations(self, red, q, nudot)
         if found:
             warnings.warn(message(found), RobotDynWarning, stacklevel=3)
 

@@ -53,6 +53,23 @@ class RowViolation:
         return f"{self.label} by {self.acceleration:.3g} {u}/s^2 (velocity level: {self.velocity:.3g} {u}/s)"
 
 
+def dropped_rows(red) -> np.ndarray:
+    """The indices of the rows that the reduced model ``red``'s projection dropped as redundant.
+
+    Args:
+        red: The :class:`~robotdyn.reduction.reduced_dynamics.ReducedDynamics` (its ``jacobian_rows`` and
+            ``projection.rows``; a projection without ``rows`` kept them all).
+
+    Returns:
+        The dropped rows' indices into ``red.jacobian_rows`` (sorted; empty: none dropped).
+    """
+    m = red.jacobian_rows.A.shape[0]
+    kept = np.asarray(getattr(red.projection, "rows", np.arange(m)), dtype=int)
+    keep = np.ones(m, dtype=bool)  # np.setdiff1d(np.arange(m), kept) without importing numpy.ma (np.unique)
+    keep[kept[(kept >= 0) & (kept < m)]] = False
+    return np.flatnonzero(keep)
+
+
 def violations(red, nudot=None, tol: float = TOL) -> list[RowViolation]:
     """The rows that the reduced model ``red`` dropped as redundant and that its velocity :math:`v = S\\nu`, or its
     accelerations :math:`a = S\\dot\\nu + w` for ``nudot``, violate by more than ``tol`` (relative).
@@ -69,11 +86,7 @@ def violations(red, nudot=None, tol: float = TOL) -> list[RowViolation]:
         The :class:`RowViolation` of each violated row (empty: consistent).
     """
     rows = red.jacobian_rows
-    m = rows.A.shape[0]
-    kept = np.asarray(getattr(red.projection, "rows", np.arange(m)), dtype=int)
-    keep = np.ones(m, dtype=bool)  # np.setdiff1d(np.arange(m), kept) without importing numpy.ma (np.unique)
-    keep[kept[(kept >= 0) & (kept < m)]] = False
-    dropped = np.flatnonzero(keep)
+    dropped = dropped_rows(red)
     if dropped.size == 0:
         return []
     A = rows.A[dropped]

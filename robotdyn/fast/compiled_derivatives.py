@@ -71,7 +71,7 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
     if fast is None or fast.slip_refusal is not None \
             or not hasattr(fast.ev, "derivatives"):  # (an extension built before the derivatives)
         return None
-    if fast._hint is None:  # (not fast.ready)
+    if not fast.ready:
         fast._choose(q, nu)
     try:
         nudot, dq, dnu, dtau, v, Vq, S, A = fast.ev.derivatives(q, nu, tau)

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..constraints.redundancy import TOL, RowViolation
+from ..constraints.redundancy import TOL, RowViolation, dropped_rows
 from ..constraints.redundancy import violations as exact_violations
 from .compiled import Fallback
 from .dispatch import compiled_model
@@ -37,15 +37,6 @@ STEP = 1e-6
 """Largest coordinate change h [m or rad] of the central difference of the rows along v."""
 MARGIN = 0.25
 """Fraction of the exact check's tolerance below which the screen clears a dropped row."""
-
-
-def _dropped(red) -> np.ndarray:
-    """Indices of the rows the projection of ``red`` dropped (as :func:`robotdyn.constraints.redundancy.violations`)."""
-    m = red.jacobian_rows.A.shape[0]
-    kept = np.asarray(getattr(red.projection, "rows", np.arange(m)), dtype=int)
-    keep = np.ones(m, dtype=bool)
-    keep[kept[(kept >= 0) & (kept < m)]] = False
-    return np.flatnonzero(keep)
 
 
 def drift_estimate(robot, q: np.ndarray, v: np.ndarray) -> np.ndarray | None:
@@ -91,7 +82,7 @@ def violations(robot, red, q: np.ndarray, nudot) -> list[RowViolation]:
     v = red.v
     if nudot is None or not v.any():  # no Adot needed there: the exact check is already cheap
         return exact_violations(red, nudot)
-    dropped = _dropped(red)
+    dropped = dropped_rows(red)
     if dropped.size == 0:
         return []
     A_all = red.jacobian_rows.A

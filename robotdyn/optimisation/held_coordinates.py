@@ -44,12 +44,11 @@ def rank_changing(robot, q0: np.ndarray, positions, pair: Callable | None) -> li
         The indices (into q) of the coordinates whose step by :math:`\\pm` :data:`STEP` (1 + abs(q_i)) changes the rank,
         in coordinate order (empty where every row is independent at q0).
     """
-    def rank(q: np.ndarray) -> int:
-        A = robot.rows_at(q).A
+    def rank(A: np.ndarray) -> int:
         return len(independent_rows(A)) if A.size else 0
 
     A0 = robot.rows_at(q0).A
-    r0 = rank(q0)
+    r0 = rank(A0)
     if r0 == A0.shape[0]:  # every row independent at q0: the rank cannot change nearby (it cannot rise further)
         return []
     out = []
@@ -62,7 +61,7 @@ def rank_changing(robot, q0: np.ndarray, positions, pair: Callable | None) -> li
                 steps = pair(q0, int(i), h)
             except ConstraintError:  # no level set along it: not a direction the robot moves in either
                 steps = None
-        if steps is None or any(rank(q) != r0 for q in steps):
+        if steps is None or any(rank(robot.rows_at(q).A) != r0 for q in steps):
             out.append(int(i))
     return out
 

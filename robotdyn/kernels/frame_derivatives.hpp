@@ -2,8 +2,11 @@
 // at one state (q, x), twin of robotdyn/constraints/row_derivatives.py (FramePass, _rot_dq, _cross_d).
 //
 // A pass with accelerations runs computeForwardKinematicsDerivatives on a Pinocchio data of its own and takes, per
-// joint, Pinocchio's getJointVelocityDerivatives / getJointAccelerationDerivatives in WORLD, carried to each frame's
-// origin (FramePass below). A velocity-only pass (run_velocities) reuses the evaluator's configuration pass instead
+// joint, the WORLD configuration derivatives of the joint's velocity and acceleration that Pinocchio's
+// getJointVelocityDerivatives / getJointAccelerationDerivatives assemble, by their own steps (motionSet::motionAction
+// over the joint's support) without the outputs those functions also fill and the pass does not read, carried to
+// each frame's origin (FramePass below; the compiled derivatives equal the Python twin's, which calls Pinocchio's
+// functions themselves, to 1e-10 in tests/test_compiled_derivatives*.py). A velocity-only pass (run_velocities) reuses the evaluator's configuration pass instead
 // of recomputing the placements: the world joint velocities ov_i = ov_parent + J_i x_i from the world Jacobian
 // columns J (CRBA's data.J) and, per column c of a joint on the support of j, the same WORLD derivative that
 // getJointVelocityDerivatives assembles from computeForwardKinematicsDerivatives' dVdq:

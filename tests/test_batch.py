@@ -52,3 +52,24 @@ def test_small_batches_start_no_workers(quasimoro, monkeypatch):
     assert started == []
     for name in ("M", "h", "g", "B", "S"):
         assert np.array_equal(getattr(serial, name), getattr(two, name))
+
+
+def test_workers_end_on_sigterm_whatever_handler_the_parent_has(quasimoro, monkeypatch, capfd):
+    """The pool ends its workers with SIGTERM; a handler inherited from the parent (the CLI's raises
+    KeyboardInterrupt, and stays installed when the CLI runs in-process) must not run in them: it left a worker dead
+    while holding the pool's queue lock and its sibling blocked on it, and the pool's exit waiting forever."""
+    import signal
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        monkeypatch.setattr(batch, "MIN_WORK_PER_PROCESS", 0.0)
+        rng = np.random.default_rng(1)
+        Q, NU = rng.uniform(-2, 2, (300, quasimoro.nq)), rng.normal(size=(300, quasimoro.mobility))
+        for _ in range(20):
+            evaluate(quasimoro, Q, NU, processes=2)
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert "KeyboardInterrupt" not in capfd.readouterr().err  # no worker ran the parent's handler

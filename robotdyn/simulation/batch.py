@@ -103,6 +103,15 @@ def _worker(args):
     return _evaluate_chunk(_WORKER_ROBOT, Q, NU, offset)
 
 
+def _default_sigterm() -> None:
+    """A forked worker's SIGTERM back to the default (end the process): the pool ends its workers with SIGTERM, and
+    a handler inherited from the parent (the CLI's, which raises KeyboardInterrupt) left a worker blocked on the
+    pool's queue lock alive, so that the pool's exit waited for it forever (seen once in the test suite)."""
+    import signal
+
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
     """The reduced model of ``robot`` at the states (Q[i], NU[i]).
 
@@ -145,7 +154,7 @@ def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
         bounds = np.linspace(head, len(Q), processes + 1).astype(int)
         chunks = [(Q[a:b], NU[a:b], a) for a, b in zip(bounds[:-1], bounds[1:])]
         try:
-            with mp.get_context("fork").Pool(processes) as pool:
+            with mp.get_context("fork").Pool(processes, initializer=_default_sigterm) as pool:
                 parts += pool.map(_worker, chunks)
         finally:
             _WORKER_ROBOT = None

@@ -132,7 +132,8 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "closures[].components": ("the closed components, a subset of x y z rx ry rz in frame1's axes", '"x y z"',
                               'components = "x z"'),
     "springs": ("springs and dampers on joints: generalised force -k (q - rest) - c q' on the joint's "
-                "coordinate", "[]", '[[springs]]\njoint = "front_left_suspension"\nstiffness = 3.0e4'),
+                "coordinate (the URDF's joint <dynamics damping friction> are not applied: robotdyn info names "
+                "them; a damping is applied as a spring with stiffness 0)", "[]", '[[springs]]\njoint = "front_left_suspension"\nstiffness = 3.0e4'),
     "springs[].name": ("the spring's name (messages, reports)", "the joint name", 'name = "front_left"'),
     "springs[].joint": ("the moving (not locked) joint it acts on, one coordinate: revolute, continuous or "
                         "prismatic; at most one spring per joint", "required", 'joint = "front_left_suspension"'),

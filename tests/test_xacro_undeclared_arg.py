@@ -4,7 +4,9 @@ on the package's own top-level file, which also includes sensor packages a user 
 user's own top-level file that includes only the macro got xacro's bare "Undefined substitution argument use_sim",
 and robotdyn refuses ``--xacro-arg use_sim=...`` for an argument no ``<xacro:arg>`` declares).
 
-Fixture: a package of this test's own, one macro (a box with two wheels) whose wheel mass is ``$(arg wheel_mass)``.
+Also: the macro file itself given as the description (it expands to no joints).
+
+Fixture: a package of this test's own, one macro (a box with one wheel) whose wheel mass is ``$(arg wheel_mass)``.
 """
 
 from __future__ import annotations
@@ -63,3 +65,14 @@ def test_declared_argument_is_read(folder):
 
     robot = load_robot(folder / "declared.toml", xacro_args={"wheel_mass": "0.25"})  # not the default 0.1
     assert pin.computeTotalMass(robot.model) == pytest.approx(1.25, abs=1e-12)
+
+
+def test_a_macro_file_given_as_the_description(folder, capsys):
+    """The package's macro file itself (it defines the robot but never calls it, so it expands to no joints): the
+    error says so instead of only "no joint named 'wheel_joint'"."""
+    macro = folder / "ws" / "cart_description" / "urdf" / "cart_macro.urdf.xacro"
+    assert main(["info", "--constraints", str(folder / "declared.toml"), "--urdf", str(macro)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.endswith(
+        "wheels[0] (w): joint: no joint named 'wheel_joint' in cart_macro.urdf.xacro, which has no joints at all; "
+        "expected the description's top-level file (a file of Xacro macros defines a robot only where it is called)")

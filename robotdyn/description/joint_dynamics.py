@@ -1,4 +1,4 @@
-"""The URDF's joint ``<dynamics damping=... friction=...>`` that robotdyn does not apply, named for ``info``.
+"""A URDF's joint damping and friction (its ``<dynamics>`` tags), which robotdyn does not apply, named for ``info``.
 
 Pinocchio reads a joint's ``<dynamics>`` into ``model.damping`` and ``model.friction``; robotdyn's equations of
 motion leave both out (its dynamics are those of the papers' ideal joints), so a description written for Gazebo,

@@ -653,21 +653,37 @@ class Robot:
         heights = self.wheel_heights(q)
         values = np.array(list(heights.values()))
         if rows.labels[i].rsplit(".", 1)[0] in heights and np.ptp(values) <= tol and self.spec.root != "fixed":
-            h = -float(np.mean(values)) + self.description.root_height
-            where = "above" if values[0] > 0 else "below"
-            fix = (f"set root_height = {h:.6g} in the constraint file (RobotSpec.root_height; leave it out to have it "
-                   "found from the wheels)" if self.spec.root == "planar" else
-                   f"set z = {q[self.coordinate_index('z')] - values[0]:.6g} (neutral = {{ z = ... }} in the "
-                   "constraint file)")
-            raise ConstraintError(
-                f"every wheel is {abs(values[0]):.6g} m {where} the ground at this configuration: the root link sits "
-                f"at the wrong height ({self.spec.root} root at {self.description.root_height:.6g} m); {fix}")
+            raise ConstraintError(self._root_height_advice(q, values, "at this configuration"))
         what = ("the wheels must touch the ground: check the radii and joint values, or solve the posture "
                 "(robotdyn.constraints.posture)" if rows.labels[i].rsplit(".", 1)[0] in heights else
                 "solve the closures first (robotdyn.constraints.posture solves the holonomic constraints for the free coordinates)")
         raise ConstraintError(
             f"q violates constraint {rows.labels[i]} by {rows.residual[i]:.3g}; expected |residual| <= {tol:g}; {what}"
         )
+
+    def _root_height_advice(self, q, heights, when: str) -> str:
+        """What to do when every wheel misses the ground by the same height: the root link's height and its fix.
+
+        Args:
+            q: Natural coordinates (n,) [m, rad] at which the wheels were measured.
+            heights: Each wheel's contact-point height above the terrain [m] (:meth:`wheel_heights`), all equal.
+            when: Where they were measured, e.g. "at the neutral configuration".
+
+        Returns:
+            One line: how far the wheels are off, where the root is, and the value to set (rounded to 1e-9 m, so
+            that a root already in place reads 0, not a rounding residue).
+        """
+        d = float(np.mean(heights))
+        where = "above" if d > 0 else "below"
+        if self.spec.root == "planar":
+            now = self.description.root_height
+            fix = (f"set root_height = {round(now - d, 9) + 0.0:.6g} in the constraint file (RobotSpec.root_height; leave "
+                   "it out to have it found from the wheels)")
+        else:
+            now = float(np.asarray(q, float)[self.coordinate_index("z")])
+            fix = f"set z = {round(now - d, 9) + 0.0:.6g} (neutral = {{ z = ... }} in the constraint file)"
+        return (f"every wheel is {abs(d):.6g} m {where} the ground {when}: the root link sits at the wrong height "
+                f"({self.spec.root} root at {now:.6g} m); {fix}")
 
     def wheel_heights(self, q=None) -> dict[str, float]:
         """Each wheel's contact-point height above the terrain [m] (its holonomic residual); 0 when it touches,
@@ -1147,12 +1163,17 @@ class Robot:
         """
         mobility, notes = self.mobility_check()
         report = self.description.visual_report
+        from .description.joint_dynamics import unapplied_joint_dynamics
+
         heights = self.wheel_heights() if self.spec.root != "fixed" else {}
-        if heights and max(map(abs, heights.values())) > 1e-6:
+        if heights and max(map(abs, heights.values())) > 1e-6 and np.ptp(list(heights.values())) <= 1e-6:
+            notes.append(self._root_height_advice(self.neutral(), list(heights.values()), "at the neutral configuration"))
+        elif heights and max(map(abs, heights.values())) > 1e-6:
             listed = ", ".join(f"{k} {v:+.4g} m" for k, v in heights.items())
             notes.append(f"at the neutral configuration the wheels do not all touch the ground (contact heights above "
                          f"it: {listed}); a {self.spec.root} root cannot fix that with one height: check the radii, "
                          "the joint values (neutral) or the terrain")
+        notes += unapplied_joint_dynamics(self.model, {sp.index for sp in self.springs if sp.damping > 0})
         if self.spec.root != "fixed":  # an axis in the wrong axes (robotdyn.constraints.rolling_contact.lying_flat)
             from .constraints.rolling_contact import lying_flat
 

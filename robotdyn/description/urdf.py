@@ -157,6 +157,11 @@ def expand_xacro(path: str | Path, args: dict[str, object] | None = None, packag
                 needed |= required_packages(path, index)
             if needed:
                 raise MissingPackagesError(needed, f"cannot expand xacro {path.name}: ") from None
+            undefined = re.fullmatch(r"Undefined substitution argument (\w+)", msg)
+            if undefined:  # a macro reads $(arg NAME) that the file given here does not declare
+                msg += (f"; expected <xacro:arg name=\"{undefined[1]}\" default=\"...\"/> in {path.name} (the "
+                        f"description reads $(arg {undefined[1]}): the top-level file declares it, also to set it "
+                        "with --xacro-arg or xacro_args)")
             raise DescriptionError(f"cannot expand xacro {path.name}: {msg}") from None
     urdf = doc.toxml()
     check_size(urdf, path.name)

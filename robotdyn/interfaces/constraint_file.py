@@ -536,6 +536,9 @@ class _Context:
         """A joint of the description (with ``movable``, not a fixed one)."""
         r, joints = self.r, self.tree.joints
         name = r.string(where, name, what)
+        if name not in joints and not joints:  # e.g. a file of Xacro macros that nothing calls
+            r.fail(where, f"{what}: no joint named {name!r} in {self.desc.name}, which has no joints at all; expected "
+                   "the description's top-level file (a file of Xacro macros defines a robot only where it is called)")
         if name not in joints:
             r.fail(where, f"{what}: no joint named {name!r} in {self.desc.name}{_suggest(name, joints)}")
         if movable and joints[name]["type"] == "fixed":

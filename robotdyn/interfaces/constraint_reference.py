@@ -81,7 +81,11 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "wheels[].kind": ("standard (rolls without slipping) | omni (with roller_angle) | caster (a wheel on a steering "
                       "joint of the URDF) | support (touches the ground only: normal row, frictionless, e.g. a ball "
                       "caster or a skid)", "standard", 'kind = "support"'),
-    "wheels[].roller_angle": ("omni: angle of the rollers' axes", "0", 'roller_angle = "45 deg"'),
+    "wheels[].roller_angle": ("omni: angle of the axis of the roller touching the ground (the "
+                              "one direction in which the wheel cannot slip) from the wheel's rolling direction, "
+                              "counter-clockwise seen from above; 0: a 90-degree omni wheel; a mecanum wheel whose "
+                              "ground roller points forward-right is -45 deg, forward-left +45 deg", "0",
+                              'roller_angle = "-45 deg"'),
     "wheels[].radius_joint": ("a prismatic joint that sets the radius (adaptable wheels)", "none",
                               'radius_joint = "leg_joint"'),
     "wheels[].mu": ("friction coefficient (dimensionless): the traction check's limit; the coulomb law's limit and "
@@ -128,7 +132,8 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "closures[].components": ("the closed components, a subset of x y z rx ry rz in frame1's axes", '"x y z"',
                               'components = "x z"'),
     "springs": ("springs and dampers on joints: generalised force -k (q - rest) - c q' on the joint's "
-                "coordinate", "[]", '[[springs]]\njoint = "front_left_suspension"\nstiffness = 3.0e4'),
+                "coordinate (the URDF's joint <dynamics damping friction> are not applied: robotdyn info names "
+                "them; a damping is applied as a spring with stiffness 0)", "[]", '[[springs]]\njoint = "front_left_suspension"\nstiffness = 3.0e4'),
     "springs[].name": ("the spring's name (messages, reports)", "the joint name", 'name = "front_left"'),
     "springs[].joint": ("the moving (not locked) joint it acts on, one coordinate: revolute, continuous or "
                         "prismatic; at most one spring per joint", "required", 'joint = "front_left_suspension"'),

@@ -328,9 +328,12 @@ def stiff_slip_warning(robot, duration: float) -> None:
 
     from ..errors import RobotDynWarning
 
+    wheels = slipping_wheels(robot)
+    if not wheels:  # (the usual case: nothing to compute)
+        return
     g = float(np.linalg.norm(robot.model.gravity.linear))
     stiff = {}
-    for wheel in slipping_wheels(robot):
+    for wheel in wheels:
         law = getattr(wheel, "law", None)
         k = getattr(law, "stiffness", None)
         if k is None and getattr(law, "slip_velocity", None):

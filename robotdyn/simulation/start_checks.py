@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..contact.stick_slip_wheel import stick_slip_wheels
 from ..fast.dispatch import compiled_model
 from ..reduction.pull_back import start_offsets as python_start_offsets
 
@@ -37,7 +38,7 @@ Python rows (see the module text)."""
 
 def compiled_residuals(robot, q0: np.ndarray) -> np.ndarray | None:
     """Every constraint row's residual at q0 from the robot's compiled model (``None`` where it does not serve:
-    no compiled model, no row choice made yet, or an evaluation that fails at q0).
+    no compiled model, no row choice made yet, stick-slip wheels, or an evaluation that fails at q0).
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
@@ -46,10 +47,12 @@ def compiled_residuals(robot, q0: np.ndarray) -> np.ndarray | None:
     Returns:
         The residuals (m,) [m or rad] in the order of the robot's rows, or ``None``.
     """
-    fast = compiled_model(robot)
-    if fast is None or not fast.ready:
+    if stick_slip_wheels(robot):  # (their runs switch models segment by segment: the Python rows, as before)
         return None
-    try:
+    try:  # (the model the run's own evaluations use through robot.reduced: built here at the latest)
+        fast = compiled_model(robot)
+        if fast is None or not fast.ready:
+            return None
         residual = fast.evaluate(q0, np.zeros(robot.mobility))[8]
     except Exception:  # noqa: BLE001 (a fallback or any refusal: the Python rows decide, with their messages)
         return None

@@ -139,7 +139,7 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     """
     if method not in (*METHODS, CVODE):
         raise RobotDynError(f"unknown compiled integrator {method!r}; expected one of {', '.join(METHODS)}, {CVODE}")
-    native = native_profile(profile)
+    native = _zero_native(profile) if controller is not None else native_profile(profile)
     points = set(map(float, profile.breakpoints()))
     if controller is not None:
         points.update(map(float, controller.breakpoints()))
@@ -188,6 +188,22 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     return {"t": out["t"], "y": out["y"], "energy": out["energy"], "residual": out["residual"],
             "nfev": int(out["nfev"]), "steps": int(out["steps"]), "interrupted": interrupted,
             "event": (t_stop, np.asarray(out["y_stop"])) if out["event"] else None, "flights": out["flights"]}
+
+
+_ZERO: dict[int, object] = {}
+"""The C++ zero profile by number of motors (:func:`_zero_native`)."""
+
+
+def _zero_native(profile: TorqueProfile):
+    """:func:`native_profile` of ``profile``, built once per number of motors where it is zero torques
+    (:class:`~robotdyn.simulation.torque_profile.Constant`): the profile of every run with a feedback law, which the
+    C++ run reads only as const."""
+    if type(profile) is not Constant or profile.values.any():
+        return native_profile(profile)
+    m = len(profile.values)
+    if m not in _ZERO:
+        _ZERO[m] = native_profile(Constant(np.zeros(m)))
+    return _ZERO[m]
 
 
 def as_data(torque):

@@ -25,7 +25,7 @@ from ..fast.dispatch import compiled_model
 from .compiled_engine import as_data, at_time, choose_engine, default_method, simulate_compiled
 from ..errors import ConstraintError, NonFiniteError, RobotDynError
 from ..reduction.projection import solve
-from ..reduction.pull_back import STABILISATION, failure_note, position_rate, start_offsets
+from ..reduction.pull_back import STABILISATION, failure_note, position_rate
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import contact_load, lift_off_message, slipping_wheels
@@ -35,6 +35,7 @@ from ..contact.applied_forces import applied, has_applied
 from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .progress import Progress
 from .run_options import check_run_options
+from .start_checks import start_offsets
 from .feedback import FeedbackLaw
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
@@ -160,10 +161,9 @@ def simulate(
         as_profile(torque, len(robot.motors))  # one line if it is for another number of motors
     if isinstance(torque, FeedbackLaw):
         torque = torque.bound(robot)  # one line if it does not fit the robot; its model is the robot simulated
-    rows0 = robot.rows_at(q0)  # (once: both checks below read them)
-    if not t0:  # a continuation starts where the earlier run ended (its drift is reported, not refused)
-        robot.check_constraints(q0, rows=rows0)
-    offsets = start_offsets(robot, q0, stabilisation, rows0)
+    # a continuation starts where the earlier run ended (its drift is reported, not refused); the compiled rows
+    # where they settle both checks (robotdyn.simulation.start_checks)
+    offsets = start_offsets(robot, q0, stabilisation, check=not t0)
     stiff_slip_warning(robot, t_end - t0)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
     if stick_slip_wheels(robot):  # exact switching: segment by segment
@@ -328,9 +328,12 @@ def stiff_slip_warning(robot, duration: float) -> None:
 
     from ..errors import RobotDynWarning
 
+    wheels = slipping_wheels(robot)
+    if not wheels:  # (the usual case: nothing to compute)
+        return
     g = float(np.linalg.norm(robot.model.gravity.linear))
     stiff = {}
-    for wheel in slipping_wheels(robot):
+    for wheel in wheels:
         law = getattr(wheel, "law", None)
         k = getattr(law, "stiffness", None)
         if k is None and getattr(law, "slip_velocity", None):

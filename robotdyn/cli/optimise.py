@@ -49,10 +49,10 @@ def cmd_optimise(args) -> int:
                                 cost=args.cost)
     s = problem.solve()
     if not s.success:  # nothing printed or written: an unconverged iterate is not a result
-        raise RobotDynError(f"the optimisation did not converge: IPOPT {s.status} after {s.iterations} iterations "
-                            f"(largest defect {s.max_defect:.2g}; looser bounds, more time or more nodes may make "
-                            "the problem feasible)" + (f"; the model refused a point IPOPT tried: {problem.refused}"
-                                                       if getattr(problem, "refused", None) else ""))
+        raise RobotDynError(f"the optimisation did not converge: IPOPT {s.status} after {s.iterations} iterations, "
+                            f"largest defect {s.max_defect:.2g}: {s.diagnosis}"
+                            + (f"; the model refused a point IPOPT tried: {problem.refused}"
+                               if getattr(problem, "refused", None) else ""))
     if args.csv:
         header = ["t"] + s.coordinates + s.velocity_names + [f"tau_{m}" for m in s.motors]
         with atomic_output(args.csv, "CSV file") as tmp:

@@ -21,7 +21,10 @@ Jacobian is block-sparse (two state blocks and two torque blocks per interval) a
 comparison, central finite differences of the forward dynamics (``derivatives="finite-difference"``; with holonomic
 rows the coordinates are stepped along their level set, :mod:`robotdyn.optimisation.manifold_steps`). The cost is
 quadratic and its gradient exact in both cases; IPOPT's Hessian is its limited-memory (L-BFGS) approximation, in
-both cases, so that the two differ only in the constraint Jacobian.
+both cases, so that the two differ only in the constraint Jacobian. With the effort cost IPOPT sees the torques in
+units of their expected size and the effort in units of its expected value (:mod:`robotdyn.optimisation.scaling`:
+powers of 2 from the torques of a guessed motion; without them a light robot's problem, where 1 N m gives
+thousands of rad/s^2, did not converge).
 
 Solver choice: IPOPT (interior point, sparse, the reference NLP solver of the optimal-control community) through
 CasADi's ``nlpsol``, because CasADi's PyPI wheel bundles IPOPT with its sparse linear solver (MUMPS): it installs
@@ -63,6 +66,7 @@ from ..fast.compiled import Fallback
 from ..fast.compiled_derivatives import raw_derivatives
 from .callbacks import _casadi, refusal, sparse_callback
 from .node_batches import analytic_jacobians, central_jacobians, rhs_nodes
+from .scaling import effort_units
 
 DERIVATIVES = ("analytic", "finite-difference")
 """How the dynamics' Jacobian is computed (``derivatives`` of :class:`TrajectoryProblem`)."""
@@ -74,6 +78,8 @@ memory)."""
 square of the largest required friction coefficient over wheels and nodes plus ``effort_weight`` times the effort."""
 HOLONOMIC_TOL = 1e-8
 """Largest holonomic residual [m or rad] accepted at q0 (the collocation keeps every node on the manifold)."""
+FEASIBLE_DEFECT = 1e-6
+"""Largest defect [state units] at which :attr:`TrajectorySolution.diagnosis` calls an iterate feasible."""
 HELD_TOL = 1e-6
 """Largest defect [state units] of a held coordinate or velocity (:mod:`robotdyn.optimisation.held_coordinates`)
 accepted at the optimum: their rows are not the NLP's, and a larger one means the motion would leave them."""
@@ -139,6 +145,31 @@ class TrajectorySolution:
         from .contact_limits import required_mu
 
         return required_mu(self.forces)
+
+    @property
+    def diagnosis(self) -> str:
+        """What IPOPT's stop says about the problem, as one line (empty on success); what the CLI prints with a
+        failed solve. The iteration limit is told apart by the largest defect: at most :data:`FEASIBLE_DEFECT`
+        means that the iterates met the constraints and the cost still fell (the old code's light differential
+        drive, :mod:`robotdyn.optimisation.scaling`), not that the problem is infeasible."""
+        status = self.status.split(";")[0]
+        if self.success:
+            return ""
+        if "held rows" in self.status:
+            return ("the motion leaves a coordinate held at its start value (the constraints change rank along it): "
+                    "ask for a motion that keeps it")
+        if status == "Maximum_Iterations_Exceeded" and self.max_defect <= FEASIBLE_DEFECT:
+            return ("the iteration limit came on feasible points (the constraints held) before the optimum: a badly "
+                    "scaled problem (torques, distances or times of very different magnitudes) or a flat optimum, "
+                    "not an infeasible one")
+        if status in ("Maximum_Iterations_Exceeded", "Infeasible_Problem_Detected", "Restoration_Failed"):
+            what = {"Maximum_Iterations_Exceeded": "the iteration limit came before the constraints held",
+                    "Infeasible_Problem_Detected": "IPOPT found the constraints locally infeasible",
+                    "Restoration_Failed": "IPOPT's restoration phase could not reduce the constraints' violation"}
+            return f"{what[status]}: looser bounds, more time or more nodes may make the problem feasible"
+        if status == "Invalid_Number_Detected":
+            return "the model gave a non-finite number at a point IPOPT tried"
+        return f"IPOPT stopped before convergence ({status})"
 
     def profile(self):
         """The optimal torques as a :class:`~robotdyn.simulation.torque_profile.Table` (linear between nodes,
@@ -625,9 +656,12 @@ class TrajectoryProblem:
         sdot = 0.5 * np.pi / self.t_end * np.sin(np.pi * t / self.t_end)
         X = x0 + s[:, None] * (x1 - x0)
         dq = x1[:self.n] - x0[:self.n]
+        self._guess_S, self._guess_q = [], X[1:-1, :self.n].copy()  # kept for robotdyn.optimisation.scaling
         for j in range(1, N - 1):  # velocities that best follow the coordinates' path (least squares on S)
             S = self.robot.reduced(X[j, :self.n], np.zeros(self.k)).S
+            self._guess_S.append(S)
             X[j, self.n:] = np.linalg.lstsq(S, sdot[j] * dq, rcond=None)[0]
+        self._guess_S = np.array(self._guess_S)
         X[-1] = np.where(np.isfinite(self.x_end), self.x_end, X[-1])
         return np.concatenate([np.clip(X, self.x_lo, self.x_hi).ravel(), np.zeros(N * self.m)] + extra)
 
@@ -653,7 +687,15 @@ class TrajectoryProblem:
         self._callbacks = []  # CasADi holds no Python reference to them
         constraints = sparse_callback("constraints", nz, ng, self.constraints, self.jacobian_values, rows, cols,
                                       self._callbacks)
-        z = ca.MX.sym("z", nz)
+        z0 = self._initial()
+        # IPOPT's variables zhat = z / D and objective cf * cost: the torques in units of their expected size and the
+        # effort in units of its expected value (robotdyn.optimisation.scaling; powers of 2, exact)
+        D, cf = np.ones(nz), 1.0
+        if self.cost_kind == "effort":
+            units, cf = effort_units(self, z0)
+            D[N * nx:N * (nx + m)] = np.tile(units, N)
+        zhat = ca.MX.sym("z", nz)
+        z = ca.DM(D) * zhat
         h = self.t_end / (N - 1)
         w = np.full(N, h)
         w[[0, -1]] = 0.5 * h
@@ -683,17 +725,17 @@ class TrajectoryProblem:
                 "ipopt.max_iter": int(max_iter), "ipopt.print_level": 5 if verbose else 0, "print_time": bool(verbose),
                 "ipopt.sb": "yes", "ipopt.honor_original_bounds": "yes",
                 "show_eval_warnings": False}  # a refused trial point: robotdyn.optimisation.callbacks._refused
-        solver = ca.nlpsol("trajectory", "ipopt", {"x": z, "f": cost, "g": constraints(z)}, opts)
+        solver = ca.nlpsol("trajectory", "ipopt", {"x": zhat, "f": cf * cost, "g": constraints(z)}, opts)
         self.calls = {"dynamics": 0, "derivatives": 0}
         if self.limits is not None:
             self.limits.calls = 0
         self._defect_cache = self._jac_cache = (None, None)
         start = time.perf_counter()
-        res = solver(x0=self._initial(), lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        res = solver(x0=z0 / D, lbx=lbx / D, ubx=ubx / D, lbg=lbg, ubg=ubg)
         wall = time.perf_counter() - start
         stats = solver.stats()
         self.refused = refusal(self._callbacks)  # the model's first error at a trial point (None: none)
-        zopt = np.asarray(res["x"], float).ravel()
+        zopt = np.asarray(res["x"], float).ravel() * D
         X, U = self._split(zopt)
         calls = dict(self.calls)
         if self.limits is not None:
@@ -710,7 +752,7 @@ class TrajectoryProblem:
             forces = np.array([self.limits.forces(X[j, :self.n], X[j, self.n:], U[j]) for j in range(N)])
             wheels = list(self.limits.wheels)
         effort = float(np.sum(np.repeat(w, m) * U.ravel() ** 2))
-        return TrajectorySolution(t, X[:, :self.n].copy(), X[:, self.n:].copy(), U.copy(), float(res["f"]),
+        return TrajectorySolution(t, X[:, :self.n].copy(), X[:, self.n:].copy(), U.copy(), float(res["f"]) / cf,
                                   str(stats["return_status"]) + ("" if success or not stats["success"] else
                                                                  f"; held rows' largest defect {held:.2g}"),
                                   success, int(stats["iter_count"]),
@@ -766,4 +808,5 @@ def _fmt(a: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:g}" for v in a) + "]"
 
 
-__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES", "COSTS", "HOLONOMIC_TOL", "HELD_TOL"]
+__all__ = ["TrajectoryProblem", "TrajectorySolution", "DERIVATIVES", "COSTS", "HOLONOMIC_TOL", "HELD_TOL",
+           "FEASIBLE_DEFECT"]

@@ -23,9 +23,10 @@ expected size, and the objective in units of its own expected value, both from a
    2, so that the scaling is exact in floating point (IPOPT's iterates map back to the same bits, and the optimum's
    cost is unchanged by it).
 
-Measured on the fixture (0.3 m in 2 s): 11, 21, 41 and 81 nodes converge (``Solve_Succeeded``) in 10-20 iterations,
-with analytic and finite-difference Jacobians, to the same cost; the built-in optimisations keep their optima and
-their iteration counts within a few (``bench/bench.py trajectory`` for Quasimoro). The ``peak-mu`` cost (a squared
+Measured on the fixture (0.3 m in 2 s): 11, 21, 41 and 81 nodes converge (``Solve_Succeeded``) in 15-18 iterations,
+with analytic and finite-difference Jacobians, to the same cost (12 digits). The built-in optimisations keep their
+optima (within 1.3e-9 in cost): Quasimoro's rest-to-rest (``bench/bench.py trajectory``) 14 -> 15 iterations, the
+rover's traction path 18 -> 14, the sprung car 8 -> 6, the adaptable tricycle's fixed radii 24 -> 24. The ``peak-mu`` cost (a squared
 friction coefficient, already of order 1) is left in SI units. Where the guessed motion's torques cannot be found
 (a model that refuses a node, non-finite values, a motion that needs no torque) the units stay 1: the problem as
 it was.

@@ -789,6 +789,9 @@ def main(argv: list[str] | None = None) -> int:
         The exit status: 0 on success, 2 on a one-line error, 130 after Ctrl-C.
     """
     _one_line_warnings()
+    from . import sigterm
+
+    handler = sigterm.current()  # simulate and sweep install their own SIGTERM handler: theirs only while they run
     try:
         argv = sys.argv[1:] if argv is None else list(argv)
         parser = build_parser(argv[0] if argv and argv[0] in BUILT_IN else None)  # `robotdyn CMD ...`: CMD alone
@@ -826,3 +829,5 @@ def main(argv: list[str] | None = None) -> int:
         print(f"robotdyn: error: cannot access file{name}: {exc.strerror or exc}; expected a readable input or a "
               "writable output in an existing directory", file=sys.stderr)
         return 2
+    finally:
+        sigterm.restore(handler)

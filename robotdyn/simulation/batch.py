@@ -106,10 +106,15 @@ def _worker(args):
 def _default_sigterm() -> None:
     """A forked worker's SIGTERM back to the default (end the process): the pool ends its workers with SIGTERM, and
     a handler inherited from the parent (the CLI's, which raises KeyboardInterrupt) left a worker blocked on the
-    pool's queue lock alive, so that the pool's exit waited for it forever (seen once in the test suite)."""
+    pool's queue lock alive, so that the pool's exit waited for it forever (seen once in the test suite). The
+    workers are forked with SIGTERM blocked (:func:`evaluate`) and unblock it only here, after the default is back: a
+    SIGTERM that came between the fork and this line used to trip the inherited Python handler, which the default
+    installed here then discarded (CPython skips a tripped signal whose handler is now SIG_DFL), so the worker lived
+    on, waiting for tasks, and the pool's exit joined it forever (seen in tests/test_batch.py under load)."""
     import signal
 
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})  # a SIGTERM already sent now ends the worker
 
 
 def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
@@ -154,7 +159,14 @@ def evaluate(robot, Q, NU, processes: int | None = 1) -> Batch:
         bounds = np.linspace(head, len(Q), processes + 1).astype(int)
         chunks = [(Q[a:b], NU[a:b], a) for a, b in zip(bounds[:-1], bounds[1:])]
         try:
-            with mp.get_context("fork").Pool(processes, initializer=_default_sigterm) as pool:
+            import signal
+
+            mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})  # until _default_sigterm: see there
+            try:
+                pool = mp.get_context("fork").Pool(processes, initializer=_default_sigterm)
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            with pool:
                 parts += pool.map(_worker, chunks)
         finally:
             _WORKER_ROBOT = None

@@ -50,7 +50,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..constraints.constraint import KinematicState
-from ..constraints.row_derivatives import FramePass, drift_dq, kind, velocity_dq
+from ..constraints.row_derivatives import FramePass, drift_dq, force_jacobian_dq, kind, velocity_dq, world_jacobians
 from ..errors import InputError, NonFiniteError
 from .actuation import input_matrix
 from .operational_space import project_operational
@@ -220,6 +220,42 @@ def motor_rows(robot, kin0: KinematicState, passes: list[FramePass], tau: np.nda
             Vc, dVc = fp.velocity(cf)
             Vr, dVr = fp.velocity(m.rid)
             out[l] += tau[j] * (axis @ (dVc[3:] - dVr[3:]) + (Vc[3:] - Vr[3:]) @ daxis)
+    return out
+
+
+def motor_force_dq(robot, kin0: KinematicState, tau: np.ndarray) -> np.ndarray:
+    """:math:`\\partial(B(q)\\tau)/\\partial q` (n, n) of the motors reacting on a body, without frame passes:
+    :math:`B\\tau = \\sum_j \\tau_j (J_{\\omega,\\text{child}} - J_{\\omega,\\text{reaction}})^T\\hat a_j`, a pure
+    moment :math:`\\tau_j\\hat a_j` on the joint's body and its opposite on the reaction body, differentiated at
+    fixed moment (:func:`~robotdyn.constraints.row_derivatives.force_jacobian_dq`) plus
+    :math:`(J_{\\omega,c} - J_{\\omega,r})^T\\tau_j\\,\\partial\\hat a/\\partial q` (twin of the compiled
+    ``ReducedDerivatives::motor_force_dq``; :func:`motor_rows` at the unit velocities gives the same matrix).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (its model and motors).
+        kin0: Kinematics at q (joint axes in world axes).
+        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+
+    Returns:
+        The derivative (n, n) [N m or N per unit of each coordinate].
+    """
+    model = robot.model
+    out = np.zeros((model.nv, model.nv))
+    J = None
+    for j, m in enumerate(robot.motors):
+        if m.rid is None or tau[j] == 0.0:
+            continue
+        if J is None:
+            J = world_jacobians(kin0)
+        cf = model.getFrameId(m.joint)
+        _, jac_c = kin0.pose(cf)
+        _, jac_r = kin0.pose(m.rid)
+        axis = jac_c[3:, m.index]
+        daxis = -np.cross(axis[:, None], jac_c[3:], axis=0)  # -[a]x Jw
+        phi = np.concatenate([np.zeros(3), tau[j] * axis])
+        force_jacobian_dq(model, J, model.frames[cf].parentJoint, phi, out)
+        force_jacobian_dq(model, J, model.frames[m.rid].parentJoint, phi, out, -1.0)
+        out += tau[j] * (jac_c[3:] - jac_r[3:]).T @ daxis
     return out
 
 

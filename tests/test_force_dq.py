@@ -1,7 +1,8 @@
 """The constraint forces' configuration derivative at fixed multipliers, d(A(q)^T mu)/dq, and the motors'
 d(B(q) tau)/dq at fixed torques (robotdyn.constraints.row_derivatives.force_dq, robotdyn.reduction.dynamics_derivatives
-.motor_force_dq; twins of the compiled ReducedDerivatives::force_dq, which the compiled derivative set uses for its
-multiplier term S^T d(A^T mu)/dq instead of one frame pass per column of S).
+.motor_force_dq, the operational twist rows' twist_force_dq; twins of the compiled ReducedDerivatives::force_dq and
+twist_force_dq, which the compiled derivative sets use for their multiplier term S^T d(A^T mu)/dq instead of one frame
+pass per column of S).
 
 Reference: the same matrix assembled row by row from the rows' velocity derivatives at the unit velocities,
 T[j, :] = mu^T d(A e_j)/dq (row_derivatives.velocity_dq on a FramePass at e_j: Pinocchio's own
@@ -16,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import warnings
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -26,7 +28,7 @@ from robotdyn.constraints.constraint import KinematicState
 from robotdyn.constraints.posture import set_terrain, solve_posture
 from robotdyn.constraints.terrain import SineTerrain
 from robotdyn.interfaces.constraint_file import read
-from robotdyn.reduction.dynamics_derivatives import motor_force_dq, motor_rows
+from robotdyn.reduction.dynamics_derivatives import motor_force_dq, motor_rows, twist_force_dq
 from robotdyn.robot import MotorSpec, Robot
 from robotdyn.robots import module
 
@@ -103,3 +105,21 @@ def test_compiled_derivatives_with_reacting_motors_equal_python(reacting_tiago):
     C = compiled_derivatives(robot, q, nu, tau)
     assert C is not None
     assert_same(C, dynamics_derivatives(robot, q, nu, tau))
+
+
+@pytest.mark.parametrize("frame, axes", [("platform", "local"), ("wheel_link_1", "local"), ("link_2", "world")])
+def test_twist_force_dq_equals_the_frame_velocity_derivatives_at_the_unit_velocities(frame, axes):
+    """An operational twist's rows J_o (the omni platform's own, and frames away from the root, in both axes):
+    d(J_o^T mu)/dq against mu^T d(J_o e_j)/dq from Pinocchio's frame velocity derivatives (FramePass)."""
+    robot = Robot(module("omni_caster").SPEC)
+    rng = np.random.default_rng(8)
+    q = admissible_state(robot, START["omni_caster"], rng)[0]
+    kin0 = _kin(robot, q)
+    twist = SimpleNamespace(fid=robot.model.getFrameId(frame), axes=axes, select=np.array([0, 1, 2, 3, 5]))
+    mu = rng.normal(size=5)
+    T = twist_force_dq(twist, kin0, mu)
+    rows = [(fp.local_velocity if axes == "local" else fp.velocity)(twist.fid)[1][twist.select]
+            for fp in _unit_passes(kin0)]
+    ref = np.vstack([mu @ r for r in rows])
+    assert np.abs(ref).max() > 0.01
+    assert np.abs(T - ref).max() <= 1e-12 * np.abs(ref).max()

@@ -16,8 +16,8 @@
 // LU of A_d, or K^-1 here): the operational derivatives and the slipping wheels' (sliding_derivatives.hpp) finish
 // from them. A selection of v without slipping wheels keeps ReducedDerivatives::run. OperationalDerivatives::run
 // takes its multiplier term as one derivative of the constraint and twist forces at fixed mu (force_dq,
-// twist_force_dq; twin dynamics_derivatives.twist_force_dq) on two frame passes (at a = S nudot + w and at v:
-// ProjectedPieces::build_at); the slipping wheels' kernel keeps the passes at the columns of S (build).
+// twist_force_dq; twin dynamics_derivatives.twist_force_dq) on two frame passes (at a = S nudot + w, velocity-only,
+// and at v: ProjectedPieces::build_at); the slipping wheels' kernel keeps the passes at the columns of S (build).
 #pragma once
 
 #include "reduced_dynamics_derivatives.hpp"
@@ -37,11 +37,24 @@ struct TwistFrame {
   const std::vector<int>* select;
 };
 
-// d(J_o x)/dq at fixed x = fp.x (k x n) (_Projection.twist_velocity_dq); w1, w2 work
+// d(J_o x)/dq at fixed x = fp.x (k x n) (_Projection.twist_velocity_dq); w1, w2 work. LOCAL on a velocity-only pass
+// (FramePass::run_velocities, no Pinocchio data): the frame's world-axes velocity V = (v, w) and dV (FramePass.velocity)
+// rotated into its axes, d(R^T y)/dq = R^T ([y]x J_w + dy) (the Python twin's FramePass.velocity inverted); else
+// Pinocchio's getFrameVelocityDerivatives(LOCAL) on the pass's data
 inline void twist_velocity_dq(const pin::Model& model, FramePass& fp, const TwistFrame& tf, MatrixXd& out,
                               Matrix6x& w1, Matrix6x& w2) {
   const Matrix6x* dV;
-  if (tf.local) {
+  if (tf.local && fp.base) {
+    fp.velocity(model, tf.fid, *tf.oMf, *tf.J);
+    const Vector6d& V = fp.V[tf.fid];
+    const Matrix6x& dVw = fp.dV[tf.fid];
+    const Matrix3d RT = tf.oMf->rotation().transpose();
+    const auto Jw = tf.J->bottomRows<3>();
+    w1.resize(6, model.nv);
+    rotate_skew_add(RT, V.head<3>(), Jw, Matrix3x(dVw.topRows<3>()), w1.topRows<3>());
+    rotate_skew_add(RT, V.tail<3>(), Jw, Matrix3x(dVw.bottomRows<3>()), w1.bottomRows<3>());
+    dV = &w1;
+  } else if (tf.local) {
     w1.setZero(6, model.nv);
     w2.setZero(6, model.nv);
     pin::getFrameVelocityDerivatives(model, fp.data, static_cast<pin::FrameIndex>(tf.fid), pin::LOCAL, w1, w2);
@@ -175,14 +188,14 @@ struct ProjectedPieces {
     finish(ev, ws.dA[k + 1], ws.passes[k + 1], op ? k + 1 : 0);
   }
 
-  // after start(): every piece on two passes only, at a = S nudot + w (full: the LOCAL twist's derivative is
-  // Pinocchio's getFrameVelocityDerivatives) and at v (ReducedDerivatives::run_passes); Aq(nudot) then holds for
-  // this a's nudot only, and the multiplier term is force_dq's (OperationalDerivatives::run)
+  // after start(): every piece on two passes only, at a = S nudot + w (velocity-only) and at v
+  // (ReducedDerivatives::run_passes); Aq(nudot) then holds for this a's nudot only, and the multiplier term is
+  // force_dq's (OperationalDerivatives::run)
   void build_at(Ev& ev, const VectorXd& a) {
     const pinocchio::Model& model = ev.model_;
     auto& ws = ev.deriv_;
     lean = true;
-    RD::run_passes(ev, a, true);
+    RD::run_passes(ev, a);  // velocity-only at a (a LOCAL twist: twist_velocity_dq's rotation of the world velocity)
     dJ.resize(op ? 1 : 0);
     if (op) {
       derivs::twist_velocity_dq(model, ws.pass_a, tf, dJa, w1, w2);
@@ -253,9 +266,10 @@ struct OperationalDerivatives {
     // S^T d(K^T mu)/dq at fixed mu as one derivative of the constraint and twist forces (with the motors' d(B tau)/dq)
     const int nr = static_cast<int>(ev.rows_.size());
     const VectorXd mu = ev.Kinv_.transpose() * rho;
-    VectorXd muf = VectorXd::Zero(ev.nrows());
+    VectorXd& muf = ws.muf;  // (the workspace's: no allocation once sized)
+    muf.setZero(ev.nrows());
     for (int r = 0; r < nr; ++r) muf[ev.rows_[r]] = mu[r];
-    MatrixXd Tf;
+    MatrixXd& Tf = ws.Tf;
     ReducedDerivatives<Ev>::force_dq(ev, muf, tau, Tf);
     derivs::twist_force_dq(ev.model_, ev.data_.J, pc.tf, mu.tail(k), Tf);
     const MatrixXd Aq = pc.Aq(ev, out.nudot);

@@ -476,6 +476,175 @@ def coupling_velocity_dq(coupling: JointCoupling, kin0: KinematicState, x: np.nd
     return out
 
 
+# ----------------------------------------------------------------- constraint forces at fixed multipliers
+def world_jacobians(kin0: KinematicState) -> np.ndarray:
+    """The joints' world Jacobian columns at the world origin (6 x n, linear rows first; Pinocchio's ``data.J`` after
+    ``computeJointJacobians``) at ``kin0.q``: what :func:`force_jacobian_dq` differentiates.
+
+    Args:
+        kin0: Kinematics at the configuration q.
+
+    Returns:
+        The columns (6 x n) [m/s, rad/s per unit of each velocity coordinate], each joint's on its own columns.
+    """
+    data = kin0.model.createData()
+    return np.array(pin.computeJointJacobians(kin0.model, data, kin0.q))
+
+
+def force_jacobian_dq(model, J: np.ndarray, jid: int, phi: np.ndarray, T: np.ndarray, sign: float = 1.0) -> None:
+    """Add ``sign`` times :math:`\\partial(J^T\\phi)/\\partial q` at fixed :math:`\\phi` into T (n x n): the
+    generalized force of a spatial force :math:`\\phi = (f, m)` fixed in the world (force f, moment m about the
+    world origin, world axes) on the body of joint ``jid``, J its world Jacobian columns at the origin. In
+    Pinocchio's tangent, :math:`\\partial J_j/\\partial q_c = J_c \\times J_j` (motion cross product) where c's
+    joint supports j's (itself included), else zero (the rule ``getJointVelocityDerivatives`` sums), so
+    :math:`\\partial Q_j/\\partial q_c = J_j\\cdot(f\\times\\omega_c,\\ f\\times v_c + m\\times\\omega_c)`.
+
+    Args:
+        model: The Pinocchio model.
+        J: World Jacobian columns at the origin (6 x n), e.g. :func:`world_jacobians`.
+        jid: The joint whose body the force acts on.
+        phi: The spatial force (6,): force [N] then moment about the world origin [N m], world axes.
+        T: The (n x n) matrix added into, rows the generalized force's components, columns the coordinates.
+        sign: Factor of the added term (-1: the force's reaction).
+    """
+    f, m = phi[:3], phi[3:]
+    sup = [s for s in model.supports[jid] if s != 0]
+    cols = [list(range(model.joints[s].idx_v, model.joints[s].idx_v + model.joints[s].nv)) for s in sup]
+    for a, ca in enumerate(cols):
+        later = [j for cb in cols[a:] for j in cb]
+        for c in ca:
+            v, w = J[:3, c], J[3:, c]
+            psi = sign * np.concatenate([np.cross(f, w), np.cross(f, v) + np.cross(m, w)])
+            T[later, c] += J[:, later].T @ psi
+
+
+def wheel_force_dq(wheel: RollingWheel, kin0: KinematicState, mu: np.ndarray, J: np.ndarray,
+                   directions: np.ndarray | None = None) -> np.ndarray:
+    """:math:`\\partial(A^T\\mu)/\\partial q` at fixed :math:`\\mu` (n x n) of a rolling wheel's rows
+    :math:`A = D E^T A_c`, :math:`A_c = J_c - [r]_\\times J_\\omega - u\\,e_R` (the contact point p = c + r): with
+    :math:`f = E D^T\\mu` (the force at p, world axes), :math:`A^T\\mu = J_O^T(f, p\\times f) - e_R (u\\cdot f)`, so
+
+    .. math:: \\frac{\\partial(A^T\\mu)}{\\partial q} = \\frac{\\partial J_O^T}{\\partial q}\\Big|_{(f, p\\times f)}
+              + A_c^T \\frac{\\partial f}{\\partial q} - J_\\omega^T [f]_\\times \\frac{\\partial p}{\\partial q}
+              - e_R\\, f^T \\frac{\\partial u}{\\partial q},
+
+    :math:`\\partial p/\\partial q = J_c + \\partial r/\\partial q`. Row l of :math:`S^T` times it is
+    :math:`\\mu^T\\partial(A S_l)/\\partial q`, the multiplier term of the reduced dynamics' derivative, without a
+    frame pass per column of S (twin of ``kernels/rolling_contact_derivatives.hpp``'s ``wheel_force_dq``).
+
+    Args:
+        wheel: The rolling wheel.
+        kin0: Kinematics at the configuration q.
+        mu: The rows' multipliers (rows,) [N], held fixed.
+        J: World Jacobian columns at the origin (6 x n), :func:`world_jacobians`.
+        directions: D (rows x 3); default None: the wheel's own rows.
+
+    Returns:
+        The derivative (n x n) [N or N m per unit of each coordinate].
+    """
+    model = kin0.model
+    D = wheel._directions if directions is None else directions
+    _, _, R, _, u, p, _, _, _, E, _ = wheel._geometry(kin0)
+    g = wheel_geometry_dq(wheel, kin0)
+    _, jac = kin0.pose(wheel.fid)
+    Jc, Jw = jac[:3], jac[3:]
+    lam = D.T @ mu
+    f = E @ lam
+    T = np.zeros((model.nv, model.nv))
+    force_jacobian_dq(model, J, model.frames[wheel.fid].parentJoint, np.concatenate([f, np.cross(p, f)]), T)
+    Ac = Jc - skew(-R * u) @ Jw - np.outer(u, g["R"])
+    df = sum(lam[i] * g["E"][i] for i in range(3))
+    T += Ac.T @ df - Jw.T @ skew(f) @ (Jc + g["r"])
+    T -= np.outer(g["R"], f @ g["u"])
+    return T
+
+
+def closure_force_dq(closure: LoopClosure, kin0: KinematicState, mu: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """:math:`\\partial(A^T\\mu)/\\partial q` at fixed :math:`\\mu` (n x n) of a loop closure's rows: with
+    :math:`g = R_1\\mu` (mu on the closed components, translation half :math:`g_t`, rotation half :math:`g_r`, world
+    axes), :math:`A^T\\mu = (J_{2,O} - J_{1,O})^T\\Phi`, :math:`\\Phi = (g_t, p_2\\times g_t + g_r)`; its derivative
+    is that of the Jacobians at fixed :math:`\\Phi` (:func:`force_jacobian_dq`) plus
+    :math:`(J_{2,O} - J_{1,O})^T\\partial\\Phi/\\partial q`, :math:`\\partial g = -[g]_\\times J_{1,\\omega}`
+    (twin of ``kernels/loop_closure_derivatives.hpp``'s ``closure_force_dq``).
+
+    Args:
+        closure: The loop closure.
+        kin0: Kinematics at the configuration q.
+        mu: The closed components' multipliers (rows,) [N, N m], held fixed.
+        J: World Jacobian columns at the origin (6 x n), :func:`world_jacobians`.
+
+    Returns:
+        The derivative (n x n) [N or N m per unit of each coordinate].
+    """
+    model = kin0.model
+    M1, J1 = kin0.pose(closure.f1)
+    M2, J2 = kin0.pose(closure.f2)
+    m6 = np.zeros(6)
+    np.add.at(m6, closure._sel, mu)
+    gt, gr = M1.rotation @ m6[:3], M1.rotation @ m6[3:]
+    p1, p2 = M1.translation, M2.translation
+    phi = np.concatenate([gt, np.cross(p2, gt) + gr])
+    T = np.zeros((model.nv, model.nv))
+    force_jacobian_dq(model, J, model.frames[closure.f2].parentJoint, phi, T)
+    force_jacobian_dq(model, J, model.frames[closure.f1].parentJoint, phi, T, -1.0)
+    dJ = np.vstack([J2[:3] + skew(p2) @ J2[3:] - J1[:3] - skew(p1) @ J1[3:], J2[3:] - J1[3:]])
+    dgt = -skew(gt) @ J1[3:]
+    dphi = np.vstack([dgt, -skew(gr) @ J1[3:] - skew(gt) @ J2[:3] + skew(p2) @ dgt])
+    return T + dJ.T @ dphi
+
+
+def coupling_force_dq(coupling: JointCoupling, kin0: KinematicState, mu: float) -> np.ndarray:
+    """:math:`\\partial(A^T\\mu)/\\partial q` (n x n) of a joint coupling's row: :math:`-f''(q_r)\\,\\mu` at
+    (r, r) (twin of ``kernels/joint_coupling_derivatives.hpp``'s ``coupling_force_dq``).
+
+    Args:
+        coupling: The joint coupling.
+        kin0: Kinematics at the configuration q.
+        mu: The row's multiplier, held fixed.
+
+    Returns:
+        The derivative (n x n).
+    """
+    T = np.zeros((kin0.model.nv, kin0.model.nv))
+    T[coupling.j, coupling.j] = -float(coupling.ddlaw(float(kin0.q[coupling.j]))) * mu
+    return T
+
+
+def force_dq(constraints, kin0: KinematicState, mu: np.ndarray) -> np.ndarray:
+    """:math:`\\partial(A(q)^T\\mu)/\\partial q` at fixed :math:`\\mu` (n x n) of all rows, in constraint order
+    (rolling wheels, loop closures, joint couplings): the compiled derivatives' multiplier term
+    (``ReducedDerivatives::force_dq``), :math:`S^T` times it being :math:`\\sum_r\\mu_r\\,\\partial(A_r S_l)/\\partial q`.
+
+    Args:
+        constraints: The constraints, in the order of the rows of A.
+        kin0: Kinematics at the configuration q.
+        mu: The multipliers (m,), one per row of A, held fixed.
+
+    Returns:
+        The derivative (n x n).
+
+    Raises:
+        InputError: A constraint without a derivative rule (see :func:`kind`).
+    """
+    n = kin0.model.nv
+    J = world_jacobians(kin0)
+    T = np.zeros((n, n))
+    row = 0
+    for c in constraints:
+        k = kind(c, sliding=True)
+        if k == "wheel":
+            nr = len(c._directions)
+            T += wheel_force_dq(c, kin0, mu[row:row + nr], J)
+        elif k == "closure":
+            nr = len(c._sel)
+            T += closure_force_dq(c, kin0, mu[row:row + nr], J)
+        else:
+            nr = 1
+            T += coupling_force_dq(c, kin0, float(mu[row]))
+        row += nr
+    return T
+
+
 # ------------------------------------------------------------------------------------------------ dispatch
 def kind(constraint, sliding: bool = False) -> str:
     """The derivative rule that serves a constraint: ``wheel``, ``closure`` or ``coupling``.

@@ -65,16 +65,15 @@ struct ContactForcesDerivatives {
   using VectorXd = Eigen::VectorXd;
 
   // Pieces.Aq(nudot) and Pieces.Wnu from the workspace the last ReducedDerivatives::run(ev, q, nu, tau) left (its
-  // passes at the columns of S, at w and at v): -K^-1 (d(K a)/dq + dgamma) and -K^-1 dgamma/dv S.
+  // passes at a = S nudot + w and at v: d(A a)/dq, d(A v)/dq): -K^-1 (d(K a)/dq + dgamma) and -K^-1 dgamma/dv S.
   static derivs::ForceChain chain(Ev& ev, const derivs::Result& r) {
     auto& ws = ev.deriv_;
-    const int k = static_cast<int>(r.S.cols());
-    if (static_cast<int>(ws.dA.size()) != k + 2) throw std::logic_error("the chain needs the derivatives' run first");
+    if (ws.dAa.rows() != ev.nrows() || ws.dAa.cols() != ev.nv_ || ws.dAv.rows() != ev.nrows())
+      throw std::logic_error("the chain needs the derivatives' run first");
     derivs::ForceChain out;
     out.a = r.S * r.nudot + ev.w_;
-    const MatrixXd dgam_v = ws.Adot + ws.dA[k + 1];
-    MatrixXd dKa = ws.dA[k] + ws.dgam_q + dgam_v * r.Vq;
-    for (int l = 0; l < k; ++l) dKa += r.nudot[l] * ws.dA[l];
+    const MatrixXd dgam_v = ws.Adot + ws.dAv;
+    MatrixXd dKa = ws.dAa + ws.dgam_q + dgam_v * r.Vq;
     out.Aq = RD::solve_neg(ev, dKa);
     out.Wnu = RD::solve_neg(ev, dgam_v * r.S);
     return out;

@@ -75,6 +75,35 @@ inline Matrix3x cross_d(const Vector3d& x, const Matrix3x& dx, const Vector3d& y
   return -skew3(y) * dx + skew3(x) * dy;
 }
 
+// T += sign d(J^T phi)/dq at fixed phi: the generalized force of a spatial force phi = (f, m) fixed in the world
+// (force f, moment m about the world origin, world axes) on the body of joint jid, J its world Jacobian columns at
+// the origin (CRBA's data.J, on jid's support). Pinocchio's tangent: d J_j / dq_c = J_c x J_j (motion cross product)
+// where c's joint supports j's (itself included), else zero (getKinematicHessian's WORLD rule, the one
+// getJointVelocityDerivatives sums); so dQ_j/dq_c = (J_c x J_j) . phi = J_j . (f x w_c, f x v_c + m x w_c) with
+// J_c = (v_c, w_c). The constraint forces' derivative at fixed multipliers (ReducedDerivatives::force_dq), one pass
+// over the support's column pairs instead of one frame velocity pass per column of S.
+template <class JM, class Out>
+void force_jacobian_dq(const pin::Model& model, const JM& J, pin::JointIndex jid, const Vector6d& phi, double sign,
+                       Out&& T) {
+  const Vector3d f = phi.head<3>(), m = phi.tail<3>();
+  const auto& sup = model.supports[jid];
+  for (size_t a = 0; a < sup.size(); ++a) {
+    const pin::JointIndex s1 = sup[a];
+    if (s1 == 0) continue;
+    const int c0 = model.joints[s1].idx_v(), c1 = c0 + model.joints[s1].nv();
+    for (int c = c0; c < c1; ++c) {
+      const Vector3d vc = J.col(c).template head<3>(), wc = J.col(c).template tail<3>();
+      Vector6d psi;
+      psi << sign * f.cross(wc), sign * (f.cross(vc) + m.cross(wc));
+      for (size_t b = a; b < sup.size(); ++b) {
+        const pin::JointIndex s2 = sup[b];
+        const int j0 = model.joints[s2].idx_v(), j1 = j0 + model.joints[s2].nv();
+        for (int j = j0; j < j1; ++j) T(j, c) += J.col(j).dot(psi);
+      }
+    }
+  }
+}
+
 // One pass (FramePass): the kinematics derivatives at (q, x) (with accelerations: at (q, x, 0)) and, per frame,
 // cached world-axes results. Pinocchio's joint derivatives are taken in WORLD (the spatial velocity and
 // acceleration at the world origin, whose q-derivatives at fixed x are exact there) and carried to the frame

@@ -32,5 +32,11 @@ void coupling_drift_dq(const CosineCoupling& c, double qj, double vj, Out1&& dri
   adot_out(0, c.j) = -c.second(qj) * vj;
 }
 
+// d(A^T mu)/dq at fixed mu of the row (A^T mu = mu (e_i - f'(q_j) e_j)): -f''(q_j) mu at (j, j), added into T
+template <class Out>
+void coupling_force_dq(const CosineCoupling& c, double qj, double mu, Out&& T) {
+  T(c.j, c.j) += -c.second(qj) * mu;
+}
+
 }  // namespace derivs
 }  // namespace robotdyn

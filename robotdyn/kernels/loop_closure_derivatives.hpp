@@ -90,5 +90,38 @@ void closure_drift_dq(const ClosureFrames& f, const std::vector<int>& select, co
   select_rows(full, select, adot_out);
 }
 
+// d(A_c^T mu_c)/dq at fixed mu_c, added into T (n x n). With g = R1 mu (mu scattered on the selected components:
+// g_t its translation half, g_r its rotation half, world axes) the rows' generalized force is
+// (J2_O - J1_O)^T Phi, Phi = (g_t, p2 x g_t + g_r) (g_t acts at p2; J_i the frames' joints' world Jacobians at the
+// origin). Its derivative: (dJ2_O - dJ1_O)^T at fixed Phi [force_jacobian_dq] + (J2_O - J1_O)^T dPhi, with
+// dg = -[g]x J1_w (R1's rotation) and d(p2 x g_t) = -[g_t]x J2_v + [p2]x dg_t. f's J1, J2: the frames'
+// LOCAL_WORLD_ALIGNED Jacobians gathered on `cols` (the closure's columns); Jworld: CRBA's data.J.
+template <class JM>
+void closure_force_dq(const pin::Model& model, const JM& Jworld, pin::JointIndex jid1, pin::JointIndex jid2,
+                      const ClosureFrames& f, const std::vector<int>& select, const Eigen::Ref<const VectorXd>& mu,
+                      const std::vector<int>& cols, MatrixXd& block, MatrixXd& T) {
+  const Matrix6x &J1 = *f.J1, &J2 = *f.J2;
+  Vector6d m6 = Vector6d::Zero();
+  for (size_t r = 0; r < select.size(); ++r) m6[select[r]] += mu[static_cast<Eigen::Index>(r)];
+  const Vector3d gt = f.R1 * m6.head<3>(), gr = f.R1 * m6.tail<3>();
+  Vector6d phi;
+  phi << gt, f.p2.cross(gt) + gr;
+  force_jacobian_dq(model, Jworld, jid2, phi, 1.0, T);
+  force_jacobian_dq(model, Jworld, jid1, phi, -1.0, T);
+  const Eigen::Index nc = J1.cols();
+  Matrix6xB dJ(6, nc), dphi(6, nc);  // J2_O - J1_O (v_O = v_p + p x w) and dPhi
+  dJ.topRows<3>() = J2.topRows<3>() - J1.topRows<3>();
+  dJ.topRows<3>().noalias() += skew3(f.p2) * J2.bottomRows<3>();
+  dJ.topRows<3>().noalias() -= skew3(f.p1) * J1.bottomRows<3>();
+  dJ.bottomRows<3>() = J2.bottomRows<3>() - J1.bottomRows<3>();
+  dphi.topRows<3>().noalias() = -skew3(gt) * J1.bottomRows<3>();
+  dphi.bottomRows<3>().noalias() = -skew3(gr) * J1.bottomRows<3>();
+  dphi.bottomRows<3>().noalias() -= skew3(gt) * J2.topRows<3>();
+  dphi.bottomRows<3>().noalias() += skew3(f.p2) * dphi.topRows<3>();
+  block.noalias() = dJ.transpose() * dphi;
+  for (size_t a = 0; a < cols.size(); ++a)
+    for (size_t b = 0; b < cols.size(); ++b) T(cols[a], cols[b]) += block(a, b);
+}
+
 }  // namespace derivs
 }  // namespace robotdyn

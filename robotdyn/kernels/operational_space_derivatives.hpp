@@ -14,7 +14,10 @@
 //
 // ProjectedPieces below are the Python `pieces` for either projection (a selection of v through ReducedDerivatives'
 // LU of A_d, or K^-1 here): the operational derivatives and the slipping wheels' (sliding_derivatives.hpp) finish
-// from them. A selection of v without slipping wheels keeps ReducedDerivatives::run.
+// from them. A selection of v without slipping wheels keeps ReducedDerivatives::run. OperationalDerivatives::run
+// takes its multiplier term as one derivative of the constraint and twist forces at fixed mu (force_dq,
+// twist_force_dq; twin dynamics_derivatives.twist_force_dq) on two frame passes (at a = S nudot + w, velocity-only,
+// and at v: ProjectedPieces::build_at); the slipping wheels' kernel keeps the passes at the columns of S (build).
 #pragma once
 
 #include "reduced_dynamics_derivatives.hpp"
@@ -34,11 +37,24 @@ struct TwistFrame {
   const std::vector<int>* select;
 };
 
-// d(J_o x)/dq at fixed x = fp.x (k x n) (_Projection.twist_velocity_dq); w1, w2 work
+// d(J_o x)/dq at fixed x = fp.x (k x n) (_Projection.twist_velocity_dq); w1, w2 work. LOCAL on a velocity-only pass
+// (FramePass::run_velocities, no Pinocchio data): the frame's world-axes velocity V = (v, w) and dV (FramePass.velocity)
+// rotated into its axes, d(R^T y)/dq = R^T ([y]x J_w + dy) (the Python twin's FramePass.velocity inverted); else
+// Pinocchio's getFrameVelocityDerivatives(LOCAL) on the pass's data
 inline void twist_velocity_dq(const pin::Model& model, FramePass& fp, const TwistFrame& tf, MatrixXd& out,
                               Matrix6x& w1, Matrix6x& w2) {
   const Matrix6x* dV;
-  if (tf.local) {
+  if (tf.local && fp.base) {
+    fp.velocity(model, tf.fid, *tf.oMf, *tf.J);
+    const Vector6d& V = fp.V[tf.fid];
+    const Matrix6x& dVw = fp.dV[tf.fid];
+    const Matrix3d RT = tf.oMf->rotation().transpose();
+    const auto Jw = tf.J->bottomRows<3>();
+    w1.resize(6, model.nv);
+    rotate_skew_add(RT, V.head<3>(), Jw, Matrix3x(dVw.topRows<3>()), w1.topRows<3>());
+    rotate_skew_add(RT, V.tail<3>(), Jw, Matrix3x(dVw.bottomRows<3>()), w1.bottomRows<3>());
+    dV = &w1;
+  } else if (tf.local) {
     w1.setZero(6, model.nv);
     w2.setZero(6, model.nv);
     pin::getFrameVelocityDerivatives(model, fp.data, static_cast<pin::FrameIndex>(tf.fid), pin::LOCAL, w1, w2);
@@ -80,6 +96,42 @@ inline void twist_drift_dq(const pin::Model& model, FramePass& fp, const TwistFr
   for (int r = 0; r < k; ++r) Jdot.row(r) = w1.row(sel[r]);
 }
 
+// d(J_o^T mu_o)/dq at fixed mu_o (n x n), added into T: the twist rows' generalized force, a wrench at the frame's
+// origin p (mu_o on the selected components: force then moment, in the frame's own axes if LOCAL, else world axes),
+// Phi = (f, p x f + m) at the world origin with f, m in world axes (LOCAL: f = R f_L, m = R m_L). Its derivative:
+// the Jacobian's at fixed Phi (force_jacobian_dq) plus J_O^T dPhi, dPhi = (df, -[f]x J_v + [p]x df + dm), df = -[f]x J_w
+// and dm = -[m]x J_w if LOCAL (else zero); J_O = (J_v + [p]x J_w; J_w) from the frame's LOCAL_WORLD_ALIGNED J.
+// S^T T is the twist part of the multiplier term, sum_r mu_o,r d(J_o S_l)/dq, without a pass per column of S.
+template <class JM>
+void twist_force_dq(const pin::Model& model, const JM& Jworld, const TwistFrame& tf,
+                    const Eigen::Ref<const VectorXd>& mu, MatrixXd& T) {
+  const std::vector<int>& sel = *tf.select;
+  Vector6d w6 = Vector6d::Zero();
+  for (size_t r = 0; r < sel.size(); ++r) w6[sel[r]] += mu[static_cast<Eigen::Index>(r)];
+  const Matrix3d R = tf.oMf->rotation();
+  const Vector3d p = tf.oMf->translation();
+  const Vector3d f = tf.local ? Vector3d(R * w6.head<3>()) : Vector3d(w6.head<3>());
+  const Vector3d m = tf.local ? Vector3d(R * w6.tail<3>()) : Vector3d(w6.tail<3>());
+  Vector6d phi;
+  phi << f, p.cross(f) + m;
+  force_jacobian_dq(model, Jworld, model.frames[static_cast<pin::FrameIndex>(tf.fid)].parentJoint, phi, 1.0, T);
+  const Matrix6x& J = *tf.J;
+  const Eigen::Index n = J.cols();
+  Matrix6xB JO(6, n), dphi(6, n);
+  JO.topRows<3>() = J.topRows<3>();
+  JO.topRows<3>().noalias() += skew3(p) * J.bottomRows<3>();
+  JO.bottomRows<3>() = J.bottomRows<3>();
+  dphi.bottomRows<3>().noalias() = -skew3(f) * J.topRows<3>();
+  if (tf.local) {
+    dphi.topRows<3>().noalias() = -skew3(f) * J.bottomRows<3>();
+    dphi.bottomRows<3>().noalias() += skew3(p) * dphi.topRows<3>();
+    dphi.bottomRows<3>().noalias() -= skew3(m) * J.bottomRows<3>();
+  } else {
+    dphi.topRows<3>().setZero();
+  }
+  T.noalias() += JO.transpose() * dphi;
+}
+
 }  // namespace derivs
 
 // The derivative pieces at (q, nu) for either projection (Python `pieces`); the passes, the rows' derivatives, the
@@ -95,6 +147,8 @@ struct ProjectedPieces {
   derivs::TwistFrame tf{};
   std::vector<MatrixXd> dJ;  // d(J_o x)/dq per pass (k x n; operational only)
   MatrixXd Jodot, dJd_q, dJd_v, dgam_v, Vq, dgA, dgJ, Wnu;
+  bool lean = false;  // build_at: passes at a and v only (ws.dAa, ws.dAv; the twist's dJa, dJ[1])
+  MatrixXd dJa;
   derivs::Matrix6x w1, w2, w3, w4;
 
   // -K^-1 [XA_rows; XJ] (n x cols); XA holds all constraint rows (Projection.solve_neg)
@@ -107,13 +161,11 @@ struct ProjectedPieces {
     return -ev.Kinv_ * X;
   }
 
-  // configure(q), dynamics(nu), then every piece (pieces)
-  void build(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
+  // configure(q), dynamics(nu), and the projection's frame (build and build_at begin with it)
+  void start(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
     if (ev.nv_ > derivs::kMaxNv) throw std::domain_error("more coordinates than the derivative kernels' blocks hold");
     ev.configure(q);
     ev.dynamics(nu);
-    const pinocchio::Model& model = ev.model_;
-    auto& ws = ev.deriv_;
     n = ev.nv_;
     k = static_cast<int>(ev.S_.cols());
     op = ev.operational_;
@@ -121,19 +173,49 @@ struct ProjectedPieces {
       const int f = ev.op_frame_;
       tf = derivs::TwistFrame{ev.frames_[f], &ev.data_.oMf[ev.frames_[f]], &ev.Jf_[f], ev.op_local_, &ev.op_select_};
     }
-    const MatrixXd& S = ev.S_;
+  }
+
+  // configure(q), dynamics(nu), then every piece (pieces), on the passes at the columns of S, at w and at v
+  void build(Ev& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu) {
+    start(ev, q, nu);
+    const pinocchio::Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    lean = false;
     dJ.resize(op ? k + 2 : 0);
     RD::frame_passes(ev, [&](int l, derivs::FramePass& fp) {
       if (op) derivs::twist_velocity_dq(model, fp, tf, dJ[l], w1, w2);
     });
-    const MatrixXd& dA_v = ws.dA[k + 1];
+    finish(ev, ws.dA[k + 1], ws.passes[k + 1], op ? k + 1 : 0);
+  }
+
+  // after start(): every piece on two passes only, at a = S nudot + w (velocity-only) and at v
+  // (ReducedDerivatives::run_passes); Aq(nudot) then holds for this a's nudot only, and the multiplier term is
+  // force_dq's (OperationalDerivatives::run)
+  void build_at(Ev& ev, const VectorXd& a) {
+    const pinocchio::Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    lean = true;
+    RD::run_passes(ev, a);  // velocity-only at a (a LOCAL twist: twist_velocity_dq's rotation of the world velocity)
+    dJ.resize(op ? 1 : 0);
+    if (op) {
+      derivs::twist_velocity_dq(model, ws.pass_a, tf, dJa, w1, w2);
+      derivs::twist_velocity_dq(model, ws.pass_v, tf, dJ[0], w1, w2);
+    }
+    finish(ev, ws.dAv, ws.pass_v, 0);
+  }
+
+  // the pieces from d(A v)/dq, the pass at v (with accelerations) and d(J_o v)/dq (dJ[jv])
+  void finish(Ev& ev, const MatrixXd& dA_v, derivs::FramePass& fv, int jv) {
+    const pinocchio::Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    const MatrixXd& S = ev.S_;
     dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
     MatrixXd none(0, n);
     if (op) {
-      derivs::twist_drift_dq(model, ws.passes[k + 1], tf, dJd_q, Jodot, w1, w2, w3, w4);
-      dJd_v = Jodot + dJ[k + 1];
+      derivs::twist_drift_dq(model, fv, tf, dJd_q, Jodot, w1, w2, w3, w4);
+      dJd_v = Jodot + dJ[jv];
     }
-    Vq = solve_neg(ev, dA_v, op ? dJ[k + 1] : none);  // v = S(q) nu: dv/dq = -K^-1 d(K v)/dq
+    Vq = solve_neg(ev, dA_v, op ? dJ[jv] : none);  // v = S(q) nu: dv/dq = -K^-1 d(K v)/dq
     dgA = ws.dgam_q + dgam_v * Vq;
     if (op) dgJ = dJd_q + dJd_v * Vq;
     Wnu = op ? solve_neg(ev, dgam_v * S, dJd_v * S) : solve_neg(ev, dgam_v * S, none);
@@ -142,6 +224,10 @@ struct ProjectedPieces {
   // da/dq at fixed nudot, a = S nudot + w: -K^-1 (d(K a)/dq + dg) (Pieces.Aq)
   MatrixXd Aq(Ev& ev, const VectorXd& nudot) const {
     const auto& ws = ev.deriv_;
+    if (lean) {  // build_at's passes: at a = S nudot + w for this nudot
+      if (!op) return solve_neg(ev, ws.dAa + dgA, MatrixXd(0, n));
+      return solve_neg(ev, ws.dAa + dgA, dJa + dgJ);
+    }
     MatrixXd dKa = ws.dA[k];
     for (int l = 0; l < k; ++l) dKa += nudot[l] * ws.dA[l];
     if (!op) return solve_neg(ev, dKa + dgA, MatrixXd(0, n));
@@ -163,30 +249,32 @@ struct OperationalDerivatives {
                             const Eigen::Ref<const VectorXd>& tau) {
     if (!ev.slips_.empty()) throw std::domain_error("slipping wheels: sliding_derivatives.hpp");
     ProjectedPieces<Ev> pc;
-    pc.build(ev, q, nu);
+    pc.start(ev, q, nu);
     if (tau.size() != ev.Br_.cols()) throw std::invalid_argument("tau has the wrong length");
     const int n = pc.n, k = pc.k;
-    const auto& ws = ev.deriv_;
+    auto& ws = ev.deriv_;
     const MatrixXd& S = ev.S_;
     const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
     derivs::Result out;
     const Eigen::LLT<MatrixXd> llt = ReducedDerivatives<Ev>::reduced_mass(ev, tau, out);
     const VectorXd a = S * out.nudot + ev.w_;
+    pc.build_at(ev, a);  // two passes (at a and v), not one per column of S
     MatrixXd dtau_dq, dtau_dv;
     ReducedDerivatives<Ev>::tree(ev, a, dtau_dq, dtau_dv);
     const VectorXd rho = ws.tree.tau - ev.B_ * tau;
-    // dS^T rho = -S^T dK^T mu, mu = K^-T rho split into the rows' and the twist's parts
+    // dS^T rho = -S^T dK^T mu, mu = K^-T rho split into the rows' and the twist's parts: the multiplier term
+    // S^T d(K^T mu)/dq at fixed mu as one derivative of the constraint and twist forces (with the motors' d(B tau)/dq)
     const int nr = static_cast<int>(ev.rows_.size());
     const VectorXd mu = ev.Kinv_.transpose() * rho;
-    MatrixXd L = MatrixXd::Zero(k, n);
-    for (int l = 0; l < k; ++l) {
-      for (int r = 0; r < nr; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
-      L.row(l) += mu.tail(k).transpose() * pc.dJ[l];
-    }
+    VectorXd& muf = ws.muf;  // (the workspace's: no allocation once sized)
+    muf.setZero(ev.nrows());
+    for (int r = 0; r < nr; ++r) muf[ev.rows_[r]] = mu[r];
+    MatrixXd& Tf = ws.Tf;
+    ReducedDerivatives<Ev>::force_dq(ev, muf, tau, Tf);
+    derivs::twist_force_dq(ev.model_, ev.data_.J, pc.tf, mu.tail(k), Tf);
     const MatrixXd Aq = pc.Aq(ev, out.nudot);
     const MatrixXd ST = S.transpose();
-    MatrixXd G = -L + ST * dtau_dq + (ST * dtau_dv) * pc.Vq + (ST * M) * Aq;
-    ReducedDerivatives<Ev>::motor_rows(ev, tau, G);
+    MatrixXd G = ST * (dtau_dq - Tf) + (ST * dtau_dv) * pc.Vq + (ST * M) * Aq;
     ReducedDerivatives<Ev>::solve_reduced(ev, llt, G, dtau_dv, pc.Wnu, out);
     out.Vq = pc.Vq;
     return out;

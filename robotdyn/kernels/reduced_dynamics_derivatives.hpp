@@ -1,8 +1,15 @@
 // robotdyn/kernels/reduced_dynamics_derivatives.hpp: derivatives of the reduced forward dynamics nudot(q, nu, tau),
 // twin of robotdyn/reduction/dynamics_derivatives.py (pieces, Pieces.Aq, motor_rows, dynamics_derivatives), the same
-// formulas in the same order: the projection's chain rule (dS = -K^-1 dK S, dw = -K^-1 (dK w + d gamma)), the
-// multiplier mu = K^-T rho, Pinocchio's computeRNEADerivatives for the tree, the motors' reaction terms and the
-// reduced solve; the per-constraint pieces are the <kind>_derivatives.hpp beside this file.
+// formulas: the projection's chain rule (dS = -K^-1 dK S, dw = -K^-1 (dK w + d gamma)), the multiplier
+// mu = K^-T rho, Pinocchio's computeRNEADerivatives for the tree, the motors' reaction terms and the reduced solve;
+// the per-constraint pieces are the <kind>_derivatives.hpp beside this file. Two differ from the Python path's in
+// form, not in value: the multiplier term S^T d(A^T mu)/dq is one derivative of the constraint forces at fixed mu
+// (force_dq: each kind's <kind>_force_dq, twins in constraints/row_derivatives.py, and the motors' d(B tau)/dq,
+// motor_force_dq), where the Python path sums mu_r d(A S_l)/dq over one frame pass per column of S; and d(A a)/dq at
+// a = S nudot + w is one velocity pass at a, where the Python path adds its passes at w and at S's columns (A x is
+// linear in x). So run() takes two frame passes (at a, velocity-only, and at v with accelerations) whatever k;
+// tests/test_compiled_derivatives*.py hold it to the Python path (1e-10), tests/test_force_dq.py the force
+// derivatives to the rows' derivatives at the unit velocities (1e-12).
 //
 // Served here: independent velocities that are a selection of v (operational-space velocities and slipping wheels
 // throw, and the Python side takes its reference path). The evaluator hands over its state after configure(q)
@@ -25,7 +32,8 @@ namespace derivs {
 
 // Work buffers kept by the evaluator between calls (Pinocchio data of the passes and of the tree derivatives).
 struct Workspace {
-  std::vector<FramePass> passes;  // columns of S, then w, then v
+  std::vector<FramePass> passes;  // columns of S, then w, then v (frame_passes: the operational-space kernels)
+  FramePass pass_a, pass_v;       // run(): velocity-only at a = S nudot + w, and at v with accelerations
   std::vector<FramePass> units;   // at the unit vectors (sliding_derivatives.hpp: every column of dA/dq)
   pinocchio::Data tree;
   bool has_tree = false;
@@ -44,12 +52,13 @@ struct Workspace {
   std::vector<Matrix6x> cJ1, cJ2;
   struct Gathered {
     Matrix6x J, dV1, dV2, dA1, dA2, dJ1, dJ2;
-    MatrixXd out, out2, Aw;
+    MatrixXd out, out2, Aw, F;  // F: the force derivative's block on the columns (force_dq)
   };
   std::vector<Gathered> wheel_gather, closure_gather;
   // run()'s work matrices, kept between calls (sized on first use: no allocation per derivative set)
-  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Ygd, Ad, dgam_v, Wnu, Aq, L, G, ST, STM, Minv, T, T2;
-  VectorXd a, rho, rd, mu;
+  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Ygd, Ad, dgam_v, Wnu, Aq, G, ST, STM, Minv, T, T2;
+  MatrixXd dAa, dAv, Tf;  // run(): d(A a)/dq, d(A v)/dq, d(A^T mu + B tau)/dq at fixed (mu, tau)
+  VectorXd a, rho, rd, mu, muf;
 };
 
 // The outputs (DynamicsDerivatives' analytic contents, SI units).
@@ -311,9 +320,8 @@ struct ReducedDerivatives {
     VectorXd& a = ws.a;  // (the work matrices are the workspace's: no allocation once sized)
     a.noalias() = S * out.nudot;
     a += w;
-    frame_passes(ev, [](int, derivs::FramePass&) {}, nu.data());
-    const MatrixXd& dA_w = ws.dA[k];
-    const MatrixXd& dA_v = ws.dA[k + 1];
+    run_passes(ev, a);
+    const MatrixXd& dA_v = ws.dAv;
     MatrixXd& dgam_v = ws.dgam_v;
     dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
     // the projection's three solves in one: with Y = K^-1 [d(K v)/dq, d(K gamma)/dv, d(K a)/dq + dgamma/dq at fixed
@@ -332,8 +340,7 @@ struct ReducedDerivatives {
         X.row(r).segment(0, n) = dA_v.row(row);
         X.row(r).segment(n, n) = dgam_v.row(row);
         auto xa = X.row(r).segment(2 * n, n);
-        xa = dA_w.row(row) + ws.dgam_q.row(row);
-        for (int l = 0; l < k; ++l) xa += out.nudot[l] * ws.dA[l].row(row);
+        xa = ws.dAa.row(row) + ws.dgam_q.row(row);  // d(A a)/dq = d(A w)/dq + sum_l nudot_l d(A S_l)/dq
       }
       MatrixXd& Y = ws.Y;
       Y = ev.lu_.solve(X);
@@ -361,43 +368,128 @@ struct ReducedDerivatives {
     VectorXd& rho = ws.rho;
     rho.noalias() = ev.B_ * tau;
     rho = ws.tree.tau - rho;
-    // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d
-    MatrixXd& L = ws.L;
-    L.setZero(k, n);
+    // dS^T rho = -S^T dK^T mu, mu = A_d^-T rho_d: the multiplier term L = S^T d(A^T mu)/dq at fixed mu (sum_r mu_r
+    // d(A S_l)/dq row by row, the Python path's) as ONE derivative of the constraint force, with the motors'
+    // d(B tau)/dq (motor_rows' terms) in the same matrix: Tf = d(A^T mu + B tau)/dq (force_dq)
+    VectorXd& muf = ws.muf;  // mu on the constraint rows
+    muf.setZero(ev.nrows());
     if (nd) {
       VectorXd& rd = ws.rd;
       rd.resize(nd);
       for (int r = 0; r < nd; ++r) rd[r] = rho[ev.dependent_[r]];
       VectorXd& mu = ws.mu;
       mu = ev.lu_.transpose().solve(rd);
-      for (int l = 0; l < k; ++l)
-        for (int r = 0; r < nd; ++r) L.row(l) += mu[r] * ws.dA[l].row(ev.rows_[r]);
+      for (int r = 0; r < nd; ++r) muf[ev.rows_[r]] = mu[r];
     }
+    force_dq(ev, muf, tau, ws.Tf);
     // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot: from the one solve above
     MatrixXd& ST = ws.ST;
     ST = S.transpose();
-    MatrixXd& G = ws.G;  // -L + S^T dtau_dq + (S^T dtau_dv) Vq + (S^T M) Aq
-    G = -L;
-    G.noalias() += ST * dtau_dq;
+    MatrixXd& G = ws.G;  // S^T (dtau_dq - Tf) + (S^T dtau_dv) Vq + (S^T M) Aq
+    dtau_dq -= ws.Tf;
+    G.noalias() = ST * dtau_dq;
     MatrixXd& STM = ws.STM;
     STM.noalias() = ST * dtau_dv;
     G.noalias() += STM * out.Vq;
     STM.noalias() = ST * M;
     G.noalias() += STM * Aq;
-    motor_rows(ev, tau, G);
     solve_reduced(ev, llt, G, dtau_dv, Wnu, out);
     return out;
   }
 
-  // the shared set-up of the derivative kernels at the evaluator's state (configure(q), dynamics(nu) done): the
-  // contact geometry's derivatives (ws.geo), the frame passes at the columns of S, at w and at v (ws.passes, the
-  // last with accelerations) with every row's d(A x)/dq there (ws.dA), then per_pass(l, pass) (the
-  // operational-space rows' own), and the drift's derivatives on the pass at v (ws.dgam_q, ws.Adot). With `nu`
-  // (run's selection projection, v = S nu) the passes at the columns of S and at w are velocity-only passes on the
-  // evaluator's configuration pass (FramePass::run_velocities) and d(A v)/dq = sum_l nu_l d(A S_l)/dq (A x is linear
-  // in x), one row pass fewer
+  // run()'s passes at the evaluator's state (configure(q), dynamics(nu) done): the rows' d(A a)/dq at a = S nudot +
+  // w on a velocity-only pass (FramePass::run_velocities on the evaluator's configuration pass; A x is linear in x,
+  // so this is d(A w)/dq + sum_l nudot_l d(A S_l)/dq in one pass), and d(A v)/dq, the drift's dgamma/dq and Adot on
+  // the pass at v with accelerations (ws.dAa, ws.dAv, ws.dgam_q, ws.Adot), every row on its own columns; `full`:
+  // the pass at a is a Pinocchio pass of its own (the LOCAL operational twist reads its data)
+  static void run_passes(Ev& ev, const VectorXd& a, bool full = false) {
+    const Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    compact_columns(ev);
+    if (full)
+      ws.pass_a.run(model, ev.q_, a, false);
+    else
+      ws.pass_a.run_velocities(model, ev.data_, a);
+    velocity_dq(ev, ws.pass_a, ws.dAa, true);
+    ws.pass_v.run(model, ev.q_, ev.v_, true);
+    prepare(ev, ws.pass_v, true);
+    velocity_dq(ev, ws.pass_v, ws.dAv, true);
+    drift_dq(ev, ws.pass_v, ws.dgam_q, ws.Adot);
+  }
+
+  // Tf = d(A(q)^T mu)/dq + d(B(q) tau)/dq at fixed (mu, tau) (n x n; mu on every constraint row, m): each
+  // constraint's force derivative (wheel_force_dq, closure_force_dq, coupling_force_dq, beside its velocity_dq) on
+  // its own columns (compact_columns first), and the motors reacting on a body (motor_force_dq). S^T Tf is the sum
+  // over rows r of mu_r d(A_r S_l)/dq (the Python path's, one frame pass per column S_l) plus S^T d(B tau)/dq
+  static void force_dq(Ev& ev, const VectorXd& mu, const Eigen::Ref<const VectorXd>& tau, MatrixXd& Tf) {
+    const Model& model = ev.model_;
+    auto& ws = ev.deriv_;
+    Tf.setZero(ev.nv_, ev.nv_);
+    for (const auto& [kind, i] : ev.order_) {
+      if (kind == 0) {
+        const auto& wh = ev.wheels_[i];
+        const auto& g = ev.geo_[i];
+        const int nd = static_cast<int>(wh.D.rows());
+        if (mu.segment(g.row, nd).isZero(0.0)) continue;
+        const int fid = ev.frames_[wh.frame];
+        auto& gb = ws.wheel_gather[i];
+        derivs::gather_cols(ev.Jf_[wh.frame], ws.wheel_cols[i], gb.J);
+        derivs::gather_cols(ev.Aw_[i], ws.wheel_cols[i], gb.Aw);
+        derivs::wheel_force_dq(model, ev.data_.J, model.frames[fid].parentJoint, g, ws.geoc[i], wh.D,
+                               mu.segment(g.row, nd), gb.J, gb.Aw, ws.wheel_cols[i], ws.radius_col[i], gb.F, Tf);
+      } else if (kind == 1) {
+        const auto& c = ev.closures_[i];
+        const int row = closure_row(ev, i), nr = static_cast<int>(c.select.size());
+        if (mu.segment(row, nr).isZero(0.0)) continue;
+        auto fr = frames_of(ev, c);
+        fr.J1 = &ws.cJ1[i];
+        fr.J2 = &ws.cJ2[i];
+        derivs::closure_force_dq(model, ev.data_.J, model.frames[ev.frames_[c.f1]].parentJoint,
+                                 model.frames[ev.frames_[c.f2]].parentJoint, fr, c.select, mu.segment(row, nr),
+                                 ws.closure_cols[i], ws.closure_gather[i].F, Tf);
+      } else {
+        const auto& c = ev.couplings_[i];
+        const derivs::CosineCoupling cc{c.i, c.j, c.amplitude, c.rate, c.phase};
+        derivs::coupling_force_dq(cc, ev.q_[c.j], mu[coupling_row(ev, i)], Tf);
+      }
+    }
+    motor_force_dq(ev, tau, Tf);
+  }
+
+  // Tf += d(B(q) tau)/dq of the motors reacting on a body: B tau = sum_j tau_j (Jw_child - Jw_reaction)^T axis, a
+  // pure moment tau_j axis on the joint's body and its opposite on the reaction frame's: force_jacobian_dq at fixed
+  // (0, tau_j axis) on both supports plus (Jw_child - Jw_reaction)^T tau_j daxis (motor_axis); motor_rows' terms
+  // x^T d(B tau)/dq for all x at once
+  static void motor_force_dq(Ev& ev, const Eigen::Ref<const VectorXd>& tau, MatrixXd& Tf) {
+    const Model& model = ev.model_;
+    for (size_t j = 0; j < ev.motors_.size(); ++j) {
+      const auto& mo = ev.motors_[j];
+      if (mo.reaction < 0 || tau[j] == 0.0) continue;
+      const pinocchio::JointIndex jid = static_cast<pinocchio::JointIndex>(mo.joint);
+      Eigen::Vector3d axis;
+      derivs::Matrix3x daxis;
+      motor_axis(ev, mo, axis, daxis);
+      const int rf = ev.frames_[mo.reaction];
+      derivs::Vector6d phi;
+      phi << Eigen::Vector3d::Zero(), tau[j] * axis;
+      derivs::force_jacobian_dq(model, ev.data_.J, jid, phi, 1.0, Tf);
+      derivs::force_jacobian_dq(model, ev.data_.J, model.frames[rf].parentJoint, phi, -1.0, Tf);
+      derivs::Matrix3x Jd = -ev.Jf_[mo.reaction].template bottomRows<3>();  // Jw_child - Jw_reaction
+      for (const pinocchio::JointIndex s : model.supports[jid]) {
+        if (s == 0) continue;
+        const int c0 = model.joints[s].idx_v();
+        for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jd.col(c) += ev.data_.J.col(c).template tail<3>();
+      }
+      Tf.noalias() += tau[j] * (Jd.transpose() * daxis);
+    }
+  }
+
+  // the shared set-up of the operational-space derivative kernels at the evaluator's state (configure(q),
+  // dynamics(nu) done): the contact geometry's derivatives (ws.geo), the frame passes at the columns of S, at w and
+  // at v (ws.passes, the last with accelerations) with every row's d(A x)/dq there (ws.dA), then per_pass(l, pass)
+  // (the operational-space rows' own), and the drift's derivatives on the pass at v (ws.dgam_q, ws.Adot)
   template <class PerPass>
-  static void frame_passes(Ev& ev, PerPass&& per_pass, const double* nu = nullptr) {
+  static void frame_passes(Ev& ev, PerPass&& per_pass) {
     const Model& model = ev.model_;
     auto& ws = ev.deriv_;
     const int k = static_cast<int>(ev.S_.cols());
@@ -410,20 +502,9 @@ struct ReducedDerivatives {
     ws.dA.resize(k + 2);
     for (int l = 0; l < k + 2; ++l) {
       derivs::FramePass& fp = ws.passes[l];
-      const bool fast = nu != nullptr && l <= k;
-      if (fast && l < k)
-        fp.run_velocities(model, ev.data_, ev.S_.col(l));
-      else if (fast)
-        fp.run_velocities(model, ev.data_, ev.w_);
-      else
-        fp.run(model, ev.q_, l < k ? VectorXd(ev.S_.col(l)) : l == k ? ev.w_ : ev.v_, l == k + 1);
+      fp.run(model, ev.q_, l < k ? VectorXd(ev.S_.col(l)) : l == k ? ev.w_ : ev.v_, l == k + 1);
       prepare(ev, fp, l == k + 1);
-      if (nu != nullptr && l == k + 1) {
-        ws.dA[l].setZero(ev.nrows(), ev.nv_);
-        for (int j = 0; j < k; ++j) ws.dA[l] += nu[j] * ws.dA[j];
-      } else {
-        velocity_dq(ev, fp, ws.dA[l], true);
-      }
+      velocity_dq(ev, fp, ws.dA[l], true);
       per_pass(l, fp);
     }
     drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cmath>
+#include <vector>
 
 #include "frame_derivatives.hpp"
 
@@ -224,6 +225,38 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   Wd.noalias() = EdT * Aw;
   Wd.noalias() += ET * Awdot;
   adot_out.noalias() = D * Wd;
+}
+
+// d(A_w^T mu_w)/dq at fixed mu_w (the wheel's constraint force's generalized force, differentiated), added into T
+// (n x n). A_w = D E A_c with E's rows (t1, t2, n) and A_c = J_c - [r]x J_w - u e_R the contact point's Jacobian
+// (p = c + r, r = -R u), so A_w^T mu_w = J_O^T (f, p x f) - e_R^T (u . f) with f = E^T D^T mu_w (world force at p)
+// and J_O the frame's joint's world Jacobian at the origin. Its derivative:
+//   (dJ_O^T at fixed (f, p x f))  [force_jacobian_dq]  + A_c^T df - J_w^T [f]x dp - e_R^T (f^T du),
+// df = sum_i (D^T mu_w)_i dE_i, dp = J_c + dr (the geometry's dq, gd: on the wheel's columns `cols`, like Jc, the
+// frame's gathered LOCAL_WORLD_ALIGNED Jacobian, and Awc, the gathered A_c; radius_col: the radius column among
+// them or -1). The twin's check: mu^T d(A S_l)/dq = S_l^T T row by row (tests/test_compiled_derivatives*.py hold the
+// compiled derivatives to the Python path's, which sums mu_r d(A S_l)/dq over the columns of S).
+template <class G, class JM>
+void wheel_force_dq(const pin::Model& model, const JM& Jworld, pin::JointIndex jid, const G& g,
+                    const WheelGeometryDq& gd, const Eigen::Ref<const MatrixXd>& D, const Eigen::Ref<const VectorXd>& mu,
+                    const Matrix6x& Jc, const MatrixXd& Awc, const std::vector<int>& cols, int radius_col,
+                    MatrixXd& block, MatrixXd& T) {
+  const Vector3d lam = D.transpose() * mu;
+  const Vector3d f = lam[0] * g.t1 + lam[1] * g.t2 + lam[2] * g.n;
+  Vector6d phi;
+  phi << f, g.p.cross(f);
+  force_jacobian_dq(model, Jworld, jid, phi, 1.0, T);
+  Matrix3x df = lam[0] * gd.t1;
+  df.noalias() += lam[1] * gd.t2;
+  df.noalias() += lam[2] * gd.n;
+  Matrix3x dp = Jc.topRows<3>() + gd.r;
+  Matrix3x fdp(3, dp.cols());
+  fdp.noalias() = skew3(f) * dp;
+  block.noalias() = Awc.transpose() * df;
+  block.noalias() -= Jc.bottomRows<3>().transpose() * fdp;
+  if (radius_col >= 0) block.row(radius_col) -= f.transpose() * gd.u;
+  for (size_t a = 0; a < cols.size(); ++a)
+    for (size_t b = 0; b < cols.size(); ++b) T(cols[a], cols[b]) += block(a, b);
 }
 
 }  // namespace derivs

@@ -49,8 +49,8 @@ from types import SimpleNamespace
 import numpy as np
 import pinocchio as pin
 
-from ..constraints.constraint import KinematicState
-from ..constraints.row_derivatives import FramePass, drift_dq, kind, velocity_dq
+from ..constraints.constraint import KinematicState, skew
+from ..constraints.row_derivatives import FramePass, drift_dq, force_jacobian_dq, kind, velocity_dq, world_jacobians
 from ..errors import InputError, NonFiniteError
 from .actuation import input_matrix
 from .operational_space import project_operational
@@ -221,6 +221,78 @@ def motor_rows(robot, kin0: KinematicState, passes: list[FramePass], tau: np.nda
             Vr, dVr = fp.velocity(m.rid)
             out[l] += tau[j] * (axis @ (dVc[3:] - dVr[3:]) + (Vc[3:] - Vr[3:]) @ daxis)
     return out
+
+
+def motor_force_dq(robot, kin0: KinematicState, tau: np.ndarray) -> np.ndarray:
+    """:math:`\\partial(B(q)\\tau)/\\partial q` (n, n) of the motors reacting on a body, without frame passes:
+    :math:`B\\tau = \\sum_j \\tau_j (J_{\\omega,\\text{child}} - J_{\\omega,\\text{reaction}})^T\\hat a_j`, a pure
+    moment :math:`\\tau_j\\hat a_j` on the joint's body and its opposite on the reaction body, differentiated at
+    fixed moment (:func:`~robotdyn.constraints.row_derivatives.force_jacobian_dq`) plus
+    :math:`(J_{\\omega,c} - J_{\\omega,r})^T\\tau_j\\,\\partial\\hat a/\\partial q` (twin of the compiled
+    ``ReducedDerivatives::motor_force_dq``; :func:`motor_rows` at the unit velocities gives the same matrix).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (its model and motors).
+        kin0: Kinematics at q (joint axes in world axes).
+        tau: Motor torques/forces (n_motors,) [N m or N] in the order of ``robot.motors``.
+
+    Returns:
+        The derivative (n, n) [N m or N per unit of each coordinate].
+    """
+    model = robot.model
+    out = np.zeros((model.nv, model.nv))
+    J = None
+    for j, m in enumerate(robot.motors):
+        if m.rid is None or tau[j] == 0.0:
+            continue
+        if J is None:
+            J = world_jacobians(kin0)
+        cf = model.getFrameId(m.joint)
+        _, jac_c = kin0.pose(cf)
+        _, jac_r = kin0.pose(m.rid)
+        axis = jac_c[3:, m.index]
+        daxis = -np.cross(axis[:, None], jac_c[3:], axis=0)  # -[a]x Jw
+        phi = np.concatenate([np.zeros(3), tau[j] * axis])
+        force_jacobian_dq(model, J, model.frames[cf].parentJoint, phi, out)
+        force_jacobian_dq(model, J, model.frames[m.rid].parentJoint, phi, out, -1.0)
+        out += tau[j] * (jac_c[3:] - jac_r[3:]).T @ daxis
+    return out
+
+
+def twist_force_dq(twist, kin0: KinematicState, mu: np.ndarray) -> np.ndarray:
+    """:math:`\\partial(J_o^T\\mu_o)/\\partial q` at fixed :math:`\\mu_o` (n, n) of the operational twist's rows: a
+    wrench at the frame's origin p (mu on the selected components, force then moment; in the frame's own axes if
+    LOCAL, else world axes), :math:`\\Phi = (f, p\\times f + m)` at the world origin in world axes; its derivative is
+    that of the Jacobian at fixed :math:`\\Phi` (:func:`~robotdyn.constraints.row_derivatives.force_jacobian_dq`)
+    plus :math:`J_O^T\\partial\\Phi/\\partial q`, :math:`\\partial f = -[f]_\\times J_\\omega`,
+    :math:`\\partial m = -[m]_\\times J_\\omega` if LOCAL (else zero) and
+    :math:`\\partial(p\\times f) = -[f]_\\times J_v + [p]_\\times\\partial f` (twin of the compiled
+    ``twist_force_dq``; :meth:`_Projection.twist_velocity_dq` at the unit velocities gives the same matrix).
+
+    Args:
+        twist: The operational frame twist (its ``fid``, ``axes`` and ``select``).
+        kin0: Kinematics at q.
+        mu: The twist rows' multipliers (len(select),), held fixed.
+
+    Returns:
+        The derivative (n, n).
+    """
+    model = kin0.model
+    J = world_jacobians(kin0)
+    w6 = np.zeros(6)
+    np.add.at(w6, np.asarray(twist.select), mu)
+    placement, jac = kin0.pose(twist.fid)
+    R, p = placement.rotation, placement.translation
+    local = twist.axes == "local"
+    f, m = (R @ w6[:3], R @ w6[3:]) if local else (w6[:3], w6[3:])
+    out = np.zeros((model.nv, model.nv))
+    force_jacobian_dq(model, J, model.frames[twist.fid].parentJoint, np.concatenate([f, np.cross(p, f) + m]), out)
+    Jv, Jw = jac[:3], jac[3:]
+    df = -skew(f) @ Jw if local else np.zeros_like(Jw)
+    dm = -skew(m) @ Jw if local else np.zeros_like(Jw)
+    dphi = np.vstack([df, -skew(f) @ Jv + skew(p) @ df + dm])
+    JO = np.vstack([Jv + skew(p) @ Jw, Jw])
+    return out + JO.T @ dphi
 
 
 class Pieces(SimpleNamespace):

@@ -94,14 +94,14 @@ void force_jacobian_dq(const pin::Model& model, const JM& J, pin::JointIndex jid
   for (size_t a = 0; a < sup.size(); ++a) {
     const pin::JointIndex s1 = sup[a];
     if (s1 == 0) continue;
-    const int c0 = model.joints[s1].idx_v(), c1 = c0 + model.joints[s1].nv();
+    const int c0 = model.idx_vs[s1], c1 = c0 + model.nvs[s1];
     for (int c = c0; c < c1; ++c) {
       const Vector3d vc = J.col(c).template head<3>(), wc = J.col(c).template tail<3>();
       Vector6d psi;
       psi << sign * f.cross(wc), sign * (f.cross(vc) + m.cross(wc));
       for (size_t b = std::max(a, from); b < sup.size(); ++b) {
         const pin::JointIndex s2 = sup[b];
-        const int j0 = model.joints[s2].idx_v(), j1 = j0 + model.joints[s2].nv();
+        const int j0 = model.idx_vs[s2], j1 = j0 + model.nvs[s2];
         for (int j = j0; j < j1; ++j) T(j, c) += J.col(j).dot(psi);
       }
     }
@@ -158,7 +158,7 @@ struct FramePass {
     ov.resize(static_cast<size_t>(model.njoints));
     ov[0].setZero();
     for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model.njoints); ++i) {
-      const int c0 = model.joints[i].idx_v(), nvi = model.joints[i].nv();
+      const int c0 = model.idx_vs[i], nvi = model.nvs[i];
       ov[i] = ov[model.parents[i]];
       ov[i].toVector().noalias() += at_q.J.middleCols(c0, nvi) * x.segment(c0, nvi);
     }
@@ -189,7 +189,7 @@ struct FramePass {
       data.a[i] = at_q.a[i];
       data.ov[i] = data.oMi[i].act(data.v[i]);
       data.oa[i] = data.oMi[i].act(data.a[i]);
-      const int c0 = model.joints[i].idx_v(), nvi = model.joints[i].nv();
+      const int c0 = model.idx_vs[i], nvi = model.nvs[i];
       auto dJcols = data.dJ.middleCols(c0, nvi);
       pin::motionSet::motionAction(data.ov[i], data.J.middleCols(c0, nvi), dJcols);
     }
@@ -225,8 +225,8 @@ struct FramePass {
         for (const pin::JointIndex s : model.supports[jid]) {
           if (s == 0) continue;
           const pin::Motion rel = ov[jid] - ov[model.parents[s]];
-          const int c0 = model.joints[s].idx_v();
-          for (int c = c0; c < c0 + model.joints[s].nv(); ++c) {
+          const int c0 = model.idx_vs[s];
+          for (int c = c0; c < c0 + model.nvs[s]; ++c) {
             const auto Jc = base->J.col(c);
             const Vector3d lin = Jc.template head<3>(), ang = Jc.template tail<3>();
             jdV[jid].col(c).template head<3>() = ang.cross(rel.linear()) + lin.cross(rel.angular());
@@ -238,7 +238,7 @@ struct FramePass {
         for (const pin::JointIndex s : model.supports[jid]) {
           if (s == 0) continue;
           const pin::JointIndex parent = model.parents[s];
-          const int c0 = model.joints[s].idx_v(), nvs = model.joints[s].nv();
+          const int c0 = model.idx_vs[s], nvs = model.nvs[s];
           const pin::Motion vtmp = parent > 0 ? pin::Motion(data.ov[parent] - vlast) : pin::Motion(-vlast);
           auto cols = jdV[jid].middleCols(c0, nvs);
           pin::motionSet::motionAction(vtmp, data.J.middleCols(c0, nvs), cols);
@@ -260,7 +260,7 @@ struct FramePass {
     for (const pin::JointIndex s : model.supports[jid]) {
       if (s == 0) continue;
       const pin::JointIndex parent = model.parents[s];
-      const int c0 = model.joints[s].idx_v(), nvs = model.joints[s].nv();
+      const int c0 = model.idx_vs[s], nvs = model.nvs[s];
       auto cols = out.middleCols(c0, nvs);
       const pin::Motion atmp = parent > 0 ? pin::Motion(data.oa[parent] - alast) : pin::Motion(-alast);
       pin::motionSet::motionAction(atmp, data.J.middleCols(c0, nvs), cols);
@@ -277,7 +277,7 @@ struct FramePass {
   static void for_support_cols(const pin::Model& model, pin::JointIndex jid, F&& f) {
     for (const pin::JointIndex s : model.supports[jid]) {
       if (s == 0) continue;
-      const int c0 = model.joints[s].idx_v(), c1 = c0 + model.joints[s].nv();
+      const int c0 = model.idx_vs[s], c1 = c0 + model.nvs[s];
       for (int c = c0; c < c1; ++c) f(c);
     }
   }

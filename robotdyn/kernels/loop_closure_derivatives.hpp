@@ -119,7 +119,7 @@ void closure_force_dq(const pin::Model& model, const JM& Jworld, pin::JointIndex
   dphi.bottomRows<3>().noalias() = -skew3(gr) * J1.bottomRows<3>();
   dphi.bottomRows<3>().noalias() -= skew3(gt) * J2.topRows<3>();
   dphi.bottomRows<3>().noalias() += skew3(f.p2) * dphi.topRows<3>();
-  block.noalias() = dJ.transpose() * dphi;
+  block.noalias() = dJ.transpose().lazyProduct(dphi);  // (6-deep: coefficient-wise)
   for (size_t a = 0; a < cols.size(); ++a)
     for (size_t b = 0; b < cols.size(); ++b) T(cols[a], cols[b]) += block(a, b);
 }

@@ -178,7 +178,7 @@ struct ReducedDerivatives {
   static void support_cols(const Model& model, pinocchio::JointIndex jid, std::vector<int>& cols) {
     for (const pinocchio::JointIndex s : model.supports[jid]) {
       if (s == 0) continue;
-      for (int c = model.joints[s].idx_v(); c < model.joints[s].idx_v() + model.joints[s].nv(); ++c)
+      for (int c = model.idx_vs[s]; c < model.idx_vs[s] + model.nvs[s]; ++c)
         cols.push_back(c);
     }
   }
@@ -203,7 +203,8 @@ struct ReducedDerivatives {
       }
       if (wh.radius_index >= 0)
         ws.radius_col[i] = static_cast<int>(std::find(cols.begin(), cols.end(), wh.radius_index) - cols.begin());
-      derivs::gather_cols(ev.Jf_[wh.frame], cols, ws.wheel_gather[i].J);
+      derivs::gather_cols(ev.Jf_[wh.frame], cols, ws.wheel_gather[i].J);  // (J and Aw at q: drift_dq's, force_dq's)
+      derivs::gather_cols(ev.Aw_[i], cols, ws.wheel_gather[i].Aw);
       derivs::wheel_geometry_dq(ev.geo_[i], ws.wheel_gather[i].J, ws.radius_col[i], ev.terrain_.flat(), ws.geoc[i]);
     }
     ws.closure_cols.resize(nc);
@@ -242,11 +243,9 @@ struct ReducedDerivatives {
         const std::vector<int>& cols = ws.wheel_cols[i];
         const int nc = static_cast<int>(cols.size());
         auto& gb = ws.wheel_gather[i];
-        derivs::gather_cols(J, cols, gb.J);
-        derivs::gather_cols(fp.dV[fid], cols, gb.dV1);
+        derivs::gather_cols(fp.dV[fid], cols, gb.dV1);  // (gb.J, gb.Aw: compact_columns')
         derivs::gather_cols(fp.dAcc[fid], cols, gb.dA1);
         derivs::gather_cols(ws.dJ1, cols, gb.dJ1);
-        derivs::gather_cols(ev.Aw_[i], cols, gb.Aw);
         gb.out.resize(nd, nc);
         gb.out2.resize(nd, nc);
         derivs::wheel_drift_dq(g, ws.geoc[i], wh.D, ev.terrain_, ev.terrain_.flat(), gb.J, wh.radius_index,
@@ -439,9 +438,7 @@ struct ReducedDerivatives {
         const int nd = static_cast<int>(wh.D.rows());
         if (mu.segment(g.row, nd).isZero(0.0)) continue;
         const int fid = ev.frames_[wh.frame];
-        auto& gb = ws.wheel_gather[i];
-        derivs::gather_cols(ev.Jf_[wh.frame], ws.wheel_cols[i], gb.J);
-        derivs::gather_cols(ev.Aw_[i], ws.wheel_cols[i], gb.Aw);
+        auto& gb = ws.wheel_gather[i];  // (gb.J, gb.Aw: compact_columns')
         derivs::wheel_force_dq(model, ev.data_.J, model.frames[fid].parentJoint, g, ws.geoc[i], wh.D,
                                mu.segment(g.row, nd), gb.J, gb.Aw, ws.wheel_cols[i], ws.radius_col[i], gb.F, Tf);
       } else if (kind == 1) {
@@ -488,8 +485,8 @@ struct ReducedDerivatives {
       derivs::Matrix3x Jd = -ev.Jf_[mo.reaction].template bottomRows<3>();  // Jw_child - Jw_reaction
       for (const pinocchio::JointIndex s : model.supports[jid]) {
         if (s == 0) continue;
-        const int c0 = model.joints[s].idx_v();
-        for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jd.col(c) += ev.data_.J.col(c).template tail<3>();
+        const int c0 = model.idx_vs[s];
+        for (int c = c0; c < c0 + model.nvs[s]; ++c) Jd.col(c) += ev.data_.J.col(c).template tail<3>();
       }
       Tf.noalias() += tau[j] * (Jd.transpose() * daxis);
     }
@@ -585,8 +582,8 @@ struct ReducedDerivatives {
     derivs::Matrix3x Jw = derivs::Matrix3x::Zero(3, ev.nv_);
     for (const pinocchio::JointIndex s : model.supports[jid]) {
       if (s == 0) continue;
-      const int c0 = model.joints[s].idx_v();
-      for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
+      const int c0 = model.idx_vs[s];
+      for (int c = c0; c < c0 + model.nvs[s]; ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
     }
     axis = Jw.col(mo.index);
     daxis = -derivs::skew3(axis) * Jw;

@@ -8,8 +8,9 @@
 //
 // where dK enters only as d(K x)/dq at fixed x: the constraint rows' (the <kind>_derivatives.hpp, through
 // ReducedDerivatives) and the twist rows' d(J_o x)/dq = the frame velocity's q-derivative at fixed x (LOCAL: Pinocchio's
-// getFrameVelocityDerivatives; world axes: FramePass.velocity); d(Jdot_o v)/dq likewise from the frame's LOCAL
-// spatial acceleration (getFrameAccelerationDerivatives) or its world classical acceleration (FramePass), and
+// getFrameVelocityDerivatives, or FramePass.velocity rotated into the frame's axes; world axes: FramePass.velocity);
+// d(Jdot_o v)/dq likewise from the frame's LOCAL spatial acceleration (FramePass.acceleration rotated, the Python
+// twin's getFrameAccelerationDerivatives) or its world classical acceleration (FramePass), and
 // d(Jdot_o v)/dv = Jdot_o + d(J_o v)/dq.
 //
 // ProjectedPieces below are the Python `pieces` for either projection (a selection of v through ReducedDerivatives'

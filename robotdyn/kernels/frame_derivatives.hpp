@@ -1,8 +1,9 @@
 // robotdyn/kernels/frame_derivatives.hpp: frame velocities and accelerations with their configuration derivatives
 // at one state (q, x), twin of robotdyn/constraints/row_derivatives.py (FramePass, _rot_dq, _cross_d).
 //
-// A pass with accelerations runs computeForwardKinematicsDerivatives on a Pinocchio data of its own and takes, per
-// joint, the WORLD configuration derivatives of the joint's velocity and acceleration that Pinocchio's
+// A pass with accelerations runs computeForwardKinematicsDerivatives on a Pinocchio data of its own, or (run_on, the
+// derivative set's pass at v) takes that algorithm's forward-step fields from the evaluator's bias pass at v, and
+// takes, per joint, the WORLD configuration derivatives of the joint's velocity and acceleration that Pinocchio's
 // getJointVelocityDerivatives / getJointAccelerationDerivatives assemble, by their own steps (motionSet::motionAction
 // over the joint's support) without the outputs those functions also fill and the pass does not read, carried to
 // each frame's origin (FramePass below; the compiled derivatives equal the Python twin's, which calls Pinocchio's

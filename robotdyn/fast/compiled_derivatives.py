@@ -3,9 +3,10 @@
 
 The C++ kernels (``robotdyn/kernels/*_derivatives.hpp``: one per constraint kind, and
 ``reduced_dynamics_derivatives.hpp`` for the projection's chain rule and the reduced solve) evaluate the same
-formulas as the Python reference, in the same order, on Pinocchio's own C++ derivative algorithms
-(``computeForwardKinematicsDerivatives``, ``getFrameVelocityDerivatives``, ``getFrameAccelerationDerivatives``,
-``getFrameJacobianTimeVariation``, ``computeRNEADerivatives``) and on the compiled model's configuration pass
+formulas as the Python reference on Pinocchio's own C++ derivative algorithms (``computeRNEADerivatives``,
+``getFrameJacobianTimeVariation``, ``getFrameVelocityDerivatives``, and the steps of
+``computeForwardKinematicsDerivatives`` and of the joint velocity and acceleration derivatives, taken on the compiled
+evaluation's own kinematics where it already holds them) and on the compiled model's configuration pass
 (:class:`~robotdyn.fast.compiled.CompiledModel`): one call gives :math:`\\dot\\nu`, :math:`\\partial\\dot\\nu/\\partial q`
 (natural coordinates), :math:`\\partial\\dot\\nu/\\partial\\nu`, :math:`\\partial\\dot\\nu/\\partial\\tau`,
 :math:`\\dot q = S\\nu`, :math:`\\partial(S\\nu)/\\partial q`, S and the constraint rows A (from which the independent

@@ -1,8 +1,9 @@
 // robotdyn/kernels/frame_derivatives.hpp: frame velocities and accelerations with their configuration derivatives
 // at one state (q, x), twin of robotdyn/constraints/row_derivatives.py (FramePass, _rot_dq, _cross_d).
 //
-// A pass with accelerations runs computeForwardKinematicsDerivatives on a Pinocchio data of its own and takes, per
-// joint, the WORLD configuration derivatives of the joint's velocity and acceleration that Pinocchio's
+// A pass with accelerations runs computeForwardKinematicsDerivatives on a Pinocchio data of its own, or (run_on, the
+// derivative set's pass at v) takes that algorithm's forward-step fields from the evaluator's bias pass at v, and
+// takes, per joint, the WORLD configuration derivatives of the joint's velocity and acceleration that Pinocchio's
 // getJointVelocityDerivatives / getJointAccelerationDerivatives assemble, by their own steps (motionSet::motionAction
 // over the joint's support) without the outputs those functions also fill and the pass does not read, carried to
 // each frame's origin (FramePass below; the compiled derivatives equal the Python twin's, which calls Pinocchio's
@@ -21,6 +22,7 @@
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/frames-derivatives.hpp>
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
@@ -81,27 +83,38 @@ inline Matrix3x cross_d(const Vector3d& x, const Matrix3x& dx, const Vector3d& y
 // where c's joint supports j's (itself included), else zero (getKinematicHessian's WORLD rule, the one
 // getJointVelocityDerivatives sums); so dQ_j/dq_c = (J_c x J_j) . phi = J_j . (f x w_c, f x v_c + m x w_c) with
 // J_c = (v_c, w_c). The constraint forces' derivative at fixed multipliers (ReducedDerivatives::force_dq), one pass
-// over the support's column pairs instead of one frame velocity pass per column of S.
+// over the support's column pairs instead of one frame velocity pass per column of S. `from` > 0: only the pairs
+// whose later joint is at position >= from in jid's support. The same phi with opposite signs on two joints gives
+// the same terms on the pairs of their common support (common_support), which cancel: a closure's two frames and a
+// motor's body and reaction frame take both passes from there.
 template <class JM, class Out>
 void force_jacobian_dq(const pin::Model& model, const JM& J, pin::JointIndex jid, const Vector6d& phi, double sign,
-                       Out&& T) {
+                       Out&& T, size_t from = 0) {
   const Vector3d f = phi.head<3>(), m = phi.tail<3>();
   const auto& sup = model.supports[jid];
   for (size_t a = 0; a < sup.size(); ++a) {
     const pin::JointIndex s1 = sup[a];
     if (s1 == 0) continue;
-    const int c0 = model.joints[s1].idx_v(), c1 = c0 + model.joints[s1].nv();
+    const int c0 = model.idx_vs[s1], c1 = c0 + model.nvs[s1];
     for (int c = c0; c < c1; ++c) {
       const Vector3d vc = J.col(c).template head<3>(), wc = J.col(c).template tail<3>();
       Vector6d psi;
       psi << sign * f.cross(wc), sign * (f.cross(vc) + m.cross(wc));
-      for (size_t b = a; b < sup.size(); ++b) {
+      for (size_t b = std::max(a, from); b < sup.size(); ++b) {
         const pin::JointIndex s2 = sup[b];
-        const int j0 = model.joints[s2].idx_v(), j1 = j0 + model.joints[s2].nv();
+        const int j0 = model.idx_vs[s2], j1 = j0 + model.nvs[s2];
         for (int j = j0; j < j1; ++j) T(j, c) += J.col(j).dot(psi);
       }
     }
   }
+}
+
+// the number of leading entries two joints' supports share (their common ancestors, the universe first)
+inline size_t common_support(const pin::Model& model, pin::JointIndex j1, pin::JointIndex j2) {
+  const auto &s1 = model.supports[j1], &s2 = model.supports[j2];
+  size_t m = 0;
+  while (m < s1.size() && m < s2.size() && s1[m] == s2[m]) ++m;
+  return m;
 }
 
 // One pass (FramePass): the kinematics derivatives at (q, x) (with accelerations: at (q, x, 0)) and, per frame,
@@ -146,9 +159,40 @@ struct FramePass {
     ov.resize(static_cast<size_t>(model.njoints));
     ov[0].setZero();
     for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model.njoints); ++i) {
-      const int c0 = model.joints[i].idx_v(), nvi = model.joints[i].nv();
+      const int c0 = model.idx_vs[i], nvi = model.nvs[i];
       ov[i] = ov[model.parents[i]];
       ov[i].toVector().noalias() += at_q.J.middleCols(c0, nvi) * x.segment(c0, nvi);
+    }
+    reset(model);
+  }
+
+  // a pass with accelerations at x = v on the evaluator's state `at_q` after its bias pass at v (configure(q),
+  // dynamics(nu): placements oMi and world Jacobian columns J at q, the joints' local velocities v and accelerations
+  // a at zero joint acceleration, RNEA's forward sweep, operation for operation computeForwardKinematicsDerivatives'
+  // own at (q, v, 0)): the fields of that algorithm's forward step the pass reads (oMi, J, v, a, ov = oMi v, oa =
+  // oMi a, dJ = ov x J, the same operations) without recomputing the placements, nor its second-order outputs (dVdq,
+  // dAdq, dAdv), which nothing here reads (the frames' derivatives are assembled from ov, oa, J and dJ below)
+  template <class X>
+  void run_on(const pin::Model& model, const pin::Data& at_q, const Eigen::MatrixBase<X>& x_) {
+    if (data.oMi.size() != static_cast<size_t>(model.njoints) || data.oMf.size() != model.frames.size())
+      data = pin::Data(model);
+    x = x_;
+    accelerations = true;
+    base = nullptr;
+    data.J = at_q.J;
+    data.v[0].setZero();
+    data.a[0].setZero();
+    data.ov[0].setZero();
+    data.oa[0].setZero();
+    for (pin::JointIndex i = 1; i < static_cast<pin::JointIndex>(model.njoints); ++i) {
+      data.oMi[i] = at_q.oMi[i];
+      data.v[i] = at_q.v[i];
+      data.a[i] = at_q.a[i];
+      data.ov[i] = data.oMi[i].act(data.v[i]);
+      data.oa[i] = data.oMi[i].act(data.a[i]);
+      const int c0 = model.idx_vs[i], nvi = model.nvs[i];
+      auto dJcols = data.dJ.middleCols(c0, nvi);
+      pin::motionSet::motionAction(data.ov[i], data.J.middleCols(c0, nvi), dJcols);
     }
     reset(model);
   }
@@ -182,8 +226,8 @@ struct FramePass {
         for (const pin::JointIndex s : model.supports[jid]) {
           if (s == 0) continue;
           const pin::Motion rel = ov[jid] - ov[model.parents[s]];
-          const int c0 = model.joints[s].idx_v();
-          for (int c = c0; c < c0 + model.joints[s].nv(); ++c) {
+          const int c0 = model.idx_vs[s];
+          for (int c = c0; c < c0 + model.nvs[s]; ++c) {
             const auto Jc = base->J.col(c);
             const Vector3d lin = Jc.template head<3>(), ang = Jc.template tail<3>();
             jdV[jid].col(c).template head<3>() = ang.cross(rel.linear()) + lin.cross(rel.angular());
@@ -195,7 +239,7 @@ struct FramePass {
         for (const pin::JointIndex s : model.supports[jid]) {
           if (s == 0) continue;
           const pin::JointIndex parent = model.parents[s];
-          const int c0 = model.joints[s].idx_v(), nvs = model.joints[s].nv();
+          const int c0 = model.idx_vs[s], nvs = model.nvs[s];
           const pin::Motion vtmp = parent > 0 ? pin::Motion(data.ov[parent] - vlast) : pin::Motion(-vlast);
           auto cols = jdV[jid].middleCols(c0, nvs);
           pin::motionSet::motionAction(vtmp, data.J.middleCols(c0, nvs), cols);
@@ -217,7 +261,7 @@ struct FramePass {
     for (const pin::JointIndex s : model.supports[jid]) {
       if (s == 0) continue;
       const pin::JointIndex parent = model.parents[s];
-      const int c0 = model.joints[s].idx_v(), nvs = model.joints[s].nv();
+      const int c0 = model.idx_vs[s], nvs = model.nvs[s];
       auto cols = out.middleCols(c0, nvs);
       const pin::Motion atmp = parent > 0 ? pin::Motion(data.oa[parent] - alast) : pin::Motion(-alast);
       pin::motionSet::motionAction(atmp, data.J.middleCols(c0, nvs), cols);
@@ -228,10 +272,15 @@ struct FramePass {
     }
   }
 
-  // one past a joint's last velocity column (0 for the universe): the columns after it are zero in its Jacobian and
-  // its derivatives (the supporting joints come first in Pinocchio's depth-first order)
-  static int end_col(const pin::Model& model, pin::JointIndex jid) {
-    return jid == 0 ? 0 : model.joints[jid].idx_v() + model.joints[jid].nv();
+  // f(c) for each column c of a joint's supporting joints (in order): the only columns its world Jacobian and its
+  // derivatives can be nonzero in
+  template <class F>
+  static void for_support_cols(const pin::Model& model, pin::JointIndex jid, F&& f) {
+    for (const pin::JointIndex s : model.supports[jid]) {
+      if (s == 0) continue;
+      const int c0 = model.idx_vs[s], c1 = c0 + model.nvs[s];
+      for (int c = c0; c < c1; ++c) f(c);
+    }
   }
 
   // world-axes (LOCAL_WORLD_ALIGNED) frame velocity V = J x and dV/dq at fixed x (FramePass.velocity);
@@ -244,16 +293,16 @@ struct FramePass {
     const Vector3d p = oMf.translation(), w = vj.angular();
     const Vector3d vp = vj.linear() + w.cross(p);
     V[fid] << vp, w;
-    dV[fid].resize(6, model.nv);
-    // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place, on the columns up to the joint's last (jd
-    // and J are zero beyond: only the supporting joints' columns can be nonzero)
-    const int ce = end_col(model, jid);
-    auto top = dV[fid].topRows<3>().leftCols(ce);
-    top = jd.topRows<3>().leftCols(ce);
-    top.noalias() -= skew3(p) * jd.bottomRows<3>().leftCols(ce);
-    top.noalias() += skew3(w) * J.topRows<3>().leftCols(ce);
-    dV[fid].topRows<3>().rightCols(model.nv - ce).setZero();
-    dV[fid].bottomRows<3>() = jd.bottomRows<3>();
+    // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place, on the supporting joints' columns (jd and J
+    // are zero on the others: on a branched tree most of the columns up to the joint's last)
+    dV[fid].setZero(6, model.nv);
+    const Matrix3d Sp = skew3(p), Sw = skew3(w);
+    for_support_cols(model, jid, [&](int c) {
+      Vector3d t = jd.col(c).head<3>();
+      t.noalias() -= Sp * jd.col(c).tail<3>();
+      t.noalias() += Sw * J.col(c).head<3>();
+      dV[fid].col(c) << t, jd.col(c).tail<3>();
+    });
     has_vel[fid] = 1;
   }
 
@@ -272,16 +321,18 @@ struct FramePass {
     const Vector3d p = oMf.translation(), w = data.ov[jid].angular(), al = oa.angular();
     const Vector3d vp = V[fid].head<3>();
     Acc[fid] << oa.linear() + al.cross(p) + w.cross(vp), al;
-    dAcc[fid].resize(6, model.nv);
-    const int ce = end_col(model, jid);  // the same sum, products in place, on the columns that can be nonzero
-    auto top = dAcc[fid].topRows<3>().leftCols(ce);
-    top = ja.topRows<3>().leftCols(ce);
-    top.noalias() -= skew3(p) * ja.bottomRows<3>().leftCols(ce);
-    top.noalias() += skew3(al) * J.topRows<3>().leftCols(ce);
-    top.noalias() += skew3(w) * dV[fid].topRows<3>().leftCols(ce);
-    top.noalias() -= skew3(vp) * dV[fid].bottomRows<3>().leftCols(ce);
-    dAcc[fid].topRows<3>().rightCols(model.nv - ce).setZero();
-    dAcc[fid].bottomRows<3>() = ja.bottomRows<3>();
+    // the same sum, products in place, on the supporting joints' columns (the only ones that can be nonzero)
+    dAcc[fid].setZero(6, model.nv);
+    const Matrix6x& dv = dV[fid];
+    const Matrix3d Sp = skew3(p), Sal = skew3(al), Sw = skew3(w), Svp = skew3(vp);
+    for_support_cols(model, jid, [&](int c) {
+      Vector3d t = ja.col(c).head<3>();
+      t.noalias() -= Sp * ja.col(c).tail<3>();
+      t.noalias() += Sal * J.col(c).head<3>();
+      t.noalias() += Sw * dv.col(c).head<3>();
+      t.noalias() -= Svp * dv.col(c).tail<3>();
+      dAcc[fid].col(c) << t, ja.col(c).tail<3>();
+    });
     has_acc[fid] = 1;
   }
 

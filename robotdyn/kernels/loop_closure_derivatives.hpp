@@ -106,8 +106,9 @@ void closure_force_dq(const pin::Model& model, const JM& Jworld, pin::JointIndex
   const Vector3d gt = f.R1 * m6.head<3>(), gr = f.R1 * m6.tail<3>();
   Vector6d phi;
   phi << gt, f.p2.cross(gt) + gr;
-  force_jacobian_dq(model, Jworld, jid2, phi, 1.0, T);
-  force_jacobian_dq(model, Jworld, jid1, phi, -1.0, T);
+  const size_t common = common_support(model, jid1, jid2);  // (their pairs there cancel)
+  force_jacobian_dq(model, Jworld, jid2, phi, 1.0, T, common);
+  force_jacobian_dq(model, Jworld, jid1, phi, -1.0, T, common);
   const Eigen::Index nc = J1.cols();
   Matrix6xB dJ(6, nc), dphi(6, nc);  // J2_O - J1_O (v_O = v_p + p x w) and dPhi
   dJ.topRows<3>() = J2.topRows<3>() - J1.topRows<3>();
@@ -118,7 +119,7 @@ void closure_force_dq(const pin::Model& model, const JM& Jworld, pin::JointIndex
   dphi.bottomRows<3>().noalias() = -skew3(gr) * J1.bottomRows<3>();
   dphi.bottomRows<3>().noalias() -= skew3(gt) * J2.topRows<3>();
   dphi.bottomRows<3>().noalias() += skew3(f.p2) * dphi.topRows<3>();
-  block.noalias() = dJ.transpose() * dphi;
+  block.noalias() = dJ.transpose().lazyProduct(dphi);  // (6-deep: coefficient-wise)
   for (size_t a = 0; a < cols.size(); ++a)
     for (size_t b = 0; b < cols.size(); ++b) T(cols[a], cols[b]) += block(a, b);
 }

@@ -8,8 +8,9 @@
 //
 // where dK enters only as d(K x)/dq at fixed x: the constraint rows' (the <kind>_derivatives.hpp, through
 // ReducedDerivatives) and the twist rows' d(J_o x)/dq = the frame velocity's q-derivative at fixed x (LOCAL: Pinocchio's
-// getFrameVelocityDerivatives; world axes: FramePass.velocity); d(Jdot_o v)/dq likewise from the frame's LOCAL
-// spatial acceleration (getFrameAccelerationDerivatives) or its world classical acceleration (FramePass), and
+// getFrameVelocityDerivatives, or FramePass.velocity rotated into the frame's axes; world axes: FramePass.velocity);
+// d(Jdot_o v)/dq likewise from the frame's LOCAL spatial acceleration (FramePass.acceleration rotated, the Python
+// twin's getFrameAccelerationDerivatives) or its world classical acceleration (FramePass), and
 // d(Jdot_o v)/dv = Jdot_o + d(J_o v)/dq.
 //
 // ProjectedPieces below are the Python `pieces` for either projection (a selection of v through ReducedDerivatives'
@@ -69,20 +70,33 @@ inline void twist_velocity_dq(const pin::Model& model, FramePass& fp, const Twis
 }
 
 // d(Jdot_o v)/dq at fixed v = fp.x (a pass with accelerations) and Jdot_o (k x n each) (_Projection.twist_drift_dq,
-// FrameTwist.rows): LOCAL, the body-axes spatial acceleration; world axes, the classical acceleration
+// FrameTwist.rows): LOCAL, the body-axes spatial acceleration (Pinocchio's getFrameAccelerationDerivatives(LOCAL)
+// a_partial_dq in the Python twin); world axes, the classical acceleration. LOCAL here from the frame's world-axes
+// velocity (v_p, w) and classical acceleration (a_p, alpha) with their q-derivatives (FramePass.velocity,
+// FramePass.acceleration), like twist_velocity_dq: the body-axes spatial acceleration at zero joint acceleration is
+// d/dt (R^T v_p, R^T w) = (R^T (a_p - w x v_p), R^T alpha), and d(R^T y)/dq = R^T ([y]x J_w + dy) (into w2; w3 and
+// w4 unused)
 inline void twist_drift_dq(const pin::Model& model, FramePass& fp, const TwistFrame& tf, MatrixXd& drift,
                            MatrixXd& Jdot, Matrix6x& w1, Matrix6x& w2, Matrix6x& w3, Matrix6x& w4) {
   const Matrix6x* dA;
+  fp.acceleration(model, tf.fid, *tf.oMf, *tf.J);
   if (tf.local) {
-    w1.setZero(6, model.nv);
-    w2.setZero(6, model.nv);
-    w3.setZero(6, model.nv);
-    w4.setZero(6, model.nv);
-    pin::getFrameAccelerationDerivatives(model, fp.data, static_cast<pin::FrameIndex>(tf.fid), pin::LOCAL, w1, w2,
-                                         w3, w4);
+    const Vector6d& V = fp.V[tf.fid];
+    const Vector6d& Acc = fp.Acc[tf.fid];
+    const Matrix6x& dV = fp.dV[tf.fid];
+    const Matrix6x& dAw = fp.dAcc[tf.fid];
+    const Vector3d vp = V.head<3>(), w = V.tail<3>();
+    const Vector3d y = Acc.head<3>() - w.cross(vp);
+    Matrix3x dy = dAw.topRows<3>();  // d(a_p - w x v_p) = da_p + [v_p]x dw - [w]x dv_p
+    dy.noalias() += skew3(vp) * dV.bottomRows<3>();
+    dy.noalias() -= skew3(w) * dV.topRows<3>();
+    const Matrix3d RT = tf.oMf->rotation().transpose();
+    const auto Jw = tf.J->bottomRows<3>();
+    w2.resize(6, model.nv);
+    rotate_skew_add(RT, y, Jw, dy, w2.topRows<3>());
+    rotate_skew_add(RT, Vector3d(Acc.tail<3>()), Jw, Matrix3x(dAw.bottomRows<3>()), w2.bottomRows<3>());
     dA = &w2;
   } else {
-    fp.acceleration(model, tf.fid, *tf.oMf, *tf.J);
     dA = &fp.dAcc[tf.fid];
   }
   const std::vector<int>& sel = *tf.select;
@@ -257,11 +271,16 @@ struct OperationalDerivatives {
     const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
     derivs::Result out;
     const Eigen::LLT<MatrixXd> llt = ReducedDerivatives<Ev>::reduced_mass(ev, tau, out);
-    const VectorXd a = S * out.nudot + ev.w_;
+    VectorXd& a = ws.a;  // (the workspace's vectors and matrices, as in ReducedDerivatives::run: no allocation)
+    a.noalias() = S * out.nudot;
+    a += ev.w_;
     pc.build_at(ev, a);  // two passes (at a and v), not one per column of S
-    MatrixXd dtau_dq, dtau_dv;
+    MatrixXd& dtau_dq = ws.dtau_dq;
+    MatrixXd& dtau_dv = ws.dtau_dv;
     ReducedDerivatives<Ev>::tree(ev, a, dtau_dq, dtau_dv);
-    const VectorXd rho = ws.tree.tau - ev.B_ * tau;
+    VectorXd& rho = ws.rho;
+    rho.noalias() = ev.B_ * tau;
+    rho = ws.tree.tau - rho;
     // dS^T rho = -S^T dK^T mu, mu = K^-T rho split into the rows' and the twist's parts: the multiplier term
     // S^T d(K^T mu)/dq at fixed mu as one derivative of the constraint and twist forces (with the motors' d(B tau)/dq)
     const int nr = static_cast<int>(ev.rows_.size());
@@ -273,8 +292,16 @@ struct OperationalDerivatives {
     ReducedDerivatives<Ev>::force_dq(ev, muf, tau, Tf);
     derivs::twist_force_dq(ev.model_, ev.data_.J, pc.tf, mu.tail(k), Tf);
     const MatrixXd Aq = pc.Aq(ev, out.nudot);
-    const MatrixXd ST = S.transpose();
-    MatrixXd G = ST * (dtau_dq - Tf) + (ST * dtau_dv) * pc.Vq + (ST * M) * Aq;
+    MatrixXd& ST = ws.ST;
+    ST = S.transpose();
+    MatrixXd& G = ws.G;  // S^T (dtau_dq - Tf) + (S^T dtau_dv) Vq + (S^T M) Aq
+    dtau_dq -= Tf;
+    G.noalias() = ST * dtau_dq;
+    MatrixXd& STM = ws.STM;
+    STM.noalias() = ST * dtau_dv;
+    G.noalias() += STM * pc.Vq;
+    STM.noalias() = ST * M;
+    G.noalias() += STM * Aq;
     ReducedDerivatives<Ev>::solve_reduced(ev, llt, G, dtau_dv, pc.Wnu, out);
     out.Vq = pc.Vq;
     return out;

@@ -57,7 +57,7 @@ struct Workspace {
   std::vector<Gathered> wheel_gather, closure_gather;
   // run()'s work matrices, kept between calls (sized on first use: no allocation per derivative set)
   MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Ygd, Ad, dgam_v, Wnu, Aq, G, ST, STM, Minv, T, T2;
-  MatrixXd dAa, dAv, Tf;  // run(): d(A a)/dq, d(A v)/dq, d(A^T mu + B tau)/dq at fixed (mu, tau)
+  MatrixXd dAa, dAv, Tf, Cd;  // run(): d(A a)/dq, d(A v)/dq, d(A^T mu + B tau)/dq at fixed (mu, tau), C_d
   VectorXd a, rho, rd, mu, muf;
 };
 
@@ -178,7 +178,7 @@ struct ReducedDerivatives {
   static void support_cols(const Model& model, pinocchio::JointIndex jid, std::vector<int>& cols) {
     for (const pinocchio::JointIndex s : model.supports[jid]) {
       if (s == 0) continue;
-      for (int c = model.joints[s].idx_v(); c < model.joints[s].idx_v() + model.joints[s].nv(); ++c)
+      for (int c = model.idx_vs[s]; c < model.idx_vs[s] + model.nvs[s]; ++c)
         cols.push_back(c);
     }
   }
@@ -203,7 +203,8 @@ struct ReducedDerivatives {
       }
       if (wh.radius_index >= 0)
         ws.radius_col[i] = static_cast<int>(std::find(cols.begin(), cols.end(), wh.radius_index) - cols.begin());
-      derivs::gather_cols(ev.Jf_[wh.frame], cols, ws.wheel_gather[i].J);
+      derivs::gather_cols(ev.Jf_[wh.frame], cols, ws.wheel_gather[i].J);  // (J and Aw at q: drift_dq's, force_dq's)
+      derivs::gather_cols(ev.Aw_[i], cols, ws.wheel_gather[i].Aw);
       derivs::wheel_geometry_dq(ev.geo_[i], ws.wheel_gather[i].J, ws.radius_col[i], ev.terrain_.flat(), ws.geoc[i]);
     }
     ws.closure_cols.resize(nc);
@@ -242,11 +243,9 @@ struct ReducedDerivatives {
         const std::vector<int>& cols = ws.wheel_cols[i];
         const int nc = static_cast<int>(cols.size());
         auto& gb = ws.wheel_gather[i];
-        derivs::gather_cols(J, cols, gb.J);
-        derivs::gather_cols(fp.dV[fid], cols, gb.dV1);
+        derivs::gather_cols(fp.dV[fid], cols, gb.dV1);  // (gb.J, gb.Aw: compact_columns')
         derivs::gather_cols(fp.dAcc[fid], cols, gb.dA1);
         derivs::gather_cols(ws.dJ1, cols, gb.dJ1);
-        derivs::gather_cols(ev.Aw_[i], cols, gb.Aw);
         gb.out.resize(nd, nc);
         gb.out2.resize(nd, nc);
         derivs::wheel_drift_dq(g, ws.geoc[i], wh.D, ev.terrain_, ev.terrain_.flat(), gb.J, wh.radius_index,
@@ -389,10 +388,16 @@ struct ReducedDerivatives {
     dtau_dq -= ws.Tf;
     G.noalias() = ST * dtau_dq;
     MatrixXd& STM = ws.STM;
-    STM.noalias() = ST * dtau_dv;
-    G.noalias() += STM * out.Vq;
-    STM.noalias() = ST * M;
-    G.noalias() += STM * Aq;
+    if (nd) {  // Vq and Aq are zero off the dependent rows: (S^T C) Vq = (S^T C_d) V_d on C's dependent columns C_d
+      MatrixXd& Cd = ws.Cd;
+      Cd.resize(n, nd);
+      for (int r = 0; r < nd; ++r) Cd.col(r) = dtau_dv.col(ev.dependent_[r]);
+      STM.noalias() = ST * Cd;
+      G.noalias() += STM * ws.Vd;
+      for (int r = 0; r < nd; ++r) Cd.col(r) = M.col(ev.dependent_[r]);
+      STM.noalias() = ST * Cd;
+      G.noalias() += STM * ws.Ad;
+    }
     solve_reduced(ev, llt, G, dtau_dv, Wnu, out);
     return out;
   }
@@ -400,7 +405,8 @@ struct ReducedDerivatives {
   // run()'s passes at the evaluator's state (configure(q), dynamics(nu) done): the rows' d(A a)/dq at a = S nudot +
   // w on a velocity-only pass (FramePass::run_velocities on the evaluator's configuration pass; A x is linear in x,
   // so this is d(A w)/dq + sum_l nudot_l d(A S_l)/dq in one pass), and d(A v)/dq, the drift's dgamma/dq and Adot on
-  // the pass at v with accelerations (ws.dAa, ws.dAv, ws.dgam_q, ws.Adot), every row on its own columns; `full`:
+  // the pass at v with accelerations (ws.dAa, ws.dAv, ws.dgam_q, ws.Adot; FramePass::run_on, on the evaluator's
+  // bias pass at v), every row on its own columns; `full`:
   // the pass at a is a Pinocchio pass of its own (the LOCAL operational twist reads its data)
   static void run_passes(Ev& ev, const VectorXd& a, bool full = false) {
     const Model& model = ev.model_;
@@ -411,7 +417,7 @@ struct ReducedDerivatives {
     else
       ws.pass_a.run_velocities(model, ev.data_, a);
     velocity_dq(ev, ws.pass_a, ws.dAa, true);
-    ws.pass_v.run(model, ev.q_, ev.v_, true);
+    ws.pass_v.run_on(model, ev.data_, ev.v_);  // (the evaluator's bias pass at v: no forward kinematics of its own)
     prepare(ev, ws.pass_v, true);
     velocity_dq(ev, ws.pass_v, ws.dAv, true);
     drift_dq(ev, ws.pass_v, ws.dgam_q, ws.Adot);
@@ -432,9 +438,7 @@ struct ReducedDerivatives {
         const int nd = static_cast<int>(wh.D.rows());
         if (mu.segment(g.row, nd).isZero(0.0)) continue;
         const int fid = ev.frames_[wh.frame];
-        auto& gb = ws.wheel_gather[i];
-        derivs::gather_cols(ev.Jf_[wh.frame], ws.wheel_cols[i], gb.J);
-        derivs::gather_cols(ev.Aw_[i], ws.wheel_cols[i], gb.Aw);
+        auto& gb = ws.wheel_gather[i];  // (gb.J, gb.Aw: compact_columns')
         derivs::wheel_force_dq(model, ev.data_.J, model.frames[fid].parentJoint, g, ws.geoc[i], wh.D,
                                mu.segment(g.row, nd), gb.J, gb.Aw, ws.wheel_cols[i], ws.radius_col[i], gb.F, Tf);
       } else if (kind == 1) {
@@ -472,13 +476,17 @@ struct ReducedDerivatives {
       const int rf = ev.frames_[mo.reaction];
       derivs::Vector6d phi;
       phi << Eigen::Vector3d::Zero(), tau[j] * axis;
-      derivs::force_jacobian_dq(model, ev.data_.J, jid, phi, 1.0, Tf);
-      derivs::force_jacobian_dq(model, ev.data_.J, model.frames[rf].parentJoint, phi, -1.0, Tf);
+      // the moment on the joint's body and its opposite on the reaction frame's, their pairs on the common support
+      // left out (they cancel; the reaction's body an ancestor of the joint's, its pass is empty)
+      const pinocchio::JointIndex rj = model.frames[rf].parentJoint;
+      const size_t common = derivs::common_support(model, jid, rj);
+      derivs::force_jacobian_dq(model, ev.data_.J, jid, phi, 1.0, Tf, common);
+      derivs::force_jacobian_dq(model, ev.data_.J, rj, phi, -1.0, Tf, common);
       derivs::Matrix3x Jd = -ev.Jf_[mo.reaction].template bottomRows<3>();  // Jw_child - Jw_reaction
       for (const pinocchio::JointIndex s : model.supports[jid]) {
         if (s == 0) continue;
-        const int c0 = model.joints[s].idx_v();
-        for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jd.col(c) += ev.data_.J.col(c).template tail<3>();
+        const int c0 = model.idx_vs[s];
+        for (int c = c0; c < c0 + model.nvs[s]; ++c) Jd.col(c) += ev.data_.J.col(c).template tail<3>();
       }
       Tf.noalias() += tau[j] * (Jd.transpose() * daxis);
     }
@@ -574,8 +582,8 @@ struct ReducedDerivatives {
     derivs::Matrix3x Jw = derivs::Matrix3x::Zero(3, ev.nv_);
     for (const pinocchio::JointIndex s : model.supports[jid]) {
       if (s == 0) continue;
-      const int c0 = model.joints[s].idx_v();
-      for (int c = c0; c < c0 + model.joints[s].nv(); ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
+      const int c0 = model.idx_vs[s];
+      for (int c = c0; c < c0 + model.nvs[s]; ++c) Jw.col(c) = ev.data_.J.col(c).template tail<3>();
     }
     axis = Jw.col(mo.index);
     daxis = -derivs::skew3(axis) * Jw;

@@ -107,7 +107,7 @@ void wheel_velocity_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<c
   const Vector3d E[3] = {g.t1, g.t2, g.n};
   Matrix3x dEs(3, ds.cols());
   for (int i = 0; i < 3; ++i) dEs.row(i) = E[i].transpose() * ds + s.transpose() * gd.E(i);
-  out.noalias() = D * dEs;
+  out.noalias() = D.lazyProduct(dEs);  // (coefficient-wise: 3-deep products, no matrix-product kernel set-up)
 }
 
 // dgamma/dq at fixed v of the wheel's drift rows (wheel_drift_dq) into drift_out (rows x n), and the rows' time
@@ -209,7 +209,7 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   for (int i = 0; i < 3; ++i)
     rows.row(i) = Ed[i].transpose() * ds + s.transpose() * (*dEd[i]) + E[i].transpose() * dacc +
                   acc.transpose() * gd.E(i);
-  drift_out.noalias() = D * rows;
+  drift_out.noalias() = D.lazyProduct(rows);
   // Adot = Wdot Aw + W Awdot, Awdot = dJ_c - [rdot]x Jw - [r]x dJ_w (- udot at the radius column); the same sums,
   // the products written in place (no temporaries)
   Matrix3x Awdot = dJ.topRows<3>();
@@ -222,9 +222,9 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
     EdT.row(i) = Ed[i].transpose();
   }
   Matrix3x Wd(3, nv);
-  Wd.noalias() = EdT * Aw;
-  Wd.noalias() += ET * Awdot;
-  adot_out.noalias() = D * Wd;
+  Wd.noalias() = EdT.lazyProduct(Aw);
+  Wd.noalias() += ET.lazyProduct(Awdot);
+  adot_out.noalias() = D.lazyProduct(Wd);
 }
 
 // d(A_w^T mu_w)/dq at fixed mu_w (the wheel's constraint force's generalized force, differentiated), added into T
@@ -252,8 +252,8 @@ void wheel_force_dq(const pin::Model& model, const JM& Jworld, pin::JointIndex j
   Matrix3x dp = Jc.topRows<3>() + gd.r;
   Matrix3x fdp(3, dp.cols());
   fdp.noalias() = skew3(f) * dp;
-  block.noalias() = Awc.transpose() * df;
-  block.noalias() -= Jc.bottomRows<3>().transpose() * fdp;
+  block.noalias() = Awc.transpose().lazyProduct(df);  // (3-deep: coefficient-wise)
+  block.noalias() -= Jc.bottomRows<3>().transpose().lazyProduct(fdp);
   if (radius_col >= 0) block.row(radius_col) -= f.transpose() * gd.u;
   for (size_t a = 0; a < cols.size(); ++a)
     for (size_t b = 0; b < cols.size(); ++b) T(cols[a], cols[b]) += block(a, b);

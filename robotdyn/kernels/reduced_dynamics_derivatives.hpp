@@ -288,7 +288,7 @@ struct ReducedDerivatives {
   }
 
   // -K^-1 [X_rows] for the selection projection (Projection.solve_neg): zero except the dependent rows (the
-  // operational-space, sliding and contact-force derivative kernels use it; run() makes its three solves in one)
+  // operational-space, sliding and contact-force derivative kernels use it; run() makes its own two solves)
   static MatrixXd solve_neg(Ev& ev, const MatrixXd& X) {
     const int nd = static_cast<int>(ev.dependent_.size());
     MatrixXd out = MatrixXd::Zero(ev.nv_, X.cols());

@@ -218,10 +218,17 @@ struct FramePass {
     }
   }
 
+  // a per-joint or per-frame 6 x n result zeroed only when first sized: each is written on its joint's supporting
+  // columns only (the same columns at every state: the model's supports are fixed), so its other columns stay the
+  // zeros of that first call (no 6 x n clearing per frame and pass)
+  static void zero_once(Matrix6x& m, int nv) {
+    if (m.cols() != nv) m.setZero(6, nv);
+  }
+
   // d(ov)/dq of a joint at fixed x, WORLD (6 x n)
   const Matrix6x& joint_velocity_dq(const pin::Model& model, pin::JointIndex jid) {
     if (!has_jv[jid]) {
-      jdV[jid].setZero(6, model.nv);
+      zero_once(jdV[jid], model.nv);
       if (base) {  // d ov_j / dq_c = J_c x (ov_j - ov_parent(c)) on the support of j (header)
         for (const pin::JointIndex s : model.supports[jid]) {
           if (s == 0) continue;
@@ -253,9 +260,10 @@ struct FramePass {
   // d(oa)/dq of a joint at fixed (x, vdot = 0), WORLD (6 x n): the a_partial_dq of Pinocchio's
   // getJointAccelerationDerivatives(WORLD) on this pass's computeForwardKinematicsDerivatives, its own steps on the
   // support of jid (motionSet::motionAction of (oa_parent - oa_j) on the joint's columns J, plus that of
-  // (ov_parent - ov_j) on dJ), without the three outputs it also fills and the pass does not read
+  // (ov_parent - ov_j) on dJ), without the three outputs it also fills and the pass does not read. `out` is written
+  // on jid's supporting columns only: its other columns must be zero (zero_once on a buffer kept for jid)
   void joint_acceleration_dq(const pin::Model& model, pin::JointIndex jid, Matrix6x& out) {
-    out.setZero(6, model.nv);
+    zero_once(out, model.nv);
     const pin::Motion& vlast = data.ov[jid];
     const pin::Motion& alast = data.oa[jid];
     for (const pin::JointIndex s : model.supports[jid]) {
@@ -295,7 +303,7 @@ struct FramePass {
     V[fid] << vp, w;
     // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place, on the supporting joints' columns (jd and J
     // are zero on the others: on a branched tree most of the columns up to the joint's last)
-    dV[fid].setZero(6, model.nv);
+    zero_once(dV[fid], model.nv);
     const Matrix3d Sp = skew3(p), Sw = skew3(w);
     for_support_cols(model, jid, [&](int c) {
       Vector3d t = jd.col(c).head<3>();
@@ -322,7 +330,7 @@ struct FramePass {
     const Vector3d vp = V[fid].head<3>();
     Acc[fid] << oa.linear() + al.cross(p) + w.cross(vp), al;
     // the same sum, products in place, on the supporting joints' columns (the only ones that can be nonzero)
-    dAcc[fid].setZero(6, model.nv);
+    zero_once(dAcc[fid], model.nv);
     const Matrix6x& dv = dV[fid];
     const Matrix3d Sp = skew3(p), Sal = skew3(al), Sw = skew3(w), Svp = skew3(vp);
     for_support_cols(model, jid, [&](int c) {

@@ -56,7 +56,7 @@ struct Workspace {
   };
   std::vector<Gathered> wheel_gather, closure_gather;
   // run()'s work matrices, kept between calls (sized on first use: no allocation per derivative set)
-  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Ygd, Ad, dgam_v, Wnu, Aq, G, ST, STM, Minv, T, T2;
+  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Xg, Xgd, X2, Y2, Ad, dgam_v, Wnu, Aq, G, ST, STM, Minv, T, T2;
   MatrixXd dAa, dAv, Tf, Cd;  // run(): d(A a)/dq, d(A v)/dq, d(A^T mu + B tau)/dq at fixed (mu, tau), C_d
   VectorXd a, rho, rd, mu, muf;
 };
@@ -288,7 +288,7 @@ struct ReducedDerivatives {
   }
 
   // -K^-1 [X_rows] for the selection projection (Projection.solve_neg): zero except the dependent rows (the
-  // operational-space, sliding and contact-force derivative kernels use it; run() makes its three solves in one)
+  // operational-space, sliding and contact-force derivative kernels use it; run() makes its own two solves)
   static MatrixXd solve_neg(Ev& ev, const MatrixXd& X) {
     const int nd = static_cast<int>(ev.dependent_.size());
     MatrixXd out = MatrixXd::Zero(ev.nv_, X.cols());
@@ -323,8 +323,10 @@ struct ReducedDerivatives {
     const MatrixXd& dA_v = ws.dAv;
     MatrixXd& dgam_v = ws.dgam_v;
     dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
-    // the projection's three solves in one: with Y = K^-1 [d(K v)/dq, d(K gamma)/dv, d(K a)/dq + dgamma/dq at fixed
-    // v] (dependent rows), dv/dq = -Y_v (v = S(q) nu), W_nu = -Y_g S, and Aq = -(Y_a + Y_g dv/dq) (Pieces.Aq)
+    // the projection's solves: with K^-1 on the dependent rows, dv/dq = -K^-1 d(K v)/dq (v = S(q) nu), then, in one
+    // solve of n + k columns, Aq = -K^-1 (d(K a)/dq + dgamma/dq at fixed v + d(K gamma)/dv dv/dq) (Pieces.Aq) and
+    // W_nu = -K^-1 d(K gamma)/dv S: the products with dv/dq (zero off the dependent rows: on d(K gamma)/dv's dependent
+    // columns) and with S taken before the solve, which then runs on n + k columns rather than on d(K gamma)/dv's n
     const int nd = static_cast<int>(ev.dependent_.size());
     out.Vq = MatrixXd::Zero(n, n);
     MatrixXd& Wnu = ws.Wnu;
@@ -332,27 +334,34 @@ struct ReducedDerivatives {
     Wnu.setZero(n, k);
     Aq.setZero(n, n);
     if (nd) {
-      MatrixXd& X = ws.X;
-      X.resize(nd, 3 * n);
+      MatrixXd& X = ws.X;    // d(K v)/dq
+      MatrixXd& Xg = ws.Xg;  // d(K gamma)/dv
+      MatrixXd& X2 = ws.X2;  // [d(K a)/dq + dgamma/dq at fixed v + d(K gamma)/dv dv/dq, d(K gamma)/dv S]
+      X.resize(nd, n);
+      Xg.resize(nd, n);
+      X2.resize(nd, n + k);
       for (int r = 0; r < nd; ++r) {
         const int row = ev.rows_[r];
-        X.row(r).segment(0, n) = dA_v.row(row);
-        X.row(r).segment(n, n) = dgam_v.row(row);
-        auto xa = X.row(r).segment(2 * n, n);
+        X.row(r) = dA_v.row(row);
+        Xg.row(r) = dgam_v.row(row);
+        auto xa = X2.row(r).head(n);
         xa = ws.dAa.row(row) + ws.dgam_q.row(row);  // d(A a)/dq = d(A w)/dq + sum_l nudot_l d(A S_l)/dq
       }
       MatrixXd& Y = ws.Y;
       Y = ev.lu_.solve(X);
       MatrixXd& Vd = ws.Vd;  // dependent rows of dv/dq
-      Vd = -Y.leftCols(n);
-      MatrixXd& Wd = ws.Wd;
-      Wd.noalias() = -Y.middleCols(n, n) * S;
-      MatrixXd& Ygd = ws.Ygd;  // Y_g's dependent columns: Vq is zero off the dependent rows
-      Ygd.resize(nd, nd);
-      for (int r = 0; r < nd; ++r) Ygd.col(r) = Y.col(n + ev.dependent_[r]);
+      Vd = -Y;
+      MatrixXd& Xgd = ws.Xgd;  // Xg's dependent columns: Vq is zero off the dependent rows
+      Xgd.resize(nd, nd);
+      for (int r = 0; r < nd; ++r) Xgd.col(r) = Xg.col(ev.dependent_[r]);
+      X2.leftCols(n).noalias() += Xgd * Vd;
+      X2.rightCols(k).noalias() = Xg * S;
+      MatrixXd& Y2 = ws.Y2;
+      Y2 = ev.lu_.solve(X2);
       MatrixXd& Ad = ws.Ad;
-      Ad = -Y.rightCols(n);
-      Ad.noalias() -= Ygd * Vd;  // -(Y_a + Y_g Vq)
+      Ad = -Y2.leftCols(n);  // -(Y_a + Y_g Vq)
+      MatrixXd& Wd = ws.Wd;
+      Wd = -Y2.rightCols(k);
       for (int r = 0; r < nd; ++r) {
         const int i = ev.dependent_[r];
         out.Vq.row(i) = Vd.row(r);

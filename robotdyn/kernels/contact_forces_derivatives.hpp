@@ -12,7 +12,7 @@
 // orthogonal projector onto what stays open (null(A^T), and null(C) with a split). dA/dq comes from the rows'
 // velocity derivatives at the unit velocities (one frame pass per coordinate, ReducedDerivatives::velocity_dq on
 // Pinocchio's computeForwardKinematicsDerivatives), de/dq, de/dv and M from Pinocchio's computeRNEADerivatives at
-// (q, v, a) less the motors' d(B tau)/dq at the unit velocities (ReducedDerivatives::motor_rows' terms). The
+// (q, v, a) less the motors' d(B tau)/dq (ReducedDerivatives::motor_force_dq). The
 // pseudo-inverses are truncated at the ranks the Python path uses (SVDs), so both give the same numbers.
 //
 // Served: rolling wheels, loop closures, couplings (what ReducedDerivatives serves); operational-space velocities
@@ -106,40 +106,16 @@ struct ContactForcesDerivatives {
     for (size_t i = 0; i < ev.wheels_.size(); ++i)
       derivs::wheel_geometry_dq(ev.geo_[i], ev.Jf_[ev.wheels_[i].frame], ev.wheels_[i].radius_index,
                                 ev.terrain_.flat(), ws.geo[i]);
-    // the motors' joint axes in world axes and their q-derivatives (motor_rows)
-    struct Axis {
-      size_t j;
-      pinocchio::JointIndex jid;
-      int rf, reaction;
-      Eigen::Vector3d axis;
-      derivs::Matrix3x daxis;
-    };
-    std::vector<Axis> axes;
-    for (size_t j = 0; j < ev.motors_.size(); ++j) {
-      const auto& mo = ev.motors_[j];
-      if (mo.reaction < 0 || tau[j] == 0.0) continue;
-      Axis ax{j, static_cast<pinocchio::JointIndex>(mo.joint), ev.frames_[mo.reaction], mo.reaction, {}, {}};
-      RD::motor_axis(ev, mo, ax.axis, ax.daxis);
-      axes.push_back(ax);
-    }
-    // one frame pass per unit velocity e_j: d(A e_j)/dq (column j of A differentiated, m x n) and row j of
-    // d(B tau)/dq
+    // one frame pass per unit velocity e_j: d(A e_j)/dq (column j of A differentiated, m x n); the motors'
+    // d(B tau)/dq (ReducedDerivatives::motor_force_dq)
     std::vector<MatrixXd> dAj(n);
     MatrixXd dBt = MatrixXd::Zero(n, n);
+    RD::motor_force_dq(ev, tau, dBt);
     derivs::FramePass fp;
     for (int j = 0; j < n; ++j) {
       fp.run(model, ev.q_, VectorXd::Unit(n, j), false);
       RD::prepare(ev, fp, false);
       RD::velocity_dq(ev, fp, dAj[j]);
-      for (const Axis& ax : axes) {
-        Eigen::Vector3d wc;
-        derivs::Matrix3x dwc;
-        fp.joint_angular(model, ax.jid, wc, dwc);
-        fp.velocity(model, ax.rf, ev.data_.oMf[ax.rf], ev.Jf_[ax.reaction]);
-        const Eigen::Vector3d wr = fp.V[ax.rf].template tail<3>();
-        const derivs::Matrix3x dwr = fp.dV[ax.rf].template bottomRows<3>();
-        dBt.row(j) += tau[ax.j] * (ax.axis.transpose() * (dwc - dwr) + (wc - wr).transpose() * ax.daxis);
-      }
     }
     // the tree at (q, v, a) with gravity: e, de/dq, de/dv and M
     if (!ws.has_tree) {

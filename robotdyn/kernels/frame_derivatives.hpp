@@ -350,12 +350,6 @@ struct FramePass {
     dJ.setZero(6, model.nv);
     pin::getFrameJacobianTimeVariation(model, data, fid, pin::LOCAL_WORLD_ALIGNED, dJ);
   }
-
-  // world angular velocity of a joint's body and its q-derivative at fixed x (the motors' reaction terms)
-  void joint_angular(const pin::Model& model, pin::JointIndex jid, Vector3d& w, Matrix3x& dw) {
-    w = joint_velocity(jid).angular();
-    dw = joint_velocity_dq(model, jid).bottomRows<3>();
-  }
 };
 
 }  // namespace derivs

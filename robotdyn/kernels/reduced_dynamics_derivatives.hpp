@@ -597,34 +597,6 @@ struct ReducedDerivatives {
     axis = Jw.col(mo.index);
     daxis = -derivs::skew3(axis) * Jw;
   }
-
-  // G -= S^T d(B(q) tau)/dq at fixed S (motor_rows): motors reacting on a body; with `passes` (default: the columns
-  // of S) G -= X^T d(B tau)/dq for the passes' velocities X (at the unit vectors: d(B tau)/dq itself)
-  static void motor_rows(Ev& ev, const Eigen::Ref<const VectorXd>& tau, MatrixXd& G,
-                         std::vector<derivs::FramePass>* passes = nullptr) {
-    const Model& model = ev.model_;
-    std::vector<derivs::FramePass>& ps = passes ? *passes : ev.deriv_.passes;
-    const int k = passes ? static_cast<int>(passes->size()) : static_cast<int>(ev.S_.cols());
-    for (size_t j = 0; j < ev.motors_.size(); ++j) {
-      const auto& mo = ev.motors_[j];
-      if (mo.reaction < 0 || tau[j] == 0.0) continue;
-      const pinocchio::JointIndex jid = static_cast<pinocchio::JointIndex>(mo.joint);
-      Eigen::Vector3d axis;
-      derivs::Matrix3x daxis;
-      motor_axis(ev, mo, axis, daxis);
-      const int rf = ev.frames_[mo.reaction];
-      for (int l = 0; l < k; ++l) {
-        derivs::FramePass& fp = ps[l];
-        Eigen::Vector3d wc;
-        derivs::Matrix3x dwc;
-        fp.joint_angular(model, jid, wc, dwc);
-        fp.velocity(model, rf, ev.data_.oMf[rf], ev.Jf_[mo.reaction]);
-        const Eigen::Vector3d wr = fp.V[rf].template tail<3>();
-        const derivs::Matrix3x dwr = fp.dV[rf].template bottomRows<3>();
-        G.row(l) -= tau[j] * (axis.transpose() * (dwc - dwr) + (wc - wr).transpose() * daxis);
-      }
-    }
-  }
 };
 
 }  // namespace robotdyn

@@ -121,9 +121,10 @@ struct SlidingDerivatives {
       dGlam_q -= li * (JtC * ds_q);
       dGlam_nu -= li * (JtC * (Jt * S));
     }
-    // d(B tau)/dq on the unit passes (motor_rows with passes at e_j)
+    // -d(B tau)/dq of the motors reacting on a body (motor_force_dq: the same terms as the unit passes' would give)
     MatrixXd Bq = MatrixXd::Zero(n, n);
-    RD::motor_rows(ev, tau, Bq, &units);
+    RD::motor_force_dq(ev, tau, Bq);
+    Bq = -Bq;
     MatrixXd R(n, n + k + ev.B_.cols());
     R.leftCols(n) = dtau_dq + dtau_dv * pc.Vq + M * pc.Aq(ev, nudot) + Bq - dGlam_q;  // (Bq holds -d(B tau)/dq)
     R.middleCols(n, k) = dtau_dv * S + M * pc.Wnu - dGlam_nu;

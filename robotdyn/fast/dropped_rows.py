@@ -80,17 +80,20 @@ def violations(robot, red, q: np.ndarray, nudot) -> list[RowViolation]:
         as :func:`robotdyn.constraints.redundancy.violations` gives them.
     """
     v = red.v
-    if nudot is not None and not v.any():  # at rest (a run's start): the exact check's own test, without its tolerance
-        return _at_rest(red, nudot)
     if nudot is None:  # no Adot needed there: the exact check is already cheap
         return exact_violations(red, nudot)
     dropped = dropped_rows(red)
     if dropped.size == 0:
         return []
     A_all = red.jacobian_rows.A
-    d = drift_estimate(robot, np.asarray(q, float), v)
-    if d is None or d.shape != (A_all.shape[0],) or not np.isfinite(d).all():
-        return exact_violations(red, nudot)
+    if v.any():  # the estimated drift, with MARGIN for its error
+        d = drift_estimate(robot, np.asarray(q, float), v)
+        if d is None or d.shape != (A_all.shape[0],) or not np.isfinite(d).all():
+            return exact_violations(red, nudot)
+        margin = MARGIN
+    else:  # at rest (a run's start) the drift and every term in v are exact zeros: the exact check's own test, whose
+        # tolerance is at least TOL (only the projection's condition number raises it), without the margin
+        d, margin = np.zeros(A_all.shape[0]), 1.0
     A = A_all[dropped]
     size = float(np.abs(A_all).max())
     absv = np.abs(v)
@@ -99,30 +102,9 @@ def violations(robot, red, q: np.ndarray, nudot) -> list[RowViolation]:
     absa = np.abs(a)
     dd = np.abs(d[dropped])
     lower = np.abs(A) @ absa + size * absa.sum() + dd + float(np.abs(d).max())
-    acc_ok = np.abs(A @ a + d[dropped]) <= MARGIN * TOL * lower
+    acc_ok = np.abs(A @ a + d[dropped]) <= margin * TOL * lower
     if vel_ok.all() and acc_ok.all():
         return []
     return exact_violations(red, nudot)
-
-
-def _at_rest(red, nudot) -> list[RowViolation]:
-    """:func:`robotdyn.constraints.redundancy.violations` at v = 0. Its terms in v vanish there: the velocity level
-    is 0 against a scale of 0 (never a violation), and :math:`\\dot A v` and its scale add exact zeros. A dropped row
-    :math:`a_d` is then violated only where abs(a_d a) exceeds tol (abs(a_d) abs(a) + s sum(abs(a))), s the largest
-    entry of A, with tol at least :data:`~robotdyn.constraints.redundancy.TOL` (only the projection's condition
-    number raises it). Where every dropped row stays within TOL of that same scale (the same numbers) none is
-    violated, and the condition number (an inverse of :math:`A_d`) is not needed; else the exact check decides."""
-    dropped = dropped_rows(red)
-    if dropped.size == 0:
-        return []
-    A_all = red.jacobian_rows.A
-    A = A_all[dropped]
-    a = red.S @ np.asarray(nudot, float) + red.w
-    absa = np.abs(a)
-    scale = np.abs(A) @ absa + float(np.abs(A_all).max()) * absa.sum()
-    if np.all(np.abs(A @ a) <= TOL * scale):
-        return []
-    return exact_violations(red, nudot)
-
 
 __all__ = ["violations", "drift_estimate", "STEP", "MARGIN"]

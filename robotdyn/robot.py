@@ -1166,13 +1166,15 @@ class Robot:
         from .description.joint_dynamics import unapplied_joint_dynamics
 
         heights = self.wheel_heights() if self.spec.root != "fixed" else {}
-        if heights and max(map(abs, heights.values())) > 1e-6 and np.ptp(list(heights.values())) <= 1e-6:
-            notes.append(self._root_height_advice(self.neutral(), list(heights.values()), "at the neutral configuration"))
-        elif heights and max(map(abs, heights.values())) > 1e-6:
-            listed = ", ".join(f"{k} {v:+.4g} m" for k, v in heights.items())
-            notes.append(f"at the neutral configuration the wheels do not all touch the ground (contact heights above "
-                         f"it: {listed}); a {self.spec.root} root cannot fix that with one height: check the radii, "
-                         "the joint values (neutral) or the terrain")
+        values = list(heights.values())
+        if values and max(map(abs, values)) > 1e-6:
+            if np.ptp(values) <= 1e-6:  # all off by the same height: the root's
+                notes.append(self._root_height_advice(self.neutral(), values, "at the neutral configuration"))
+            else:
+                listed = ", ".join(f"{k} {v:+.4g} m" for k, v in heights.items())
+                notes.append(f"at the neutral configuration the wheels do not all touch the ground (contact heights "
+                             f"above it: {listed}); a {self.spec.root} root cannot fix that with one height: check the "
+                             "radii, the joint values (neutral) or the terrain")
         notes += unapplied_joint_dynamics(self.model, {sp.index for sp in self.springs if sp.damping > 0})
         if self.spec.root != "fixed":  # an axis in the wrong axes (robotdyn.constraints.rolling_contact.lying_flat)
             from .constraints.rolling_contact import lying_flat

@@ -26,7 +26,7 @@ def eager(robot, q, nu, tau):
     unsupported = False
     if any(not w.determined[2] for w in out.wheels):
         planar = out
-        out = cf._from_floating_twin(robot, q, red.v, a, tau, nudot, out)
+        out = cf._from_floating_twin(robot, q, red.v, a, tau, nudot, lambda: planar)
         unsupported = out is planar
     if not unsupported:
         cf.apply_rigid_limit(robot, out)

@@ -541,7 +541,7 @@ def _solve(robot, q, v, a, tau, rows, friction) -> tuple:
     null space of :math:`A^T` (:func:`_from_basic`), the Python path's choice on undetermined rows; else all of it in
     Python."""
     fast = None if friction else compiled_model(robot)
-    served = None if fast is None else _compiled_forces(robot, q, v, a, tau, fast)
+    served = None if fast is None else _compiled_forces(fast, q, v, a, tau)
     if rows is None:  # the rows at (q, v): the compiled evaluation's, else the Python path's
         if served is not None:
             rows = ConstraintRows(served[3], None, np.zeros(len(fast.labels)), fast.holonomic, list(fast.labels))
@@ -633,7 +633,7 @@ def _assemble(robot, solved: tuple, nudot, tau, friction) -> ConstraintForces:
                 geo = c._geometry(geometry)
                 E, p = geo[9], geo[5]
             idx = [index[lab] for lab in c._labels()]
-            out.wheels.append(_wheel_force(c, E, p, index, lam, N, fr, idx))
+            out.wheels.append(_wheel_force(c, E, p, idx, lam, N, fr))
             out._tangential.append((idx, c._directions, fr))
         elif isinstance(c, LoopClosure):
             out.closures[c.name] = {comp: float(lam[index[f"{c.name}.{comp}"]]) for comp in c.components
@@ -679,8 +679,8 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar) -> ConstraintForces:
     same state with zero z, pitch and roll rates and accelerations, has those rows active, and the out-of-plane
     equations of motion (vertical force, roll and pitch moments of the whole robot) then determine the normal
     loads. If the wheels cannot hold that equilibrium (e.g. a robot on two wheels with no other support) the
-    residual says so and the planar result is kept, with the reason. ``planar``: the planar model's
-    :class:`ConstraintForces`, or a function giving them (called only then)."""
+    residual says so and the planar result is kept, with the reason. ``planar``: a function giving the planar
+    model's :class:`ConstraintForces` (called only then)."""
     twin, index = floating_twin(robot)
 
     def lift(x):
@@ -692,7 +692,7 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar) -> ConstraintForces:
     solved = _solve(twin, qt, vt, at, tau, None, {})  # (the twin's rows: compiled where it serves)
     residual = solved[4]
     if residual > TWIN_RESIDUAL:  # (the twin's forces are not assembled then)
-        planar = planar() if callable(planar) else planar
+        planar = planar()
         planar.undetermined_reason.append(
             f"the wheels cannot hold this planar model's out-of-plane equilibrium (relative residual "
             f"{residual:.3g} on its floating twin): the description lacks a support, so its normal loads stay "
@@ -704,15 +704,11 @@ def _from_floating_twin(robot, q, v, a, tau, nudot, planar) -> ConstraintForces:
     return out
 
 
-def _compiled_forces(robot, q, v, a, tau, fast=None):
-    """``(lambda on the projection's rows, e, wheel forces and frames)`` by the robot's compiled model
-    (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`; ``fast``: that model, default ``None``: the robot's),
-    or ``None`` where it does not serve."""
+def _compiled_forces(fast, q, v, a, tau):
+    """``(lambda on the projection's rows, e, wheel forces and frames)`` by the robot's compiled model ``fast``
+    (:meth:`robotdyn.fast.compiled.CompiledModel.forces_at`), or ``None`` where it falls back."""
     from ..fast.compiled import Fallback
 
-    fast = compiled_model(robot) if fast is None else fast
-    if fast is None:
-        return None
     try:
         return fast.forces_at(np.asarray(q, float), np.asarray(v, float), np.asarray(a, float),
                               np.asarray(tau, float))
@@ -769,13 +765,11 @@ def _directions_determined(D: np.ndarray, N: np.ndarray, idx: list) -> np.ndarra
     return _row_norms(D.T @ N[idx]) <= DETERMINED_TOL
 
 
-def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, index: dict, lam: np.ndarray,
-                 N: np.ndarray, friction: np.ndarray | None = None, idx: list | None = None) -> WheelForce:
+def _wheel_force(wheel: RollingWheel, E: np.ndarray, p: np.ndarray, idx: list, lam: np.ndarray,
+                 N: np.ndarray, friction: np.ndarray | None = None) -> WheelForce:
     """A wheel's force in its contact frame (E: columns t1, t2, n; contact point p), from its rows' multipliers
-    (row i acts along D[i] of (t1, t2, n), ``idx``: the rows' indices, by default from ``index`` and its labels); a
-    slipping wheel's tangential part is its friction force (t1, t2)."""
-    if idx is None:
-        idx = [index[lab] for lab in wheel._labels()]
+    (``idx``: the rows' indices; row i acts along D[i] of (t1, t2, n)); a slipping wheel's tangential part is its
+    friction force (t1, t2)."""
     D = wheel._directions
     force = D.T @ lam[idx]
     # a direction with no row at all (e.g. the lateral direction of an omni wheel) carries no force: determined

@@ -518,8 +518,7 @@ def force_jacobian_dq(model, J: np.ndarray, jid: int, phi: np.ndarray, T: np.nda
             T[later, c] += J[:, later].T @ psi
 
 
-def wheel_force_dq(wheel: RollingWheel, kin0: KinematicState, mu: np.ndarray, J: np.ndarray,
-                   directions: np.ndarray | None = None) -> np.ndarray:
+def wheel_force_dq(wheel: RollingWheel, kin0: KinematicState, mu: np.ndarray, J: np.ndarray) -> np.ndarray:
     """:math:`\\partial(A^T\\mu)/\\partial q` at fixed :math:`\\mu` (n x n) of a rolling wheel's rows
     :math:`A = D E^T A_c`, :math:`A_c = J_c - [r]_\\times J_\\omega - u\\,e_R` (the contact point p = c + r): with
     :math:`f = E D^T\\mu` (the force at p, world axes), :math:`A^T\\mu = J_O^T(f, p\\times f) - e_R (u\\cdot f)`, so
@@ -537,13 +536,12 @@ def wheel_force_dq(wheel: RollingWheel, kin0: KinematicState, mu: np.ndarray, J:
         kin0: Kinematics at the configuration q.
         mu: The rows' multipliers (rows,) [N], held fixed.
         J: World Jacobian columns at the origin (6 x n), :func:`world_jacobians`.
-        directions: D (rows x 3); default None: the wheel's own rows.
 
     Returns:
         The derivative (n x n) [N or N m per unit of each coordinate].
     """
     model = kin0.model
-    D = wheel._directions if directions is None else directions
+    D = wheel._directions
     _, _, R, _, u, p, _, _, _, E, _ = wheel._geometry(kin0)
     g = wheel_geometry_dq(wheel, kin0)
     _, jac = kin0.pose(wheel.fid)

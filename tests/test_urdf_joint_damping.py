@@ -181,8 +181,20 @@ def test_dump_and_linearize_carry_the_damping(coaster, tmp_path, capsys):
     assert V @ [1.0, -1.0] == pytest.approx([-2 * D / J_TURN, 2 * D / J_TURN], rel=1e-9)
 
 
-def test_refusals_of_springs_name_the_switch(coaster):
+def test_refusals_of_springs_name_the_switch(coaster, tmp_path):
+    """What joint dampers are refused by (or kept off the compiled model for) says how to leave the URDF's out."""
+    from robotdyn.errors import RobotDynError
     from robotdyn.fast.compiled import why_not
 
-    assert why_not(coaster).endswith("(the description's <dynamics damping> on left_spin, right_spin is applied as "
-                                     "joint dampers: urdf_damping = false in the constraint file leaves it out)")
+    hint = ("(the description's <dynamics damping> on left_spin, right_spin is applied as joint dampers: "
+            "urdf_damping = false in the constraint file leaves it out)")
+    assert why_not(coaster).endswith(hint)
+    with pytest.raises(RobotDynError) as info:
+        coaster.contact_force_derivatives(coaster.neutral(), np.zeros(2), np.zeros(2))
+    assert str(info.value).endswith(hint)
+    path = _coaster_file(tmp_path)
+    path.write_text(path.read_text().replace("radius = 0.1", 'radius = 0.1\nfriction = "stick_slip"\nmu = 0.8'))
+    with pytest.raises(RobotDynError) as info:
+        stick_slip = load_robot(path)
+        simulate(stick_slip, 0.1, stick_slip.neutral(), [1.0, 1.0], None, progress=False)
+    assert str(info.value).endswith(hint)

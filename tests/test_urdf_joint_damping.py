@@ -198,3 +198,21 @@ def test_refusals_of_springs_name_the_switch(coaster, tmp_path):
         stick_slip = load_robot(path)
         simulate(stick_slip, 0.1, stick_slip.neutral(), [1.0, 1.0], None, progress=False)
     assert str(info.value).endswith(hint)
+
+
+def test_a_sweep_carries_the_damping(tmp_path):
+    """The sweep door: a coasting scenario's final wheel rate is the closed form w0 exp(-2 d t / J), and the energy
+    balance counts the dampers' work (no drift)."""
+    import pyarrow.parquet as pq
+
+    path = _coaster_file(tmp_path, '[[parameters]]\nname = "g"\ndefault = 9.81\nunit = "m/s^2"\n')
+    path.write_text(path.read_text() + '[[scenarios]]\nname = "coast"\nt_end = 1.0\ntorque = [0.0, 0.0]\n'
+                    'nu0 = { left_spin = 10.0, right_spin = 10.0 }\n')
+    assert main(["sweep", "--constraints", str(path), "--scenario", "coast", "--workers", "0", "--quiet", "--no-plot",
+                 "--out", str(tmp_path / "sweep"), "--vary", "g=9.81,9.8"]) == 0
+    rows = pq.read_table(tmp_path / "sweep" / "results.parquet").to_pylist()
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    for r in rows:  # (gravity does no work on a level coast)
+        assert r["final.left_spin_dot"] == pytest.approx(10.0 * math.exp(-2 * D / J), rel=1e-6)
+        assert abs(r["energy.drift"]) < 1e-6
+

@@ -28,6 +28,9 @@ import numpy as np
 
 from ..errors import InputError
 
+MAX_DAMPING = 1e12
+"""Largest joint damping a description may give [N m s/rad or N s/m] (the bound of a ``[[springs]]`` damping)."""
+
 
 @dataclass
 class JointSpring:
@@ -161,7 +164,8 @@ def build_springs(robot, springs, dampers=()) -> list[SpringForce]:
 
     Raises:
         InputError: an unknown joint, a joint with more than one coordinate, two springs on one joint, bad numbers,
-            or a joint damped both by the URDF and by a declared spring (one line each).
+            a URDF damping that is negative or above :data:`MAX_DAMPING`, or a joint damped both by the URDF and by a
+            declared spring (one line each).
     """
     out: list[SpringForce] = []
     names = robot.description.joint_names
@@ -180,6 +184,9 @@ def build_springs(robot, springs, dampers=()) -> list[SpringForce]:
                              "per joint (add the stiffnesses)")
         out.append(spring)
     for d in dampers:
+        if not (math.isfinite(d.damping) and 0.0 <= d.damping <= MAX_DAMPING):  # (as a [[springs]] damping)
+            raise InputError(f"joint {d.joint!r}: the description's <dynamics damping=\"{d.damping:g}\">; expected a "
+                             f"damping >= 0 and <= {MAX_DAMPING:g} {d.unit} (or urdf_damping = false to leave it out)")
         i = names.index(d.joint) if d.joint in names else int(d.index)
         same = next((o for o in out if o.index == i), None)
         if same is not None and same.damping > 0:  # never both: that would apply the damping twice

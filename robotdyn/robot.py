@@ -232,6 +232,8 @@ class RobotSpec:
             planar root (:meth:`Robot.root_height_from_wheels`; the default of constraint files), 0 otherwise.
         springs: :class:`~robotdyn.reduction.joint_springs.JointSpring` declarations: a spring and damper on a
             joint's coordinate each (at most one per joint; default none).
+        urdf_damping: Whether a joint's URDF ``<dynamics damping>`` is applied, as a damper of stiffness 0 on its
+            coordinate (default ``True``; :mod:`robotdyn.description.joint_dynamics`).
     """
 
     name: str
@@ -256,6 +258,7 @@ class RobotSpec:
     packages: dict[str, str] = field(default_factory=dict)
     root_height: float | None = 0.0
     springs: list = field(default_factory=list)  # robotdyn.reduction.joint_springs.JointSpring declarations
+    urdf_damping: bool = True  # a joint's URDF <dynamics damping> applied (robotdyn.description.joint_dynamics)
 
     def parameter(self, name: str) -> Parameter:
         """The declared parameter called ``name``.
@@ -328,8 +331,6 @@ class Robot:
                 raise
             given = ", ".join(f"{k}={v}" for k, v in params.items())
             raise DescriptionError(f"with the parameters {given}: {exc}") from None
-        for message in self.description.visual_report.warnings:
-            warnings.warn(message, RobotDynWarning, stacklevel=2)
         self.model = self.description.model
         self._local = threading.local()  # per-thread Pinocchio data and compiled model (see ``data``)
         self.model.gravity.linear = np.array([0.0, 0.0, -float(values.get("g", 9.81))])
@@ -349,7 +350,10 @@ class Robot:
                 self.spec = spec = replace(spec, root_height=height)
                 self.root_height_source = "found from the wheels"
         self.motors = [Motor(self.description, m.name, m.joint, m.reaction) for m in spec.motors]
-        self.springs = build_springs(self, spec.springs)  # robotdyn.reduction.joint_springs
+        from .description.joint_dynamics import urdf_dampers
+
+        dampers = urdf_dampers(self.model) if spec.urdf_damping else []  # the URDF's <dynamics damping>, applied
+        self.springs = build_springs(self, spec.springs, dampers)  # robotdyn.reduction.joint_springs
         if spec.independent is not None:
             self.independent_indices = np.array([self.coordinate_index(c) for c in spec.independent], dtype=int)
         else:
@@ -1163,7 +1167,7 @@ class Robot:
         """
         mobility, notes = self.mobility_check()
         report = self.description.visual_report
-        from .description.joint_dynamics import unapplied_joint_dynamics
+        from .description.joint_dynamics import joint_dynamics_notes
 
         heights = self.wheel_heights() if self.spec.root != "fixed" else {}
         values = list(heights.values())
@@ -1175,7 +1179,7 @@ class Robot:
                 notes.append(f"at the neutral configuration the wheels do not all touch the ground (contact heights "
                              f"above it: {listed}); a {self.spec.root} root cannot fix that with one height: check the "
                              "radii, the joint values (neutral) or the terrain")
-        notes += unapplied_joint_dynamics(self.model, {sp.index for sp in self.springs if sp.damping > 0})
+        notes += joint_dynamics_notes(self.model, self.spec.urdf_damping)
         if self.spec.root != "fixed":  # an axis in the wrong axes (robotdyn.constraints.rolling_contact.lying_flat)
             from .constraints.rolling_contact import lying_flat
 

@@ -632,6 +632,14 @@ dd_case("dump-v-1e200", "v", urdf_text(), ("dump", "--v", "1e200", "1e200", "1e2
 dd_case("dump-tau-1e300", "tau", urdf_text(), ("dump", "--v", "0", "0", "0", "--tau", "1e300", "1e300", "1e300"))
 dd_case("simulate-t-end-1e300", "--t-end", urdf_text(), ("simulate", "--scenario", "go", "--quiet", "--t-end",
                                                          "1e300"))
+dd_case("damping-twice", "urdf_damping = false",  # the URDF's <dynamics damping> and a [[springs]] damping on one joint
+        urdf_text().replace('<axis xyz="0 1 0"/><limit', '<axis xyz="0 1 0"/><dynamics damping="0.5"/><limit'),
+        toml=DD_TOML + '[[springs]]\njoint = "shoulder"\ndamping = 0.5\n')
+dd_case("damping-negative", "shoulder",  # was refused as a "spring" the user never declared
+        urdf_text().replace('<axis xyz="0 1 0"/><limit', '<axis xyz="0 1 0"/><dynamics damping="-0.5"/><limit'))
+dd_case("damping-1e300", "shoulder",  # was accepted: accelerations of 1e301
+        urdf_text().replace('<axis xyz="0 1 0"/><limit', '<axis xyz="0 1 0"/><dynamics damping="1e300"/><limit'),
+        ("dump", "--v", "0", "0", "0", "--tau", "0", "0", "0"))
 
 
 # -------------------------------------------------------------------------------- issue 24: cases named there

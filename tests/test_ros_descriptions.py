@@ -134,9 +134,10 @@ def test_packages_from_the_cli_and_the_constraint_file(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------------------------------------ meshes
-def test_meshes_missing_or_outside_are_reported_with_stand_ins():
-    robot, messages = quiet(load_robot, TOML / "diff_drive.toml",
-                            urdf=str(PKG / "urdf" / "meshes_broken.urdf.xacro"))
+def test_meshes_missing_or_outside_are_reported_with_stand_ins(capsys):
+    robot, on_load = quiet(load_robot, TOML / "diff_drive.toml", urdf=str(PKG / "urdf" / "meshes_broken.urdf.xacro"))
+    assert on_load == []  # said where meshes matter (the viewer, info), not on every load (it was, on every command)
+    _, messages = quiet(Viewer, robot)
     report = robot.description.visual_report
     assert report.standins == {"bumper": "collision", "antenna": "inertia box", "mast": "marker",
                                "cover": "collision", "plate": "inertia box"}
@@ -145,6 +146,13 @@ def test_meshes_missing_or_outside_are_reported_with_stand_ins():
     assert "Packages not found: demo_mast_description" in messages[0]
     assert "outside the description's packages not read" in messages[1] and "package_dirs" in messages[1]
     assert {Path(p) for _, p, _ in report.refused} == {(WS / "outside" / "elsewhere.stl").resolve()}
+    # the CLI: info lists them, dump says nothing of them
+    argv = ["--constraints", str(TOML / "diff_drive.toml"), "--urdf", str(PKG / "urdf" / "meshes_broken.urdf.xacro")]
+    assert main(["info", *argv]) == 0
+    out = capsys.readouterr()
+    assert [line for line in out.out.splitlines() if line.startswith("meshes: ")] == [f"meshes: {m}" for m in messages]
+    assert main(["dump", *argv, "--v", "0", "0"]) == 0
+    assert "mesh" not in capsys.readouterr().err
     shapes = {g.name.rsplit("_", 1)[0]: g for g in robot.description.visual.geometryObjects}
     assert set(shapes) >= {"base_link", "left_wheel_link", "right_wheel_link", "lidar_link", "caster_link",
                            "bumper", "antenna", "mast", "cover", "plate"}
@@ -163,7 +171,8 @@ def test_meshes_missing_or_outside_are_reported_with_stand_ins():
 def test_a_mesh_that_cannot_be_loaded_is_replaced(tmp_path):
     shutil.copytree(SRC, tmp_path / "src")
     (tmp_path / "src/demo_description/meshes/wheel.stl").write_bytes(b"not a mesh\x00\x01")
-    robot, messages = quiet(load_robot, tmp_path / "src/demo_description/robotdyn/diff_drive.toml")
+    robot = load_robot(tmp_path / "src/demo_description/robotdyn/diff_drive.toml")
+    _, messages = quiet(Viewer, robot)
     assert robot.description.visual_report.standins == {"left_wheel_link": "collision",
                                                         "right_wheel_link": "collision"}
     assert len(messages) == 1 and messages[0].count("cannot be loaded") == 2
@@ -172,8 +181,9 @@ def test_a_mesh_that_cannot_be_loaded_is_replaced(tmp_path):
 
 
 def test_meshes_outside_allowed_by_declaring_their_directory():
-    robot, messages = quiet(load_robot, TOML / "diff_drive.toml", urdf=str(PKG / "urdf" / "meshes_broken.urdf.xacro"),
-                            package_dirs=[WS / "outside"])
+    robot = load_robot(TOML / "diff_drive.toml", urdf=str(PKG / "urdf" / "meshes_broken.urdf.xacro"),
+                       package_dirs=[WS / "outside"])
+    _, messages = quiet(Viewer, robot)
     assert not robot.description.visual_report.refused
     assert robot.description.visual_report.standins.get("cover") is None
     assert len(messages) == 1 and "outside" not in messages[0]

@@ -143,6 +143,7 @@ def cmd_info(args) -> int:
         + ("" if info["mobility_at_neutral"] == info["mobility"] else
            f"; the independent velocities listed are {info['mobility']}: expected as many as the mobility"),
         *(f"note: {n}" for n in info["mobility_notes"]),
+        *(f"meshes: {w}" for w in info["visual_warnings"]),  # (the viewer warns of them too; not every command)
         *([f"root: {info['root']}, its link at {info['root_height']:.6g} m above the ground "
            f"({info['root_height_source']}; root_height in the constraint file)"]
           if info["root"] == "planar" and info["root_height"] else []),
@@ -216,6 +217,12 @@ def cmd_dump(args) -> int:
             _matrix_text("M", names, names, red.M), _matrix_text("C", names, names, red.C),
             _vector_text("g", names, red.g),
             _matrix_text("B", names, motors, red.B) if motors else "B: none (the robot has no motors)"]
+    from ..contact.applied_forces import has_applied, reduced_applied
+
+    if has_applied(robot):  # joint springs and dampers (a URDF's joint damping too), compliant wheels
+        out["applied"] = reduced_applied(robot, red, q)[0]
+        text.append(_vector_text("S^T Q (joint springs and dampers, compliant wheels: M a = B tau - C nu - g + S^T Q)",
+                                 names, out["applied"]))
     from ..contact.sliding import sliding_now
 
     sliding = bool(sliding_now(robot))  # wheels under a friction law: their forces in every solve below

@@ -65,6 +65,7 @@ from ..constraints.row_derivatives import FramePass, velocity_dq, wheel_velocity
 from ..errors import InputError, NonFiniteError
 from ..reduction.actuation import input_matrix
 from ..reduction.dynamics_derivatives import motor_rows, pieces
+from ..reduction.joint_springs import urdf_damping_hint
 from . import rigid_limit
 from .applied_forces import has_applied
 from .compliance import wheel_stiffness
@@ -377,7 +378,7 @@ def checked(robot, q, nu, tau) -> tuple:
     if has_applied(robot):
         raise InputError(f"contact force derivatives: robot {robot.spec.name!r} has joint springs or compliant "
                          "wheels, whose forces have no derivatives here; expected rigid and slipping wheels, loop "
-                         "closures and joint couplings")
+                         "closures and joint couplings" + urdf_damping_hint(getattr(robot, "springs", ())))
     return q, nu, tau
 
 

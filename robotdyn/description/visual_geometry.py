@@ -17,7 +17,8 @@ A link whose visual is not drawn gets a stand-in: its ``<collision>`` geometry (
 resolve), else the box with the link's mass and central inertia (uniform density; sides
 :math:`a_i = \\sqrt{6(\\operatorname{tr} I - 2 I_i)/m}` along the principal axes), else a 2 cm sphere. A
 description without any visual gets the inertia boxes of all its links with mass. What was replaced is reported in
-one line per kind (:attr:`VisualReport.warnings`).
+one line per kind (:attr:`VisualReport.warnings`), where meshes matter: the viewer warns with them, ``info`` lists
+them (not every command that loads the robot).
 """
 
 from __future__ import annotations

@@ -108,7 +108,10 @@ def why_not(robot, applied: bool = False) -> str | None:
     if _compiled is None:
         return "the compiled extension robotdyn._compiled was not built"
     if getattr(robot, "springs", None) and not applied:  # robotdyn.reduction.joint_springs
-        return "joint springs and dampers are evaluated on the Python path (not compiled)"
+        from ..reduction.joint_springs import urdf_damping_hint
+
+        return "joint springs and dampers are evaluated on the Python path (not compiled)" + urdf_damping_hint(
+            robot.springs)
     if any(getattr(c, "rolling", False) for c in robot.constraints) and not applied:  # contact.compliant_rolling
         return "compliant wheels that roll while in contact (friction = 'rolling') are evaluated on the Python path"
     if any(getattr(c, "compliant", False) for c in robot.constraints) and not applied:

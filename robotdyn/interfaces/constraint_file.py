@@ -21,6 +21,8 @@ Format (all lengths in m, angles in rad, masses in kg; ``#`` starts a comment)::
                                         # from which meshes may be read (robotdyn/description/ros_packages.py, visual_geometry.py)
     root_height = "auto"                # planar root: height [m] of the root link above the ground (default "auto":
                                         # found from the wheels at the neutral configuration; 0 keeps it on it)
+    urdf_damping = true                 # a joint's URDF <dynamics damping> d applied as a joint torque -d q' (as
+                                        # Gazebo does; false: left out); its dry friction is not modelled
     massless = ["some_link"]            # links whose URDF inertial is ignored
     independent = ["theta_R", "theta_L"]  # coordinate labels or joint names (default: automatic)
     xacro_args = { wheel_radius = "0.1" }
@@ -125,7 +127,7 @@ class ConstraintFileError(RobotDynError):
 TOP_KEYS = (
     "name", "title", "urdf", "root", "package_dirs", "massless", "independent", "xacro_args", "labels", "neutral",
     "locked", "terrain", "parameters", "wheels", "closures", "motors", "scenarios", "paper", "packages",
-    "root_height", "twist", "springs",
+    "root_height", "twist", "springs", "urdf_damping",
 )
 TWIST_KEYS = ("frame", "components", "axes", "names")
 PARAMETER_KEYS = ("name", "default", "unit", "description", "choices", "xacro", "minimum")
@@ -578,6 +580,10 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
     closures = _closures(cx)
     motors = _motors(cx)
     springs = _springs(cx)
+    urdf_damping = cx.data.get("urdf_damping", True)
+    if not isinstance(urdf_damping, bool):
+        r.fail("urdf_damping", f"{urdf_damping!r}; expected true (the URDF's joint <dynamics damping> applied, the "
+                               "default) or false")
     independent = _independent(cx)
     neutral = _neutral(cx)
     terrain = _terrain(cx)
@@ -605,6 +611,7 @@ def _read(path: Path, r: _Reader, data: dict, urdf, xacro_args, package_dirs, pa
         root_height=root_height,
         operational=operational,
         springs=springs,
+        urdf_damping=urdf_damping,
     )
     return ConstraintFile(path, spec, _scenarios(cx, motors, operational))
 

@@ -27,6 +27,10 @@ KEYS: dict[str, tuple[str, str, str]] = {
                  '[packages]\nmy_description = "../my_description"'),
     "root_height": ("planar root: height of the root link above the ground", "auto (from the wheels at the neutral "
                     "configuration)", "root_height = 0.1"),
+    "urdf_damping": ("whether a joint's URDF <dynamics damping> d is applied, as a viscous joint torque -d q' (as "
+                     "Gazebo, Drake and MuJoCo apply it); false leaves it out (the papers' ideal joints). A joint "
+                     "damped by the URDF takes no [[springs]] damping. A joint's dry friction is not modelled",
+                     "true", "urdf_damping = false"),
     "massless": ("links whose URDF inertial is ignored", "[]", 'massless = ["sensor_link"]'),
     "independent": ("the coordinates (labels or joint names) whose velocities are the independent ones; as many as "
                     "the mobility", "chosen automatically (info prints the choice)",
@@ -132,8 +136,7 @@ KEYS: dict[str, tuple[str, str, str]] = {
     "closures[].components": ("the closed components, a subset of x y z rx ry rz in frame1's axes", '"x y z"',
                               'components = "x z"'),
     "springs": ("springs and dampers on joints: generalised force -k (q - rest) - c q' on the joint's "
-                "coordinate (the URDF's joint <dynamics damping friction> are not applied: robotdyn info names "
-                "them; a damping is applied as a spring with stiffness 0)", "[]", '[[springs]]\njoint = "front_left_suspension"\nstiffness = 3.0e4'),
+                "coordinate (a joint's URDF <dynamics damping> is applied as such a damper: see urdf_damping)", "[]", '[[springs]]\njoint = "front_left_suspension"\nstiffness = 3.0e4'),
     "springs[].name": ("the spring's name (messages, reports)", "the joint name", 'name = "front_left"'),
     "springs[].joint": ("the moving (not locked) joint it acts on, one coordinate: revolute, continuous or "
                         "prismatic; at most one spring per joint", "required", 'joint = "front_left_suspension"'),

@@ -106,6 +106,7 @@ SCHEMA: dict = _table({
     "packages": _table_of(_string("a directory"), "a table of ROS package directories by name"),
     "root_height": {"anyOf": [{"const": "auto"}, _bounded("a height in m", MAX_LENGTH)],
                     "expected": f"'auto' or a height in m of magnitude <= {MAX_LENGTH:g}"},
+    "urdf_damping": {"type": "boolean", "expected": "true (the URDF's joint <dynamics damping> applied) or false"},
     "massless": _strings("a list of link names"),
     "independent": _strings("a non-empty list of coordinate names", 1),
     "xacro_args": _table_of({"type": ["string", "number", "boolean"], "expected": "a number, a word or a boolean"},

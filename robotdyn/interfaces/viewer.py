@@ -33,13 +33,14 @@ Example (in a notebook)::
 from __future__ import annotations
 
 import html
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from ..errors import InputError, RobotDynError
+from ..errors import InputError, RobotDynError, RobotDynWarning
 from ..output import atomic_output
 from .scene_page import _meshcat, static_page
 
@@ -170,6 +171,9 @@ class Viewer:
         mc = _meshcat()
         from pinocchio.visualize import MeshcatVisualizer  # lazy: imports trimesh (~0.65 s)
 
+        report = getattr(robot.description, "visual_report", None)
+        for message in report.warnings if report is not None else ():  # meshes not drawn: said where they matter
+            warnings.warn(message, RobotDynWarning, stacklevel=2)      # (here and in info, not on every load)
         self.robot = robot
         self.model = robot.model
         self.data = self.model.createData()

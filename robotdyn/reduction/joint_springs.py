@@ -13,6 +13,10 @@ It enters the reduced equations through :math:`S^T` like any applied force (D'Al
 
 Units: k in N/m (prismatic) or N m/rad (revolute), c in N s/m or N m s/rad, the rest position :math:`q_{j,0}` in
 m or rad.
+
+A URDF joint's ``<dynamics damping>`` d is applied as such a damper (c = d, k = 0; merged into a ``[[springs]]``
+entry on the same joint that gives a stiffness only), unless the robot's ``urdf_damping`` is false
+(:mod:`robotdyn.description.joint_dynamics`): :func:`build_springs`.
 """
 
 from __future__ import annotations
@@ -23,6 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+
+MAX_DAMPING = 1e12
+"""Largest joint damping a description may give [N m s/rad or N s/m] (the bound of a ``[[springs]]`` damping)."""
 
 
 @dataclass
@@ -53,6 +60,9 @@ class SpringForce:
         index: Index of the joint's coordinate in q and v (natural coordinates: nq == nv).
         unit: ``m`` or ``rad`` (for messages and reports).
 
+    Attributes:
+        from_urdf: Whether its damping is the description's ``<dynamics damping>`` (set by :func:`build_springs`).
+
     Raises:
         InputError: a stiffness or damping that is not a finite number >= 0, or a non-finite rest position.
     """
@@ -71,6 +81,7 @@ class SpringForce:
         self.stiffness = float(spec.stiffness)
         self.damping = float(spec.damping)
         self.rest = float(spec.rest)
+        self.from_urdf = False
 
     def force(self, q: np.ndarray, v: np.ndarray) -> float:
         """:math:`-k(q_j - q_{j,0}) - c\\dot q_j` [N or N m]: the generalised force on the joint's coordinate j.
@@ -108,8 +119,9 @@ class SpringForce:
         return -self.damping * v[self.index] ** 2
 
     def __repr__(self) -> str:
+        urdf = ", c from the URDF's <dynamics>" if getattr(self, "from_urdf", False) else ""
         return (f"SpringForce({self.name!r}, k={self.stiffness:g}, c={self.damping:g}, rest={self.rest:g} "
-                f"{self.unit})")
+                f"{self.unit}{urdf})")
 
 
 def spring_terms(springs, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -134,19 +146,26 @@ def spring_terms(springs, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.
     return Q, dq, dv
 
 
-def build_springs(robot, springs) -> list[SpringForce]:
-    """The robot's :class:`SpringForce` list from its spec's :class:`JointSpring` declarations.
+def build_springs(robot, springs, dampers=()) -> list[SpringForce]:
+    """The robot's :class:`SpringForce` list from its spec's :class:`JointSpring` declarations and the URDF's joint
+    damping.
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` under construction (description and coordinates set).
         springs: The declarations.
+        dampers: The description's damped joints to apply
+            (:class:`~robotdyn.description.joint_dynamics.JointDamper`, from
+            :func:`~robotdyn.description.joint_dynamics.urdf_dampers`; default none): each becomes a damper of
+            stiffness 0, or gives its damping to a declared spring on that joint that has a stiffness only.
 
     Returns:
-        One :class:`SpringForce` per declaration, in declaration order (empty without springs).
+        One :class:`SpringForce` per declaration, in declaration order, then one per damped joint without a
+        declaration (empty without either).
 
     Raises:
-        InputError: an unknown joint, a joint with more than one coordinate, two springs on one joint, or bad
-            numbers (one line each).
+        InputError: an unknown joint, a joint with more than one coordinate, two springs on one joint, bad numbers,
+            a URDF damping that is negative or above :data:`MAX_DAMPING`, or a joint damped both by the URDF and by a
+            declared spring (one line each).
     """
     out: list[SpringForce] = []
     names = robot.description.joint_names
@@ -164,7 +183,42 @@ def build_springs(robot, springs) -> list[SpringForce]:
             raise InputError(f"spring {spring.name!r}: a second spring on joint {s.joint!r}; expected one spring "
                              "per joint (add the stiffnesses)")
         out.append(spring)
+    for d in dampers:
+        if not (math.isfinite(d.damping) and 0.0 <= d.damping <= MAX_DAMPING):  # (as a [[springs]] damping)
+            raise InputError(f"joint {d.joint!r}: the description's <dynamics damping=\"{d.damping:g}\">; expected a "
+                             f"damping >= 0 and <= {MAX_DAMPING:g} {d.unit} (or urdf_damping = false to leave it out)")
+        i = names.index(d.joint) if d.joint in names else int(d.index)
+        same = next((o for o in out if o.index == i), None)
+        if same is not None and same.damping > 0:  # never both: that would apply the damping twice
+            raise InputError(
+                f"joint {d.joint!r} is damped twice: {d.damping:g} {d.unit} by the description's <dynamics damping> "
+                f"(applied by default) and {same.damping:g} {d.unit} by spring {same.name!r}; expected one: remove "
+                "the spring's damping, or set urdf_damping = false to keep the spring's only")
+        if same is None:
+            unit = "m" if robot.units.get(robot.coordinates[i], "rad") == "m" else "rad"
+            same = SpringForce(JointSpring(d.joint, damping=d.damping), i, unit)
+            out.append(same)
+        else:  # a stiffness-only spring on that joint takes the URDF's damping
+            same.damping = float(d.damping)
+        same.from_urdf = True
     return out
 
 
-__all__ = ["JointSpring", "SpringForce", "build_springs", "spring_terms"]
+def urdf_damping_hint(springs) -> str:
+    """The words to add to a refusal of joint springs where some of them are a URDF's joint damping.
+
+    Args:
+        springs: The robot's :class:`SpringForce` list.
+
+    Returns:
+        ``""`` where no spring's damping comes from the URDF; otherwise a clause naming the switch that leaves it
+        out (``urdf_damping = false``).
+    """
+    joints = [s.joint for s in springs if getattr(s, "from_urdf", False)]
+    if not joints:
+        return ""
+    return (f" (the description's <dynamics damping> on {', '.join(joints)} is applied as joint dampers: "
+            "urdf_damping = false in the constraint file leaves it out)")
+
+
+__all__ = ["JointSpring", "SpringForce", "build_springs", "spring_terms", "urdf_damping_hint"]

@@ -168,8 +168,11 @@ def simulate(
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
     if stick_slip_wheels(robot):  # exact switching: segment by segment
         if has_applied(robot):
+            from ..reduction.joint_springs import urdf_damping_hint
+
             raise RobotDynError("stick-slip wheels with joint springs or compliant wheels are not simulated; expected "
-                                "friction = 'coulomb' or 'linear' on the wheels of a robot with springs")
+                                "friction = 'coulomb' or 'linear' on the wheels of a robot with springs"
+                                + urdf_damping_hint(getattr(robot, "springs", ())))
         if t0 or times is not None:
             raise RobotDynError("t0/times: stick-slip wheels are simulated from t = 0 on n_out samples only")
         from .stick_slip import simulate as simulate_stick_slip

@@ -49,11 +49,20 @@ def race(workers: list[Callable[[], None]], timeout: float = 60.0) -> list[str]:
 
 
 def identical(got, expected) -> bool:
-    """Whether two lists of results are equal bit for bit (arrays by ``np.array_equal``, anything else by ``==``)."""
+    """Whether two lists of results are equal bit for bit (arrays by ``np.array_equal``, NaN equal to NaN; anything
+    else by ``==``)."""
     if len(got) != len(expected):
         return False
-    return all(np.array_equal(a, b) if isinstance(a, np.ndarray) or isinstance(b, np.ndarray) else a == b
-               for a, b in zip(got, expected))
+    return all(_same(a, b) for a, b in zip(got, expected))
+
+
+def _same(a, b) -> bool:
+    if not (isinstance(a, np.ndarray) or isinstance(b, np.ndarray)):
+        return a == b
+    try:
+        return np.array_equal(a, b, equal_nan=True)  # (a NaN where the serial call has one is the same result)
+    except TypeError:  # (not numbers)
+        return np.array_equal(a, b)
 
 
 def hammer(calls: dict[str, Callable[[], list]], lanes: list[list[str]], reps: int) -> tuple[list[str], int]:

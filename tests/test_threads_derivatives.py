@@ -26,6 +26,7 @@ from robotdyn.robots import module
 from robotdyn.simulation.engine import simulate
 from robotdyn.simulation.feedback import lqr_law
 from robotdyn.simulation.start_checks import start_offsets
+from robotdyn.simulation.torque_profile import Constant
 
 pytestmark = pytest.mark.skipif(not available(), reason="compiled extension not built")
 
@@ -50,13 +51,17 @@ def forces(robot, state) -> list:
     return [f.force, f.dforce_dq, f.dforce_dnu, f.dforce_dtau, f.required_mu, f.dmu_dq]
 
 
-KINDS = {"derivatives": derivatives, "unchecked": unchecked, "linear": linear, "forces": forces}
+def forward(robot, state) -> list:
+    return [robot.forward_dynamics(*state)]
+
+
+KINDS = {"derivatives": derivatives, "unchecked": unchecked, "linear": linear, "forces": forces, "forward": forward}
 
 
 @pytest.mark.parametrize("name", ["linkage_suspension", "mmr12_eod", "omni_caster", "adaptable_wheel"])
 @pytest.mark.parametrize("shared", [True, False], ids=["one Robot", "four Robots"])
 def test_derivatives_linearisation_and_force_derivatives_from_four_threads(name, shared):
-    """Four threads, each making every kind of call at four states in its own order, twice: 112-128 concurrent
+    """Four threads, each making every kind of call at four states in its own order, twice: 136-168 concurrent
     calls per robot (the omni platform's operational velocities have no contact-force derivatives)."""
     robots = [Robot(module(name).SPEC)] * 4 if shared else [Robot(module(name).SPEC) for _ in range(4)]
     rng = np.random.default_rng(7)
@@ -68,9 +73,11 @@ def test_derivatives_linearisation_and_force_derivatives_from_four_threads(name,
         for k in kinds:
             for i, s in enumerate(states):
                 calls[f"{k} {i} on robot {id(robot)}"] = lambda f=KINDS[k], r=robot, s=s: f(r, s)
-        lanes.append(list(np.random.default_rng(t).permutation(names)))
+        # (each thread starts with a derivative set, which lets its compiled model choose its rows: a thread's first
+        # reduced-model evaluation, e.g. by forward_dynamics, is the Python reference's, equal to round-off only)
+        lanes.append([names[0]] + list(np.random.default_rng(t).permutation(names)))
     problems, made = hammer(calls, lanes, reps=2)
-    assert problems == [] and made == 4 * 2 * len(kinds) * len(states)
+    assert problems == [] and made == 4 * 2 * (len(kinds) * len(states) + 1)
 
 
 @pytest.mark.parametrize("name", ["quasimoro", "linkage_suspension"])
@@ -98,8 +105,9 @@ def test_one_compiled_result_read_from_four_threads(name):
 
 
 def test_quasimoro_lqr_runs_beside_derivatives_and_linearisations():
-    """Quasimoro's LQR as data (lqr_law: the compiled loop, without the GIL) from 0.05-0.15 rad off upright in two
-    threads while two others take derivatives and linearisations of the same Robot at other states."""
+    """Quasimoro's LQR as data (lqr_law: the compiled loop, without the GIL) from 0.05-0.15 rad off upright and an
+    open-loop compiled run in two threads, while two others take derivatives, linearisations and forward dynamics
+    of the same Robot at other states."""
     robot = robotdyn.load("quasimoro")
     q0 = robot.neutral()
     model = linearize(robot, q0, np.zeros(3), np.zeros(2)).restrict(["theta3", "theta1_dot", "theta2_dot",
@@ -116,13 +124,19 @@ def test_quasimoro_lqr_runs_beside_derivatives_and_linearisations():
         return [tr.q, tr.nu, tr.energy, tr.stats["engine"]]
 
     calls = {f"lqr {a}": lambda a=a: run(a) for a in (0.05, 0.1, 0.15)}
-    calls.update({f"{k} {i}": lambda f=KINDS[k], s=s: f(robot, s) for k in ("derivatives", "linear")
+    calls.update({f"{k} {i}": lambda f=KINDS[k], s=s: f(robot, s) for k in ("derivatives", "linear", "forward")
                   for i, s in enumerate(states)})
-    assert calls["lqr 0.1"]()[3].startswith("compiled")
-    lanes = [["lqr 0.05", "lqr 0.1", "lqr 0.15"], ["lqr 0.15", "lqr 0.05"],
-             [f"derivatives {i}" for i in range(4)] * 5, [f"linear {i}" for i in range(4)] * 5]
+
+    def open_loop():
+        tr = simulate(robot, 0.5, q0, np.zeros(3), Constant(np.array([0.2, -0.1])), n_out=11, progress=False)
+        return [tr.q, tr.nu, tr.energy, tr.stats["engine"]]
+
+    calls["open loop"] = open_loop
+    assert calls["lqr 0.1"]()[3].startswith("compiled") and open_loop()[3].startswith("compiled")
+    lanes = [["lqr 0.05", "lqr 0.1", "lqr 0.15"], ["lqr 0.15", "open loop", "lqr 0.05"],
+             [f"derivatives {i}" for i in range(4)] * 5, [f"linear {i}" for i in range(4)] * 4 + ["forward 1"] * 4]
     problems, made = hammer(calls, lanes, reps=2)
-    assert problems == [] and made == 2 * (3 + 2 + 20 + 20)
+    assert problems == [] and made == 2 * (3 + 3 + 20 + 20)
 
 
 def test_linkage_controller_run_start_checks_and_derivatives_on_one_robot():
@@ -161,11 +175,11 @@ def test_linkage_controller_run_start_checks_and_derivatives_on_one_robot():
     assert run()[2].startswith("compiled")
     assert check(starts["clean"]) == check(starts["near"]) == [[]]
     assert refused()[0].startswith("ConstraintError: q violates constraint") and refused() == check(starts["far"])
-    lanes = [["run"], [f"derivatives {i}" for i in range(3)] + [f"unchecked {i}" for i in range(3)],
+    lanes = [["run", "forward 0"], [f"derivatives {i}" for i in range(3)] + [f"unchecked {i}" for i in range(3)],
              [f"linear {i}" for i in range(3)] + [f"forces {i}" for i in range(3)],
              ["start clean", "start near", "start far", "refused"] * 3]
     problems, made = hammer(calls, lanes, reps=2)
-    assert problems == [] and made == 2 * (1 + 6 + 6 + 12)
+    assert problems == [] and made == 2 * (2 + 6 + 6 + 12)
 
 
 def test_operational_controller_run_beside_derivatives_on_one_robot():

@@ -92,3 +92,34 @@ def test_stick_slip_runs_on_distinct_robots_at_once():
     got = {}
     assert race([lambda v0=v0: got.__setitem__(v0, launched(robots[v0], q0, v0)) for v0 in expected]) == []
     assert all(identical(got[v0], expected[v0]) for v0 in expected)
+
+
+def test_compliant_robot_keeps_one_compiled_model_per_thread_and_pickles():
+    """A robot with compliant wheels (``examples/bump_base_rolling.toml``) keeps its compiled applied model per
+    thread: a run in another thread leaves the main thread's model in place (before, one slot for all threads:
+    every run after another thread's rebuilt it, 11 ms here), each thread's run equals the main thread's bit for
+    bit, and the robot pickles after its runs (before: TypeError, the compiled model in the slot), the copy giving
+    the same run."""
+    import pickle
+    import threading
+
+    from robotdyn.fast.applied_model import applied_model
+
+    bump = read(EXAMPLES / "bump_base_rolling.toml")
+    robot, scenario = bump.robot(), bump.SCENARIOS["bump"]
+
+    def run(r=robot):
+        tr = scenario.run(r, t_end=0.05, n_out=3, progress=False)
+        return [tr.q, tr.nu, tr.energy, tr.stats["engine"]]
+
+    expected = run()
+    assert expected[3].startswith("compiled")
+    mine, seen = applied_model(robot), []
+    for _ in range(2):
+        thread = threading.Thread(target=lambda: seen.append((applied_model(robot), run())))
+        thread.start()
+        thread.join()
+        assert applied_model(robot) is mine
+    assert len(seen) == 2 and all(m is not mine and identical(r, expected) for m, r in seen)
+    copy = pickle.loads(pickle.dumps(robot))
+    assert identical(run(copy), expected)

@@ -203,3 +203,24 @@ def test_operational_controller_run_beside_derivatives_on_one_robot():
              [f"linear {i}" for i in range(3)] + [f"unchecked {i}" for i in range(3)]]
     problems, made = hammer(calls, lanes, reps=2)
     assert problems == [] and made == 2 * (3 + 3 + 6 + 6)
+
+
+def test_simulate_many_from_two_threads_beside_reduced():
+    """simulate_many (its own C++ worker threads, two each) called from two Python threads at once on one Robot, while
+    a third evaluates the reduced model: 4 calls of 4 runs each and 60 evaluations, each equal to the serial one."""
+    from robotdyn.simulation.many_runs import simulate_many
+
+    robot = robotdyn.load("quasimoro")
+    q0 = robot.neutral()
+
+    def many(a):
+        runs = simulate_many(robot, 0.3, q0=np.tile(q0, (4, 1)), nu0=[[a, 0, 0], [0, a, 0], [0, 0, a], [a, a, 0]],
+                             torque=Constant(np.array([0.1, -0.1])), n_out=5, threads=2, progress=False)
+        return [runs.q, runs.nu, runs.ok]
+
+    calls = {f"many {a}": lambda a=a: many(a) for a in (0.1, 0.2)}
+    calls.update({f"reduced {i}": lambda i=i: [robot.reduced(q0, np.array([0.1 * i, 0.2, 0.0])).h.copy()]
+                  for i in range(3)})
+    lanes = [["many 0.1", "many 0.2"], ["many 0.2", "many 0.1"], ["reduced 0", "reduced 1", "reduced 2"] * 20]
+    problems, made = hammer(calls, lanes, reps=1)
+    assert problems == [] and made == 4 + 60

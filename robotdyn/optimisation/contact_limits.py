@@ -136,11 +136,12 @@ class ContactLimits:
 
             st = forward(self.robot, q, nu, tau)
             return np.column_stack([st.force, st.normal])
-        if self._compiled is not None:
+        fast = self._compiled
+        if fast is not None:
             from ..fast.compiled import Fallback
 
             try:
-                return self._compiled_forces(self._compiled, q, nu, tau)
+                return self._compiled_forces(fast, q, nu, tau)
             except Fallback:
                 pass
         cf = self.robot.contact_forces(q, nu, tau=tau)

@@ -452,9 +452,10 @@ class TrajectoryProblem:
         """:math:`f(x, \\tau) = (S\\nu, \\dot\\nu)` at one node."""
         self.calls["dynamics"] += 1
         q, nu = x[:self.n], x[self.n:]
-        if self._fast is not None:
+        fast = self._fast
+        if fast is not None:
             try:
-                return np.array(self._fast.rhs(q, nu, u, 0.0))
+                return np.array(fast.rhs(q, nu, u, 0.0))
             except Fallback:
                 pass
         S = self.robot.reduced(q, nu).S
@@ -466,8 +467,9 @@ class TrajectoryProblem:
         n = self.n
         if self.derivatives == "analytic":
             self.calls["derivatives"] += 1
-            if self._fast is not None:  # the compiled derivative set in one call (as _f takes the compiled rhs)
-                raw = raw_derivatives(self._fast, x[:n], x[n:], u)
+            fast = self._fast
+            if fast is not None:  # the compiled derivative set in one call (as _f takes the compiled rhs)
+                raw = raw_derivatives(fast, x[:n], x[n:], u)
                 if raw is not None:
                     _, dq, dnu, dtau, _, Vq, S, _ = raw
                     Fx, Fu = np.empty((self.nx, self.nx)), np.zeros((self.nx, self.m))

@@ -7,8 +7,8 @@ thread that built it, so solving it in another thread (e.g. ``executor.submit(pr
 ThreadError from the first node batch, after the scaling had silently fallen back to SI units (it catches every
 error); its wheel-load limits (ContactLimits) alike. Now both evaluate the calling thread's own model with the
 builder's row choice (robotdyn.fast.dispatch.for_this_thread). Two threads solving one problem at once broke its
-initial guess (an AttributeError in one of them in 2 of 5 rounds): solves of one problem now run one after the
-other.
+initial guess or its result (an AttributeError or another solution in 6-8 of 10 rounds released at a barrier):
+solves of one problem now run one after the other.
 
 Fixture: ``tests/data/light_diff_drive`` (a 1 kg differential drive, 0.3 m straight ahead in 2 s, 11 nodes: 18
 IPOPT iterations, about 0.1 s a solve).

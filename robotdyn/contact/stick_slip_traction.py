@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .stick_slip_wheel import StickSlipWheel, configure, stick_slip_wheels
+from .stick_slip_wheel import StickSlipWheel, configure, phase_lock, stick_slip_wheels
 
 
 @dataclass(eq=False)
@@ -123,6 +123,12 @@ def phase_states(robot, traj, table: PhaseTable) -> Iterator[Callable[[int], np.
     if sorted(wheels) != sorted(table.wheels):
         raise InputError(f"the trajectory's stick-slip wheels {', '.join(table.wheels)} are not the robot's "
                          f"({', '.join(wheels) or 'none'}); expected the robot it was simulated with")
+    with phase_lock(robot):  # (another thread's run or pass switches the same wheels: they take turns)
+        yield from _phase_states(robot, traj, table, wheels)
+
+
+def _phase_states(robot, traj, table: PhaseTable, wheels: dict) -> Iterator[Callable[[int], np.ndarray]]:
+    """:func:`phase_states`' body, under the robot's phase lock."""
     saved = ({n: (w.phase, w.direction) for n, w in wheels.items()}, robot.independent_indices,
              list(robot.velocity_names), robot._projection_hint)
 

@@ -13,6 +13,10 @@ The events that switch the phases, and the integration segment by segment, are t
 
 from __future__ import annotations
 
+import functools
+import threading
+import weakref
+
 import numpy as np
 
 from ..constraints.rolling_contact import RollingWheel
@@ -109,6 +113,49 @@ def configure(robot, q: np.ndarray) -> None:
     else:
         robot.independent_indices = auto_independent(A)
     robot.velocity_names = [robot.velocity_labels[i] for i in robot.independent_indices]
+
+
+_GUARD = threading.Lock()  # (creating the robots' phase locks)
+_PHASE_LOCKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def phase_lock(robot) -> threading.RLock:
+    """The lock held by whatever switches the phases of ``robot``'s stick-slip wheels (and with them its
+    independent velocities, :func:`configure`): a stick-slip run (:func:`robotdyn.simulation.stick_slip.simulate`)
+    and the traction pass over its trajectory (:func:`robotdyn.contact.stick_slip_traction.phase_states`). Two of
+    them on one Robot from two threads take turns; before, each switched the other's wheels mid-run (a KeyError,
+    an InputError or a SingularConstraintError in every run of ``tests/test_threads_traction.py``). Other calls
+    on that Robot from other threads meanwhile see the run's current phases: give each thread its own Robot.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+
+    Returns:
+        The robot's re-entrant lock (one per Robot object, dropped with it).
+    """
+    with _GUARD:
+        lock = _PHASE_LOCKS.get(robot)
+        if lock is None:
+            lock = _PHASE_LOCKS[robot] = threading.RLock()
+        return lock
+
+
+def holding_phases(function):
+    """Decorate ``function(robot, ...)`` to run under :func:`phase_lock` of its robot.
+
+    Args:
+        function: A function whose first argument is the :class:`~robotdyn.robot.Robot` whose phases it switches.
+
+    Returns:
+        The wrapped function (same name, signature and docstring).
+    """
+
+    @functools.wraps(function)
+    def locked(robot, *args, **kwargs):
+        with phase_lock(robot):
+            return function(robot, *args, **kwargs)
+
+    return locked
 
 
 def unloaded_message(wheel: str, t: float, load: float, state: str) -> str:

@@ -35,12 +35,19 @@ def applied_model(robot):
     """
     if not enabled() or why_not(robot, applied=True) is not None:
         return None
+    # kept in the robot's per-thread storage (as compiled_model does): one slot shared by all threads made two
+    # threads rebuild each other's model at every run (11 ms on examples/bump_base_rolling.toml), and a robot
+    # holding it could not be pickled (Robot.__getstate__ drops the per-thread storage)
+    local = getattr(robot, "_local", None)
     key = (threading.get_ident(), _key(robot))
-    cached = robot.__dict__.get("_applied_model")
+    cached = getattr(local, "applied", None) if local is not None else robot.__dict__.get("_applied_model")
     if cached is not None and cached[0] == key:
         return cached[1]
     fast = CompiledModel(robot)
-    robot.__dict__["_applied_model"] = (key, fast)
+    if local is not None:
+        local.applied = (key, fast)
+    else:
+        robot.__dict__["_applied_model"] = (key, fast)
     return fast
 
 

@@ -27,6 +27,8 @@ built-in robot, ``tests/test_compiled_opspace_slip_derivatives.py`` the operatio
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from ..errors import NonFiniteError
@@ -36,18 +38,29 @@ from .compiled import Fallback
 from .dispatch import compiled_model
 
 
+_MANIFOLD_LOCK = threading.Lock()
+"""Held while a :class:`_CompiledDerivatives` chooses its manifold coordinates (see there)."""
+
+
 class _CompiledDerivatives(DynamicsDerivatives):
     """A :class:`~robotdyn.reduction.dynamics_derivatives.DynamicsDerivatives` whose manifold coordinates
     (``positions``, ``tangent``, ``dq_manifold``: a pivoted QR of the holonomic rows) are chosen on first access, as
     the Python path chooses them: a trajectory optimiser or a linearisation in natural coordinates never pays for
-    them."""
+    them. One result may be read from several threads at once: the three are chosen under a lock and stored
+    together before the inputs are dropped (before, a thread reading one of them while another was choosing them
+    got an AttributeError: ``tests/test_threads_derivatives.py``)."""
 
     def __getattr__(self, name: str):
-        if name in ("positions", "tangent", "dq_manifold") and "_manifold" in self.__dict__:
-            A, holonomic, prefer = self.__dict__.pop("_manifold")  # (the holonomic rows picked here, on demand)
-            positions, T = position_coordinates(A[np.asarray(holonomic, bool)], prefer)
-            self.__dict__.update(positions=positions, tangent=T, dq_manifold=self.dq @ T)
-            return self.__dict__[name]
+        if name in ("positions", "tangent", "dq_manifold"):
+            with _MANIFOLD_LOCK:
+                found = self.__dict__
+                if name not in found and "_manifold" in found:
+                    A, holonomic, prefer = found["_manifold"]  # (the holonomic rows picked here, on demand)
+                    positions, T = position_coordinates(A[np.asarray(holonomic, bool)], prefer)
+                    found.update(positions=positions, tangent=T, dq_manifold=self.dq @ T)
+                    del found["_manifold"]
+                if name in found:
+                    return found[name]
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
 

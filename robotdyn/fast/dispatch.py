@@ -92,6 +92,27 @@ def compiled_model(robot) -> CompiledModel | None:
     return fast
 
 
+def for_this_thread(robot, fast: CompiledModel | None) -> CompiledModel | None:
+    """The compiled model an object holding ``fast`` (e.g. a trajectory problem) evaluates from the calling thread:
+    ``fast`` itself in the thread that built it; in any other thread that thread's own model of ``robot``
+    (:func:`compiled_model`), given ``fast``'s row choice, so that the object gives the same numbers, bit for bit,
+    from whichever thread calls it (``None`` where ``fast`` is ``None`` or the fast path is off in this thread).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` ``fast`` was built for.
+        fast: Its :class:`CompiledModel` (built in any thread), or ``None``.
+
+    Returns:
+        A :class:`CompiledModel` the calling thread owns, or ``None``.
+    """
+    if fast is None or fast.owner == threading.get_ident():
+        return fast
+    local = compiled_model(robot)
+    if local is not None and fast._hint is not None:
+        local.select(fast._hint)  # (the same rows as the owner's: nothing to do if they already are)
+    return local
+
+
 def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
     """The reduced model of ``robot`` at (q, nu) (in its operational velocities if it has them): by the robot's
     compiled model where it serves, else (and to choose the projection's rows) by the Python reference
@@ -124,4 +145,4 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     return out
 
 
-__all__ = ["available", "enabled", "use_compiled", "compiled_model", "why_not", "reduce"]
+__all__ = ["available", "enabled", "use_compiled", "compiled_model", "for_this_thread", "why_not", "reduce"]

@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, NonFiniteError
+from ..fast.dispatch import for_this_thread
 
 
 class ContactLimits:
@@ -88,6 +89,16 @@ class ContactLimits:
         self.calls = 0
 
     @property
+    def _compiled(self):
+        """The compiled model for the calling thread (:func:`robotdyn.fast.dispatch.for_this_thread`), or ``None``."""
+        fast = self.__dict__.get("_compiled_model")
+        return None if fast is None else for_this_thread(self.robot, fast)
+
+    @_compiled.setter
+    def _compiled(self, fast) -> None:
+        self.__dict__["_compiled_model"] = fast
+
+    @property
     def rows_per_node(self) -> int:
         """Constraint rows per node: loads, then cones, then peak rows, one per wheel each where asked."""
         return len(self.wheels) * ((self.min_load is not None) + (self.mu_max is not None) + self.peak)
@@ -125,11 +136,12 @@ class ContactLimits:
 
             st = forward(self.robot, q, nu, tau)
             return np.column_stack([st.force, st.normal])
-        if self._compiled is not None:
+        fast = self._compiled
+        if fast is not None:
             from ..fast.compiled import Fallback
 
             try:
-                return self._compiled_forces(self._compiled, q, nu, tau)
+                return self._compiled_forces(fast, q, nu, tau)
             except Fallback:
                 pass
         cf = self.robot.contact_forces(q, nu, tau=tau)

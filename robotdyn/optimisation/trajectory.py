@@ -55,6 +55,7 @@ or from central differences of the forces.
 from __future__ import annotations
 
 import math
+import threading
 import time
 from dataclasses import dataclass, field
 
@@ -64,6 +65,7 @@ from ..errors import InputError, NonFiniteError
 from ..inputs import MAX_POSITION
 from ..fast.compiled import Fallback
 from ..fast.compiled_derivatives import raw_derivatives
+from ..fast.dispatch import for_this_thread
 from .callbacks import _casadi, refusal, sparse_callback
 from .node_batches import analytic_jacobians, central_jacobians, rhs_nodes
 from .scaling import effort_units
@@ -318,6 +320,7 @@ class TrajectoryProblem:
         self._fast = None
         self._fast = self._compiled_rhs()
         self._defect_cache = self._jac_cache = (None, None)
+        self._solving = threading.Lock()  # (solve: one at a time per problem)
 
     def _holonomic_setup(self) -> None:
         """The holonomic rows at q0: which are independent (:attr:`hrows`), the independent position coordinates
@@ -414,6 +417,17 @@ class TrajectoryProblem:
     def _peak(self, z: np.ndarray) -> float:
         return float(z[-1]) if self.cost_kind == "peak-mu" else 0.0
 
+    @property
+    def _fast(self):
+        """The robot's compiled model for the calling thread (:func:`robotdyn.fast.dispatch.for_this_thread`: a
+        problem built in one thread solves in another with the same numbers), or ``None``: the Python path."""
+        fast = self.__dict__.get("_fast_model")
+        return None if fast is None else for_this_thread(self.robot, fast)
+
+    @_fast.setter
+    def _fast(self, fast) -> None:
+        self.__dict__["_fast_model"] = fast
+
     def _compiled_rhs(self):
         """The robot's compiled one-call :math:`(S\\nu, \\dot\\nu)` (:meth:`robotdyn.fast.compiled.CompiledModel.rhs`,
         what the simulation integrates) where it serves this robot and equals the Python path at q0, else None."""
@@ -438,9 +452,10 @@ class TrajectoryProblem:
         """:math:`f(x, \\tau) = (S\\nu, \\dot\\nu)` at one node."""
         self.calls["dynamics"] += 1
         q, nu = x[:self.n], x[self.n:]
-        if self._fast is not None:
+        fast = self._fast
+        if fast is not None:
             try:
-                return np.array(self._fast.rhs(q, nu, u, 0.0))
+                return np.array(fast.rhs(q, nu, u, 0.0))
             except Fallback:
                 pass
         S = self.robot.reduced(q, nu).S
@@ -452,8 +467,9 @@ class TrajectoryProblem:
         n = self.n
         if self.derivatives == "analytic":
             self.calls["derivatives"] += 1
-            if self._fast is not None:  # the compiled derivative set in one call (as _f takes the compiled rhs)
-                raw = raw_derivatives(self._fast, x[:n], x[n:], u)
+            fast = self._fast
+            if fast is not None:  # the compiled derivative set in one call (as _f takes the compiled rhs)
+                raw = raw_derivatives(fast, x[:n], x[n:], u)
                 if raw is not None:
                     _, dq, dnu, dtau, _, Vq, S, _ = raw
                     Fx, Fu = np.empty((self.nx, self.nx)), np.zeros((self.nx, self.m))
@@ -515,8 +531,9 @@ class TrajectoryProblem:
             The defects ((N-1) nx,), node-major, in the state's (q, nu) order.
         """
         key = z.tobytes()
-        if self._defect_cache[0] == key:
-            return self._defect_cache[1]
+        cached, value = self._defect_cache  # (one read: another thread may replace the pair meanwhile)
+        if cached == key:
+            return value
         X, U = self._split(z)
         F = rhs_nodes(self._fast, self.n, X, U)  # all nodes in one compiled call, else node by node
         if F is None:
@@ -604,8 +621,9 @@ class TrajectoryProblem:
             The values (nnz,), in the order given above (that of the problem's sparsity pattern).
         """
         key = z.tobytes()
-        if self._jac_cache[0] == key:  # IPOPT asks again at the same point (e.g. after a function evaluation)
-            return self._jac_cache[1]
+        cached, value = self._jac_cache  # (one read, as in defects)
+        if cached == key:  # IPOPT asks again at the same point (e.g. after a function evaluation)
+            return value
         X, U = self._split(z)
         N = self.nodes
         h = self.t_end / (N - 1)
@@ -668,6 +686,10 @@ class TrajectoryProblem:
     def solve(self, tol: float = 1e-9, max_iter: int = 500, verbose: bool = False) -> TrajectorySolution:
         """Solve with IPOPT (CasADi ``nlpsol``, limited-memory Hessian).
 
+        A problem may be solved from any thread (each evaluates its own compiled model). Calls on one problem from
+        several threads at once run one after the other (the problem keeps its initial guess, caches and counters
+        during a solve); problems built for the same robot solve in parallel.
+
         Args:
             tol: IPOPT's convergence tolerance (scaled KKT error) and its largest constraint violation [state units].
             max_iter: Largest number of IPOPT iterations.
@@ -680,6 +702,11 @@ class TrajectoryProblem:
             raise InputError(f"tol = {tol!r}; expected a finite number > 0")
         if int(max_iter) != max_iter or max_iter < 0:
             raise InputError(f"max_iter = {max_iter!r}; expected an integer >= 0")
+        with self._solving:
+            return self._solve(tol, int(max_iter), verbose)
+
+    def _solve(self, tol: float, max_iter: int, verbose: bool) -> TrajectorySolution:
+        """:meth:`solve` after its checks, under the problem's lock."""
         ca = _casadi()
         N, nx, m = self.nodes, self.nx, self.m
         nz, ng = self.nz, self.n_constraints

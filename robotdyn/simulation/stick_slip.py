@@ -40,7 +40,7 @@ from ..reduction.pull_back import STABILISATION
 from ..contact.sliding import forward as forward_sliding
 from ..contact.sliding import sliding_now
 from ..contact.sliding import tangential as slip
-from ..contact.stick_slip_wheel import StickSlipWheel, configure, unloaded_message
+from ..contact.stick_slip_wheel import StickSlipWheel, configure, holding_phases, unloaded_message
 from ..contact.stick_slip_traction import phase_table, recorded_phases
 from ..contact.sticking_cone import check as cone_check
 from ..reduction.pull_back import position_rate
@@ -60,6 +60,7 @@ def _forces(robot, q, nu, tau):
     return constraint_forces(robot, q, nu, tau=tau)
 
 
+@holding_phases
 def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: float = 1e-10,
              atol: float = 1e-12, method: str = "DOP853", stabilisation: float = STABILISATION,
              progress: bool = True, max_switches: int = 10_000, time_limit: float | None = None):

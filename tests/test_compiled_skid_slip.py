@@ -194,3 +194,43 @@ def test_derivatives_still_refuse_open_loads_in_one_line():
     with pytest.raises(InputError, match="redundant normal row.*rigid limit") as info:
         robot.dynamics_derivatives(robot.neutral(), np.zeros(robot.mobility), np.zeros(4))
     assert "\n" not in str(info.value)
+
+
+def test_an_axle_lifting_stops_both_engines_at_the_same_instant():
+    """examples/husky_like as shipped under a rear torque 20000 t per wheel (tests/test_stick_slip_axle_lift.py
+    derives the front axle's load): once no split keeps both front loads >= 0 the coupled solve returns the
+    compatible loads and the lift-off event stops the run; the compiled engine stops where scipy's does."""
+    from robotdyn.simulation.torque_profile import Polynomial
+
+    robot, *_ = _centred()
+    torque = Polynomial([[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 20000.0, 20000.0]])
+    runs = [_run(robot, engine, 0.005, np.zeros(7), torque) for engine in ("compiled", "scipy")]
+    assert runs[0].stats["engine"].startswith("compiled")
+    assert runs[0].stats["t_event"] == pytest.approx(runs[1].stats["t_event"], rel=1e-8)
+    assert 0.0031 < runs[0].stats["t_event"] < 0.0032
+    head = [r.stats["event"].split(" (normal load")[0] for r in runs]
+    assert head[0] == head[1] and head[0].startswith("wheel front_left unloads at t = 0.0031")
+
+
+@pytest.mark.parametrize("mu, refused", [(5.0, False), (8.0, False), (12.0, True), (25.0, True)])
+def test_painleve_verdicts_equal_the_python_path(mu, refused):
+    """Base sliding forward at 1 m/s on locked front wheels, rear wheels rolling, every wheel at mu: the coupled
+    system's effective normal matrix on the loads' subspace is no P-matrix above mu_P = 10.48 (the Python path's
+    threshold): both paths refuse the same states (at mu = 8 the rear axle would pull: the compatible loads)."""
+    from dataclasses import replace
+
+    from robotdyn.errors import SingularConstraintError
+    from robotdyn.robot import Robot
+
+    spec = read(EXAMPLES / "husky_like.toml").SPEC
+    robot = Robot(replace(spec, wheels=[replace(w, mu=mu) for w in spec.wheels]))
+    q, nu, tau = robot.neutral(), np.array([1.0, 0, 0, 0, 0, 1 / R, 1 / R]), np.zeros(4)
+    if not refused:
+        with use_compiled(False):
+            st = forward(robot, q, nu, tau)
+        np.testing.assert_allclose(_compiled(robot, q, nu, tau)[2], st.normal, rtol=1e-10)
+        return
+    with use_compiled(False), pytest.raises(SingularConstraintError, match="Painleve paradox"):
+        forward(robot, q, nu, tau)
+    with pytest.raises(RuntimeError, match="no P-matrix"):
+        _compiled(robot, q, nu, tau)

@@ -234,3 +234,11 @@ def test_painleve_verdicts_equal_the_python_path(mu, refused):
         forward(robot, q, nu, tau)
     with pytest.raises(RuntimeError, match="no P-matrix"):
         _compiled(robot, q, nu, tau)
+    # where a compiled run stops on it, the error raised is the Python path's at the stopping state, word for word
+    from robotdyn.simulation.compiled_engine import _python_refusal
+
+    with pytest.raises(SingularConstraintError) as run:
+        _python_refusal(robot, 0.1, np.concatenate([q, nu, [0.0]]), Constant(tau), None)
+    with use_compiled(False), pytest.raises(SingularConstraintError) as python:
+        forward(robot, q, nu, tau)
+    assert str(run.value) == str(python.value) and "\n" not in str(run.value)

@@ -242,3 +242,9 @@ def test_painleve_verdicts_equal_the_python_path(mu, refused):
     with use_compiled(False), pytest.raises(SingularConstraintError) as python:
         forward(robot, q, nu, tau)
     assert str(run.value) == str(python.value) and "\n" not in str(run.value)
+    from robotdyn.simulation.compiled_engine import _slip_error, at_time
+
+    stop = {"slip_error": 2, "slip_value": float("nan"), "slip_wheels": 15, "t_stop": 0.1,
+            "y_stop": np.concatenate([q, nu, [0.0]])}
+    error = at_time(_slip_error(robot, compiled_model(robot), stop, Constant(tau), None), 0.1)
+    assert str(error) == f"at t = 0.1 s: {python.value}"  # as the scipy engine words an error at that time

@@ -164,22 +164,8 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     finally:
         fast.ev.set_controller(None)
     status, t_stop = out["status"], float(out["t_stop"])
-    if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's errors
-        from ..contact.sliding import painleve_error, redundant_load_error
-
-        if fast.loads_open:  # coupled's refusals (Painleve on a basis of the loads' subspace): its own words
-            _python_refusal(robot, float(out["t_stop"]), np.asarray(out["y_stop"]), profile, controller)
-        wheels = slipping_wheels(robot)
-        if out["slip_error"] == 0:
-            raise painleve_error(wheels, float(out["slip_value"]))
-        if out["slip_error"] == 2:  # the effective normal matrix is no P-matrix (robotdyn.contact.painleve)
-            from ..contact.painleve import painleve_sign_error
-
-            mu_p, mask = float(out["slip_value"]), int(out["slip_wheels"])
-            raise painleve_sign_error([w for i, w in enumerate(wheels) if mask >> i & 1],
-                                      mu_p if np.isfinite(mu_p) else None,
-                                      [w for i, w in enumerate(wheels) if not mask >> i & 1])
-        raise redundant_load_error(wheels[int(out["slip_value"])])
+    if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's error, timed as its own
+        raise at_time(_slip_error(robot, fast, out, profile, controller), t_stop) from None
     interrupted = None
     if status == INTERRUPTED:
         reached = float(out["t"][-1]) if len(out["t"]) else t0
@@ -194,6 +180,29 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     return {"t": out["t"], "y": out["y"], "energy": out["energy"], "residual": out["residual"],
             "nfev": int(out["nfev"]), "steps": int(out["steps"]), "interrupted": interrupted,
             "event": (t_stop, np.asarray(out["y_stop"])) if out["event"] else None, "flights": out["flights"]}
+
+
+def _slip_error(robot, fast, out: dict, profile: TorqueProfile, controller) -> RobotDynError:
+    """The Python path's error where a compiled run stopped on its slipping wheels' contact problem (``out``: the
+    run's result, its ``slip_error`` kind, value and wheels; see ``kernels/sliding.hpp``'s SlipError)."""
+    from ..contact.sliding import painleve_error, redundant_load_error
+
+    if fast.loads_open:  # coupled's refusals (Painleve on a basis of the loads' subspace): its own words
+        try:
+            _python_refusal(robot, float(out["t_stop"]), np.asarray(out["y_stop"]), profile, controller)
+        except RobotDynError as exc:
+            return exc
+    wheels = slipping_wheels(robot)
+    if out["slip_error"] == 0:
+        return painleve_error(wheels, float(out["slip_value"]))
+    if out["slip_error"] == 2:  # the effective normal matrix is no P-matrix (robotdyn.contact.painleve)
+        from ..contact.painleve import painleve_sign_error
+
+        mu_p, mask = float(out["slip_value"]), int(out["slip_wheels"])
+        return painleve_sign_error([w for i, w in enumerate(wheels) if mask >> i & 1],
+                                   mu_p if np.isfinite(mu_p) else None,
+                                   [w for i, w in enumerate(wheels) if not mask >> i & 1])
+    return redundant_load_error(wheels[int(out["slip_value"])])
 
 
 def _python_refusal(robot, t: float, y: np.ndarray, profile: TorqueProfile, controller) -> None:

@@ -23,8 +23,7 @@ from . import painleve
 def coupled(robot, q: np.ndarray, red, kin, wheels: list, tau: np.ndarray):
     """Accelerations, loads and friction of slipping wheels solved together where rigid-body dynamics leave wheel
     loads open (:mod:`robotdyn.contact.rigid_limit`): :func:`robotdyn.contact.sliding.forward`'s system on every row
-    (redundant ones included),
-    closed by the compatibility of the rigid limit of normal compliance.
+    (redundant ones included), closed by the compatibility of the rigid limit of normal compliance.
 
     Unknowns :math:`(\\dot\\nu, \\lambda)` (k + m) and, for wheels held at zero load, their no-pull multipliers
     :math:`\\mu_U`; equations

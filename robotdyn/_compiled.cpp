@@ -18,6 +18,7 @@
 //   kernels/rigid_limit.hpp        contact/rigid_limit.py (the loads rigid-body dynamics leave open)
 //   kernels/sliding.hpp            contact/sliding.py and contact/friction.py (slipping wheels, friction laws)
 //   kernels/painleve.hpp           contact/painleve.py (the sliding wheels' Painleve check: a P-matrix of loads)
+//   kernels/sliding_rigid_limit.hpp contact/sliding.py coupled (slipping wheels whose loads rigid statics leave open)
 //   kernels/joint_springs.hpp      reduction/joint_springs.py (springs and dampers on joints)
 //   kernels/compliant_contact.hpp  contact/compliant_contact.py (wheels that fly and land: normal force laws)
 //   kernels/compliant_rolling.hpp  contact/compliant_rolling.py (compliant wheels rolling while in contact)
@@ -39,6 +40,7 @@
 #include "kernels/contact_forces.hpp"
 #include "kernels/rigid_limit.hpp"
 #include "kernels/sliding.hpp"
+#include "kernels/sliding_rigid_limit.hpp"
 #include "_integrator.hpp"
 #include "_stiff_integrator.hpp"
 #include "kernels/compliant_contact.hpp"
@@ -174,6 +176,15 @@ class Evaluator {
     slips_.push_back(Slip{wheel, normal_row, law, p0, p1, free});
   }
   int slipping() const { return static_cast<int>(slips_.size()); }
+  // Whether the slipping wheels' loads may be left open by the rows (a rigid chassis on four wheels): then, where
+  // the projection drops rows, slip_rhs_into solves coupled's system (kernels/sliding_rigid_limit.hpp).
+  void set_slip_open(bool on) { slip_open_ = on; }
+  // The last slipping evaluation's multipliers on every row and the wheels held at zero load (indices among the
+  // wheels), where coupled's system served it; None otherwise.
+  py::object slip_multipliers() const {
+    if (!slip_coupled_) return py::none();
+    return py::make_tuple(slip_rl_.lam, slip_rl_.unloaded);
+  }
   // The rows used and the independent velocity indices (a selection of v).
   void set_selection(const std::vector<int>& rows, const std::vector<int>& independent,
                      const std::vector<int>& dependent) {
@@ -372,7 +383,17 @@ class Evaluator {
     if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
     if (out.size() != nv_ + k + 1) throw std::invalid_argument("state has the wrong length");
     if (k + nr != nv_) throw Fallback("rows and independent velocities do not make a square system");
-    slip_.solve(slips_, rows_, A_, SM_, geo_, Aw_, v_, B_, tau, data_.tau, data_.M, w_, nv_, k, lus_);
+    if (controller_) {  // a feedback law's torques at this state (as rhs_into)
+      control_tau_.resize(Br_.cols());
+      controller_->eval(control_t_, q, nu, Mr_, hr_, Br_, S_, w_, v_, [this](int f) { return frame_kinematics(f); },
+                        control_tau_);
+    }
+    const Eigen::Ref<const VectorXd> torque = controller_ ? Eigen::Ref<const VectorXd>(control_tau_) : tau;
+    slip_coupled_ = slip_open_ && nr < A_.rows() &&
+                    slip_rl_.solve(slip_, slips_, wheels_, A_, SM_, geo_, Aw_, v_, B_, torque, data_.tau, data_.M, w_,
+                                   rigid_.kstiff, nv_, k, lus_);
+    if (!slip_coupled_)
+      slip_.solve(slips_, rows_, A_, SM_, geo_, Aw_, v_, B_, torque, data_.tau, data_.M, w_, nv_, k, lus_);
     out.head(nv_) = v_;
     if (alpha != 0.0) pull_back(alpha, out);
     out.segment(nv_, k) = slip_.x.head(k);
@@ -566,7 +587,6 @@ class Evaluator {
     }
     if (c->motors() != static_cast<int>(motors_.size()) || c->n() != nv_ || c->k() != mobility())
       throw std::invalid_argument("the feedback law is for another robot (motors, coordinates or velocities)");
-    if (!slips_.empty()) throw std::invalid_argument("feedback laws do not run with slipping wheels");
     controller_ = *c;
   }
 
@@ -1429,6 +1449,8 @@ class Evaluator {
   double cond_ = 1.0;
   RigidLimit rigid_;  // the rigid limit's split (forces) and its buffers
   SlipSystem slip_;   // the slipping wheels' system (slip_rhs_into), its results and buffers
+  kernels::SlipRigidLimit slip_rl_;  // ... where the rows leave their loads open (coupled's system)
+  bool slip_open_ = false, slip_coupled_ = false;
   // joint springs and compliant wheels (applied_forces)
   std::vector<robotdyn::kernels::JointSpring> springs_;
   std::vector<robotdyn::kernels::CompliantContact> contacts_;
@@ -1601,6 +1623,8 @@ PYBIND11_MODULE(_compiled, m) {
                              "||K^-1||_1, the 2-norm condition number from the singular values or NaN where the "
                              "estimate cleared the state)")
       .def("slip_rhs", &Evaluator::slip_rhs)
+      .def("set_slip_open", &Evaluator::set_slip_open)
+      .def("slip_multipliers", &Evaluator::slip_multipliers)
       .def("set_selection", &Evaluator::set_selection)
       .def("set_operational", &Evaluator::set_operational)
       .def("full", &Evaluator::full)

@@ -50,6 +50,7 @@ LAZY_CIRCLES = {
     frozenset({"cli.commands", "cli.linearize"}),  # the linearize subcommand registers itself, prints with _emit
     frozenset({"cli.commands", "cli.optimise"}),  # the optimise subcommand likewise
     frozenset({"sweep.chunk", "sweep.batched"}),
+    frozenset({"contact.sliding", "contact.sliding_rigid_limit"}),  # forward <-> its coupled solve on open loads
     # MMR12-EOD's CLI hook (model) registers the climbing-posture command, which builds on the model's climbing robot
     frozenset({"robots.mmr12_eod.model", "robots.mmr12_eod.climbing_posture"}),  # a chunk's batched runs; the batch reuses the per-run summary
     # the adaptable wheel's hold scenario (model) starts from the paper's IK placement (comparison, missions)

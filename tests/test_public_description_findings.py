@@ -7,8 +7,8 @@ session 30), reproduced on our own fixtures (examples/bump_base.toml: a rigid fo
   touches (d > 0, d' < 0); it leaves the ground when d = 0. The traction event of a compliant wheel is now called
   what it is, a zero load, and the word lift-off is kept for the instant the wheel leaves the ground.
 - Turning the Husky in place under a Coulomb law took 78 s for 1 s simulated, on the scipy engine, and nothing
-  said why (its loads are statically indeterminate: the rigid limit of compliance with friction has no compiled
-  twin). The summary now says why a run is not on the compiled engine (examples/husky_like.toml).
+  said why (its loads are statically indeterminate: the rigid limit of compliance with friction had no compiled
+  twin; it has one now). The summary now says why a run is not on the compiled engine.
 - On Clearpath's Ridgeback (a mecanum base), ``info`` listed the four omni wheels without their roller angles,
   so a user could not check the handedness (+45/-45 deg) that decides whether the base moves sideways.
 """
@@ -46,15 +46,17 @@ def test_a_compliant_wheel_unloads_before_it_lifts_off_and_the_summary_says_so()
 
 
 def test_a_run_off_the_compiled_engine_says_why(capsys):
-    argv = ["simulate", "--constraints", str(EXAMPLES / "husky_like.toml"), "--scenario", "turn_in_place",
-            "--t-end", "0.005", "--quiet"]
-    assert main(argv) == 0
-    out = capsys.readouterr().out
-    assert "scipy" in out and "(not on the compiled engine: the wheels' normal loads are statically " \
-        "indeterminate" in out, out
-    assert main([*argv, "--json"]) == 0
+    """(The Husky itself now runs compiled: tests/test_compiled_skid_slip.py; here the fast path is turned off.)"""
+    from robotdyn.fast.dispatch import use_compiled
+
+    argv = ["simulate", "quasimoro", "--scenario", "rectilinear", "--t-end", "0.01", "--quiet"]
+    with use_compiled(False):
+        assert main(argv) == 0
+        out = capsys.readouterr().out
+        assert "scipy" in out and "(not on the compiled engine: the compiled fast path is turned off" in out, out
+        assert main([*argv, "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["engine"].startswith("scipy") and "rigid limit" in data["engine_reason"]
+    assert data["engine"].startswith("scipy") and "turned off" in data["engine_reason"]
     assert main(["simulate", "quasimoro", "--scenario", "rectilinear", "--t-end", "0.01", "--quiet"]) == 0
     assert "not on the compiled engine" not in capsys.readouterr().out  # (a compiled run: nothing to explain)
 

@@ -29,7 +29,7 @@ friction columns :math:`f = J_{t,j}^T c_j` give the friction's part of D, :math:
 F scales with wheel j's mu (where its law is proportional to mu), so :math:`D_{jj}` vanishes at the threshold
 :math:`\\mu_P = \\mu_j D^0_{jj}/F_{jj}`.
 
-On a statically indeterminate chassis (:func:`robotdyn.contact.sliding.coupled`) the sliding wheels' separations
+On a statically indeterminate chassis (:func:`robotdyn.contact.sliding_rigid_limit.coupled`) the sliding wheels' separations
 are restricted to those the rigid rows allow (an orthonormal basis V): the check holds for :math:`V^T D^{-1} V`,
 and where one direction fails, the threshold is where :math:`\\det K` vanishes as the wheels' mu scale together:
 :math:`\\det(I - (1 - t) Q)`, :math:`Q = [K^{-1} U]_{\\lambda_n}` (Sherman and Morrison).

@@ -28,7 +28,7 @@ other sideways) are not fixed by normal compliance: they stay open (:attr:`Rigid
 there are the minimum-norm choice among the loads of the rigid limit.
 
 With slipping wheels the friction forces depend on the loads, so the split belongs inside the coupled solve of
-accelerations and loads (:func:`robotdyn.contact.sliding.coupled`, used by :func:`robotdyn.contact.sliding.forward`).
+accelerations and loads (:func:`robotdyn.contact.sliding_rigid_limit.coupled`, used by :func:`robotdyn.contact.sliding.forward`).
 """
 
 from __future__ import annotations

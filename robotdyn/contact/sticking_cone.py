@@ -6,7 +6,7 @@ indeterminate chassis (a rigid car or skid steer on four wheels) part of the mul
 :math:`\\lambda + N z` (:mod:`robotdyn.contact.contact_forces`), and the decision is made thus:
 
 - **normal loads**: those of the rigid limit of the wheels' normal compliance (:mod:`robotdyn.contact.rigid_limit`;
-  with sliding wheels, of the coupled solve :func:`robotdyn.contact.sliding.coupled`). They come from the whole
+  with sliding wheels, of the coupled solve :func:`robotdyn.contact.sliding_rigid_limit.coupled`). They come from the whole
   multiplier vector, so they include the load transfer by the moments of the tangential forces (a driven car's
   rear wheels carry :math:`m a_x h / L` more), and they do not depend on the rest of the choice: the directions
   that stay open (:attr:`~robotdyn.contact.contact_forces.ConstraintForces.open`) move no normal load;

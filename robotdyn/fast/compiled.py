@@ -251,6 +251,7 @@ class CompiledModel:
             from .compiled_applied import add_springs
 
             add_springs(ev, robot)
+        self.loads_open = False  # (set by _add_slipping)
         self.slip_refusal = self._add_slipping(ev, robot)
         if self.wheels and hasattr(ev, "set_normal_stiffness"):  # the rigid limit of :meth:`forces`' open loads
             from ..constraints.wheel_compliance import wheel_stiffness
@@ -271,15 +272,25 @@ class CompiledModel:
     def _add_slipping(self, ev, robot) -> str | None:
         """Give the evaluator the slipping wheels' friction laws (each wheel's ``compiled_friction()``, see
         :class:`robotdyn.contact.sliding.SlippingWheel`; this stage does not import the contact stage): returns why
-        their friction is not compiled (``None``: it is, or there are none). Their rows are compiled either way."""
+        their friction is not compiled (``None``: it is, or there are none). Their rows are compiled either way.
+
+        Where the rows leave the wheels' normal loads open (a rigid chassis on four wheels), the simulation's
+        right-hand side solves the loads with the friction as :func:`robotdyn.contact.sliding_rigid_limit.coupled`
+        does (``kernels/sliding_rigid_limit.hpp``; :attr:`loads_open` True), but the compiled derivatives and batched
+        runs do not: the string returned then says so, and :func:`robotdyn.simulation.compiled_engine.choose_engine`
+        runs the simulation compiled all the same."""
         sliding = [c for c in robot.constraints if getattr(c, "sliding", False)]  # contact.sliding.sliding_now
         if not sliding:
             return None
         rows = robot.rows_at(robot.neutral())
         labels = rows.labels
+        opened = None
         if _loads_open(rows.A, labels, self.wheels):
-            return ("the wheels' normal loads are statically indeterminate (split by the rigid limit of their normal "
-                    "compliance, robotdyn.contact.rigid_limit): simulated on the Python path")
+            opened = ("the wheels' normal loads are statically indeterminate (split by the rigid limit of their "
+                      "normal compliance, robotdyn.contact.rigid_limit, solved with the friction): their derivatives "
+                      "and batched runs are on the Python path")
+            if not hasattr(ev, "set_slip_open"):  # (an extension built before the compiled coupled solve)
+                return opened
         laws = []
         for c in sliding:
             friction = c.compiled_friction() if hasattr(c, "compiled_friction") else \
@@ -290,7 +301,10 @@ class CompiledModel:
             laws.append((self.wheels.index(c), labels.index(f"{c.name}.normal"), code, free))
         for wheel, row, (law, p0, p1), free in laws:
             ev.add_slipping(wheel, row, law, float(p0), float(p1), free)
-        return None
+        if opened is not None:
+            ev.set_slip_open(True)
+            self.loads_open = True
+        return opened
 
     def __repr__(self) -> str:
         return f"CompiledModel({self.robot.spec.name!r}, nv={self.ev.nv}, rows={self.ev.nrows})"

@@ -28,7 +28,11 @@ accelerations and normal loads come from the same coupled linear system as :func
 (``Evaluator.slip_rhs``), the friction work is an extra state, a singular system raises the Python path's
 Painleve error, and the terminal lift-off event (the smallest normal load of a slipping wheel crossing zero
 downwards) is located on the stepper's dense output, or for Adams on a Dormand-Prince re-integration of the step,
-with the Python path's ``stats["event"]`` (and ``stats["t_event"]``). Exact stick-slip stays on the Python path.
+with the Python path's ``stats["event"]`` (and ``stats["t_event"]``). Where the rows leave the wheels' normal loads
+open (a rigid chassis on four wheels), the loads come with the accelerations and the friction from the rigid limit
+of the wheels' normal compliance, as :func:`robotdyn.contact.sliding_rigid_limit.coupled` solves them
+(``kernels/sliding_rigid_limit.hpp``; wheels it holds at zero load are no lift-off), and a refusal there is the Python
+path's error at that state. Feedback laws run with slipping wheels too. Exact stick-slip stays on the Python path.
 
 Robots with joint springs or compliant wheels (:mod:`robotdyn.contact.applied_forces`) run on their own compiled model
 (:func:`engine_model`, :mod:`robotdyn.fast.compiled_applied`): the evaluator adds :math:`S^T Q(q, v)` and carries the
@@ -160,20 +164,8 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     finally:
         fast.ev.set_controller(None)
     status, t_stop = out["status"], float(out["t_stop"])
-    if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's errors
-        from ..contact.sliding import painleve_error, redundant_load_error
-
-        wheels = slipping_wheels(robot)
-        if out["slip_error"] == 0:
-            raise painleve_error(wheels, float(out["slip_value"]))
-        if out["slip_error"] == 2:  # the effective normal matrix is no P-matrix (robotdyn.contact.painleve)
-            from ..contact.painleve import painleve_sign_error
-
-            mu_p, mask = float(out["slip_value"]), int(out["slip_wheels"])
-            raise painleve_sign_error([w for i, w in enumerate(wheels) if mask >> i & 1],
-                                      mu_p if np.isfinite(mu_p) else None,
-                                      [w for i, w in enumerate(wheels) if not mask >> i & 1])
-        raise redundant_load_error(wheels[int(out["slip_value"])])
+    if out["slip_error"] >= 0:  # the slipping wheels' contact problem: the Python path's error, timed as its own
+        raise at_time(_slip_error(robot, fast, out, profile, controller), t_stop) from None
     interrupted = None
     if status == INTERRUPTED:
         reached = float(out["t"][-1]) if len(out["t"]) else t0
@@ -188,6 +180,43 @@ def run(robot, fast, t_end: float, q0: np.ndarray, nu0: np.ndarray, profile: Tor
     return {"t": out["t"], "y": out["y"], "energy": out["energy"], "residual": out["residual"],
             "nfev": int(out["nfev"]), "steps": int(out["steps"]), "interrupted": interrupted,
             "event": (t_stop, np.asarray(out["y_stop"])) if out["event"] else None, "flights": out["flights"]}
+
+
+def _slip_error(robot, fast, out: dict, profile: TorqueProfile, controller) -> RobotDynError:
+    """The Python path's error where a compiled run stopped on its slipping wheels' contact problem (``out``: the
+    run's result, its ``slip_error`` kind, value and wheels; see ``kernels/sliding.hpp``'s SlipError)."""
+    from ..contact.sliding import painleve_error, redundant_load_error
+
+    if fast.loads_open:  # coupled's refusals (Painleve on a basis of the loads' subspace): its own words
+        try:
+            _python_refusal(robot, float(out["t_stop"]), np.asarray(out["y_stop"]), profile, controller)
+        except RobotDynError as exc:
+            return exc
+    wheels = slipping_wheels(robot)
+    if out["slip_error"] == 0:
+        return painleve_error(wheels, float(out["slip_value"]))
+    if out["slip_error"] == 2:  # the effective normal matrix is no P-matrix (robotdyn.contact.painleve)
+        from ..contact.painleve import painleve_sign_error
+
+        mu_p, mask = float(out["slip_value"]), int(out["slip_wheels"])
+        return painleve_sign_error([w for i, w in enumerate(wheels) if mask >> i & 1],
+                                   mu_p if np.isfinite(mu_p) else None,
+                                   [w for i, w in enumerate(wheels) if not mask >> i & 1])
+    return redundant_load_error(wheels[int(out["slip_value"])])
+
+
+def _python_refusal(robot, t: float, y: np.ndarray, profile: TorqueProfile, controller) -> None:
+    """Raise the Python path's error at the state y = (q, nu, ...) where a compiled run with open loads stopped on a
+    refusal of the slipping wheels' contact problem (:func:`robotdyn.contact.sliding.forward`); return where that
+    path solves the state (the caller then words the compiled verdict)."""
+    from ..contact.sliding import forward
+    from ..fast.dispatch import use_compiled
+
+    n, k = robot.nq, robot.mobility
+    q, nu = y[:n], y[n:n + k]
+    tau = controller(t, q, nu) if controller is not None else profile(t)  # (run's controller: the bound law)
+    with use_compiled(False):
+        forward(robot, q, nu, np.asarray(tau, float))
 
 
 _ZERO: dict[int, object] = {}
@@ -278,7 +307,7 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
 
         reason = why_not(robot, applied=forced) if enabled() else (
             "the compiled fast path is turned off (ROBOTDYN_COMPILED=0 or use_compiled(False))")
-    elif fast.slip_refusal is not None:
+    elif fast.slip_refusal is not None and not fast.loads_open:  # (open loads: coupled's system is compiled)
         reason = fast.slip_refusal
     elif method == CVODE and not forced:
         reason = (f"method {CVODE!r} (SUNDIALS' stiff BDF) runs robots with compliant wheels or joint springs; "
@@ -291,8 +320,6 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     elif forced and as_data(torque) is not None and not isinstance(torque, FeedbackLaw):
         reason = ("model-based controllers on robots with joint springs or compliant wheels are simulated on the "
                   "Python path")
-    elif as_data(torque) is not None and slipping_wheels(robot):
-        reason = "feedback laws on robots with slipping wheels are simulated on the Python path"
     elif torque is not None and not isinstance(torque, TorqueProfile) and as_data(torque) is None:
         reason = ("the torques are a Python function; give a robotdyn.simulation.torque_profile.TorqueProfile (constant, sine, "
                   "table, polynomial) or a robotdyn.simulation.feedback.FeedbackLaw to run them compiled")
@@ -384,7 +411,8 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
         from ..contact.sliding import lift_off_message
 
         t_ev, y_ev = out["event"]
-        stats["event"] = lift_off_message(robot, t_ev, y_ev[:n], y_ev[n:n + k], profile(t_ev))
+        tau_ev = law(t_ev, y_ev[:n], y_ev[n:n + k]) if law is not None else profile(t_ev)
+        stats["event"] = lift_off_message(robot, t_ev, y_ev[:n], y_ev[n:n + k], tau_ev)
         stats["t_event"] = t_ev
         print(f"simulate: {stats['event']}", file=sys.stderr, flush=True)
     if offsets:

@@ -1,6 +1,7 @@
 """Why a simulation runs on the Python (scipy) path rather than the compiled engine, in words, for the run's
 summary: a run on the Python path can take a hundred times longer (a rigid four-wheel Husky turning in place under
-a Coulomb law: 78 s for 1 s simulated), and its user should learn why without reading the source."""
+a Coulomb law took 78 s for 1 s simulated there, before its coupled solve was compiled), and its user should learn
+why without reading the source."""
 
 from __future__ import annotations
 

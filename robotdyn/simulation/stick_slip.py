@@ -238,8 +238,8 @@ def simulate(robot, t_end: float, q0, v0, torque=None, n_out: int = 1001, rtol: 
     V = np.array(out_v).reshape(len(T), n)
     energy = np.array([robot.energy(qq, vv) for qq, vv in zip(Q, V)])
     residual = np.array([np.max(np.abs(robot.constraint_residual(qq)), initial=0.0) for qq in Q])
-    stats = {"nfev": nfev, "wall": wall, "method": method, "rtol": rtol, "switches": switches,
-             "phases": phase_table([w.name for w in wheels], out_p, len(T))}
+    stats = {"nfev": nfev, "wall": wall, "method": method, "rtol": rtol, "engine": f"scipy ({method})",
+             "switches": switches, "phases": phase_table([w.name for w in wheels], out_p, len(T))}
     if stop:
         stats["event"] = stop
     if lift:

@@ -248,3 +248,25 @@ def test_painleve_verdicts_equal_the_python_path(mu, refused):
             "y_stop": np.concatenate([q, nu, [0.0]])}
     error = at_time(_slip_error(robot, compiled_model(robot), stop, Constant(tau), None), 0.1)
     assert str(error) == f"at t = 0.1 s: {python.value}"  # as the scipy engine words an error at that time
+
+
+def test_a_start_with_a_wheel_pulling_the_ground_is_refused_on_both_engines():
+    """examples/husky_like with a 4 cm wheelbase braking from 1 m/s: the pitch balance (module text) needs the rear
+    axle to pull, and no split of the rigid limit avoids it (an axle, not one wheel), so the rear loads are
+    negative from t = 0. A lift-off event only finds a crossing; without this check both engines ran on with a
+    friction force of the wrong sign. The loads still sum to m g (flat ground, no vertical acceleration)."""
+    from robotdyn.errors import InputError
+
+    robot = read(EXAMPLES / "husky_like.toml", xacro_args={"wheelbase": "0.04"}).robot()
+    nu0 = np.zeros(robot.mobility)
+    nu0[0] = 1.0
+    with use_compiled(False):
+        st = forward(robot, robot.neutral(), nu0, np.zeros(4))
+    assert np.all(st.normal[2:] < 0) and st.normal.sum() == pytest.approx(
+        float(pin.computeTotalMass(robot.model)) * G0, rel=1e-9)
+    for engine in ("compiled", "scipy"):
+        with pytest.raises(InputError) as err:
+            _run(robot, engine, 0.01, nu0, None)
+        text = str(err.value)
+        assert "\n" not in text and text.startswith("at t = 0 s slipping wheel rear_")
+        assert f"(normal load {st.normal[2]:.4g} N)" in text and "contact = \"compliant\"" in text

@@ -311,6 +311,41 @@ def contact_load(robot, st: SlidingState) -> float:
     return float(np.min(st.normal[loaded] if loaded.any() else st.normal))
 
 
+def check_start_loads(robot, t0: float, q0: np.ndarray, nu0: np.ndarray, tau0: np.ndarray) -> None:
+    """Refuse a run whose slipping wheels' smallest load is already negative where it starts (the same on every
+    engine).
+
+    The lift-off event stops a run where that load falls through zero (:func:`contact_load`); a run that starts
+    below zero has no crossing to find, so it would go on with a rigid contact pulling the ground and a friction
+    force of the wrong sign (:math:`-\mu N` with N < 0). A load within :data:`~robotdyn.contact.rigid_limit.PULL_TOL`
+    of the largest one counts as zero (rounding), as the rigid limit's split counts it.
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot` (with slipping wheels).
+        t0: Start time [s] (for the message).
+        q0: Natural coordinates (n,) [m, rad] where the run starts.
+        nu0: Independent velocities (k,) [m/s, rad/s] there.
+        tau0: Motor torques (one per motor) [N m or N] there.
+
+    Raises:
+        InputError: A slipping wheel carrying a negative load at the start (one line: the wheel, its load, what
+            to change).
+    """
+    from .rigid_limit import PULL_TOL
+
+    st = forward(robot, q0, nu0, tau0)
+    load = contact_load(robot, st)
+    if load >= -PULL_TOL * max(float(np.max(np.abs(st.normal), initial=0.0)), 1e-300):
+        return
+    wheels = sliding_now(robot)
+    i = min((j for j, w in enumerate(wheels) if w.name not in st.unloaded), key=lambda j: st.normal[j],
+            default=int(np.argmin(st.normal)))
+    raise InputError(f"at t = {t0:g} s slipping wheel {wheels[i].name} would pull the ground (normal load "
+                     f"{st.normal[i]:.4g} N): the rigid contact cannot start there; expected a start where every "
+                     "slipping wheel presses on the ground (e.g. a smaller mu, speed or torque), or contact = "
+                     "\"compliant\" in its [[wheels]] entry to let it fly and land")
+
+
 def lift_off_message(robot, t: float, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> str:
     """``stats["event"]`` of a run stopped where a slipping wheel's normal load reached zero at time t [s] and
     state (q, nu), with torques tau there (the same on every engine).

@@ -163,6 +163,26 @@ def test_the_coaster_closed_forms_through_the_compiled_doors(coaster):
     assert along == pytest.approx(5.0 * 0.1 * (-2 * D * w / J), rel=1e-10)  # m_total r w'
 
 
+def test_contact_force_derivatives_carry_the_springs(tricycle):
+    """The contact-force and required-mu derivatives (compiled and Python, now that both take -Q and its
+    derivatives) equal each other and Richardson differences of the reported forces, on the tricycle whose sprung
+    coupled joint moves with nu (its spring terms enter the derivatives, not only the forces); they were refused."""
+    from test_force_derivatives import check_against_differences
+
+    from robotdyn.contact.compiled_force_derivatives import compiled_force_derivatives
+
+    q, nu, tau = next(states(tricycle, np.random.default_rng(8), 1))
+    assert compiled_force_derivatives(tricycle, q, nu, tau) is not None  # (the compiled twin serves it)
+    D_fast = check_against_differences(tricycle, q, nu, tau)
+    with use_compiled(False):
+        D_slow = tricycle.contact_force_derivatives(q, nu, tau)
+    bare = Robot(module("adaptable_wheel").SPEC).contact_force_derivatives(q, nu, tau)
+    assert np.abs(bare.dforce_dnu - D_fast.dforce_dnu).max() > 1e-3 * np.abs(D_fast.dforce_dnu).max()
+    for name in ("force", "dforce_dq", "dforce_dnu", "dforce_dtau", "dmu_dq"):
+        got, ref = getattr(D_fast, name), getattr(D_slow, name)
+        assert np.abs(got - ref).max() <= 1e-10 * max(1.0, np.abs(ref).max()), name
+
+
 def test_traction_fast_pass_carries_the_springs():
     """The fast traction pass (compiled forward dynamics and forces over blocks of samples) equals the per-sample
     reference on the linkage rover with its loop spring and rocker damper, rolling freely down its ramp, and differs

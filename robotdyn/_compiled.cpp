@@ -20,6 +20,7 @@
 //   kernels/painleve.hpp           contact/painleve.py (the sliding wheels' Painleve check: a P-matrix of loads)
 //   kernels/sliding_rigid_limit.hpp contact/sliding.py coupled (slipping wheels whose loads rigid statics leave open)
 //   kernels/joint_springs.hpp      reduction/joint_springs.py (springs and dampers on joints)
+//   kernels/joint_springs_derivatives.hpp  their terms in the derivative set and in the constraint forces
 //   kernels/compliant_contact.hpp  contact/compliant_contact.py (wheels that fly and land: normal force laws)
 //   kernels/compliant_rolling.hpp  contact/compliant_rolling.py (compliant wheels rolling while in contact)
 //   kernels/lu_solve.hpp           LU substitutions and LAPACK's 1-norm condition estimate (used by the above)
@@ -45,6 +46,7 @@
 #include "_stiff_integrator.hpp"
 #include "kernels/compliant_contact.hpp"
 #include "kernels/joint_springs.hpp"
+#include "kernels/joint_springs_derivatives.hpp"  // (and the constraint forces' e - Q)
 #include "kernels/compliant_rolling.hpp"
 #include "_torque_profile.hpp"
 #include "_controller.hpp"
@@ -799,6 +801,7 @@ class Evaluator {
     dynamics(nu);
     force_.noalias() = Br_ * tau;
     force_ -= hr_;
+    kernels::add_reduced_joint_springs(springs_, q_, v_, S_, force_);  // joint springs and dampers: + S^T Q
     llt_.compute(Mr_);
     if (llt_.info() != Eigen::Success) throw Fallback("reduced mass matrix not positive definite");
     nudot_ = force_;
@@ -807,6 +810,7 @@ class Evaluator {
     a_.noalias() += S_ * nudot_;
     e_ = data_.tau;  // C v + g (dynamics)
     e_.noalias() += data_.M * a_;
+    kernels::subtract_joint_springs(springs_, q_, v_, e_);  // e = M a + C v + g - Q (joint springs and dampers)
     lambda_from(tau);
     rigid_limit_split();
     fill_wheel_forces();
@@ -828,6 +832,7 @@ class Evaluator {
     configure(q);
     pin::rnea(model_, data_, q_, v, a);  // without gravity: M a + C v
     e_ = data_.tau + g_;
+    kernels::subtract_joint_springs(springs_, q_, v, e_);  // - Q (joint springs and dampers)
     lambda_from(tau);
     return py::make_tuple(lambda_, e_, wheel_forces(), A_);
   }

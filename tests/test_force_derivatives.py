@@ -230,10 +230,13 @@ def test_quasimoro_load_derivatives_equal_a_closed_form():
                 assert np.abs(got - ref).max() < 1e-10 * max(1.0, np.abs(ref).max())
 
 
-def test_springs_are_refused_in_one_line():
-    robot = read(EXAMPLES / "sprung_car.toml").robot()
-    with pytest.raises(InputError, match="springs"):
+def test_compliant_wheels_are_refused_in_one_line():
+    from compliant_disc import disc  # tests/compliant_disc.py (joint springs: tests/test_compiled_springs.py)
+
+    robot = disc(g=9.81)
+    with pytest.raises(InputError, match="compliant wheels") as info:
         robot.contact_force_derivatives(robot.neutral(), np.zeros(robot.mobility), np.zeros(len(robot.motors)))
+    assert "\n" not in str(info.value)
 
 
 def test_repr_names_the_shapes_and_mu():

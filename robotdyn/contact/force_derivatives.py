@@ -49,7 +49,9 @@ current active set's branch (one-sided there), and :attr:`ContactForceDerivative
 required mu :math:`\\mu_i = \\|F_{t,i}\\|/F_{n,i}` is differentiable where :math:`F_{n,i} > 0` and
 :math:`F_{t,i} \\ne 0`; elsewhere its derivative is reported as zero and the wheel is listed in
 :attr:`ContactForceDerivatives.not_smooth` (a frictionless support wheel's mu is identically zero: exact).
-Robots with joint springs or compliant wheels (applied forces) are refused in one line.
+Joint springs and dampers (:mod:`robotdyn.reduction.joint_springs`) enter e as :math:`-Q(q, v)` and its
+derivatives as :math:`-\\partial Q/\\partial q`, :math:`-\\partial Q/\\partial v` (diagonal: the stiffnesses and
+dampings); robots with compliant wheels are refused in one line.
 """
 
 from __future__ import annotations
@@ -65,9 +67,9 @@ from ..constraints.row_derivatives import FramePass, velocity_dq, wheel_velocity
 from ..errors import InputError, NonFiniteError
 from ..reduction.actuation import input_matrix
 from ..reduction.dynamics_derivatives import motor_rows, pieces
-from ..reduction.joint_springs import urdf_damping_hint
+from ..reduction.joint_springs import spring_terms
 from . import rigid_limit
-from .applied_forces import has_applied
+from .compliant_contact import compliant_wheels
 from .compliance import wheel_stiffness
 from .contact_forces import DETERMINED_TOL, constraint_forces, floating_twin
 from .sliding import sliding_now, tangential
@@ -235,6 +237,10 @@ def layer(robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau: np.ndarray, s
     dR_q, dR_v, M = (x.copy() for x in pin.computeRNEADerivatives(model, tree, q, v, a))
     M = np.triu(M) + np.triu(M, 1).T
     e = pin.rnea(model, model.createData(), q, v, a) - B @ tau
+    Q, dQ_dq, dQ_dv = spring_terms(getattr(robot, "springs", ()), q, v)  # joint springs and dampers (zeros: none)
+    e -= Q
+    dR_q -= dQ_dq
+    dR_v -= dQ_dv
     units = [FramePass(kin0, col) for col in np.eye(n)]
     T = np.stack([velocity_dq(robot.constraints, fp) for fp in units], axis=1) if m else np.zeros((0, n, n))
     de_q = dR_q - motor_rows(robot, kin0, units, tau)
@@ -360,7 +366,7 @@ def _wheel_forces(lay: _Layer, Vq: np.ndarray, S: np.ndarray, Dq: np.ndarray, Dn
 
 def checked(robot, q, nu, tau) -> tuple:
     """The state's arrays checked for :func:`contact_force_derivatives` (and its compiled twin), with its one-line
-    refusal of applied forces.
+    refusal of compliant wheels.
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
@@ -372,13 +378,13 @@ def checked(robot, q, nu, tau) -> tuple:
         ``(q, nu, tau)`` as float arrays.
 
     Raises:
-        InputError: Wrong sizes; joint springs or compliant wheels.
+        InputError: Wrong sizes; compliant wheels.
     """
     q, nu, tau = robot.check_q(q), robot.check_nu(nu), robot.check_tau(tau)
-    if has_applied(robot):
-        raise InputError(f"contact force derivatives: robot {robot.spec.name!r} has joint springs or compliant "
-                         "wheels, whose forces have no derivatives here; expected rigid and slipping wheels, loop "
-                         "closures and joint couplings" + urdf_damping_hint(getattr(robot, "springs", ())))
+    if compliant_wheels(robot):
+        raise InputError(f"contact force derivatives: robot {robot.spec.name!r} has compliant wheels, whose forces "
+                         "have no derivatives here; expected rigid and slipping wheels, loop closures and joint "
+                         "couplings")
     return q, nu, tau
 
 
@@ -409,7 +415,8 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
 
     Args:
         robot: A :class:`~robotdyn.robot.Robot` (rolling, omni and support wheels, smoothly slipping wheels, loop
-            closures, joint couplings, operational-space velocities; no joint springs or compliant wheels).
+            closures, joint couplings, operational-space velocities, joint springs and dampers; no compliant
+            wheels).
         q: Natural coordinates (n,) [m, rad] in the order of ``robot.coordinates``, on the holonomic manifold
             for ``dforce_dq_manifold`` to be the derivative along it.
         nu: Independent velocities (k,) [m/s, rad/s] in the order of ``robot.velocity_names``.
@@ -419,7 +426,7 @@ def contact_force_derivatives(robot, q, nu, tau) -> ContactForceDerivatives:
         A :class:`ContactForceDerivatives`.
 
     Raises:
-        InputError: Wrong sizes; joint springs or compliant wheels; a constraint without derivatives (see
+        InputError: Wrong sizes; compliant wheels; a constraint without derivatives (see
             :meth:`robotdyn.robot.Robot.dynamics_derivatives`).
         NonFiniteError: A non-finite result.
     """

@@ -38,6 +38,7 @@ from ..constraints.rolling_contact import RollingWheel
 from ..fast.compiled import Fallback
 from ..fast.dispatch import compiled_model
 from ..inputs import MAX_FORCE, MAX_POSITION, MAX_VELOCITY
+from ..reduction.joint_springs import spring_forces
 from .contact_forces import DETERMINED_TOL, TWIN_RESIDUAL, cone_minimum, constraint_forces, floating_twin
 from .sliding import sliding_now
 from .compliance import wheel_stiffness
@@ -351,9 +352,12 @@ def _block(robot, models: list, Q, NU, TAU, ok) -> dict:
             idx = np.flatnonzero(ok)
         if idx.size:
             rhs = np.einsum("gij,gj->gi", Br[idx], TAU[idx]) - h[idx]
+            V[idx] = np.einsum("gij,gj->gi", S[idx], NU[idx])
+            springs = getattr(robot, "springs", None)
+            if springs:  # joint springs and dampers: + S^T Q (the compiled forces_at takes e - Q)
+                rhs += np.einsum("gij,gi->gj", S[idx], spring_forces(springs, Q[idx], V[idx]))
             Li = L[idx]
             nudot = np.linalg.solve(np.swapaxes(Li, 1, 2), np.linalg.solve(Li, rhs[:, :, None]))[:, :, 0]
-            V[idx] = np.einsum("gij,gj->gi", S[idx], NU[idx])
             A[idx] = np.einsum("gij,gj->gi", S[idx], nudot) + w[idx]
             ok[idx] &= np.all(np.isfinite(A[idx]), axis=1)
     own = models[0].forces(Q, V, A, TAU, np.flatnonzero(ok))

@@ -98,20 +98,18 @@ def why_not(robot, applied: bool = False) -> str | None:
 
     Args:
         robot: The :class:`~robotdyn.robot.Robot`.
-        applied: Whether joint springs and compliant wheels are compiled too (the compiled simulation's model,
+        applied: Whether compliant wheels are compiled too (the compiled simulation's model,
             :func:`robotdyn.fast.applied_model.applied_model`); default ``False``: they keep a robot on the
-            Python path.
+            Python path. Joint springs and dampers are compiled either way (the evaluator adds their
+            :math:`S^T Q` to the forward dynamics, their terms to the derivative set and :math:`-Q` to the
+            constraint forces' right-hand side: ``kernels/joint_springs*.hpp``); the reduced model
+            :math:`M_r, h_r` it returns is without them, as the Python path's.
 
     Returns:
         A one-line reason, or ``None``.
     """
     if _compiled is None:
         return "the compiled extension robotdyn._compiled was not built"
-    if getattr(robot, "springs", None) and not applied:  # robotdyn.reduction.joint_springs
-        from ..reduction.joint_springs import urdf_damping_hint
-
-        return "joint springs and dampers are evaluated on the Python path (not compiled)" + urdf_damping_hint(
-            robot.springs)
     if any(getattr(c, "rolling", False) for c in robot.constraints) and not applied:  # contact.compliant_rolling
         return "compliant wheels that roll while in contact (friction = 'rolling') are evaluated on the Python path"
     if any(getattr(c, "compliant", False) for c in robot.constraints) and not applied:
@@ -247,7 +245,7 @@ class CompiledModel:
                 ev.add_closure(frame(c.f1), frame(c.f2), [int(s) for s in c._sel])
         for m in robot.motors:
             ev.add_motor(int(m.index), int(m.jid), -1 if m.rid is None else frame(m.rid))
-        if getattr(robot, "springs", None):  # only where why_not(robot, applied=True) let them in
+        if getattr(robot, "springs", None):  # joint springs and dampers (kernels/joint_springs*.hpp)
             from .compiled_applied import add_springs
 
             add_springs(ev, robot)
@@ -282,6 +280,11 @@ class CompiledModel:
         sliding = [c for c in robot.constraints if getattr(c, "sliding", False)]  # contact.sliding.sliding_now
         if not sliding:
             return None
+        if getattr(robot, "springs", None):  # (the compiled slipping solve and its derivatives carry no Q)
+            from ..reduction.joint_springs import urdf_damping_hint
+
+            return ("slipping wheels on a robot with joint springs or dampers are evaluated on the Python path"
+                    + urdf_damping_hint(robot.springs))
         rows = robot.rows_at(robot.neutral())
         labels = rows.labels
         opened = None

@@ -2,13 +2,15 @@
 :mod:`robotdyn.contact.applied_forces` encoded for ``robotdyn/_compiled.cpp`` (formulas in
 ``robotdyn/kernels/joint_springs.hpp`` and ``robotdyn/kernels/compliant_contact.hpp``).
 
-This module encodes them for :class:`robotdyn.fast.compiled.CompiledModel`. The general compiled model
-(:func:`robotdyn.fast.dispatch.compiled_model`, behind every door that evaluates a reduced model) still refuses robots
-with springs or compliant wheels in one line (:func:`robotdyn.fast.compiled.why_not`): their doors add the applied
-forces on the Python path. The compiled *simulation* of such robots (:mod:`robotdyn.simulation.compiled_engine`)
-takes its own model from :func:`robotdyn.fast.applied_model.applied_model`, in which the evaluator adds :math:`S^T Q(q, v)` to the reduced equations, carries the
-friction and damper work as two extra states and counts the stored energy, exactly as the scipy path does with
-:func:`robotdyn.contact.applied_forces.applied`.
+This module encodes them for :class:`robotdyn.fast.compiled.CompiledModel`. Joint springs and dampers are in the
+general compiled model (:func:`robotdyn.fast.dispatch.compiled_model`, behind every door that evaluates a reduced
+model): its reduced model is without them (as the Python path's, whose doors add :math:`S^T Q`), its forward
+dynamics, derivative set and constraint forces carry them (``robotdyn/kernels/joint_springs_derivatives.hpp``). The
+general model still refuses compliant wheels in one line (:func:`robotdyn.fast.compiled.why_not`). The compiled
+*simulation* of a robot with either (:mod:`robotdyn.simulation.compiled_engine`) takes its own model from
+:func:`robotdyn.fast.applied_model.applied_model`, in which the evaluator adds :math:`S^T Q(q, v)` to the reduced
+equations, carries the friction and damper work as two extra states and counts the stored energy, exactly as the
+scipy path does with :func:`robotdyn.contact.applied_forces.applied`.
 """
 
 from __future__ import annotations

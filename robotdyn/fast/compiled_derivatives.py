@@ -15,12 +15,14 @@ position coordinates and the tangent of the holonomic manifold are chosen here, 
 It serves what the compiled model serves (:func:`robotdyn.fast.compiled.why_not`): rolling wheels on the compiled
 terrains (whose third derivatives are closed forms, so every piece is analytic), loop closures and cosine-law joint
 couplings, with independent velocities that are a selection of v or a frame's twist (operational-space velocities,
-``kernels/operational_space_derivatives.hpp``), and wheels slipping under the compiled friction laws (regularised
-Coulomb, the linear tyre: ``kernels/sliding_derivatives.hpp``, the twin of
+``kernels/operational_space_derivatives.hpp``), joint springs and dampers (their joint-diagonal terms in the tree's
+residual and the reduced solve, ``kernels/joint_springs_derivatives.hpp``, as
+:func:`~robotdyn.reduction.joint_springs.spring_terms` enters the Python reference), and wheels slipping under the
+compiled friction laws (regularised Coulomb, the linear tyre: ``kernels/sliding_derivatives.hpp``, the twin of
 :func:`robotdyn.contact.sliding_derivatives.sliding_derivatives`). The Python path answers (:func:`compiled_derivatives`
 returns ``None``) where the compiled model does not serve, where it simulates the slipping wheels on the Python path
-(its ``slip_refusal``: e.g. statically indeterminate loads), and at any state where the compiled evaluation falls
-back (a projection that must be re-chosen, a wheel lying flat, a singular slipping contact problem: the Python path
+(its ``slip_refusal``: e.g. statically indeterminate loads, or joint springs beside them), and at any state where
+the compiled evaluation falls back (a projection that must be re-chosen, a wheel lying flat, a singular slipping contact problem: the Python path
 raises its error there). ``tests/test_compiled_derivatives.py`` checks every output against the Python path on every
 built-in robot, ``tests/test_compiled_opspace_slip_derivatives.py`` the operational and slipping ones.
 """

@@ -57,8 +57,8 @@ def use_compiled(flag: bool):
 
 def compiled_model(robot) -> CompiledModel | None:
     """The robot's :class:`CompiledModel` for the calling thread (built once per thread; rebuilt when its
-    constraints, their terrain, radius or friction law, or the model's gravity change), or ``None`` when the fast
-    path is off or :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated
+    constraints, their terrain, radius or friction law, its joint springs' numbers or the model's gravity change),
+    or ``None`` when the fast path is off or :func:`why_not` gives a reason. Each thread gets its own model, so one robot may be evaluated
     from several threads at once.
 
     Args:
@@ -73,10 +73,13 @@ def compiled_model(robot) -> CompiledModel | None:
     # overwrite (the robot's Pinocchio data is per thread as well, see Robot.data)
     local = getattr(robot, "_local", None)
     cached = getattr(local, "compiled", None) if local is not None else getattr(robot, "_compiled_model", None)
-    gravity = robot.model.gravity.linear.tobytes()  # (bit for bit: a cheaper test than np.array_equal)
+    numbers = robot.model.gravity.linear.tobytes()  # (bit for bit: a cheaper test than np.array_equal)
+    springs = getattr(robot, "springs", None)  # joint springs and dampers are compiled with their numbers
+    if springs:
+        numbers += repr([(s.index, s.stiffness, s.damping, s.rest) for s in springs]).encode()
     constraints = robot.constraints
     if cached is not None and (cached[3] is None or cached[3].owner == threading.get_ident()) \
-            and cached[1] == gravity and cached[0] == constraints and all(
+            and cached[1] == numbers and cached[0] == constraints and all(
         getattr(c, "terrain", None) is t and getattr(c, "radius", None) == r and getattr(c, "law", None) is law
         for c, t, r, law in cached[2]  # (only the constraints that have any of the three: a closure has none)
     ):
@@ -84,7 +87,7 @@ def compiled_model(robot) -> CompiledModel | None:
     fast = CompiledModel(robot) if why_not(robot) is None else None
     state = [(c, getattr(c, "terrain", None), getattr(c, "radius", None), getattr(c, "law", None))
              for c in constraints]
-    entry = (list(constraints), gravity, [s for s in state if s[1:] != (None, None, None)], fast)
+    entry = (list(constraints), numbers, [s for s in state if s[1:] != (None, None, None)], fast)
     if local is not None:
         local.compiled = entry
     else:

@@ -131,6 +131,8 @@ struct ContactForcesDerivatives {
       throw;
     }
     ev.model_.gravity.setZero();
+    kernels::subtract_joint_springs_derivatives(ev.springs_, ev.q_, v, ws.tree.tau, dR_q, dR_v);  // e and its
+    // derivatives less the joint springs' Q (joint_springs_derivatives.hpp; contact/force_derivatives.py's twin)
     M.triangularView<Eigen::StrictlyLower>() = M.transpose().triangularView<Eigen::StrictlyLower>();
     const VectorXd e = ws.tree.tau - B * tau;
     const MatrixXd de_q = dR_q - dBt;

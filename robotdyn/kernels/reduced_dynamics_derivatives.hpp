@@ -24,6 +24,7 @@
 
 #include "frame_derivatives.hpp"
 #include "joint_coupling_derivatives.hpp"
+#include "joint_springs_derivatives.hpp"
 #include "loop_closure_derivatives.hpp"
 #include "rolling_contact_derivatives.hpp"
 
@@ -527,11 +528,13 @@ struct ReducedDerivatives {
     drift_dq(ev, ws.passes[k + 1], ws.dgam_q, ws.Adot);
   }
 
-  // the reduced mass matrix's factors and nudot = M_r^-1 (B_r tau - h_r) into out.nudot
+  // the reduced mass matrix's factors and nudot = M_r^-1 (B_r tau - h_r + S^T Q) into out.nudot (Q: joint springs)
   static Eigen::LLT<MatrixXd> reduced_mass(Ev& ev, const Eigen::Ref<const VectorXd>& tau, derivs::Result& out) {
     Eigen::LLT<MatrixXd> llt(ev.Mr_);
     if (llt.info() != Eigen::Success) throw std::domain_error("reduced mass matrix not positive definite");
-    out.nudot = llt.solve(ev.Br_ * tau - ev.hr_);
+    VectorXd f = ev.Br_ * tau - ev.hr_;
+    kernels::add_reduced_joint_springs(ev.springs_, ev.q_, ev.v_, ev.S_, f);  // joint springs and dampers: + S^T Q
+    out.nudot = llt.solve(f);
     return llt;
   }
 
@@ -560,7 +563,8 @@ struct ReducedDerivatives {
     out.A = ev.A_;
   }
 
-  // RNEA(q, v, a) with gravity and its q-, v-derivatives on the workspace's tree data (ws.tree.tau: RNEA)
+  // RNEA(q, v, a) with gravity, less the joint springs' Q, and its q-, v-derivatives on the workspace's tree data
+  // (ws.tree.tau: RNEA - Q)
   static void tree(Ev& ev, const VectorXd& a, MatrixXd& dtau_dq, MatrixXd& dtau_dv) {
     auto& ws = ev.deriv_;
     const int n = ev.nv_;
@@ -580,6 +584,8 @@ struct ReducedDerivatives {
       throw;
     }
     ev.model_.gravity.setZero();
+    // joint springs and dampers (joint_springs_derivatives.hpp): tau - Q, dtau_dq - dQ/dq, dtau_dv - dQ/dv
+    kernels::subtract_joint_springs_derivatives(ev.springs_, ev.q_, ev.v_, ws.tree.tau, dtau_dq, dtau_dv);
   }
 
   // a motor's joint axis in world axes and its q-derivative at fixed S: the joint body's world angular Jacobian

@@ -431,11 +431,12 @@ class TrajectoryProblem:
     def _compiled_rhs(self):
         """The robot's compiled one-call :math:`(S\\nu, \\dot\\nu)` (:meth:`robotdyn.fast.compiled.CompiledModel.rhs`,
         what the simulation integrates) where it serves this robot and equals the Python path at q0, else None."""
-        from ..contact.applied_forces import has_applied
         from ..contact.sliding import slipping_wheels
         from ..fast.dispatch import compiled_model
 
-        fast = None if slipping_wheels(self.robot) or has_applied(self.robot) else compiled_model(self.robot)
+        # (joint springs and dampers are compiled: the rhs and the derivative set carry their Q; compliant wheels
+        # are not, and compiled_model answers None for them)
+        fast = None if slipping_wheels(self.robot) else compiled_model(self.robot)
         if fast is None:
             return None
         self._fast = None

@@ -146,6 +146,23 @@ def spring_terms(springs, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.
     return Q, dq, dv
 
 
+def spring_forces(springs, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """The springs' generalised force at many states at once (:meth:`SpringForce.force` row by row).
+
+    Args:
+        springs: The robot's :class:`SpringForce` list.
+        Q: Natural coordinates (N, n) [m, rad].
+        V: Full velocities (N, n) [m/s, rad/s].
+
+    Returns:
+        Q_springs (N, n) [N, N m]: nonzero on the springs' coordinates only.
+    """
+    out = np.zeros(np.shape(V))
+    for s in springs:
+        out[:, s.index] += -s.stiffness * (Q[:, s.index] - s.rest) - s.damping * V[:, s.index]
+    return out
+
+
 def build_springs(robot, springs, dampers=()) -> list[SpringForce]:
     """The robot's :class:`SpringForce` list from its spec's :class:`JointSpring` declarations and the URDF's joint
     damping.
@@ -221,4 +238,4 @@ def urdf_damping_hint(springs) -> str:
             "urdf_damping = false in the constraint file leaves it out)")
 
 
-__all__ = ["JointSpring", "SpringForce", "build_springs", "spring_terms", "urdf_damping_hint"]
+__all__ = ["JointSpring", "SpringForce", "build_springs", "spring_forces", "spring_terms", "urdf_damping_hint"]

@@ -211,7 +211,9 @@ def simulate(
     slipping = slipping_wheels(robot)
     forced = has_applied(robot)  # joint springs, compliant wheels (robotdyn.contact.applied_forces)
     works = bool(slipping) or forced  # y[n + k:] = (friction work, damper work)
-    fast = None if slipping else compiled_model(robot)  # friction forces are added on the Python path
+    # friction forces are added on the Python path; joint springs and dampers (forced) add two work states, which
+    # the compiled rhs does not carry: robot.reduced below is still the compiled reduced model
+    fast = None if slipping or forced else compiled_model(robot)
     k = robot.mobility
 
     # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.reduction.reduced_dynamics.solve_mass)

@@ -197,6 +197,11 @@ def simulate_many(robot, t_end: float, q0=None, nu0=None, torque=None, params: d
         from ..fast.compiled import why_not
 
         raise RobotDynError(f"simulate_many needs the compiled model: {why_not(robot)}")
+    if getattr(robot, "springs", None):  # (its runs carry no damper work: simulate runs them, compiled, one by one)
+        from ..reduction.joint_springs import urdf_damping_hint
+
+        raise RobotDynError("simulate_many does not run robots with joint springs or dampers; expected "
+                            "robotdyn.simulation.simulate per run" + urdf_damping_hint(robot.springs))
     if fast.ev.slipping or fast.slip_refusal is not None:  # (refused: slipping wheels whose friction is not
         raise RobotDynError("simulate_many does not run robots with slipping wheels (their friction and lift-off "
                             "are on robotdyn.simulation.simulate); expected wheels that roll without slipping")

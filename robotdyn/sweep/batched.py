@@ -150,6 +150,10 @@ def model_vectors(ctx: RunContext, runs: list[RunInput], mode: str = "auto") -> 
                 reasons.append(f"runs{where} built one at a time: "
                                + ("slipping wheels" if fast is not None else why_not(base)))
                 continue
+            if getattr(base, "springs", None):  # (simulate_many carries no damper work: each run on the compiled
+                # simulation of its own robot, robotdyn.fast.applied_model)
+                reasons.append(f"runs{where} built one at a time: joint springs and dampers are simulated run by run")
+                continue
             ok = []
             for name in dict.fromkeys(r.scenario for r in group):
                 scenario = scenario_of(ctx, mod, next(r for r in group if r.scenario == name))

@@ -313,12 +313,13 @@ struct FramePass {
     // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place, on the supporting joints' columns (jd and J
     // are zero on the others: on a branched tree most of the columns up to the joint's last)
     zero_once(dV[fid], model.nv);
-    const Matrix3d Sp = skew3(p), Sw = skew3(w);
+    // ([p]x y = p x y: the skew products' own sums, their zero terms left out)
     for_support_cols(model, jid, [&](int c) {
       Vector3d t = jd.col(c).head<3>();
-      t.noalias() -= Sp * jd.col(c).tail<3>();
-      t.noalias() += Sw * J.col(c).head<3>();
-      dV[fid].col(c) << t, jd.col(c).tail<3>();
+      t -= p.cross(jd.col(c).tail<3>());
+      t += w.cross(J.col(c).head<3>());
+      dV[fid].col(c).head<3>() = t;
+      dV[fid].col(c).tail<3>() = jd.col(c).tail<3>();
     });
     has_vel[fid] = 1;
   }
@@ -341,14 +342,14 @@ struct FramePass {
     // the same sum, products in place, on the supporting joints' columns (the only ones that can be nonzero)
     zero_once(dAcc[fid], model.nv);
     const Matrix6x& dv = dV[fid];
-    const Matrix3d Sp = skew3(p), Sal = skew3(al), Sw = skew3(w), Svp = skew3(vp);
-    for_support_cols(model, jid, [&](int c) {
+    for_support_cols(model, jid, [&](int c) {  // (cross products for the skew products, as in velocity)
       Vector3d t = ja.col(c).head<3>();
-      t.noalias() -= Sp * ja.col(c).tail<3>();
-      t.noalias() += Sal * J.col(c).head<3>();
-      t.noalias() += Sw * dv.col(c).head<3>();
-      t.noalias() -= Svp * dv.col(c).tail<3>();
-      dAcc[fid].col(c) << t, ja.col(c).tail<3>();
+      t -= p.cross(ja.col(c).tail<3>());
+      t += al.cross(J.col(c).head<3>());
+      t += w.cross(dv.col(c).head<3>());
+      t -= vp.cross(dv.col(c).tail<3>());
+      dAcc[fid].col(c).head<3>() = t;
+      dAcc[fid].col(c).tail<3>() = ja.col(c).tail<3>();
     });
     has_acc[fid] = 1;
   }

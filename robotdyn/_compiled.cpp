@@ -1491,7 +1491,8 @@ class Evaluator {
 
 // The derivative set at one state by the evaluator's kind (slipping wheels, operational velocities, else the reduced
 // dynamics): for the "derivatives" binding and the batched and timed bindings below.
-robotdyn::derivs::Result derivative_set(Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
+robotdyn::derivs::Result derivative_set(Evaluator& ev, const Eigen::Ref<const VectorXd>& q,
+                                        const Eigen::Ref<const VectorXd>& nu, const Eigen::Ref<const VectorXd>& tau) {
   try {
     if (ev.slipping()) return robotdyn::SlidingDerivatives<Evaluator>::run(ev, q, nu, tau);
     if (robotdyn::OperationalDerivatives<Evaluator>::serves(ev))
@@ -1500,6 +1501,19 @@ robotdyn::derivs::Result derivative_set(Evaluator& ev, const VectorXd& q, const 
   } catch (const std::domain_error& e) {
     throw Fallback(e.what());
   }
+}
+
+// The set's tuple (nudot, dnudot/dq, dnudot/dnu, dnudot/dtau, v, dv/dq, S, A), the matrices moved into the arrays (no
+// copies), then with `check` the bits of its first six outputs that are not finite (bit i: output i), tested here
+// where they were just written: robotdyn.fast.compiled_derivatives (a non-finite result is its NonFiniteError)
+py::tuple derivative_tuple(robotdyn::derivs::Result&& r, bool check) {
+  if (!check)
+    return py::make_tuple(std::move(r.nudot), std::move(r.dq), std::move(r.dnu), std::move(r.dtau), std::move(r.v),
+                          std::move(r.Vq), std::move(r.S), std::move(r.A));
+  const int bad = (r.nudot.allFinite() ? 0 : 1) | (r.dq.allFinite() ? 0 : 2) | (r.dnu.allFinite() ? 0 : 4) |
+                  (r.dtau.allFinite() ? 0 : 8) | (r.v.allFinite() ? 0 : 16) | (r.Vq.allFinite() ? 0 : 32);
+  return py::make_tuple(std::move(r.nudot), std::move(r.dq), std::move(r.dnu), std::move(r.dtau), std::move(r.v),
+                        std::move(r.Vq), std::move(r.S), std::move(r.A), bad);
 }
 
 // The state equation's Jacobians at many states, one per row of Q (N, n), NU (N, k), TAU (N, motors), in one call
@@ -1682,14 +1696,15 @@ PYBIND11_MODULE(_compiled, m) {
         return py::make_tuple(e, r);
       })
       .def("evaluate_many", &Evaluator::evaluate_many)
-      .def("derivatives",
-           [](Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {
-             robotdyn::derivs::Result r = derivative_set(ev, q, nu, tau);
-             // moved into the arrays (no copies)
-             return py::make_tuple(std::move(r.nudot), std::move(r.dq), std::move(r.dnu), std::move(r.dtau),
-                                   std::move(r.v), std::move(r.Vq), std::move(r.S), std::move(r.A));
-           },
+      .def("derivatives",  // (q, nu, tau as Eigen::Ref: a float64 array is read in place, not copied)
+           [](Evaluator& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+              const Eigen::Ref<const VectorXd>& tau) { return derivative_tuple(derivative_set(ev, q, nu, tau), false); },
            "(nudot, dnudot/dq, dnudot/dnu, dnudot/dtau, v, dv/dq, S, A) at (q, nu, tau) "
+           "(robotdyn.fast.compiled_derivatives)")
+      .def("derivatives_checked",
+           [](Evaluator& ev, const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
+              const Eigen::Ref<const VectorXd>& tau) { return derivative_tuple(derivative_set(ev, q, nu, tau), true); },
+           "the derivatives' tuple and the bits of its first six outputs that are not finite (bit i: output i) "
            "(robotdyn.fast.compiled_derivatives)")
       .def("force_chain",
            [](Evaluator& ev, const VectorXd& q, const VectorXd& nu, const VectorXd& tau) {

@@ -854,10 +854,11 @@ class Robot:
             NonFiniteError: A non-finite result.
         """
         from .fast.compiled_derivatives import compiled_derivatives
-        from .constraints.row_derivatives import kind
 
         sliding = bool(sliding_now(self))
         if check:
+            from .constraints.row_derivatives import kind  # (the checked call's only: not on the fast entry)
+
             q, nu, tau = self.checked_state(q, nu, tau)
             if sliding:
                 from .contact.sliding_derivatives import smooth_sliding

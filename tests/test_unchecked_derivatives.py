@@ -1,7 +1,8 @@
 """The fast entries of the derivatives (issue 26: the API's overhead per call): ``Robot.dynamics_derivatives`` with
 ``check=False`` gives the checked call's numbers bit for bit, on the compiled and on the Python path; the inputs'
 vectorised check keeps every one-line refusal; the trajectory optimiser's stacked Jacobian assembly equals the
-block-by-block one it replaced (the same numbers in the same order) and central differences of its constraints."""
+block-by-block one it replaced (the same numbers in the same order) and central differences of its constraints; the
+compiled set's finiteness, tested in C++, is the API's NonFiniteError."""
 
 from __future__ import annotations
 
@@ -9,8 +10,10 @@ import numpy as np
 import pytest
 
 import robotdyn
-from robotdyn.errors import InputError
-from robotdyn.fast.dispatch import use_compiled
+from robotdyn.errors import InputError, NonFiniteError
+from robotdyn.fast.compiled import available
+from robotdyn.fast.compiled_derivatives import raw_derivatives
+from robotdyn.fast.dispatch import compiled_model, use_compiled
 from robotdyn.inputs import as_vector
 
 FIELDS = ("nudot", "dq", "dnu", "dtau", "qdot", "dqdot_dq", "S", "dq_manifold")
@@ -69,3 +72,24 @@ def test_stacked_jacobian_assembly_equals_blocks_and_differences(robot):
         e[i] = 1e-6
         fd[:, i] = (p.constraints(z + e) - p.constraints(z - e)) / 2e-6
     assert np.abs(fd - J).max() <= 1e-6 * max(1.0, np.abs(J).max())
+
+
+@pytest.mark.skipif(not available(), reason="compiled extension not built")
+def test_compiled_finiteness_bits_and_the_non_finite_error(robot):
+    """The compiled set tests its outputs' finiteness in C++ (Evaluator.derivatives_checked: bit i for output i):
+    the bits equal numpy's test of the returned arrays, at a regular state (none) and at an infinite torque (the
+    acceleration and what follows from it); the API's NonFiniteError names the first non-finite output, and the
+    optimiser's raw entry answers None there."""
+    q = robot.neutral()
+    nu, tau = np.array([0.1, 0.2, -0.1]), np.array([0.3, -0.2])
+    fast = compiled_model(robot)
+    robot.dynamics_derivatives(q, nu, tau)  # (the projection chosen)
+    for t in (tau, np.array([np.inf, 0.0])):
+        *out, bits = fast.ev.derivatives_checked(q, nu, t)
+        assert bits == sum(1 << i for i, x in enumerate(out[:6]) if not np.isfinite(x).all())
+        for x, y in zip(out, fast.ev.derivatives(q, nu, t)):
+            assert x.tobytes() == y.tobytes()
+    assert bits & 1 and not bits & 16  # nudot infinite, qdot = S nu finite
+    assert raw_derivatives(fast, q, nu, tau) is not None and raw_derivatives(fast, q, nu, t) is None
+    with pytest.raises(NonFiniteError, match="nudot is not finite"):
+        robot.dynamics_derivatives(q, nu, t, check=False)

@@ -34,10 +34,12 @@ import threading
 import numpy as np
 
 from ..errors import NonFiniteError
-from ..inputs import all_finite
 from ..reduction.dynamics_derivatives import DynamicsDerivatives, position_coordinates
 from .compiled import Fallback
 from .dispatch import compiled_model
+
+_NAMES = ("nudot", "dq", "dnu", "dtau", "qdot", "dqdot_dq")  # the outputs of Evaluator.derivatives_checked, in order
+_CHECKED = 0b101111  # the bits of the outputs compiled_derivatives tests (all but qdot)
 
 
 _MANIFOLD_LOCK = threading.Lock()
@@ -85,17 +87,17 @@ def compiled_derivatives(robot, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) 
     """
     fast = compiled_model(robot)
     if fast is None or fast.slip_refusal is not None \
-            or not hasattr(fast.ev, "derivatives"):  # (an extension built before the derivatives)
+            or not hasattr(fast.ev, "derivatives_checked"):  # (an extension built before it)
         return None
     if not fast.ready:
         fast._choose(q, nu)
-    try:
-        nudot, dq, dnu, dtau, v, Vq, S, A = fast.ev.derivatives(q, nu, tau)
+    try:  # (the finiteness tested in C++ where the outputs were just written: bit i for output i)
+        nudot, dq, dnu, dtau, v, Vq, S, A, bad = fast.ev.derivatives_checked(q, nu, tau)
     except Fallback:
         return None
-    arrays = (nudot, dq, dnu, dtau, Vq)
-    if not all_finite(arrays):
-        name = ("nudot", "dq", "dnu", "dtau", "dqdot_dq")[[all_finite((x,)) for x in arrays].index(False)]
+    bad &= _CHECKED  # (qdot = S nu is not among the tested outputs)
+    if bad:
+        name = _NAMES[(bad & -bad).bit_length() - 1]  # the first one
         raise NonFiniteError(f"dynamics derivatives: {name} is not finite at this state (|q| up to "
                              f"{np.max(np.abs(q)):.3g}, |nu| up to {np.max(np.abs(nu), initial=0):.3g})")
     out = _CompiledDerivatives.__new__(_CompiledDerivatives)
@@ -123,13 +125,13 @@ def raw_derivatives(fast, q: np.ndarray, nu: np.ndarray, tau: np.ndarray) -> tup
     Returns:
         The tuple of arrays, or ``None``.
     """
-    if fast.slip_refusal is not None or not hasattr(fast.ev, "derivatives") or not fast.ready:
+    if fast.slip_refusal is not None or not hasattr(fast.ev, "derivatives_checked") or not fast.ready:
         return None
     try:
-        out = fast.ev.derivatives(q, nu, tau)
+        out = fast.ev.derivatives_checked(q, nu, tau)
     except Fallback:
         return None
-    return out if all_finite(out[:6]) else None
+    return None if out[8] else out[:8]  # (out[8]: the bits of the non-finite outputs)
 
 
 __all__ = ["compiled_derivatives", "raw_derivatives"]

@@ -72,9 +72,18 @@ void rotate_skew_add(const Matrix3d& RT, const Vector3d& y, const JW& Jw, const 
 // d(R(q) y)/dq at fixed y for a frame rotation R with world angular Jacobian Jw: -[R y]x Jw (_rot_dq)
 inline Matrix3x rot_dq(const Vector3d& Ry, const Matrix3x& Jw) { return -skew3(Ry) * Jw; }
 
-// derivative of x cross y from those of x and y (3 x n each) (_cross_d)
+// derivative of x cross y from those of x and y (3 x n each) (_cross_d): -[y]x dx + [x]x dy, column by column as
+// the two cross products dx_c x y + x x dy_c (the skew-matrix products' own sums in their order, their zero terms
+// left out: the same numbers, without building the 3 x 3 matrices or a product kernel's set-up)
 inline Matrix3x cross_d(const Vector3d& x, const Matrix3x& dx, const Vector3d& y, const Matrix3x& dy) {
-  return -skew3(y) * dx + skew3(x) * dy;
+  Matrix3x out(3, dx.cols());
+  for (Eigen::Index c = 0; c < dx.cols(); ++c) {
+    const double a0 = dx(0, c), a1 = dx(1, c), a2 = dx(2, c), b0 = dy(0, c), b1 = dy(1, c), b2 = dy(2, c);
+    out(0, c) = (y[2] * a1 - y[1] * a2) + (x[1] * b2 - x[2] * b1);
+    out(1, c) = (y[0] * a2 - y[2] * a0) + (x[2] * b0 - x[0] * b2);
+    out(2, c) = (y[1] * a0 - y[0] * a1) + (x[0] * b1 - x[1] * b0);
+  }
+  return out;
 }
 
 // T += sign d(J^T phi)/dq at fixed phi: the generalized force of a spatial force phi = (f, m) fixed in the world
@@ -304,12 +313,13 @@ struct FramePass {
     // jd_lin - [p]x jd_ang + [w]x J_lin, the products written in place, on the supporting joints' columns (jd and J
     // are zero on the others: on a branched tree most of the columns up to the joint's last)
     zero_once(dV[fid], model.nv);
-    const Matrix3d Sp = skew3(p), Sw = skew3(w);
+    // ([p]x y = p x y: the skew products' own sums, their zero terms left out)
     for_support_cols(model, jid, [&](int c) {
       Vector3d t = jd.col(c).head<3>();
-      t.noalias() -= Sp * jd.col(c).tail<3>();
-      t.noalias() += Sw * J.col(c).head<3>();
-      dV[fid].col(c) << t, jd.col(c).tail<3>();
+      t -= p.cross(jd.col(c).tail<3>());
+      t += w.cross(J.col(c).head<3>());
+      dV[fid].col(c).head<3>() = t;
+      dV[fid].col(c).tail<3>() = jd.col(c).tail<3>();
     });
     has_vel[fid] = 1;
   }
@@ -332,23 +342,41 @@ struct FramePass {
     // the same sum, products in place, on the supporting joints' columns (the only ones that can be nonzero)
     zero_once(dAcc[fid], model.nv);
     const Matrix6x& dv = dV[fid];
-    const Matrix3d Sp = skew3(p), Sal = skew3(al), Sw = skew3(w), Svp = skew3(vp);
-    for_support_cols(model, jid, [&](int c) {
+    for_support_cols(model, jid, [&](int c) {  // (cross products for the skew products, as in velocity)
       Vector3d t = ja.col(c).head<3>();
-      t.noalias() -= Sp * ja.col(c).tail<3>();
-      t.noalias() += Sal * J.col(c).head<3>();
-      t.noalias() += Sw * dv.col(c).head<3>();
-      t.noalias() -= Svp * dv.col(c).tail<3>();
-      dAcc[fid].col(c) << t, ja.col(c).tail<3>();
+      t -= p.cross(ja.col(c).tail<3>());
+      t += al.cross(J.col(c).head<3>());
+      t += w.cross(dv.col(c).head<3>());
+      t -= vp.cross(dv.col(c).tail<3>());
+      dAcc[fid].col(c).head<3>() = t;
+      dAcc[fid].col(c).tail<3>() = ja.col(c).tail<3>();
     });
     has_acc[fid] = 1;
   }
 
-  // the frame Jacobian's time variation along x in LOCAL_WORLD_ALIGNED (KinematicState.frame's dJ): the forward
-  // kinematics derivatives leave data.dJ as computeJointJacobiansTimeVariation does
-  void jacobian_dot(const pin::Model& model, pin::FrameIndex fid, Matrix6x& dJ) {
-    dJ.setZero(6, model.nv);
-    pin::getFrameJacobianTimeVariation(model, data, fid, pin::LOCAL_WORLD_ALIGNED, dJ);
+  // the frame Jacobian's time variation along x in LOCAL_WORLD_ALIGNED (KinematicState.frame's dJ) on the columns
+  // `cols` (sorted; they hold the frame's supporting columns): out = its columns cols (6 x cols.size()), zero off the
+  // support. Pinocchio's getFrameJacobianTimeVariation(LOCAL_WORLD_ALIGNED) on the forward kinematics derivatives'
+  // data.dJ (as computeJointJacobiansTimeVariation leaves it), its own steps column for column (translateJointJacobian
+  // then the frame velocity's term; no mimic joints here), written into the gathered block directly instead of a
+  // 6 x n block cleared and gathered
+  void jacobian_dot(const pin::Model& model, pin::FrameIndex fid, const std::vector<int>& cols, Matrix6x& out) {
+    const pin::Frame& frame = model.frames[fid];
+    const pin::JointIndex jid = frame.parentJoint;
+    const pin::SE3 oMframe = data.oMi[jid] * frame.placement;
+    const Vector3d& p = oMframe.translation();
+    const pin::Motion& ov = data.ov[jid];
+    out.setZero(6, static_cast<Eigen::Index>(cols.size()));
+    size_t at = cols.size();  // the support's columns, last first (the order of Pinocchio's loop), found in cols
+    for (int j = model.idx_vs[jid] + model.nvs[jid] - 1; j >= 0; j = data.parents_fromRow[static_cast<size_t>(j)]) {
+      while (at > 0 && cols[at - 1] > j) --at;
+      if (at == 0 || cols[at - 1] != j) throw std::logic_error("jacobian_dot: a supporting column not in cols");
+      const auto v_in = data.dJ.col(j);
+      auto v_out = out.col(static_cast<Eigen::Index>(at - 1));
+      v_out = v_in;
+      v_out.head<3>().noalias() -= p.cross(v_in.tail<3>());
+      v_out.head<3>() -= Vector3d(ov.linear() + ov.angular().cross(p)).cross(data.J.col(j).tail<3>());
+    }
   }
 };
 

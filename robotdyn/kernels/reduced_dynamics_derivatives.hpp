@@ -2,12 +2,14 @@
 // twin of robotdyn/reduction/dynamics_derivatives.py (pieces, Pieces.Aq, motor_rows, dynamics_derivatives), the same
 // formulas: the projection's chain rule (dS = -K^-1 dK S, dw = -K^-1 (dK w + d gamma)), the multiplier
 // mu = K^-T rho, Pinocchio's computeRNEADerivatives for the tree, the motors' reaction terms and the reduced solve;
-// the per-constraint pieces are the <kind>_derivatives.hpp beside this file. Two differ from the Python path's in
+// the per-constraint pieces are the <kind>_derivatives.hpp beside this file. Three differ from the Python path's in
 // form, not in value: the multiplier term S^T d(A^T mu)/dq is one derivative of the constraint forces at fixed mu
 // (force_dq: each kind's <kind>_force_dq, twins in constraints/row_derivatives.py, and the motors' d(B tau)/dq,
 // motor_force_dq), where the Python path sums mu_r d(A S_l)/dq over one frame pass per column of S; and d(A a)/dq at
 // a = S nudot + w is one velocity pass at a, where the Python path adds its passes at w and at S's columns (A x is
-// linear in x). So run() takes two frame passes (at a, velocity-only, and at v with accelerations) whatever k;
+// linear in x). So run() takes two frame passes (at a, velocity-only, and at v with accelerations) whatever k; and
+// the projection's pieces Aq and W_nu enter only through S^T M Aq and S^T M W_nu, taken by one adjoint solve of k
+// columns, Z = K^-T (S^T M_d)^T, rather than formed (a solve of n + k columns, the Python path's Pieces.Aq, .Wnu).
 // tests/test_compiled_derivatives*.py hold it to the Python path (1e-10), tests/test_force_dq.py the force
 // derivatives to the rows' derivatives at the unit velocities (1e-12).
 //
@@ -41,7 +43,6 @@ struct Workspace {
   std::vector<MatrixXd> dA;  // d(A x)/dq per pass (m x n)
   std::vector<WheelGeometryDq> geo;
   MatrixXd dgam_q, Adot;
-  Matrix6x dJ1, dJ2;
   // the rows' nonzero columns (zero blocks: a wheel's rows depend on q only through its frame's supporting joints and
   // its radius coordinate, a closure's through its two frames' supporting joints): per wheel and per closure the
   // sorted columns, the wheels' geometry derivatives and the closures' frame Jacobians on them (frame_passes), and
@@ -57,7 +58,8 @@ struct Workspace {
   };
   std::vector<Gathered> wheel_gather, closure_gather;
   // run()'s work matrices, kept between calls (sized on first use: no allocation per derivative set)
-  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Wd, Xg, Xgd, X2, Y2, Ad, dgam_v, Wnu, Aq, G, ST, STM, Minv, T, T2;
+  MatrixXd dtau_dq, dtau_dv, dtau_da, X, Y, Vd, Xg, Xgd, X2, G, ST, STM, Minv, T, T2;
+  MatrixXd Z, XgS, STT;  // run()'s adjoint: K^-T (S^T M_d)^T, d(K gamma)/dv S, S^T (dtau/dv S + M W_nu)
   MatrixXd dAa, dAv, Tf, Cd;  // run(): d(A a)/dq, d(A v)/dq, d(A^T mu + B tau)/dq at fixed (mu, tau), C_d
   VectorXd a, rho, rd, mu, muf;
 };
@@ -83,13 +85,23 @@ struct ReducedDerivatives {
   using VectorXd = Eigen::VectorXd;
   using Matrix3d = Eigen::Matrix3d;
 
+  // an m x n matrix of the rows' derivatives (ws.dAa, ws.dAv, ws.dgam_q, ws.Adot) zeroed only when first sized: on
+  // the compact columns every row is written on the same columns at every state (a wheel's and a closure's own
+  // columns, compact_columns; a coupling's whole row), so its other entries stay the zeros of that first call
+  static void zero_once(MatrixXd& m, int rows, int cols) {
+    if (m.rows() != rows || m.cols() != cols) m.setZero(rows, cols);
+  }
+
   // d(A x)/dq of every row at the pass's x (velocity_dq), stacked in constraint order. With `compact` (after
   // frame_passes' column lists) each wheel's and closure's formulas run on their nonzero columns only, gathered, and
   // are scattered back: the same formulas, column by column, on fewer columns
   static void velocity_dq(Ev& ev, derivs::FramePass& fp, MatrixXd& out, bool compact = false) {
     const Model& model = ev.model_;
     auto& ws = ev.deriv_;
-    out.setZero(ev.nrows(), ev.nv_);
+    if (compact)
+      zero_once(out, ev.nrows(), ev.nv_);
+    else
+      out.setZero(ev.nrows(), ev.nv_);
     for (const auto& [kind, i] : ev.order_) {
       if (kind == 0) {
         const auto& wh = ev.wheels_[i];
@@ -229,8 +241,8 @@ struct ReducedDerivatives {
   static void drift_dq(Ev& ev, derivs::FramePass& fp, MatrixXd& dgam, MatrixXd& Adot) {
     const Model& model = ev.model_;
     auto& ws = ev.deriv_;
-    dgam.setZero(ev.nrows(), ev.nv_);
-    Adot.setZero(ev.nrows(), ev.nv_);
+    zero_once(dgam, ev.nrows(), ev.nv_);
+    zero_once(Adot, ev.nrows(), ev.nv_);
     for (const auto& [kind, i] : ev.order_) {
       if (kind == 0) {
         const auto& wh = ev.wheels_[i];
@@ -238,7 +250,6 @@ struct ReducedDerivatives {
         const int fid = ev.frames_[wh.frame];
         const auto& J = ev.Jf_[wh.frame];
         fp.acceleration(model, fid, ev.data_.oMf[fid], J);
-        fp.jacobian_dot(model, fid, ws.dJ1);
         const int nd = static_cast<int>(wh.D.rows());
         // on the wheel's nonzero columns (compact_columns), scattered back
         const std::vector<int>& cols = ws.wheel_cols[i];
@@ -246,7 +257,7 @@ struct ReducedDerivatives {
         auto& gb = ws.wheel_gather[i];
         derivs::gather_cols(fp.dV[fid], cols, gb.dV1);  // (gb.J, gb.Aw: compact_columns')
         derivs::gather_cols(fp.dAcc[fid], cols, gb.dA1);
-        derivs::gather_cols(ws.dJ1, cols, gb.dJ1);
+        fp.jacobian_dot(model, fid, cols, gb.dJ1);
         gb.out.resize(nd, nc);
         gb.out2.resize(nd, nc);
         derivs::wheel_drift_dq(g, ws.geoc[i], wh.D, ev.terrain_, ev.terrain_.flat(), gb.J, wh.radius_index,
@@ -258,8 +269,6 @@ struct ReducedDerivatives {
         const auto& c = ev.closures_[i];
         const int row = closure_row(ev, i), nr = static_cast<int>(c.select.size());
         const int f1 = ev.frames_[c.f1], f2 = ev.frames_[c.f2];
-        fp.jacobian_dot(model, f1, ws.dJ1);
-        fp.jacobian_dot(model, f2, ws.dJ2);
         // on the closure's nonzero columns (compact_columns), scattered back
         const std::vector<int>& cols = ws.closure_cols[i];
         const int nc = static_cast<int>(cols.size());
@@ -271,8 +280,8 @@ struct ReducedDerivatives {
         derivs::gather_cols(fp.dV[f2], cols, gb.dV2);
         derivs::gather_cols(fp.dAcc[f1], cols, gb.dA1);
         derivs::gather_cols(fp.dAcc[f2], cols, gb.dA2);
-        derivs::gather_cols(ws.dJ1, cols, gb.dJ1);
-        derivs::gather_cols(ws.dJ2, cols, gb.dJ2);
+        fp.jacobian_dot(model, f1, cols, gb.dJ1);
+        fp.jacobian_dot(model, f2, cols, gb.dJ2);
         gb.out.resize(nr, nc);
         gb.out2.resize(nr, nc);
         derivs::closure_drift_dq(fr, c.select, fp.V[f1], gb.dV1, fp.V[f2], gb.dV2, fp.Acc[f1], gb.dA1, fp.Acc[f2],
@@ -311,7 +320,6 @@ struct ReducedDerivatives {
     if (tau.size() != ev.Br_.cols()) throw std::invalid_argument("tau has the wrong length");
     auto& ws = ev.deriv_;
     const int n = ev.nv_;
-    const int k = static_cast<int>(ev.S_.cols());
     const MatrixXd& S = ev.S_;
     const VectorXd& w = ev.w_;
     const MatrixXd& M = ev.data_.M;  // symmetric (dynamics)
@@ -322,53 +330,42 @@ struct ReducedDerivatives {
     a += w;
     run_passes(ev, a);
     const MatrixXd& dA_v = ws.dAv;
-    MatrixXd& dgam_v = ws.dgam_v;
-    dgam_v = ws.Adot + dA_v;  // d gamma / dv = Adot + d(A v)/dq
-    // the projection's solves: with K^-1 on the dependent rows, dv/dq = -K^-1 d(K v)/dq (v = S(q) nu), then, in one
-    // solve of n + k columns, Aq = -K^-1 (d(K a)/dq + dgamma/dq at fixed v + d(K gamma)/dv dv/dq) (Pieces.Aq) and
-    // W_nu = -K^-1 d(K gamma)/dv S: the products with dv/dq (zero off the dependent rows: on d(K gamma)/dv's dependent
-    // columns) and with S taken before the solve, which then runs on n + k columns rather than on d(K gamma)/dv's n
+    // the projection's solves. With K^-1 on the dependent rows (K = A_d, the rows rows_ and columns dependent_):
+    // dv/dq = -K^-1 d(K v)/dq (v = S(q) nu), an output (Vq), one solve of n columns. The two other pieces of the
+    // Python path (Pieces.Aq, Pieces.Wnu), Aq = -K^-1 (d(K a)/dq + dgamma/dq at fixed v + d(K gamma)/dv dv/dq) and
+    // W_nu = -K^-1 d(K gamma)/dv S, enter the reduced dynamics only through (S^T M) Aq and (S^T M) W_nu, which are
+    // zero off the dependent rows: (S^T M_d) K^-1 X = Z^T X with Z = K^-T (S^T M_d)^T, one transposed solve of k
+    // columns (the adjoint) instead of a solve of n + k (the contact forces' chain forms Aq and W_nu itself,
+    // ContactForcesDerivatives::chain)
     const int nd = static_cast<int>(ev.dependent_.size());
     out.Vq = MatrixXd::Zero(n, n);
-    MatrixXd& Wnu = ws.Wnu;
-    MatrixXd& Aq = ws.Aq;
-    Wnu.setZero(n, k);
-    Aq.setZero(n, n);
+    MatrixXd& ST = ws.ST;
+    ST = S.transpose();
+    MatrixXd& STM = ws.STM;  // S^T C_d for a matrix C's dependent columns C_d (ws.Cd)
+    MatrixXd& Cd = ws.Cd;
+    MatrixXd& Xa = ws.X2;  // d(K a)/dq + dgamma/dq at fixed v
+    MatrixXd& Xg = ws.Xg;  // d(K gamma)/dv
+    MatrixXd& Z = ws.Z;
     if (nd) {
-      MatrixXd& X = ws.X;    // d(K v)/dq
-      MatrixXd& Xg = ws.Xg;  // d(K gamma)/dv
-      MatrixXd& X2 = ws.X2;  // [d(K a)/dq + dgamma/dq at fixed v + d(K gamma)/dv dv/dq, d(K gamma)/dv S]
+      MatrixXd& X = ws.X;  // d(K v)/dq
       X.resize(nd, n);
       Xg.resize(nd, n);
-      X2.resize(nd, n + k);
+      Xa.resize(nd, n);
       for (int r = 0; r < nd; ++r) {
         const int row = ev.rows_[r];
         X.row(r) = dA_v.row(row);
-        Xg.row(r) = dgam_v.row(row);
-        auto xa = X2.row(r).head(n);
-        xa = ws.dAa.row(row) + ws.dgam_q.row(row);  // d(A a)/dq = d(A w)/dq + sum_l nudot_l d(A S_l)/dq
+        Xg.row(r) = ws.Adot.row(row) + dA_v.row(row);  // d gamma / dv = Adot + d(A v)/dq
+        Xa.row(r) = ws.dAa.row(row) + ws.dgam_q.row(row);  // d(A a)/dq = d(A w)/dq + sum_l nudot_l d(A S_l)/dq
       }
       MatrixXd& Y = ws.Y;
       Y = ev.lu_.solve(X);
       MatrixXd& Vd = ws.Vd;  // dependent rows of dv/dq
       Vd = -Y;
-      MatrixXd& Xgd = ws.Xgd;  // Xg's dependent columns: Vq is zero off the dependent rows
-      Xgd.resize(nd, nd);
-      for (int r = 0; r < nd; ++r) Xgd.col(r) = Xg.col(ev.dependent_[r]);
-      X2.leftCols(n).noalias() += Xgd * Vd;
-      X2.rightCols(k).noalias() = Xg * S;
-      MatrixXd& Y2 = ws.Y2;
-      Y2 = ev.lu_.solve(X2);
-      MatrixXd& Ad = ws.Ad;
-      Ad = -Y2.leftCols(n);  // -(Y_a + Y_g Vq)
-      MatrixXd& Wd = ws.Wd;
-      Wd = -Y2.rightCols(k);
-      for (int r = 0; r < nd; ++r) {
-        const int i = ev.dependent_[r];
-        out.Vq.row(i) = Vd.row(r);
-        Wnu.row(i) = Wd.row(r);
-        Aq.row(i) = Ad.row(r);
-      }
+      for (int r = 0; r < nd; ++r) out.Vq.row(ev.dependent_[r]) = Vd.row(r);
+      Cd.resize(n, nd);
+      for (int r = 0; r < nd; ++r) Cd.col(r) = M.col(ev.dependent_[r]);
+      STM.noalias() = ST * Cd;  // S^T M_d (k x nd)
+      Z = ev.lu_.transpose().solve(STM.transpose());
     }
     // the tree: RNEA(q, v, a) and its derivatives, with gravity
     MatrixXd& dtau_dq = ws.dtau_dq;
@@ -391,24 +388,28 @@ struct ReducedDerivatives {
       for (int r = 0; r < nd; ++r) muf[ev.rows_[r]] = mu[r];
     }
     force_dq(ev, muf, tau, ws.Tf);
-    // Aq(nudot) = -K^-1 (d(K a)/dq + dg), a = S nudot + w at fixed nudot: from the one solve above
-    MatrixXd& ST = ws.ST;
-    ST = S.transpose();
     MatrixXd& G = ws.G;  // S^T (dtau_dq - Tf) + (S^T dtau_dv) Vq + (S^T M) Aq
     dtau_dq -= ws.Tf;
     G.noalias() = ST * dtau_dq;
-    MatrixXd& STM = ws.STM;
-    if (nd) {  // Vq and Aq are zero off the dependent rows: (S^T C) Vq = (S^T C_d) V_d on C's dependent columns C_d
-      MatrixXd& Cd = ws.Cd;
-      Cd.resize(n, nd);
+    MatrixXd& STT = ws.STT;  // S^T (dtau_dv S + M W_nu)
+    ws.T.noalias() = dtau_dv * S;
+    STT.noalias() = ST * ws.T;
+    if (nd) {
+      // Vq and Aq are zero off the dependent rows: (S^T C) Vq = (S^T C_d) V_d, and (S^T M) Aq = -Z^T (Xa + Xg_d V_d)
+      // with Xg_d = d(K gamma)/dv's dependent columns: G += (S^T C_d - Z^T Xg_d) V_d - Z^T Xa
       for (int r = 0; r < nd; ++r) Cd.col(r) = dtau_dv.col(ev.dependent_[r]);
       STM.noalias() = ST * Cd;
+      MatrixXd& Xgd = ws.Xgd;
+      Xgd.resize(nd, nd);
+      for (int r = 0; r < nd; ++r) Xgd.col(r) = Xg.col(ev.dependent_[r]);
+      STM.noalias() -= Z.transpose() * Xgd;
       G.noalias() += STM * ws.Vd;
-      for (int r = 0; r < nd; ++r) Cd.col(r) = M.col(ev.dependent_[r]);
-      STM.noalias() = ST * Cd;
-      G.noalias() += STM * ws.Ad;
+      G.noalias() -= Z.transpose() * Xa;
+      // (S^T M) W_nu = -Z^T (Xg S)
+      ws.XgS.noalias() = Xg * S;
+      STT.noalias() -= Z.transpose() * ws.XgS;
     }
-    solve_reduced(ev, llt, G, dtau_dv, Wnu, out);
+    solve_reduced(ev, llt, G, STT, out);
     return out;
   }
 
@@ -544,22 +545,27 @@ struct ReducedDerivatives {
                             const MatrixXd& Wnu, derivs::Result& out) {
     const MatrixXd& S = ev.S_;
     const MatrixXd& M = ev.data_.M;
-    const int k = static_cast<int>(S.cols());
     auto& ws = ev.deriv_;  // (its work matrices: the same products, without temporaries)
-    MatrixXd& Minv = ws.Minv;
-    Minv.setIdentity(k, k);
-    llt.solveInPlace(Minv);
-    out.dq.noalias() = -Minv * G;
     MatrixXd& T = ws.T;  // dtau_dv S + M W_nu
     T.noalias() = dtau_dv * S;
     ws.T2.noalias() = M * Wnu;
     T += ws.T2;
     ws.ST = S.transpose();
     ws.T2.noalias() = ws.ST * T;
-    out.dnu.noalias() = -Minv * ws.T2;
+    solve_reduced(ev, llt, G, ws.T2, out);
+  }
+  // the same from STT = S^T (dtau/dv S + M W_nu) (k x k)
+  static void solve_reduced(Ev& ev, const Eigen::LLT<MatrixXd>& llt, const MatrixXd& G, const MatrixXd& STT,
+                            derivs::Result& out) {
+    const int k = static_cast<int>(ev.S_.cols());
+    MatrixXd& Minv = ev.deriv_.Minv;
+    Minv.setIdentity(k, k);
+    llt.solveInPlace(Minv);
+    out.dq.noalias() = -Minv * G;
+    out.dnu.noalias() = -Minv * STT;
     out.dtau.noalias() = Minv * ev.Br_;
     out.v = ev.v_;
-    out.S = S;
+    out.S = ev.S_;
     out.A = ev.A_;
   }
 

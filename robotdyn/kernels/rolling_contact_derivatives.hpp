@@ -164,24 +164,35 @@ void wheel_drift_dq(const G& g, const WheelGeometryDq& gd, const Eigen::Ref<cons
   const double nad = n.dot(adot);
   const Vector3d rc = -nad * a - na * adot;
   const Matrix3x drc = -a * (adot.transpose() * dn + n.transpose() * dadot) - nad * da - adot * dna - na * dadot;
-  const Vector3d e = cd - Rd * u;
-  const Matrix3x de = dcd - Rd * du;
-  const Vector3d m1 = N * e;
-  const Matrix3x dm1 = dN_times(e) + N * de;
-  const Vector3d m2 = Qa * m1 + rc;
-  const Matrix3x dm2 = dQ_times(m1) + Qa * dm1 + drc;
-  const Vector3d z = P * m2;
-  const Matrix3x dz = dP_times(m2) + P * dm2;
-  const Matrix3d K = Matrix3d::Identity() + R * P * Qa * N;
-  const auto Klu = K.partialPivLu();
-  const Vector3d udot = Klu.solve(z);
-  const Vector3d x1 = N * udot, x2 = Qa * x1;
-  const Matrix3x dK_udot = (P * x2) * eR + R * (dP_times(x2) + P * (dQ_times(x1) + Qa * dN_times(udot)));
-  const Matrix3x dudot = Klu.solve(dz - dK_udot);
-  const Vector3d hh = cd - R * udot - Rd * u;
-  const Matrix3x dhh = dcd - udot * eR - R * dudot - Rd * du;
-  const Vector3d ndot = N * hh;
-  const Matrix3x dndot = dN_times(hh) + N * dhh;
+  Vector3d udot, ndot;
+  Matrix3x dudot, dndot;
+  if (flat) {
+    // N = 0: m1 = N e = 0, m2 = rc, K = I, udot = z, dudot = dz, ndot = 0: the sums below with their zero terms
+    // left out (the same numbers)
+    udot = P * rc;
+    dudot = dP_times(rc) + P * drc;
+    ndot.setZero();
+    dndot.setZero(3, nv);
+  } else {
+    const Vector3d e = cd - Rd * u;
+    const Matrix3x de = dcd - Rd * du;
+    const Vector3d m1 = N * e;
+    const Matrix3x dm1 = dN_times(e) + N * de;
+    const Vector3d m2 = Qa * m1 + rc;
+    const Matrix3x dm2 = dQ_times(m1) + Qa * dm1 + drc;
+    const Vector3d z = P * m2;
+    const Matrix3x dz = dP_times(m2) + P * dm2;
+    const Matrix3d K = Matrix3d::Identity() + R * P * Qa * N;
+    const auto Klu = K.partialPivLu();
+    udot = Klu.solve(z);
+    const Vector3d x1 = N * udot, x2 = Qa * x1;
+    const Matrix3x dK_udot = (P * x2) * eR + R * (dP_times(x2) + P * (dQ_times(x1) + Qa * dN_times(udot)));
+    dudot = Klu.solve(dz - dK_udot);
+    const Vector3d hh = cd - R * udot - Rd * u;
+    const Matrix3x dhh = dcd - udot * eR - R * dudot - Rd * du;
+    ndot = N * hh;
+    dndot = dN_times(hh) + N * dhh;
+  }
   const Vector3d rdot = -R * udot - Rd * u;
   const Matrix3x drdot = -udot * eR - R * dudot - Rd * du;
   const Vector3d& t1 = g.t1;

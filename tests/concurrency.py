@@ -9,9 +9,22 @@ from __future__ import annotations
 
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 import numpy as np
+
+
+@contextmanager
+def switching_often() -> Iterator[None]:
+    """While inside, the interpreter switches threads every microsecond (instead of every 5 ms), so that state
+    shared without synchronisation shows; the previous interval is restored on the way out."""
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        yield
+    finally:
+        sys.setswitchinterval(interval)
 
 
 def race(workers: list[Callable[[], None]], timeout: float = 60.0) -> list[str]:
@@ -36,15 +49,11 @@ def race(workers: list[Callable[[], None]], timeout: float = 60.0) -> list[str]:
             raised.append(repr(exc))
 
     threads = [threading.Thread(target=run, args=(w,), daemon=True) for w in workers]
-    interval = sys.getswitchinterval()
-    sys.setswitchinterval(1e-6)
-    try:
+    with switching_often():
         for t in threads:
             t.start()
         for t in threads:
             t.join(timeout)
-    finally:
-        sys.setswitchinterval(interval)
     return raised + [f"thread {i} still running after {timeout} s" for i, t in enumerate(threads) if t.is_alive()]
 
 

@@ -6,7 +6,6 @@ rather than bit for bit. The interpreter switches threads every microsecond here
 
 from __future__ import annotations
 
-import sys
 import threading
 
 import numpy as np
@@ -15,19 +14,17 @@ import pytest
 import robotdyn
 from robotdyn.fast.dispatch import compiled_model
 
+from concurrency import switching_often
+
 
 def _race(threads) -> None:
     """Start and join ``threads`` with the interpreter switching between them as often as it can (a switch interval
     of 1 us), so that unsynchronised shared state shows."""
-    interval = sys.getswitchinterval()
-    sys.setswitchinterval(1e-6)
-    try:
+    with switching_often():
         for t in threads:
             t.start()
         for t in threads:
             t.join()
-    finally:
-        sys.setswitchinterval(interval)
 
 
 @pytest.mark.parametrize("name", ["quasimoro", "linkage_suspension"])

@@ -317,7 +317,7 @@ def check_start_loads(robot, t0: float, q0: np.ndarray, nu0: np.ndarray, tau0: n
 
     The lift-off event stops a run where that load falls through zero (:func:`contact_load`); a run that starts
     below zero has no crossing to find, so it would go on with a rigid contact pulling the ground and a friction
-    force of the wrong sign (:math:`-\mu N` with N < 0). A load within :data:`~robotdyn.contact.rigid_limit.PULL_TOL`
+    force of the wrong sign (:math:`-\\mu N` with N < 0). A load within :data:`~robotdyn.contact.rigid_limit.PULL_TOL`
     of the largest one counts as zero (rounding), as the rigid limit's split counts it.
 
     Args:

@@ -235,17 +235,23 @@ def forces_bench() -> None:
               f"{t_roll:.3f} s ({other.stats['nfev']}): ratio slipping / rolling {t_slip / t_roll:.1f}")
     # a rigid four-wheel skid steer (statically indeterminate loads: the coupled solve, kernels/sliding_rigid_limit.hpp)
     # turning in place under a Coulomb law, 0.2 s from rest
+    # turning in place under a Coulomb law, 0.2 s from rest; then with its wheels damped (0.5 N m s/rad each, as a
+    # URDF's <dynamics damping> is applied: the springs' Q in the same solve)
+    from robotdyn.reduction.joint_springs import JointSpring
+
     mod = read(Path(__file__).resolve().parents[1] / "examples" / "husky_like.toml")
     husky, turn = mod.robot(), mod.SCENARIOS["turn_in_place"]
-    walls = {}
-    for engine in ("compiled", "scipy"):
-        turn.run(husky, t_end=0.002, progress=False, engine=engine)
-        start = time.perf_counter()
-        traj = turn.run(husky, t_end=0.2, progress=False, engine=engine)
-        walls[engine] = (time.perf_counter() - start) / 0.2
-        print(f"husky_like 'turn_in_place' (open loads), {engine:<8}: {walls[engine]:.3f} s wall per simulated second "
-              f"({traj.stats['nfev']} evaluations in 0.2 s)")
-    print(f"  scipy / compiled: {walls['scipy'] / walls['compiled']:.0f}x")
+    damped = Robot(replace(mod.SPEC, springs=[JointSpring(m.joint, damping=0.5) for m in mod.SPEC.motors]))
+    for label, robot in (("open loads", husky), ("open loads, damped wheels", damped)):
+        walls = {}
+        for engine in ("compiled", "scipy"):
+            turn.run(robot, t_end=0.002, progress=False, engine=engine)
+            start = time.perf_counter()
+            traj = turn.run(robot, t_end=0.2, progress=False, engine=engine)
+            walls[engine] = (time.perf_counter() - start) / 0.2
+            print(f"husky_like 'turn_in_place' ({label}), {engine:<8}: {walls[engine]:.3f} s wall per simulated "
+                  f"second ({traj.stats['nfev']} evaluations in 0.2 s)")
+        print(f"  scipy / compiled: {walls['scipy'] / walls['compiled']:.0f}x")
 
 
 # ------------------------------------------------------------------ compiled simulation engine (issue 17, items 1, 2)

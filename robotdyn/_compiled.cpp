@@ -373,9 +373,11 @@ class Evaluator {
   }
 
   // ------------------------------------------------------------------------------------------ slipping wheels
-  // d/dt of (q, nu, W) with slipping wheels (robotdyn/contact/sliding.py forward; kernels/sliding.hpp): the
-  // accelerations and the normal loads from one linear system, W-dot the friction power. Leaves the normal loads
-  // and their minimum (the lift-off event's value) and the Painleve test's condition numbers in slip_.
+  // d/dt of (q, nu, W[, W_d]) with slipping wheels (robotdyn/contact/sliding.py forward; kernels/sliding.hpp): the
+  // accelerations and the normal loads from one linear system, W-dot the friction power. Joint springs and dampers
+  // (kernels/joint_springs.hpp) add their Q(q, v) to the system's right-hand side (as forward adds app.Q), and
+  // W_d-dot, their dampers' power, is the state's last component. Leaves the normal loads and their minimum (the
+  // lift-off event's value) and the Painleve test's condition numbers in slip_.
   void slip_rhs_into(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                      const Eigen::Ref<const VectorXd>& tau, double alpha, Eigen::Ref<VectorXd> out) {
     configure(q);
@@ -383,7 +385,7 @@ class Evaluator {
     const int k = static_cast<int>(S_.cols());
     const int nr = static_cast<int>(rows_.size());
     if (tau.size() != Br_.cols()) throw std::invalid_argument("tau has the wrong length");
-    if (out.size() != nv_ + k + 1) throw std::invalid_argument("state has the wrong length");
+    if (out.size() != nv_ + k + works()) throw std::invalid_argument("state has the wrong length");
     if (k + nr != nv_) throw Fallback("rows and independent velocities do not make a square system");
     if (controller_) {  // a feedback law's torques at this state (as rhs_into)
       control_tau_.resize(Br_.cols());
@@ -391,23 +393,36 @@ class Evaluator {
                         control_tau_);
     }
     const Eigen::Ref<const VectorXd> torque = controller_ ? Eigen::Ref<const VectorXd>(control_tau_) : tau;
+    VectorXd* bias = &data_.tau;  // C v + g (RNEA at zero acceleration), less Q where springs act
+    if (applied()) {  // joint springs and dampers (compliant wheels too): b = B tau - (C v + g - Q) - M w
+      applied_forces();
+      slip_bias_ = data_.tau - Qa_;
+      bias = &slip_bias_;
+    }
     slip_coupled_ = slip_open_ && nr < A_.rows() &&
-                    slip_rl_.solve(slip_, slips_, wheels_, A_, SM_, geo_, Aw_, v_, B_, torque, data_.tau, data_.M, w_,
+                    slip_rl_.solve(slip_, slips_, wheels_, A_, SM_, geo_, Aw_, v_, B_, torque, *bias, data_.M, w_,
                                    rigid_.kstiff, nv_, k, lus_);
     if (!slip_coupled_)
-      slip_.solve(slips_, rows_, A_, SM_, geo_, Aw_, v_, B_, torque, data_.tau, data_.M, w_, nv_, k, lus_);
+      slip_.solve(slips_, rows_, A_, SM_, geo_, Aw_, v_, B_, torque, *bias, data_.M, w_, nv_, k, lus_);
     out.head(nv_) = v_;
     if (alpha != 0.0) pull_back(alpha, out);
     out.segment(nv_, k) = slip_.x.head(k);
     out[nv_ + k] = slip_.power;
+    if (applied()) {  // (+ compliant wheels' friction power, as forward adds app.friction_power)
+      out[nv_ + k] += friction_power_;
+      out[nv_ + k + 1] = damper_power_;
+    }
   }
+  // The extra states of a run after (q, nu): the friction work with slipping wheels or compliant wheels, and the
+  // damper work with joint springs or compliant wheels (the friction work then stays in its place).
+  int works() const { return applied() ? 2 : !slips_.empty() ? 1 : 0; }
 
-  // (d/dt (q, nu, W), normal loads (W,), slip velocities (W, 2), friction forces (W, 2)) at one state: the compiled
-  // sliding.forward (tests compare it with the Python path).
+  // (d/dt (q, nu, W[, W_d]), normal loads (W,), slip velocities (W, 2), friction forces (W, 2)) at one state: the
+  // compiled sliding.forward (tests compare it with the Python path); W_d-dot (the dampers' power) with springs.
   py::tuple slip_rhs(const Eigen::Ref<const VectorXd>& q, const Eigen::Ref<const VectorXd>& nu,
                      const Eigen::Ref<const VectorXd>& tau, double alpha) {
     if (slips_.empty()) throw std::invalid_argument("no slipping wheels");
-    VectorXd out(nv_ + nu.size() + 1);
+    VectorXd out(nv_ + nu.size() + works());
     slip_rhs_into(q, nu, tau, alpha, out);
     RowMat force(slips_.size(), 2);
     for (size_t i = 0; i < slips_.size(); ++i) force.row(i) = -slip_.normal[i] * slip_.c.row(i);
@@ -670,10 +685,10 @@ class Evaluator {
       }
       return;
     }
-    try {  // y = (q, nu, friction work)
+    try {  // y = (q, nu, friction work[, damper work])
       with_rechoice(y.data(), rechoose, [&] {
         slip_rhs_into(Eigen::Map<const VectorXd>(y.data(), nv_), Eigen::Map<const VectorXd>(y.data() + nv_, k),
-                      tau_, alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k + 1));
+                      tau_, alpha, Eigen::Map<VectorXd>(dy.data(), nv_ + k + works()));
       });
     } catch (const SlipError&) {
       slip_error_t_ = t;
@@ -700,7 +715,7 @@ class Evaluator {
   // One call per evaluation for an integrator driven from Python (robotdyn/simulation/cvode.py: SUNDIALS CVODE):
   // dy = d/dt y of simulate()'s ODE at (t, y), y = (q, nu[, works]) as in simulate, written into dy (no allocation);
   // the compliant wheels' penetrations [m] at y into `out`; the terminal event's value (lift_off) at (t, y).
-  int state_size() const { return nv_ + mobility() + (!slips_.empty() ? 1 : applied() ? 2 : 0); }
+  int state_size() const { return nv_ + mobility() + works(); }
   void deriv_into(double t, const Eigen::Ref<const VectorXd>& y, Eigen::Ref<VectorXd> dy, double alpha,
                   const robotdyn::TorqueProfile& profile, const py::object& rechoose) {
     if (y.size() != state_size() || dy.size() != state_size())
@@ -1132,10 +1147,10 @@ class Evaluator {
     if (profile.motors() != static_cast<int>(motors_.size()))
       throw std::invalid_argument("the torque profile is for another number of motors");
     const bool slipping = !slips_.empty();
-    if (slipping && applied()) throw std::invalid_argument("slipping wheels with joint springs or compliant wheels");
+    if (slipping && !contacts_.empty()) throw std::invalid_argument("slipping wheels with compliant wheels");
     if (method == "rosenbrock4" && slipping) throw std::invalid_argument("rosenbrock4 does not run slipping wheels");
-    // slipping wheels: the friction work as the last component; springs, compliant wheels: friction and damper work
-    const int dim = nv_ + k + (slipping ? 1 : applied() ? 2 : 0);
+    // slipping wheels: the friction work; springs, compliant wheels: friction and damper work (works())
+    const int dim = nv_ + k + works();
     robotdyn::State y0(dim, 0.0);
     Eigen::Map<VectorXd>(y0.data(), nv_) = q0;
     Eigen::Map<VectorXd>(y0.data() + nv_, k) = nu0;
@@ -1456,6 +1471,7 @@ class Evaluator {
   SlipSystem slip_;   // the slipping wheels' system (slip_rhs_into), its results and buffers
   kernels::SlipRigidLimit slip_rl_;  // ... where the rows leave their loads open (coupled's system)
   bool slip_open_ = false, slip_coupled_ = false;
+  VectorXd slip_bias_;  // C v + g - Q of the slipping wheels' system where joint springs act (slip_rhs_into)
   // joint springs and compliant wheels (applied_forces)
   std::vector<robotdyn::kernels::JointSpring> springs_;
   std::vector<robotdyn::kernels::CompliantContact> contacts_;
@@ -1664,6 +1680,9 @@ PYBIND11_MODULE(_compiled, m) {
       .def("event_value", &Evaluator::event_value, "the terminal event's value at (t, y, alpha, profile, rechoose): the "
            "slipping wheels' smallest load [N] or the rolling compliant wheels' switch value")
       .def_property_readonly("state_size", &Evaluator::state_size)
+      .def_property_readonly("works", &Evaluator::works,
+                             "The run's extra states after (q, nu): 1 (friction work) with slipping wheels, 2 (and "
+                             "the damper work) with joint springs or compliant wheels, slipping wheels or not")
       .def("set_differencing", &Evaluator::set_differencing, "a Jacobian's differences are being taken (on/off)")
       .def("set_controller", &Evaluator::set_controller, py::arg("controller").none(true),
            "a feedback law replacing the torque profile in simulate (None: none)")

@@ -249,7 +249,7 @@ class CompiledModel:
             from .compiled_applied import add_springs
 
             add_springs(ev, robot)
-        self.loads_open = False  # (set by _add_slipping)
+        self.loads_open = self.slip_simulated = False  # (set by _add_slipping)
         self.slip_refusal = self._add_slipping(ev, robot)
         if self.wheels and hasattr(ev, "set_normal_stiffness"):  # the rigid limit of :meth:`forces`' open loads
             from ..constraints.wheel_compliance import wheel_stiffness
@@ -276,22 +276,28 @@ class CompiledModel:
         right-hand side solves the loads with the friction as :func:`robotdyn.contact.sliding_rigid_limit.coupled`
         does (``kernels/sliding_rigid_limit.hpp``; :attr:`loads_open` True), but the compiled derivatives and batched
         runs do not: the string returned then says so, and :func:`robotdyn.simulation.compiled_engine.choose_engine`
-        runs the simulation compiled all the same."""
+        runs the simulation compiled all the same. Joint springs and dampers beside slipping wheels likewise: the
+        simulation's right-hand side adds their generalised force (``Evaluator.slip_rhs``), the compiled derivatives
+        and batched runs do not carry it, and the string returned says so."""
         sliding = [c for c in robot.constraints if getattr(c, "sliding", False)]  # contact.sliding.sliding_now
         if not sliding:
             return None
-        if getattr(robot, "springs", None):  # (the compiled slipping solve and its derivatives carry no Q)
+        opened = None
+        if getattr(robot, "springs", None):  # (the compiled slipping derivatives carry no Q)
             from ..reduction.joint_springs import urdf_damping_hint
 
-            return ("slipping wheels on a robot with joint springs or dampers are evaluated on the Python path"
-                    + urdf_damping_hint(robot.springs))
+            opened = ("slipping wheels beside joint springs or dampers: their derivatives and batched runs are on the "
+                      "Python path" + urdf_damping_hint(robot.springs))
+            if not hasattr(ev, "works"):  # (an extension whose slipping solve carries no Q)
+                return ("slipping wheels on a robot with joint springs or dampers are evaluated on the Python path"
+                        + urdf_damping_hint(robot.springs))
         rows = robot.rows_at(robot.neutral())
         labels = rows.labels
-        opened = None
-        if _loads_open(rows.A, labels, self.wheels):
-            opened = ("the wheels' normal loads are statically indeterminate (split by the rigid limit of their "
-                      "normal compliance, robotdyn.contact.rigid_limit, solved with the friction): their derivatives "
-                      "and batched runs are on the Python path")
+        open_loads = _loads_open(rows.A, labels, self.wheels)
+        if open_loads:
+            opened = opened or ("the wheels' normal loads are statically indeterminate (split by the rigid limit of "
+                                "their normal compliance, robotdyn.contact.rigid_limit, solved with the friction): "
+                                "their derivatives and batched runs are on the Python path")
             if not hasattr(ev, "set_slip_open"):  # (an extension built before the compiled coupled solve)
                 return opened
         laws = []
@@ -304,9 +310,10 @@ class CompiledModel:
             laws.append((self.wheels.index(c), labels.index(f"{c.name}.normal"), code, free))
         for wheel, row, (law, p0, p1), free in laws:
             ev.add_slipping(wheel, row, law, float(p0), float(p1), free)
-        if opened is not None:
+        if open_loads:
             ev.set_slip_open(True)
             self.loads_open = True
+        self.slip_simulated = opened is not None  # (the simulation's right-hand side is compiled all the same)
         return opened
 
     def __repr__(self) -> str:

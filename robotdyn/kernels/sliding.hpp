@@ -8,8 +8,9 @@
 //
 // The accelerations and the normal loads solve one linear system (the friction direction fixed by the current slip)
 //
-//   [M S,  -(A_R^T - sum_i J_t,i^T c_i e_i^T)] [nudot; lambda] = B tau - RNEA(q, v, w),
+//   [M S,  -(A_R^T - sum_i J_t,i^T c_i e_i^T)] [nudot; lambda] = B tau - RNEA(q, v, w) + Q(q, v),
 //
+// Q the joint springs' and dampers' generalised force (joint_springs.hpp; the caller passes C v + g - Q as Cvg),
 // A_R the projection's rows, J_t,i = (t1, t2)^T A_w,i the tangential rows of slipping wheel i, e_i selecting its
 // normal load; the friction power W-dot = sum_i F_i . s_i. The system's 2-norm condition number above 1e12 is the
 // Painleve case (sliding.PAINLEVE_CONDITION).
@@ -81,8 +82,8 @@ struct SlipSystem {
   double power = 0.0;                 // the friction power sum_i F_i . s_i [W]
 
   // Solves for x = (nudot (k), lambda_R) at a state: SM = M S, A the stacked rows (the projection's `rows`), geo and
-  // Aw the wheels' geometry and A_w, v the velocities, B tau the motors' forces, Cvg = C v + g, M w the drift's force
-  // (Aw, v, B, Cvg, M, w read only).
+  // Aw the wheels' geometry and A_w, v the velocities, B tau the motors' forces, Cvg = C v + g (- Q), M w the
+  // drift's force (Aw, v, B, Cvg, M, w read only).
   void solve(const std::vector<Slip>& slips, const std::vector<int>& rows, const MatrixXd& A, const MatrixXd& SM,
              const std::vector<WheelGeometry>& geo, std::vector<MatrixXd>& Aw, VectorXd& v, MatrixXd& B,
              const Eigen::Ref<const VectorXd>& tau, VectorXd& Cvg, MatrixXd& M, VectorXd& w, int nv, int k,

@@ -4,7 +4,7 @@
 // called by robotdyn/contact/sliding.py's forward where the projection drops rows. Unknowns
 // (nudot (k), lambda on every row (m), the no-pull multipliers mu_U of the wheels held at zero load (u)):
 //
-//   M S nudot - (A^T - sum_i J_t,i^T c_i e_i^T) lambda = B tau - RNEA(q, v, w)        (n rows)
+//   M S nudot - (A^T - sum_i J_t,i^T c_i e_i^T) lambda = B tau - RNEA(q, v, w) + Q    (n rows; Q: joint springs)
 //   (C N V_n)^T (K^-1 C lambda - mu) = 0                                              (p rows: compatibility)
 //   (N V_o)^T lambda = 0                                                              (d - p rows: minimum norm)
 //   C_U lambda = 0                                                                    (u rows: held at zero)
@@ -47,8 +47,8 @@ struct SlipRigidLimit {
 
   // One evaluation: true with the results in sys (x's head the accelerations, s, c, U, normal, power, min_normal)
   // and lam, unloaded here; false where p = 0 (sys untouched: the determinate system decides). A the stacked rows
-  // (m x nv), SM = M S, geo/Aw the wheels' geometry and A_w, Cvg = C v + g, M w the drift's force, kstiff the
-  // wheels' normal stiffnesses (empty: equal). Throws SlipError kind 0 (singular, or no active set found: value
+  // (m x nv), SM = M S, geo/Aw the wheels' geometry and A_w, Cvg = C v + g (- Q, sliding.hpp), M w the drift's
+  // force, kstiff the wheels' normal stiffnesses (empty: equal). Throws SlipError kind 0 (singular, or no active set found: value
   // inf) and kind 2 (no P-matrix; wheels: the bit mask of the slipping wheels involved, value NaN).
   bool solve(SlipSystem& sys, const std::vector<Slip>& slips, const std::vector<Wheel>& wheels, const MatrixXd& A,
              const MatrixXd& SM, const std::vector<WheelGeometry>& geo, std::vector<MatrixXd>& Aw, VectorXd& v,

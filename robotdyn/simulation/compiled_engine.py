@@ -32,7 +32,10 @@ with the Python path's ``stats["event"]`` (and ``stats["t_event"]``). Where the 
 open (a rigid chassis on four wheels), the loads come with the accelerations and the friction from the rigid limit
 of the wheels' normal compliance, as :func:`robotdyn.contact.sliding_rigid_limit.coupled` solves them
 (``kernels/sliding_rigid_limit.hpp``; wheels it holds at zero load are no lift-off), and a refusal there is the Python
-path's error at that state. Feedback laws run with slipping wheels too. Exact stick-slip stays on the Python path.
+path's error at that state. Feedback laws run with slipping wheels too, and so do joint springs and dampers (a URDF's
+wheel damping): their generalised force joins the system's right-hand side and the damper work is a second extra
+state, as on the scipy path. Exact stick-slip stays on the Python path, as do slipping wheels beside compliant wheels,
+and the stiff methods (``rosenbrock4``, ``cvode``) refuse slipping wheels.
 
 Robots with joint springs or compliant wheels (:mod:`robotdyn.contact.applied_forces`) run on their own compiled model
 (:func:`engine_model`, :mod:`robotdyn.fast.compiled_applied`): the evaluator adds :math:`S^T Q(q, v)` and carries the
@@ -43,8 +46,9 @@ on the scipy path's LSODA): :data:`COMPLIANT_DEFAULT` by default, :data:`STIFF` 
 finite-difference Jacobian: ``robotdyn/_stiff_integrator.hpp``) for stiff contacts, or :data:`CVODE` (SUNDIALS'
 variable-order BDF driven from Python, one compiled call per evaluation, its events by CVODE's rootfinding:
 :mod:`robotdyn.simulation.cvode`); springs alone run on the default Adams stepper. Compliant wheels that roll while in contact run segment by segment between their contact
-switches (:mod:`robotdyn.simulation.compiled_rolling`). Slipping wheels and model-based controllers on such
-robots, and :func:`robotdyn.simulation.many_runs.simulate_many`, stay on the Python path (refused in one line).
+switches (:mod:`robotdyn.simulation.compiled_rolling`). Slipping wheels beside compliant wheels, model-based
+controllers on such robots, and :func:`robotdyn.simulation.many_runs.simulate_many`, stay on the Python path (refused
+in one line).
 
 The scipy path (DOP853) stays the reference; ``tests/test_compiled_simulation.py`` checks the compiled trajectories
 against it to 1e-8 on every compiled robot.
@@ -299,16 +303,19 @@ def choose_engine(robot, torque, method: str | None, engine: str) -> bool:
     fast = None if stick_slip_wheels(robot) else engine_model(robot)
     if stick_slip_wheels(robot):
         reason = "stick-slip wheels (exact switching) are simulated on the Python path"
-    elif forced and slipping_wheels(robot):
-        reason = "slipping wheels on a robot with joint springs or compliant wheels are simulated on the Python path"
+    elif compliant_wheels(robot) and slipping_wheels(robot):
+        reason = "slipping wheels on a robot with compliant wheels are simulated on the Python path"
     elif fast is None:
         from ..fast.dispatch import enabled
         from ..fast.compiled import why_not
 
         reason = why_not(robot, applied=forced) if enabled() else (
             "the compiled fast path is turned off (ROBOTDYN_COMPILED=0 or use_compiled(False))")
-    elif fast.slip_refusal is not None and not fast.loads_open:  # (open loads: coupled's system is compiled)
+    elif fast.slip_refusal is not None and not fast.slip_simulated:  # (open loads, springs: its rhs is compiled)
         reason = fast.slip_refusal
+    elif method in (STIFF, CVODE) and slipping_wheels(robot):
+        reason = (f"method {method!r} does not run slipping wheels (their lift-off event is located on an explicit "
+                  f"stepper's dense output); expected one of {', '.join(m for m in METHODS if m != STIFF)}")
     elif method == CVODE and not forced:
         reason = (f"method {CVODE!r} (SUNDIALS' stiff BDF) runs robots with compliant wheels or joint springs; "
                   f"expected one of {', '.join(METHODS)} for rigid contacts")

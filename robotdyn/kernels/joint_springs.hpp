@@ -19,12 +19,18 @@ struct JointSpring {
   double rest;       // q_j0 [m or rad]
 };
 
+// One spring's force Q_j = -k (q_j - q_j0) - c qdot_j (SpringForce.force) [N or N m].
+inline double joint_spring_force(const JointSpring& s, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                 const Eigen::Ref<const Eigen::VectorXd>& v) {
+  return -s.stiffness * (q[s.index] - s.rest) - s.damping * v[s.index];
+}
+
 // Q += each spring's force (SpringForce.force); returns the dampers' power (sum of SpringForce.damper_power) [W].
 inline double add_joint_springs(const std::vector<JointSpring>& springs, const Eigen::Ref<const Eigen::VectorXd>& q,
                                 const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> Q) {
   double power = 0.0;
   for (const JointSpring& s : springs) {
-    Q[s.index] += -s.stiffness * (q[s.index] - s.rest) - s.damping * v[s.index];
+    Q[s.index] += joint_spring_force(s, q, v);
     power += -s.damping * (v[s.index] * v[s.index]);
   }
   return power;

@@ -22,7 +22,7 @@ inline void subtract_joint_springs_derivatives(const std::vector<JointSpring>& s
                                                const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> tau,
                                                Eigen::Ref<Eigen::MatrixXd> dtau_dq, Eigen::Ref<Eigen::MatrixXd> dtau_dv) {
   for (const JointSpring& s : springs) {
-    tau[s.index] -= -s.stiffness * (q[s.index] - s.rest) - s.damping * v[s.index];
+    tau[s.index] -= joint_spring_force(s, q, v);
     dtau_dq(s.index, s.index) += s.stiffness;
     dtau_dv(s.index, s.index) += s.damping;
   }
@@ -34,13 +34,13 @@ inline void add_reduced_joint_springs(const std::vector<JointSpring>& springs,
                                       const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::MatrixXd& S,
                                       Eigen::Ref<Eigen::VectorXd> f) {
   for (const JointSpring& s : springs)
-    f.noalias() += (-s.stiffness * (q[s.index] - s.rest) - s.damping * v[s.index]) * S.row(s.index).transpose();
+    f.noalias() += joint_spring_force(s, q, v) * S.row(s.index).transpose();
 }
 
 // e -= Q(q, v) (the constraint forces' right-hand side).
 inline void subtract_joint_springs(const std::vector<JointSpring>& springs, const Eigen::Ref<const Eigen::VectorXd>& q,
                                    const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> e) {
-  for (const JointSpring& s : springs) e[s.index] -= -s.stiffness * (q[s.index] - s.rest) - s.damping * v[s.index];
+  for (const JointSpring& s : springs) e[s.index] -= joint_spring_force(s, q, v);
 }
 
 }  // namespace kernels

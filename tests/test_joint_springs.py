@@ -99,3 +99,14 @@ def test_braking_load_transfer():
     assert n_front == pytest.approx(expected, rel=1e-8)  # (the pitch transient has decayed to 1e-9 of it)
     static = m * G * (G_[0] - x_r) / (x_f - x_r)
     assert n_front - static > 0.1 * static  # a real transfer, not a rounding
+
+
+@pytest.mark.parametrize("unit, stiffness, damping", [("rad", "N m/rad", "N m s/rad"), ("m", "N/m", "N s/m")])
+def test_a_negative_spring_constant_is_refused_in_its_own_unit(unit, stiffness, damping):
+    """The one-line refusal names the unit of the number refused (a damping's was written 'N m/rad s')."""
+    from robotdyn.reduction.joint_springs import SpringForce
+
+    with pytest.raises(InputError, match=rf"stiffness = -1\.0; expected a finite number >= 0 \[{stiffness}\]$"):
+        SpringForce(JointSpring("hinge", stiffness=-1.0), 0, unit)
+    with pytest.raises(InputError, match=rf"damping = -1\.0; expected a finite number >= 0 \[{damping}\]$"):
+        SpringForce(JointSpring("hinge", damping=-1.0), 0, unit)

@@ -72,8 +72,8 @@ class SpringForce:
         self.joint = spec.joint
         self.index = int(index)
         self.unit = unit
-        per = "N/m" if unit == "m" else "N m/rad"
-        for what, value, u in (("stiffness", spec.stiffness, per), ("damping", spec.damping, per + " s")):
+        units = ("N/m", "N s/m") if unit == "m" else ("N m/rad", "N m s/rad")
+        for what, value, u in (("stiffness", spec.stiffness, units[0]), ("damping", spec.damping, units[1])):
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise InputError(f"spring {self.name!r}: {what} = {value!r}; expected a finite number >= 0 [{u}]")
         if not (isinstance(spec.rest, (int, float)) and math.isfinite(spec.rest)):

@@ -73,6 +73,7 @@ from .flight import airborne
 from .feedback import FeedbackLaw
 from .torque_profile import Constant, TorqueProfile, as_profile
 from .trajectory import Trajectory
+from .start_checks import start_dynamics
 from .cvode import missing as missing_cvode
 
 
@@ -397,7 +398,7 @@ def simulate_compiled(robot, t_end, q0, nu0, torque, n_out, rtol, atol, method, 
     law = torque.bound(robot) if isinstance(torque, FeedbackLaw) else as_data(torque)
     profile = Constant(np.zeros(len(robot.motors))) if law is not None else as_profile(torque, len(robot.motors))
     tau0 = law(t0, q0, nu0) if law is not None else profile(t0)
-    robot.forward_dynamics(q0, nu0, tau0)  # regular where the run starts (raises the Python path's error)
+    start_dynamics(robot, t0, q0, nu0, tau0)  # regular where the run starts (the Python path's errors), no load pulling
     fast = engine_model(robot)
     if not fast.ready:  # (forward_dynamics chose the rows of the robot's own compiled model, not of this one)
         fast._choose(q0, nu0)

@@ -28,14 +28,14 @@ from ..reduction.projection import solve
 from ..reduction.pull_back import STABILISATION, failure_note, position_rate
 from ..reduction.reduced_dynamics import velocity
 from ..contact.sliding import forward as forward_sliding
-from ..contact.sliding import check_start_loads, contact_load, lift_off_message, slipping_wheels
+from ..contact.sliding import contact_load, lift_off_message, slipping_wheels
 from ..contact.stick_slip_wheel import stick_slip_wheels
 from ..contact.compliant_contact import compliant_wheels
 from ..contact.applied_forces import applied, has_applied
 from .flight import STIFF_METHOD, airborne, flight_events, flight_phases
 from .progress import Progress
 from .run_options import check_run_options
-from .start_checks import start_offsets
+from .start_checks import start_dynamics, start_offsets
 from .feedback import FeedbackLaw
 from .torque_profile import TorqueProfile, as_profile
 from .trajectory import Trajectory
@@ -166,9 +166,6 @@ def simulate(
     offsets = start_offsets(robot, q0, stabilisation, check=not t0)
     stiff_slip_warning(robot, t_end - t0)
     compiled_engine = choose_engine(robot, torque, method, engine)  # robotdyn.simulation.compiled_engine
-    if slipping_wheels(robot) and not stick_slip_wheels(robot):  # no lift-off crossing to find below zero
-        check_start_loads(robot, t0, q0, nu0, np.zeros(len(robot.motors)) if torque is None else
-                          np.asarray(torque(t0, q0, nu0), float))
     if stick_slip_wheels(robot):  # exact switching: segment by segment
         if has_applied(robot):
             from ..reduction.joint_springs import urdf_damping_hint
@@ -216,8 +213,9 @@ def simulate(
     fast = None if slipping or forced else compiled_model(robot)
     k = robot.mobility
 
-    # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.reduction.reduced_dynamics.solve_mass)
-    robot.forward_dynamics(q0, nu0, zero_tau if torque is None else np.asarray(torque(t0, q0, nu0), float))
+    # the dynamics must be regular where the run starts (a positive-definite mass matrix: robotdyn.reduction.reduced_dynamics.solve_mass),
+    # and no slipping wheel may pull the ground there (its lift-off event only finds a downward crossing)
+    start_dynamics(robot, t0, q0, nu0, zero_tau if torque is None else np.asarray(torque(t0, q0, nu0), float))
 
     def finite(t: float, y: np.ndarray) -> None:  # on the Python paths only: the compiled one stays lean
         if not np.isfinite(y).all():

@@ -21,12 +21,17 @@ twins of the Python ones, equal to them to rounding: ``tests/test_compiled.py``)
 So the result is the one of the Python rows: no offsets and no error. Any other start (a residual above
 :data:`CLEAR`, no compiled model, no row choice yet, a compiled evaluation that falls back) runs both checks on the
 Python rows exactly as before, so every refusal keeps its one-line message and every offset its value.
+
+:func:`start_dynamics` checks the dynamics where a run starts, for every engine: regular (the Python path's
+forward dynamics, its errors), and with slipping wheels none pulling the ground
+(:func:`robotdyn.contact.sliding.check_start_loads`, from the same forward solve).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..contact.sliding import check_start_loads, sliding_now
 from ..contact.stick_slip_wheel import stick_slip_wheels
 from ..fast.dispatch import compiled_model
 from ..reduction.pull_back import start_offsets as python_start_offsets
@@ -87,4 +92,26 @@ def start_offsets(robot, q0: np.ndarray, stabilisation: float, check: bool = Tru
     return python_start_offsets(robot, q0, stabilisation, rows)
 
 
-__all__ = ["start_offsets", "compiled_residuals", "CLEAR"]
+def start_dynamics(robot, t0: float, q0: np.ndarray, nu0: np.ndarray, tau0: np.ndarray) -> None:
+    """Refuse a start where the dynamics are not regular (:meth:`~robotdyn.robot.Robot.forward_dynamics`'s errors)
+    or, with slipping wheels, where one already pulls the ground
+    (:func:`~robotdyn.contact.sliding.check_start_loads`, whose forward solve is the one ``forward_dynamics`` makes
+    with slipping wheels: the state is solved once).
+
+    Args:
+        robot: The :class:`~robotdyn.robot.Robot`.
+        t0: Start time [s] (for the messages).
+        q0: Natural coordinates (n,) [m, rad] where the run starts.
+        nu0: Independent velocities (k,) [m/s, rad/s] there.
+        tau0: Motor torques (one per motor) [N m or N] there.
+
+    Raises:
+        RobotDynError: As ``forward_dynamics`` and ``check_start_loads`` raise it (one line each).
+    """
+    if sliding_now(robot):
+        check_start_loads(robot, t0, q0, nu0, tau0)
+    else:
+        robot.forward_dynamics(q0, nu0, tau0)
+
+
+__all__ = ["start_offsets", "start_dynamics", "compiled_residuals", "CLEAR"]

@@ -81,6 +81,61 @@ struct SlipSystem {
   double min_normal = HUGE_VAL;       // the smallest normal load (the lift-off event's value) [N]
   double power = 0.0;                 // the friction power sum_i F_i . s_i [W]
 
+  // Each slipping wheel's tangential rows J_t = (t1, t2)^T A_w, slip velocity s = J_t v, law c(s) and friction
+  // column U_i = J_t^T c (the system's K takes U_i on the wheel's normal-load column).
+  void friction_columns(const std::vector<Slip>& slips, const std::vector<WheelGeometry>& geo,
+                        std::vector<MatrixXd>& Aw, VectorXd& v, int nv) {
+    const int nw = static_cast<int>(slips.size());
+    s.resize(nw, 2);
+    c.resize(nw, 2);
+    Jt.resize(2, nv);
+    U.resize(nv, nw);
+    for (int i = 0; i < nw; ++i) {
+      const Slip& sl = slips[i];
+      const WheelGeometry& g = geo[sl.wheel];
+      Jt.row(0).noalias() = g.t1.transpose() * Aw[sl.wheel];
+      Jt.row(1).noalias() = g.t2.transpose() * Aw[sl.wheel];
+      const Eigen::Vector2d si = Jt * v;
+      const Eigen::Vector2d ci = friction_coefficient(sl, si);
+      s.row(i) = si.transpose();
+      c.row(i) = ci.transpose();
+      U.col(i).noalias() = Jt.transpose() * ci;
+    }
+  }
+
+  // b = B tau - (C v + g - Q) - M w: the system's right-hand side above the rows (the header's).
+  void right_hand_side(MatrixXd& B, const Eigen::Ref<const VectorXd>& tau, VectorXd& Cvg, MatrixXd& M, VectorXd& w) {
+    b.noalias() = B * tau;
+    b -= Cvg;
+    b.noalias() -= M * w;
+  }
+
+  // The LU factors of a square system K into lu, and the Painleve test on its condition: the decision of the Python
+  // path's np.linalg.cond(K) > 1e12 (2-norm) without an O(n^3) inverse or SVD at regular states. From the LU factors
+  // just computed, LAPACK's O(n^2) estimate e of ||K^-1||_1 (the projection's estimator,
+  // LuSolver::inverse_norm_estimate) gives kappa_1 ~ ||K||_1 e. For n x n matrices kappa_2 <= n kappa_1, and
+  // e <= ||K^-1||_1 underestimates by a small factor in practice (the projection counts on 100: its estimate decides
+  // below 1e8 against its bound 1e10). So:
+  //   n ||K||_1 e <= 1e12 / 100  ->  regular, no further work (kappa_2 <= 1e12 unless e underestimates by > 100);
+  //   otherwise (near the threshold, beyond it, or NaN / inf from a zero pivot) the singular values decide,
+  //   exactly as numpy.linalg.cond does (kappa_2 = s_max / s_min, singular above 1e12 or not finite), and give
+  //   the value the Python path reports.
+  // The band [1e10 / n, 1e12] of estimates that pay for the SVD is a factor 100 n wide: only a state near
+  // Painleve pays there. Both systems use it: this one's K and sliding_rigid_limit.hpp's coupled K.
+  void factor_checked(const MatrixXd& Ks, Eigen::PartialPivLU<MatrixXd>& factors, LuSolver& lus) {
+    factors.compute(Ks);
+    const int n = static_cast<int>(Ks.rows());
+    kappa1 = Ks.cwiseAbs().colwise().sum().maxCoeff() * lus.inverse_norm_estimate(factors);
+    kappa2 = std::numeric_limits<double>::quiet_NaN();  // (not computed)
+    if (!(n * kappa1 <= 1e12 / 100)) {  // NaN too
+      svd.compute(Ks);
+      const VectorXd& sv = svd.singularValues();
+      const double cond = sv[0] / sv[sv.size() - 1];
+      kappa2 = std::isnan(cond) ? HUGE_VAL : cond;
+      if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, kappa2);
+    }
+  }
+
   // Solves for x = (nudot (k), lambda_R) at a state: SM = M S, A the stacked rows (the projection's `rows`), geo and
   // Aw the wheels' geometry and A_w, v the velocities, B tau the motors' forces, Cvg = C v + g (- Q), M w the
   // drift's force (Aw, v, B, Cvg, M, w read only).
@@ -94,49 +149,15 @@ struct SlipSystem {
     K.leftCols(k) = SM;  // M S
     for (int r = 0; r < nr; ++r) K.col(k + r) = -A.row(rows[r]).transpose();
     pos.resize(nw);
-    s.resize(nw, 2);
-    c.resize(nw, 2);
-    Jt.resize(2, nv);
-    U.resize(nv, nw);
     for (int i = 0; i < nw; ++i) {
-      const Slip& sl = slips[i];
-      const auto hit = std::find(rows.begin(), rows.end(), sl.normal_row);
+      const auto hit = std::find(rows.begin(), rows.end(), slips[i].normal_row);
       if (hit == rows.end()) throw SlipError(1, i);
       pos[i] = static_cast<int>(hit - rows.begin());
-      const WheelGeometry& g = geo[sl.wheel];
-      Jt.row(0).noalias() = g.t1.transpose() * Aw[sl.wheel];
-      Jt.row(1).noalias() = g.t2.transpose() * Aw[sl.wheel];
-      const Eigen::Vector2d si = Jt * v;
-      const Eigen::Vector2d ci = friction_coefficient(sl, si);
-      s.row(i) = si.transpose();
-      c.row(i) = ci.transpose();
-      U.col(i).noalias() = Jt.transpose() * ci;
-      K.col(k + pos[i]) += U.col(i);
     }
-    b.noalias() = B * tau;
-    b -= Cvg;
-    b.noalias() -= M * w;
-    lu.compute(K);
-    // Painleve test, the decision of the Python path's np.linalg.cond(K) > 1e12 (2-norm) without an O(n^3) inverse
-    // or SVD at regular states. From the LU factors just computed, LAPACK's O(n^2) estimate e of ||K^-1||_1 (the
-    // projection's estimator, LuSolver::inverse_norm_estimate) gives kappa_1 ~ ||K||_1 e. For n x n matrices
-    // kappa_2 <= n kappa_1, and e <= ||K^-1||_1 underestimates by a small factor in practice (the projection
-    // counts on 100: its estimate decides below 1e8 against its bound 1e10). So:
-    //   n ||K||_1 e <= 1e12 / 100  ->  regular, no further work (kappa_2 <= 1e12 unless e underestimates by > 100);
-    //   otherwise (near the threshold, beyond it, or NaN / inf from a zero pivot) the singular values decide,
-    //   exactly as numpy.linalg.cond does (kappa_2 = s_max / s_min, singular above 1e12 or not finite), and give
-    //   the value the Python path reports.
-    // The band [1e10 / n, 1e12] of estimates that pay for the SVD is a factor 100 n wide: only a state near
-    // Painleve pays there.
-    kappa1 = K.cwiseAbs().colwise().sum().maxCoeff() * lus.inverse_norm_estimate(lu);
-    kappa2 = std::numeric_limits<double>::quiet_NaN();  // (not computed)
-    if (!(nv * kappa1 <= 1e12 / 100)) {  // NaN too
-      svd.compute(K);
-      const VectorXd& sv = svd.singularValues();
-      const double cond = sv[0] / sv[sv.size() - 1];
-      kappa2 = std::isnan(cond) ? HUGE_VAL : cond;
-      if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, kappa2);
-    }
+    friction_columns(slips, geo, Aw, v, nv);
+    for (int i = 0; i < nw; ++i) K.col(k + pos[i]) += U.col(i);
+    right_hand_side(B, tau, Cvg, M, w);
+    factor_checked(K, lu, lus);
     x = lu.solve(b);
     if (nw > 0) check_painleve(slips, rows, A, M, nv, k, nr);
     normal.resize(nw);

@@ -82,27 +82,13 @@ struct SlipRigidLimit {
     else kinv.setOnes(nwh);
     // G = A^T with each slipping wheel's friction column J_t^T c taken from its normal row's column
     G = A.transpose();
-    sys.s.resize(nw, 2);
-    sys.c.resize(nw, 2);
-    sys.Jt.resize(2, n);
-    sys.U.resize(n, nw);
+    sys.friction_columns(slips, geo, Aw, v, n);
     where.resize(nw);
     for (int i = 0; i < nw; ++i) {
-      const Slip& sl = slips[i];
-      const WheelGeometry& g = geo[sl.wheel];
-      sys.Jt.row(0).noalias() = g.t1.transpose() * Aw[sl.wheel];
-      sys.Jt.row(1).noalias() = g.t2.transpose() * Aw[sl.wheel];
-      const Eigen::Vector2d si = sys.Jt * v;
-      const Eigen::Vector2d ci = friction_coefficient(sl, si);
-      sys.s.row(i) = si.transpose();
-      sys.c.row(i) = ci.transpose();
-      sys.U.col(i).noalias() = sys.Jt.transpose() * ci;
-      G.col(sl.normal_row) -= sys.U.col(i);
-      where[i] = sl.wheel;
+      G.col(slips[i].normal_row) -= sys.U.col(i);
+      where[i] = slips[i].wheel;
     }
-    sys.b.noalias() = B * tau;
-    sys.b -= Cvg;
-    sys.b.noalias() -= M * w;
+    sys.right_hand_side(B, tau, Cvg, M, w);
     const MatrixXd& V = svd_p.matrixV();
     PV.noalias() = P * V.leftCols(p);                                    // (W, p)
     compat.noalias() = PV.transpose() * (kinv.asDiagonal() * C);           // (p, m)
@@ -110,7 +96,7 @@ struct SlipRigidLimit {
     const int nrow = n + d, ncol = k + m;
     if (nrow != ncol) throw Fallback("rows and independent velocities do not make a square system");
     unloaded.clear();
-    bool have_compatible = false, done = false;
+    bool done = false;
     for (int iter = 0; iter < 2 * nwh + 2; ++iter) {
       const int u = static_cast<int>(unloaded.size());
       K.setZero(nrow + u, ncol + u);
@@ -122,7 +108,7 @@ struct SlipRigidLimit {
       for (int j = 0; j < u; ++j) K.block(nrow + j, k, 1, m) = C.row(unloaded[j]);
       b.setZero(nrow + u);
       b.head(n) = sys.b;
-      factor_checked(sys, lus);
+      sys.factor_checked(K, lu, lus);
       x = lu.solve(b);
       lam = x.segment(k, m);
       mu = x.tail(u);
@@ -136,7 +122,6 @@ struct SlipRigidLimit {
       if (u == 0) {
         sol_c = x;
         Kc = K;
-        have_compatible = true;
       }
       if (worst >= 0 && loads[worst] < -PULL_TOL * scale) {
         tmp.resize(u + 1, p);
@@ -169,7 +154,6 @@ struct SlipRigidLimit {
       done = true;
       break;
     }
-    (void)have_compatible;
     if (!done) throw SlipError(0, HUGE_VAL);
     check_painleve(sys, slips, A, M, n, k);
     sys.x = x;
@@ -187,21 +171,6 @@ struct SlipRigidLimit {
     }
     if (sys.min_normal == HUGE_VAL) sys.min_normal = any_min;  // (every slipping wheel unloaded)
     return true;
-  }
-
-  // LU of K and sliding.hpp's Painleve test on its condition (the estimate first, the SVD near the threshold).
-  void factor_checked(SlipSystem& sys, LuSolver& lus) {
-    lu.compute(K);
-    const int nk = static_cast<int>(K.rows());
-    sys.kappa1 = K.cwiseAbs().colwise().sum().maxCoeff() * lus.inverse_norm_estimate(lu);
-    sys.kappa2 = std::numeric_limits<double>::quiet_NaN();
-    if (!(nk * sys.kappa1 <= 1e12 / 100)) {  // NaN too
-      svd_k.compute(K);
-      const VectorXd& s = svd_k.singularValues();
-      const double cond = s[0] / s[s.size() - 1];
-      sys.kappa2 = std::isnan(cond) ? HUGE_VAL : cond;
-      if (!(std::isfinite(cond) && cond <= 1e12)) throw SlipError(0, sys.kappa2);
-    }
   }
 
   // coupled's Painleve check on the separations the rigid rows allow (painleve.check with its basis).

@@ -204,3 +204,22 @@ def test_traction_fast_pass_carries_the_springs():
     set_terrain(bare, robot.terrain)
     other = traction(bare, traj, sc.torque)
     assert np.abs(other.normal - ref.normal).max() > 1e-3 * np.abs(ref.normal).max()
+
+
+def test_a_damping_changed_in_place_rebuilds_the_compiled_model(tmp_path):
+    """The compiled model holds copies of the springs' numbers, so compiled_model keys its cache on them: after a
+    damper's c is doubled in place the compiled forward dynamics follow the closed form -2 (2 d) w / J, not the
+    stale -2 d w / J."""
+    robot = load_robot(_coaster_file(tmp_path))
+    w = 10.0
+    robot.forward_dynamics(robot.neutral(), [w, w], [0.0, 0.0])  # (the first call: the Python path chooses rows)
+    before = compiled_model(robot)
+    assert robot.forward_dynamics(robot.neutral(), [w, w], [0.0, 0.0]) == pytest.approx([-2 * D * w / J] * 2,
+                                                                                         rel=1e-12)
+    for spring in robot.springs:
+        spring.damping = 2 * D
+    assert compiled_model(robot) is not before
+    robot.forward_dynamics(robot.neutral(), [w, w], [0.0, 0.0])
+    assert robot.forward_dynamics(robot.neutral(), [w, w], [0.0, 0.0]) == pytest.approx([-4 * D * w / J] * 2,
+                                                                                         rel=1e-12)
+    assert compiled_model(robot) is compiled_model(robot)  # (unchanged numbers: the cached model)

@@ -116,6 +116,24 @@ def for_this_thread(robot, fast: CompiledModel | None) -> CompiledModel | None:
     return local
 
 
+class ThreadModel:
+    """A class attribute holding the compiled model an object (e.g. a trajectory problem) built for its ``robot``,
+    which each thread reads as its own: assigned the model (or ``None``: the Python path) in the building thread,
+    read as :func:`for_this_thread` of the object's ``robot`` and that model, so that the object gives the same
+    numbers from whichever thread calls it."""
+
+    def __set_name__(self, owner, name: str) -> None:
+        self._slot = f"_{name.lstrip('_')}_model"  # (where the instance keeps the model it was given)
+
+    def __get__(self, obj, objtype=None):
+        if obj is None:
+            return self
+        return for_this_thread(obj.robot, obj.__dict__.get(self._slot))
+
+    def __set__(self, obj, fast: CompiledModel | None) -> None:
+        obj.__dict__[self._slot] = fast
+
+
 def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, independent=None) -> ReducedDynamics:
     """The reduced model of ``robot`` at (q, nu) (in its operational velocities if it has them): by the robot's
     compiled model where it serves, else (and to choose the projection's rows) by the Python reference
@@ -148,4 +166,5 @@ def reduce(robot, q: np.ndarray, nu: np.ndarray, coriolis: bool = False, indepen
     return out
 
 
-__all__ = ["available", "enabled", "use_compiled", "compiled_model", "for_this_thread", "why_not", "reduce"]
+__all__ = ["available", "enabled", "use_compiled", "compiled_model", "for_this_thread", "ThreadModel", "why_not",
+           "reduce"]

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, NonFiniteError
-from ..fast.dispatch import for_this_thread
+from ..fast.dispatch import ThreadModel
 
 
 class ContactLimits:
@@ -44,6 +44,8 @@ class ContactLimits:
     Raises:
         InputError: A robot without wheels, a non-finite or negative bound.
     """
+
+    _compiled = ThreadModel()  # the compiled model for the calling thread (None: the Python path)
 
     def __init__(self, robot, q0: np.ndarray, min_load: float | None = None, mu_max: float | None = None,
                  peak: bool = False, derivatives: str = "finite-difference") -> None:
@@ -87,16 +89,6 @@ class ContactLimits:
                     same = False
                 self._compiled = fast if same else None
         self.calls = 0
-
-    @property
-    def _compiled(self):
-        """The compiled model for the calling thread (:func:`robotdyn.fast.dispatch.for_this_thread`), or ``None``."""
-        fast = self.__dict__.get("_compiled_model")
-        return None if fast is None else for_this_thread(self.robot, fast)
-
-    @_compiled.setter
-    def _compiled(self, fast) -> None:
-        self.__dict__["_compiled_model"] = fast
 
     @property
     def rows_per_node(self) -> int:

@@ -65,7 +65,7 @@ from ..errors import InputError, NonFiniteError
 from ..inputs import MAX_POSITION
 from ..fast.compiled import Fallback
 from ..fast.compiled_derivatives import raw_derivatives
-from ..fast.dispatch import for_this_thread
+from ..fast.dispatch import ThreadModel
 from .callbacks import _casadi, refusal, sparse_callback
 from .node_batches import analytic_jacobians, central_jacobians, rhs_nodes
 from .scaling import effort_units
@@ -235,6 +235,10 @@ class TrajectoryProblem:
             coordinate or velocity to move.
         ConstraintError: q0 off the holonomic constraint manifold (by more than :data:`HOLONOMIC_TOL`).
     """
+
+    # the robot's compiled model for the calling thread: built in one thread, solved in another with the same numbers
+    # (None: the Python path)
+    _fast = ThreadModel()
 
     def __init__(self, robot, t_end: float, nodes: int, q0, nu0=None, q_end: dict | None = None,
                  nu_end=None, tau_bounds=None, bounds: dict | None = None, derivatives: str = "analytic",
@@ -416,17 +420,6 @@ class TrajectoryProblem:
 
     def _peak(self, z: np.ndarray) -> float:
         return float(z[-1]) if self.cost_kind == "peak-mu" else 0.0
-
-    @property
-    def _fast(self):
-        """The robot's compiled model for the calling thread (:func:`robotdyn.fast.dispatch.for_this_thread`: a
-        problem built in one thread solves in another with the same numbers), or ``None``: the Python path."""
-        fast = self.__dict__.get("_fast_model")
-        return None if fast is None else for_this_thread(self.robot, fast)
-
-    @_fast.setter
-    def _fast(self, fast) -> None:
-        self.__dict__["_fast_model"] = fast
 
     def _compiled_rhs(self):
         """The robot's compiled one-call :math:`(S\\nu, \\dot\\nu)` (:meth:`robotdyn.fast.compiled.CompiledModel.rhs`,

@@ -78,8 +78,8 @@ def guessed_torques(problem, X: np.ndarray) -> np.ndarray:
     t = np.linspace(0.0, problem.t_end, N)
     sdot = 0.5 * np.pi / problem.t_end * np.sin(np.pi * t / problem.t_end)
     if P.size:  # the guess's S(q_j) where it built them (the same coordinates), else built here
-        S = getattr(problem, "_guess_S", None)
-        if S is None or S.shape[0] != N - 2 or not np.array_equal(problem._guess_q, X[1:-1, :n]):
+        S, q = getattr(problem, "_guess_S_q", (None, None))  # (one read: the pair the guess published)
+        if S is None or S.shape[0] != N - 2 or not np.array_equal(q, X[1:-1, :n]):
             S = np.array([problem.robot.reduced(X[j, :n], np.zeros(k)).S for j in range(1, N - 1)])
         X[1:-1, n:] = np.einsum("jkp,p->jk", np.linalg.pinv(S[:, P]), dq) * sdot[1:-1, None]
         X[[0, -1], n:] = 0.0

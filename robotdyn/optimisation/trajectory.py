@@ -668,12 +668,15 @@ class TrajectoryProblem:
         sdot = 0.5 * np.pi / self.t_end * np.sin(np.pi * t / self.t_end)
         X = x0 + s[:, None] * (x1 - x0)
         dq = x1[:self.n] - x0[:self.n]
-        self._guess_S, self._guess_q = [], X[1:-1, :self.n].copy()  # kept for robotdyn.optimisation.scaling
+        inner = X[1:-1, :self.n].copy()
+        Ss = []
         for j in range(1, N - 1):  # velocities that best follow the coordinates' path (least squares on S)
             S = self.robot.reduced(X[j, :self.n], np.zeros(self.k)).S
-            self._guess_S.append(S)
+            Ss.append(S)
             X[j, self.n:] = np.linalg.lstsq(S, sdot[j] * dq, rcond=None)[0]
-        self._guess_S = np.array(self._guess_S)
+        # kept for robotdyn.optimisation.scaling: the S(q_j) and their q_j, published as one finished pair (a thread
+        # scaling this problem while another solve builds its guess reads the old pair or the new, never a half)
+        self._guess_S_q = (np.array(Ss), inner)
         X[-1] = np.where(np.isfinite(self.x_end), self.x_end, X[-1])
         return np.concatenate([np.clip(X, self.x_lo, self.x_hi).ravel(), np.zeros(N * self.m)] + extra)
 
